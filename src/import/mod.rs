@@ -1,0 +1,1 @@
+//! Importers for tracking-tool exports (filled in by the import work).

@@ -1,0 +1,1 @@
+//! SVG figures (filled in by the plotting work).

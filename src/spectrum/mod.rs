@@ -1,0 +1,1 @@
+//! Spectral estimation (filled in by the spectrum work).
