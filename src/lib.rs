@@ -13,7 +13,9 @@
 
 pub mod error;
 pub mod import;
+pub mod model;
 pub mod report;
+pub mod simulate;
 pub mod spectrum;
 pub mod trace;
 

@@ -1,0 +1,129 @@
+//! The mass-on-a-moving-belt stick–slip oscillator: the benchmark family with closed-form or
+//! tabulated reference solutions (physics.md §3.1–3.4, reference numbers in §0.4).
+//!
+//! `m ẍ + c ẋ + k x = f`, slip velocity `γ = ẋ − v_b`; slip friction `f = −sign(γ) μ_d(|γ|) N`, stick
+//! `ẋ = v_b` with `|f| ≤ μ_s N`. It implements the same [`StickSlipModel`] as the blade, so the
+//! benchmarks exercise exactly the blade's event machinery. State `[x, ẋ]` (m, m/s).
+
+use super::friction::FrictionLaw;
+use crate::Result;
+use crate::simulate::hybrid::{Contact, Mode, ModelFault, Phase, StickSlipModel};
+use crate::simulate::hybrid::{SolverOptions, integrate};
+
+/// A block on a belt.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Belt {
+    pub mass_kg: f64,
+    pub k_n_per_m: f64,
+    pub c_ns_per_m: f64,
+    pub v_belt_m_per_s: f64,
+    pub normal_n: f64,
+    pub law: FrictionLaw,
+}
+
+impl StickSlipModel<2> for Belt {
+    #[inline]
+    fn rhs(
+        &self,
+        mode: &Mode,
+        _t: f64,
+        y: &[f64; 2],
+        dy: &mut [f64; 2],
+    ) -> std::result::Result<Contact, ModelFault> {
+        let spring = -self.k_n_per_m * y[0] - self.c_ns_per_m * y[1];
+        let limit = self.law.mu_static() * self.normal_n;
+        dy[0] = y[1];
+        match mode.phase.slip_dir() {
+            Some(s) => {
+                let f = -s * self.law.mu_slip(y[1] - self.v_belt_m_per_s) * self.normal_n;
+                dy[1] = (spring + f) / self.mass_kg;
+                Ok(Contact {
+                    normal: self.normal_n,
+                    friction: f,
+                    limit,
+                })
+            }
+            None => {
+                // ẍ = 0: friction balances the spring and damper.
+                dy[1] = 0.0;
+                Ok(Contact {
+                    normal: self.normal_n,
+                    friction: -spring,
+                    limit,
+                })
+            }
+        }
+    }
+
+    fn slip_velocity(&self, _t: f64, y: &[f64; 2]) -> f64 {
+        y[1] - self.v_belt_m_per_s
+    }
+
+    fn contact_position(&self, t: f64, y: &[f64; 2]) -> f64 {
+        y[0] - self.v_belt_m_per_s * t
+    }
+
+    fn enter_stick(&self, _t: f64, y: &mut [f64; 2], _anchor: f64) {
+        y[1] = self.v_belt_m_per_s;
+    }
+
+    fn describe(&self, _t: f64, y: &[f64; 2]) -> String {
+        format!("x = {:.9e} m, ẋ = {:.9e} m/s", y[0], y[1])
+    }
+}
+
+/// Durations of one limit cycle of the belt oscillator.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BeltCycle {
+    pub t_slip_s: f64,
+    pub t_stick_s: f64,
+    pub period_s: f64,
+    /// Position at the slip→stick transition (x_e in physics.md §3.1).
+    pub x_stick_onset_m: f64,
+    /// Number of transitions located.
+    pub transitions: usize,
+}
+
+impl Belt {
+    /// Simulates from stick at `x0_m` over `[0, t_end_s]` and returns the durations of the last
+    /// complete stick–slip cycle (slip→stick to slip→stick). Returns `Ok(None)` when fewer than two
+    /// stick onsets occur: the motion does not stick–slip (the steady-sliding case of physics.md
+    /// §3.2).
+    pub fn limit_cycle(
+        &self,
+        x0_m: f64,
+        t_end_s: f64,
+        opts: &SolverOptions,
+    ) -> Result<Option<BeltCycle>> {
+        let mode = Mode {
+            phase: Phase::Stick,
+            anchor: x0_m,
+        };
+        let run = integrate(
+            self,
+            0.0,
+            [x0_m, self.v_belt_m_per_s],
+            mode,
+            t_end_s,
+            &[],
+            opts,
+        )?;
+        let tr = &run.transitions;
+        let onsets: Vec<usize> = (0..tr.len())
+            .filter(|&i| tr[i].to == Phase::Stick)
+            .collect();
+        if onsets.len() < 2 {
+            return Ok(None);
+        }
+        let i1 = onsets[onsets.len() - 1];
+        let i0 = onsets[onsets.len() - 2];
+        let departure = tr[i0 + 1].t_s;
+        Ok(Some(BeltCycle {
+            t_slip_s: tr[i1].t_s - departure,
+            t_stick_s: departure - tr[i0].t_s,
+            period_s: tr[i1].t_s - tr[i0].t_s,
+            x_stick_onset_m: run.transition_states[i1][0],
+            transitions: tr.len(),
+        }))
+    }
+}

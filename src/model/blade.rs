@@ -1,0 +1,529 @@
+//! The 2-DOF head/neck/lip link model of the seed paper, in SI units.
+//!
+//! Geometry (seed Fig. 1, physics.md §2.3): the head moves horizontally with the prescribed drive
+//! `v(t) = a(1 − cos ωt)` and is free vertically on a spring `k0` (damper `c0`) pre-compressed by `h_d`.
+//! The neck (rigid rod, length `l1`, angle θ from the vertical) hangs from the head; the lip (length
+//! `l2`, angle φ) hangs from the neck's end; the lip tip stays on the glass. The head's drop is
+//! `u = l1(1 − cos θ) + l2(1 − cos φ)` and the tip's horizontal position `v3 = v + l1 sin θ + l2 sin φ`.
+//! Rotational springs/dampers: `k1, c1` (neck to head), `k2, c2` (lip to neck).
+//!
+//! With the mass coefficients
+//! `M_t = M + m1 + m2`, `m_a = m1 d1 + m2 l1`, `m_b = m2 d2`, `m_c = m2 l1 d2`,
+//! `m_θ = J1 + m1 d1² + m2 l1²`, `m_φ = J2 + m2 d2²`
+//! (`d1`, `d2`: distance of each rod's centre of mass from its upper hinge; `J1`, `J2`: moments of
+//! inertia about the centres of mass), Lagrange's equations for θ and φ with the head height
+//! eliminated are exactly the seed's eqs. (1) and (2) in dimensional form, and the vertical force
+//! balance is its eq. (3):
+//!
+//! ```text
+//! (1) (m_θ − m_a l1 sin²θ) θ̈ + [m_c cos(θ−φ) − m_a l2 sinθ sinφ] φ̈ − m_a l1 cosθ sinθ θ̇²
+//!     + [m_c sin(θ−φ) − m_a l2 cosφ sinθ] φ̇² + m_a v̈ cosθ − N l1 sinθ − f l1 cosθ
+//!     − k2 (φ−θ) − c2 (φ̇−θ̇) + k1 θ + c1 θ̇ = 0
+//! (2) [m_c cos(θ−φ) − m_b l1 sinθ sinφ] θ̈ + (m_φ − m_b l2 sin²φ) φ̈ − [m_c sin(θ−φ) + m_b l1 cosθ sinφ] θ̇²
+//!     − m_b l2 cosφ sinφ φ̇² + m_b v̈ cosφ − N l2 sinφ − f l2 cosφ + k2 (φ−θ) + c2 (φ̇−θ̇) = 0
+//! (3) N = (m_a − M_t l1)(sinθ θ̈ + cosθ θ̇²) + (m_b − M_t l2)(sinφ φ̈ + cosφ φ̇²)
+//!     + k0 (h_d − u) − c0 u̇
+//! ```
+//! (the seed prints `m_φ(φ − θ)` for the lip spring term, a typesetting slip for `k2(φ − θ)`,
+//! physics.md §5.2). Friction: slip `f = −sign(v̇3)(A e^{−B|v̇3|} + C) N` (eq. 4); stick
+//! `|f| ≤ (A + C) N` (eq. 5), with `f` the fourth unknown and the constraint `v3 = const`.
+//!
+//! The normal force depends on the accelerations, so `(θ̈, φ̈, N)` in slip and `(θ̈, φ̈, N, f)` in
+//! stick are solved together as one linear system (physics.md §1.8).
+
+use super::friction::FrictionLaw;
+use crate::simulate::hybrid::{Contact, Mode, ModelFault, Phase, StickSlipModel};
+use nalgebra::{Matrix3, Matrix4, Vector3, Vector4};
+use serde::{Deserialize, Serialize};
+
+/// Physical parameters of the blade, SI units (per blade, or per metre of blade: frequencies do not
+/// depend on which, physics.md §0.2).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BladeParams {
+    /// Neck length l1, m.
+    pub l1_m: f64,
+    /// Lip length l2, m.
+    pub l2_m: f64,
+    /// Head mass M, kg.
+    pub head_mass_kg: f64,
+    /// Neck mass m1, kg.
+    pub neck_mass_kg: f64,
+    /// Lip mass m2, kg.
+    pub lip_mass_kg: f64,
+    /// Neck centre of mass from the head hinge d1, m.
+    pub neck_com_m: f64,
+    /// Lip centre of mass from the neck-lip hinge d2, m.
+    pub lip_com_m: f64,
+    /// Neck moment of inertia about its centre of mass J1, kg·m².
+    pub neck_inertia_kg_m2: f64,
+    /// Lip moment of inertia about its centre of mass J2, kg·m².
+    pub lip_inertia_kg_m2: f64,
+    /// Head vertical spring k0, N/m.
+    pub k0_n_per_m: f64,
+    /// Neck rotational stiffness k1, N·m/rad.
+    pub k1_nm_per_rad: f64,
+    /// Lip-to-neck rotational stiffness k2, N·m/rad.
+    pub k2_nm_per_rad: f64,
+    /// Head vertical damper c0, N·s/m.
+    pub c0_ns_per_m: f64,
+    /// Neck rotational damper c1, N·m·s/rad.
+    pub c1_nms_per_rad: f64,
+    /// Lip rotational damper c2, N·m·s/rad.
+    pub c2_nms_per_rad: f64,
+    /// Support pre-compression h_d, m (preload N0 = k0·h_d).
+    pub hd_m: f64,
+    /// Friction law at the lip tip (seed eqs. 4–5).
+    pub friction: FrictionLaw,
+    /// Drive amplitude a in v = a(1 − cos ωt), m.
+    pub drive_a_m: f64,
+    /// Drive angular frequency ω, rad/s.
+    pub drive_omega_rad_per_s: f64,
+}
+
+/// The mass coefficients of eqs. (1)–(3) (dimensional; see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MassCoefficients {
+    pub mt: f64,
+    pub ma: f64,
+    pub mb: f64,
+    pub mc: f64,
+    pub mth: f64,
+    pub mph: f64,
+}
+
+impl BladeParams {
+    /// Mass coefficients from the rod properties.
+    pub fn mass_coefficients(&self) -> MassCoefficients {
+        let (l1, m1, m2, d1, d2) = (
+            self.l1_m,
+            self.neck_mass_kg,
+            self.lip_mass_kg,
+            self.neck_com_m,
+            self.lip_com_m,
+        );
+        MassCoefficients {
+            mt: self.head_mass_kg + m1 + m2,
+            ma: m1 * d1 + m2 * l1,
+            mb: m2 * d2,
+            mc: m2 * l1 * d2,
+            mth: self.neck_inertia_kg_m2 + m1 * d1 * d1 + m2 * l1 * l1,
+            mph: self.lip_inertia_kg_m2 + m2 * d2 * d2,
+        }
+    }
+
+    /// Head vertical natural frequency √(k0/M_t)/2π, Hz.
+    pub fn head_freq_hz(&self) -> f64 {
+        (self.k0_n_per_m / self.mass_coefficients().mt).sqrt() / std::f64::consts::TAU
+    }
+
+    /// Neck natural frequency with the lip rigidly attached, √(k1/m_θ)/2π, Hz (the sample's
+    /// "neck_def = mth" definition).
+    pub fn neck_freq_hz(&self) -> f64 {
+        (self.k1_nm_per_rad / self.mass_coefficients().mth).sqrt() / std::f64::consts::TAU
+    }
+
+    /// Static preload N0 = k0·h_d, N.
+    pub fn preload_n(&self) -> f64 {
+        self.k0_n_per_m * self.hd_m
+    }
+
+    /// Checks that every parameter is finite and physical.
+    pub fn validate(&self) -> Result<(), String> {
+        let named = [
+            ("l1_m", self.l1_m, true),
+            ("l2_m", self.l2_m, true),
+            ("head_mass_kg", self.head_mass_kg, true),
+            ("neck_mass_kg", self.neck_mass_kg, false),
+            ("lip_mass_kg", self.lip_mass_kg, false),
+            ("neck_com_m", self.neck_com_m, false),
+            ("lip_com_m", self.lip_com_m, false),
+            ("neck_inertia_kg_m2", self.neck_inertia_kg_m2, false),
+            ("lip_inertia_kg_m2", self.lip_inertia_kg_m2, false),
+            ("k0_n_per_m", self.k0_n_per_m, true),
+            ("k1_nm_per_rad", self.k1_nm_per_rad, true),
+            ("k2_nm_per_rad", self.k2_nm_per_rad, false),
+            ("c0_ns_per_m", self.c0_ns_per_m, false),
+            ("c1_nms_per_rad", self.c1_nms_per_rad, false),
+            ("c2_nms_per_rad", self.c2_nms_per_rad, false),
+            ("hd_m", self.hd_m, true),
+            ("drive_a_m", self.drive_a_m, false),
+            ("drive_omega_rad_per_s", self.drive_omega_rad_per_s, true),
+        ];
+        for (name, v, strictly) in named {
+            if !v.is_finite() || v < 0.0 || (strictly && v == 0.0) {
+                return Err(format!(
+                    "blade parameter {name} = {v} must be finite and {}",
+                    if strictly { "> 0" } else { ">= 0" }
+                ));
+            }
+        }
+        if self.mass_coefficients().mph <= 0.0 || self.mass_coefficients().mth <= 0.0 {
+            return Err("blade: the neck and lip need mass or inertia (m_θ, m_φ > 0)".into());
+        }
+        self.friction.validate()
+    }
+}
+
+/// How the stick phase (constraint `v3 = const`) is integrated.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
+pub enum StickForm {
+    /// All four coordinates integrated, the constraint enforced at acceleration level with
+    /// Baumgarte's stabilisation Φ̈ + 2ω_B Φ̇ + ω_B² Φ = 0 (Baumgarte 1972; physics.md §0.3, §1.4;
+    /// critical damping α = β = ω_B).
+    Baumgarte { omega_b_per_s: f64 },
+    /// Drift-free reduced form: only θ is integrated; φ = arcsin((v3* − v − l1 sin θ)/l2) and φ̇
+    /// follow from the constraint exactly (physics.md §1.4, "drift-free alternative").
+    Reduced,
+}
+
+impl Default for StickForm {
+    fn default() -> Self {
+        StickForm::Reduced
+    }
+}
+
+/// The drive `v = a(1 − cos ωt)` and its first two derivatives.
+#[inline]
+fn drive(a: f64, w: f64, t: f64) -> (f64, f64, f64) {
+    let (s, c) = (w * t).sin_cos();
+    (a * (1.0 - c), a * w * s, a * w * w * c)
+}
+
+/// The blade as a hybrid stick–slip system; state `[θ, φ, θ̇, φ̇]` (rad, rad/s).
+#[derive(Debug, Clone, Copy)]
+pub struct Blade {
+    pub params: BladeParams,
+    pub stick_form: StickForm,
+    mc: MassCoefficients,
+    mu_s: f64,
+}
+
+/// Accelerations and contact forces at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dynamics {
+    pub theta_dd: f64,
+    pub phi_dd: f64,
+    pub normal_n: f64,
+    pub friction_n: f64,
+}
+
+impl Blade {
+    /// A blade with the given parameters and stick form.
+    pub fn new(params: BladeParams, stick_form: StickForm) -> Self {
+        Blade {
+            params,
+            stick_form,
+            mc: params.mass_coefficients(),
+            mu_s: params.friction.mu_static(),
+        }
+    }
+
+    /// Head horizontal position, velocity, acceleration at `t`.
+    pub fn drive(&self, t: f64) -> (f64, f64, f64) {
+        drive(self.params.drive_a_m, self.params.drive_omega_rad_per_s, t)
+    }
+
+    /// Head drop u = l1(1 − cos θ) + l2(1 − cos φ), m.
+    pub fn head_drop(&self, y: &[f64; 4]) -> f64 {
+        self.params.l1_m * (1.0 - y[0].cos()) + self.params.l2_m * (1.0 - y[1].cos())
+    }
+
+    /// Tip horizontal position v3 = v + l1 sin θ + l2 sin φ, m.
+    pub fn tip_position(&self, t: f64, y: &[f64; 4]) -> f64 {
+        self.drive(t).0 + self.params.l1_m * y[0].sin() + self.params.l2_m * y[1].sin()
+    }
+
+    /// Tip horizontal velocity v̇3, m/s.
+    #[inline]
+    pub fn tip_velocity(&self, t: f64, y: &[f64; 4]) -> f64 {
+        self.drive(t).1
+            + self.params.l1_m * y[0].cos() * y[2]
+            + self.params.l2_m * y[1].cos() * y[3]
+    }
+
+    /// Rows (1)–(3) of the equations of motion as `A·[θ̈, φ̈, N]ᵀ + a_f·f = b`; returns
+    /// `(A, a_f, b)` with `a_f` the coefficients of the friction force.
+    #[inline]
+    fn rows(&self, t: f64, y: &[f64; 4]) -> (Matrix3<f64>, Vector3<f64>, Vector3<f64>) {
+        let p = &self.params;
+        let m = &self.mc;
+        let (l1, l2) = (p.l1_m, p.l2_m);
+        let (th, ph, thd, phd) = (y[0], y[1], y[2], y[3]);
+        let (sth, cth) = th.sin_cos();
+        let (sph, cph) = ph.sin_cos();
+        let (sd, cd) = (th - ph).sin_cos();
+        let (_, _, vdd) = self.drive(t);
+        let u = l1 * (1.0 - cth) + l2 * (1.0 - cph);
+        let ud = l1 * sth * thd + l2 * sph * phd;
+        let ka = m.ma - m.mt * l1;
+        let kb = m.mb - m.mt * l2;
+        // Row 1 (eq. 1) and row 2 (eq. 2): inertia terms left, everything else right.
+        let a11 = m.mth - m.ma * l1 * sth * sth;
+        let a12 = m.mc * cd - m.ma * l2 * sth * sph;
+        let r1 = -m.ma * l1 * cth * sth * thd * thd
+            + (m.mc * sd - m.ma * l2 * cph * sth) * phd * phd
+            + m.ma * vdd * cth
+            - p.k2_nm_per_rad * (ph - th)
+            - p.c2_nms_per_rad * (phd - thd)
+            + p.k1_nm_per_rad * th
+            + p.c1_nms_per_rad * thd;
+        let a21 = m.mc * cd - m.mb * l1 * sth * sph;
+        let a22 = m.mph - m.mb * l2 * sph * sph;
+        let r2 = -(m.mc * sd + m.mb * l1 * cth * sph) * thd * thd
+            - m.mb * l2 * cph * sph * phd * phd
+            + m.mb * vdd * cph
+            + p.k2_nm_per_rad * (ph - th)
+            + p.c2_nms_per_rad * (phd - thd);
+        // Row 3 (eq. 3): N − ka sinθ θ̈ − kb sinφ φ̈ = ka cosθ θ̇² + kb cosφ φ̇² + k0(h_d − u) − c0 u̇.
+        let b3 = ka * cth * thd * thd + kb * cph * phd * phd + p.k0_n_per_m * (p.hd_m - u)
+            - p.c0_ns_per_m * ud;
+        let a = Matrix3::new(
+            a11,
+            a12,
+            -l1 * sth,
+            a21,
+            a22,
+            -l2 * sph,
+            -ka * sth,
+            -kb * sph,
+            1.0,
+        );
+        let af = Vector3::new(-l1 * cth, -l2 * cph, 0.0);
+        let b = Vector3::new(-r1, -r2, b3);
+        (a, af, b)
+    }
+
+    /// Slip dynamics in direction `s = ±1` (eq. 4 substituted into eqs. 1–3).
+    ///
+    /// # Errors
+    /// [`ModelFault::Singular`] when the 3×3 system with friction is singular or its determinant has
+    /// the opposite sign to the frictionless one (a Painlevé-type inconsistency: no unique slip
+    /// solution).
+    pub fn slip_dynamics(&self, s: f64, t: f64, y: &[f64; 4]) -> Result<Dynamics, ModelFault> {
+        let (a0, af, b) = self.rows(t, y);
+        let mu = self.params.friction.mu_slip(self.tip_velocity(t, y));
+        // f = −s μ N: fold into the N column.
+        let mut a = a0;
+        for i in 0..3 {
+            a[(i, 2)] += af[i] * (-s * mu);
+        }
+        let det0 = a0.determinant();
+        let det = a.determinant();
+        if !(det * det0 > 0.0) || det.abs() < 1e-9 * det0.abs() {
+            return Err(ModelFault::Singular(format!(
+                "slip equations singular (Painlevé-type): det with friction {det:.3e}, frictionless {det0:.3e}, μ = {mu:.4}"
+            )));
+        }
+        let z = a
+            .lu()
+            .solve(&b)
+            .ok_or_else(|| ModelFault::Singular("slip system not solvable".into()))?;
+        Ok(Dynamics {
+            theta_dd: z[0],
+            phi_dd: z[1],
+            normal_n: z[2],
+            friction_n: -s * mu * z[2],
+        })
+    }
+
+    /// Stick dynamics: eqs. (1)–(3) plus the constraint acceleration
+    /// `l1 cos θ θ̈ + l2 cos φ φ̈ = −v̈ + l1 sin θ θ̇² + l2 sin φ φ̇² − 2ω_B Φ̇ − ω_B² Φ`
+    /// with `Φ = v3 − anchor` (Baumgarte; `ω_B = 0` for the drift-free form, where Φ = Φ̇ = 0 exactly).
+    pub fn stick_dynamics(
+        &self,
+        t: f64,
+        y: &[f64; 4],
+        anchor: f64,
+        omega_b: f64,
+    ) -> Result<Dynamics, ModelFault> {
+        let (a3, af, b3) = self.rows(t, y);
+        let (l1, l2) = (self.params.l1_m, self.params.l2_m);
+        let (sth, cth) = y[0].sin_cos();
+        let (sph, cph) = y[1].sin_cos();
+        let (_, _, vdd) = self.drive(t);
+        let mut rhs4 = -vdd + l1 * sth * y[2] * y[2] + l2 * sph * y[3] * y[3];
+        if omega_b > 0.0 {
+            let phi_c = self.tip_position(t, y) - anchor;
+            let phi_cd = self.tip_velocity(t, y);
+            rhs4 -= 2.0 * omega_b * phi_cd + omega_b * omega_b * phi_c;
+        }
+        // Unknowns [θ̈, φ̈, N, f]; scale the constraint row to the size of the others.
+        let w = a3[(0, 0)].abs().max(a3[(1, 1)].abs()) / l1.max(l2);
+        let a = Matrix4::new(
+            a3[(0, 0)],
+            a3[(0, 1)],
+            a3[(0, 2)],
+            af[0],
+            a3[(1, 0)],
+            a3[(1, 1)],
+            a3[(1, 2)],
+            af[1],
+            a3[(2, 0)],
+            a3[(2, 1)],
+            a3[(2, 2)],
+            af[2],
+            w * l1 * cth,
+            w * l2 * cph,
+            0.0,
+            0.0,
+        );
+        let b = Vector4::new(b3[0], b3[1], b3[2], w * rhs4);
+        let z = a
+            .lu()
+            .solve(&b)
+            .ok_or_else(|| ModelFault::Singular("stick constraint system is singular".into()))?;
+        Ok(Dynamics {
+            theta_dd: z[0],
+            phi_dd: z[1],
+            normal_n: z[2],
+            friction_n: z[3],
+        })
+    }
+
+    /// Lip angle and rate that satisfy the stick constraint `v3 = anchor` for the given θ, θ̇ at `t`.
+    pub fn constrained_lip(
+        &self,
+        t: f64,
+        theta: f64,
+        theta_d: f64,
+        anchor: f64,
+    ) -> Result<(f64, f64), ModelFault> {
+        let (l1, l2) = (self.params.l1_m, self.params.l2_m);
+        let (v, vd, _) = self.drive(t);
+        let (sth, cth) = theta.sin_cos();
+        let arg = (anchor - v - l1 * sth) / l2;
+        if !(arg.abs() < 1.0) {
+            return Err(ModelFault::Geometry(format!(
+                "stick constraint has no lip angle: sin φ = {arg:.6} (the head moved beyond the lip's reach)"
+            )));
+        }
+        let phi = arg.asin();
+        let phi_d = -(vd + l1 * cth * theta_d) / (l2 * phi.cos());
+        Ok((phi, phi_d))
+    }
+
+    /// Quasi-static slip equilibrium at `t` (θ̇ = φ̇ = 0 and θ̈ = φ̈ = 0, slip direction from the
+    /// drive velocity): the initial state used by the sample's generator (its first frames are at
+    /// rest relative to the head). Newton's method on the accelerations.
+    pub fn slip_equilibrium(&self, t: f64) -> Result<[f64; 4], ModelFault> {
+        let (_, vd, _) = self.drive(t);
+        let s = if vd >= 0.0 { 1.0 } else { -1.0 };
+        let acc = |th: f64, ph: f64| -> Result<[f64; 2], ModelFault> {
+            let d = self.slip_dynamics(s, t, &[th, ph, 0.0, 0.0])?;
+            Ok([d.theta_dd, d.phi_dd])
+        };
+        let (mut th, mut ph) = (0.0f64, 0.0f64);
+        for _ in 0..100 {
+            let f0 = acc(th, ph)?;
+            let e = 1e-7;
+            let fa = acc(th + e, ph)?;
+            let fb = acc(th, ph + e)?;
+            let j = nalgebra::Matrix2::new(
+                (fa[0] - f0[0]) / e,
+                (fb[0] - f0[0]) / e,
+                (fa[1] - f0[1]) / e,
+                (fb[1] - f0[1]) / e,
+            );
+            let dx = j
+                .lu()
+                .solve(&nalgebra::Vector2::new(-f0[0], -f0[1]))
+                .ok_or_else(|| ModelFault::Singular("equilibrium Jacobian singular".into()))?;
+            // Damp large steps (angles stay within ±0.5 rad per iteration).
+            let scale = (0.5 / dx.amax()).min(1.0);
+            th += scale * dx[0];
+            ph += scale * dx[1];
+            if dx.amax() < 1e-15 {
+                break;
+            }
+        }
+        let f = acc(th, ph)?;
+        let scale = self.params.k1_nm_per_rad / self.mc.mth;
+        if !(f[0].abs() < 1e-8 * scale && f[1].abs() < 1e-8 * scale) {
+            return Err(ModelFault::Geometry(format!(
+                "no quasi-static slip equilibrium found at t = {t} s (residual accelerations {:.3e}, {:.3e} rad/s²)",
+                f[0], f[1]
+            )));
+        }
+        Ok([th, ph, 0.0, 0.0])
+    }
+}
+
+impl StickSlipModel<4> for Blade {
+    #[inline]
+    fn rhs(
+        &self,
+        mode: &Mode,
+        t: f64,
+        y: &[f64; 4],
+        dy: &mut [f64; 4],
+    ) -> Result<Contact, ModelFault> {
+        let d = match (mode.phase, self.stick_form) {
+            (Phase::Stick, StickForm::Baumgarte { omega_b_per_s }) => {
+                self.stick_dynamics(t, y, mode.anchor, omega_b_per_s)?
+            }
+            (Phase::Stick, StickForm::Reduced) => {
+                let (phi, phi_d) = self.constrained_lip(t, y[0], y[2], mode.anchor)?;
+                let yc = [y[0], phi, y[2], phi_d];
+                let d = self.stick_dynamics(t, &yc, mode.anchor, 0.0)?;
+                dy[0] = y[2];
+                dy[1] = 0.0;
+                dy[2] = d.theta_dd;
+                dy[3] = 0.0;
+                return Ok(Contact {
+                    normal: d.normal_n,
+                    friction: d.friction_n,
+                    limit: self.mu_s * d.normal_n,
+                });
+            }
+            (phase, _) => self.slip_dynamics(phase.slip_dir().unwrap_or(1.0), t, y)?,
+        };
+        dy[0] = y[2];
+        dy[1] = y[3];
+        dy[2] = d.theta_dd;
+        dy[3] = d.phi_dd;
+        Ok(Contact {
+            normal: d.normal_n,
+            friction: d.friction_n,
+            limit: self.mu_s * d.normal_n,
+        })
+    }
+
+    #[inline]
+    fn slip_velocity(&self, t: f64, y: &[f64; 4]) -> f64 {
+        self.tip_velocity(t, y)
+    }
+
+    fn contact_position(&self, t: f64, y: &[f64; 4]) -> f64 {
+        self.tip_position(t, y)
+    }
+
+    fn enter_stick(&self, t: f64, y: &mut [f64; 4], _anchor: f64) {
+        // Re-impose Φ̇ = 0 exactly (physics.md §0.3) by correcting φ̇; Φ = 0 holds by the anchor choice.
+        let (_, vd, _) = self.drive(t);
+        let (l1, l2) = (self.params.l1_m, self.params.l2_m);
+        y[3] = -(vd + l1 * y[0].cos() * y[2]) / (l2 * y[1].cos());
+    }
+
+    fn complete(&self, mode: &Mode, t: f64, y: &mut [f64; 4]) -> Result<(), ModelFault> {
+        if mode.phase == Phase::Stick && self.stick_form == StickForm::Reduced {
+            let (phi, phi_d) = self.constrained_lip(t, y[0], y[2], mode.anchor)?;
+            y[1] = phi;
+            y[3] = phi_d;
+        }
+        Ok(())
+    }
+
+    fn describe(&self, t: f64, y: &[f64; 4]) -> String {
+        format!(
+            "θ = {:.6e} rad, φ = {:.6e} rad, θ̇ = {:.6e} rad/s, φ̇ = {:.6e} rad/s, v3 = {:.9e} m, v̇3 = {:.6e} m/s",
+            y[0],
+            y[1],
+            y[2],
+            y[3],
+            self.tip_position(t, y),
+            self.tip_velocity(t, y)
+        )
+    }
+}

@@ -1,0 +1,8 @@
+//! Physical models: the friction law, the blade link model, the belt-oscillator benchmarks.
+
+pub mod belt;
+pub mod blade;
+pub mod friction;
+
+pub use blade::{Blade, BladeParams, StickForm};
+pub use friction::FrictionLaw;

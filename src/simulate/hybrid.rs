@@ -1,0 +1,635 @@
+//! Event-driven integration of a one-contact stick–slip system.
+//!
+//! Each smooth phase (slip+, slip−, stick) is integrated with DOPRI5 ([`super::rk`]). Transitions are
+//! zeros of smooth event functions located on the step's continuous extension by the Illinois method to
+//! a bracket of a few ulps (physics.md §1.5–1.6, "how the transition time is located exactly"):
+//!
+//! | phase   | event function            | becomes zero when                      | next phase            |
+//! |---------|---------------------------|----------------------------------------|-----------------------|
+//! | slip s  | `s·v_rel`                 | the contact stops slipping             | stick, or slip −s if \|f_stick\| > μ_s·N |
+//! | stick   | `μ_s·N − f`, `μ_s·N + f`  | static friction reaches its limit (seed eq. 5) | slip −sign(f) |
+//! | any     | `N`                       | the contact lifts off                  | error (the model assumes contact) |
+//!
+//! `v_rel` is the slip velocity of the contact, `f` the friction force on it along +x, `N` the normal
+//! force. An event fires on a change from `g > 0` to `g ≤ 0`; besides both ends of a step, `g` is also
+//! sampled at interior points of the step (DifferentialEquations.jl's `interp_points`), so a function
+//! that dips across zero and back within one step is not missed. Right after a transition the new
+//! phase's event function may start at exactly 0 (a tangential stick→slip departure, physics.md §1.8);
+//! it is armed by the first strictly positive value.
+
+use super::rk;
+use crate::{Error, Result};
+use serde::Serialize;
+
+/// The contact's phase.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub enum Phase {
+    /// Slipping with positive slip velocity.
+    #[serde(rename = "slip+")]
+    SlipPos,
+    /// Slipping with negative slip velocity.
+    #[serde(rename = "slip-")]
+    SlipNeg,
+    /// Sticking: slip velocity held at zero by static friction.
+    #[serde(rename = "stick")]
+    Stick,
+}
+
+impl Phase {
+    /// Slip direction `s = ±1`, or `None` in stick.
+    pub fn slip_dir(self) -> Option<f64> {
+        match self {
+            Phase::SlipPos => Some(1.0),
+            Phase::SlipNeg => Some(-1.0),
+            Phase::Stick => None,
+        }
+    }
+
+    /// Slip phase for direction `s` (its sign).
+    pub fn slip(s: f64) -> Phase {
+        if s >= 0.0 {
+            Phase::SlipPos
+        } else {
+            Phase::SlipNeg
+        }
+    }
+
+    /// The label used in files: `slip+`, `slip-`, `stick`.
+    pub fn label(self) -> &'static str {
+        match self {
+            Phase::SlipPos => "slip+",
+            Phase::SlipNeg => "slip-",
+            Phase::Stick => "stick",
+        }
+    }
+
+    /// Numeric code as in the sample's `state` column: 1 = slip+, 0 = stick, −1 = slip−.
+    pub fn code(self) -> i8 {
+        match self {
+            Phase::SlipPos => 1,
+            Phase::SlipNeg => -1,
+            Phase::Stick => 0,
+        }
+    }
+}
+
+impl std::fmt::Display for Phase {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.label())
+    }
+}
+
+/// A phase together with its data: in stick, `anchor` is the contact position held by the constraint.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Mode {
+    pub phase: Phase,
+    pub anchor: f64,
+}
+
+/// Contact forces at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Contact {
+    /// Normal force N (> 0 while in contact), N.
+    pub normal: f64,
+    /// Friction force on the contact along +x, N.
+    pub friction: f64,
+    /// Static limit μ_s·N, N.
+    pub limit: f64,
+}
+
+/// Why a model could not evaluate its right-hand side.
+#[derive(Debug, Clone)]
+pub enum ModelFault {
+    /// The slip equations have no unique solution (Painlevé-type inconsistency) or the constraint
+    /// system is singular.
+    Singular(String),
+    /// The geometry left the model's domain (e.g. the stick constraint has no solution).
+    Geometry(String),
+}
+
+impl std::fmt::Display for ModelFault {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ModelFault::Singular(s) | ModelFault::Geometry(s) => f.write_str(s),
+        }
+    }
+}
+
+/// A mechanical system with one frictional contact, integrated as a hybrid system.
+///
+/// `N` is the length of the state vector, the same in every phase. A phase may leave some
+/// components un-integrated (their derivative 0) and fill them in [`StickSlipModel::complete`]
+/// (the drift-free stick form does this).
+pub trait StickSlipModel<const N: usize>: Sync {
+    /// Derivative `dy` at `(t, y)` in `mode`, and the contact forces there.
+    fn rhs(
+        &self,
+        mode: &Mode,
+        t: f64,
+        y: &[f64; N],
+        dy: &mut [f64; N],
+    ) -> std::result::Result<Contact, ModelFault>;
+
+    /// Slip velocity of the contact at `(t, y)`.
+    fn slip_velocity(&self, t: f64, y: &[f64; N]) -> f64;
+
+    /// Position of the contact along the slip direction (becomes the stick anchor).
+    fn contact_position(&self, t: f64, y: &[f64; N]) -> f64;
+
+    /// Makes `y` consistent with stick at `anchor` at time `t` (slip velocity exactly 0).
+    fn enter_stick(&self, t: f64, y: &mut [f64; N], anchor: f64);
+
+    /// Fills the components `mode` does not integrate. Default: nothing.
+    fn complete(
+        &self,
+        _mode: &Mode,
+        _t: f64,
+        _y: &mut [f64; N],
+    ) -> std::result::Result<(), ModelFault> {
+        Ok(())
+    }
+
+    /// A one-line description of the state for error messages.
+    fn describe(&self, t: f64, y: &[f64; N]) -> String;
+}
+
+/// Settings of the event-driven integrator.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolverOptions {
+    /// Relative tolerance of the local error test.
+    pub rtol: f64,
+    /// Absolute tolerance of the local error test (in the state's units).
+    pub atol: f64,
+    /// Largest step, s.
+    pub h_max: f64,
+    /// Interior points per step at which event functions are sampled (0 = ends only).
+    pub event_samples: usize,
+    /// Largest number of accepted steps before giving up.
+    pub max_steps: usize,
+    /// Largest number of transitions before giving up (accumulation guard).
+    pub max_transitions: usize,
+}
+
+impl Default for SolverOptions {
+    fn default() -> Self {
+        SolverOptions {
+            rtol: 1e-10,
+            atol: 1e-12,
+            h_max: f64::INFINITY,
+            event_samples: 3,
+            max_steps: 20_000_000,
+            max_transitions: 1_000_000,
+        }
+    }
+}
+
+impl SolverOptions {
+    /// Checks ranges: tolerances positive and finite, `h_max > 0`.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.rtol > 0.0 && self.rtol.is_finite() && self.atol > 0.0 && self.atol.is_finite()) {
+            return Err(Error::Config(format!(
+                "solver: rtol and atol must be positive and finite (got rtol = {}, atol = {})",
+                self.rtol, self.atol
+            )));
+        }
+        if self.rtol < 1e-14 {
+            return Err(Error::Config(format!(
+                "solver: rtol = {} is below what double precision can deliver (use >= 1e-14)",
+                self.rtol
+            )));
+        }
+        if self.h_max.is_nan() || self.h_max <= 0.0 {
+            return Err(Error::Config(format!(
+                "solver: h_max must be > 0 (got {})",
+                self.h_max
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// One located transition.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Transition {
+    pub t_s: f64,
+    pub from: Phase,
+    pub to: Phase,
+}
+
+/// Counters of one run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct Stats {
+    pub steps: usize,
+    pub rejected: usize,
+    pub rhs_evals: usize,
+    /// Event-function evaluations (each one solves for the contact forces).
+    pub event_evals: usize,
+}
+
+/// Output of [`integrate`]: the state at each requested time, the transitions and the counters.
+#[derive(Debug, Clone)]
+pub struct Run<const N: usize> {
+    pub t_s: Vec<f64>,
+    pub y: Vec<[f64; N]>,
+    pub phase: Vec<Phase>,
+    pub transitions: Vec<Transition>,
+    /// State just after each transition (consistent with the new phase).
+    pub transition_states: Vec<[f64; N]>,
+    pub stats: Stats,
+    /// State and mode at the end time.
+    pub y_end: [f64; N],
+    pub mode_end: Mode,
+}
+
+const NO_EVENT: f64 = f64::INFINITY;
+
+/// Event-function values in `mode` (`[g0, g1, g2]`, unused = +∞) and the contact forces.
+fn event_values<M: StickSlipModel<N>, const N: usize>(
+    model: &M,
+    mode: &Mode,
+    t: f64,
+    y: &[f64; N],
+) -> std::result::Result<([f64; 3], Contact), ModelFault> {
+    let mut yc = *y;
+    model.complete(mode, t, &mut yc)?;
+    let mut dy = [0.0; N];
+    let c = model.rhs(mode, t, &yc, &mut dy)?;
+    let g = match mode.phase.slip_dir() {
+        Some(s) => [s * model.slip_velocity(t, &yc), NO_EVENT, c.normal],
+        None => [c.limit - c.friction, c.limit + c.friction, c.normal],
+    };
+    Ok((g, c))
+}
+
+/// Locates a zero of `g` in `[a, b]` with `g(a) > 0 ≥ g(b)` by the Illinois variant of regula falsi
+/// (Dowell & Jarratt, BIT 11 (1971) 168; the method of SUNDIALS CVODE's root finder), with a bisection
+/// whenever the bracket fails to halve in three iterations. Returns the right end of the final bracket
+/// (where `g ≤ 0`), so that the event has happened at the returned time; the bracket is closed to a
+/// few ulps of `t`.
+fn illinois_right<F: FnMut(f64) -> std::result::Result<f64, ModelFault>>(
+    mut g: F,
+    mut a: f64,
+    mut b: f64,
+    mut fa: f64,
+    mut fb: f64,
+) -> std::result::Result<f64, ModelFault> {
+    let mut side = 0i8;
+    let mut width_3_ago = (b - a).abs();
+    for it in 0..300 {
+        let width = (b - a).abs();
+        if width <= 4.0 * f64::EPSILON * a.abs().max(b.abs()) || fb == 0.0 {
+            return Ok(b);
+        }
+        let mut c = if it % 3 == 2 && width > 0.5 * width_3_ago {
+            0.5 * (a + b)
+        } else {
+            (a * fb - b * fa) / (fb - fa)
+        };
+        if it % 3 == 2 {
+            width_3_ago = width;
+        }
+        let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+        if !(c > lo && c < hi) {
+            c = 0.5 * (a + b);
+        }
+        let fc = g(c)?;
+        if fc > 0.0 {
+            a = c;
+            fa = fc;
+            if side == 1 {
+                fb *= 0.5;
+            }
+            side = 1;
+        } else {
+            b = c;
+            fb = fc;
+            if side == -1 {
+                fa *= 0.5;
+            }
+            side = -1;
+        }
+    }
+    Ok(b)
+}
+
+/// Integrates `model` from `(t0, y0)` in `mode0` to `t_end`, recording the state at `out_times`
+/// (sorted ascending, inside `[t0, t_end]`), every transition, and counters.
+///
+/// # Errors
+/// [`Error::Simulation`] naming the time and state when the contact lifts off (N ≤ 0), the slip
+/// system is singular (Painlevé), the step size collapses, or the step/transition budget runs out;
+/// [`Error::Config`] for invalid options.
+pub fn integrate<M: StickSlipModel<N>, const N: usize>(
+    model: &M,
+    t0: f64,
+    y0: [f64; N],
+    mode0: Mode,
+    t_end: f64,
+    out_times: &[f64],
+    opts: &SolverOptions,
+) -> Result<Run<N>> {
+    opts.validate()?;
+    if !(t_end > t0) {
+        return Err(Error::Config(format!(
+            "simulation window must have t_end > t0 (got {t0} .. {t_end})"
+        )));
+    }
+    let fail = |t: f64, y: &[f64; N], msg: String| Error::Simulation {
+        t_s: t,
+        message: msg,
+        state: model.describe(t, y),
+    };
+    let mut stats = Stats::default();
+    let mut run = Run {
+        t_s: Vec::with_capacity(out_times.len()),
+        y: Vec::with_capacity(out_times.len()),
+        phase: Vec::with_capacity(out_times.len()),
+        transitions: Vec::new(),
+        transition_states: Vec::new(),
+        stats,
+        y_end: y0,
+        mode_end: mode0,
+    };
+    let mut next_out = out_times.partition_point(|&to| to < t0);
+    let mut t = t0;
+    let mut y = y0;
+    let mut mode = mode0;
+    model
+        .complete(&mode, t, &mut y)
+        .map_err(|e| fail(t, &y, e.to_string()))?;
+    // Emit outputs at exactly t0.
+    while next_out < out_times.len() && out_times[next_out] <= t0 {
+        run.t_s.push(out_times[next_out]);
+        run.y.push(y);
+        run.phase.push(mode.phase);
+        next_out += 1;
+    }
+    let span = t_end - t0;
+    let mut h = (1e-6 * span).min(opts.h_max);
+    let mut quick_transitions = 0usize;
+    let mut last_transition_t = f64::NEG_INFINITY;
+
+    'phases: loop {
+        // Start of a phase.
+        let mut f = [0.0; N];
+        model
+            .rhs(&mode, t, &y, &mut f)
+            .map_err(|e| fail(t, &y, e.to_string()))?;
+        stats.rhs_evals += 1;
+        let (mut g_prev, c0) =
+            event_values(model, &mode, t, &y).map_err(|e| fail(t, &y, e.to_string()))?;
+        stats.event_evals += 1;
+        if c0.normal <= 0.0 {
+            return Err(fail(
+                t,
+                &y,
+                format!("contact lost: normal force N = {:.6e} N <= 0", c0.normal),
+            ));
+        }
+        loop {
+            if t >= t_end {
+                break 'phases;
+            }
+            if stats.steps >= opts.max_steps {
+                return Err(fail(
+                    t,
+                    &y,
+                    format!("step budget of {} steps exhausted", opts.max_steps),
+                ));
+            }
+            h = h.min(opts.h_max);
+            let last = t + h >= t_end;
+            if last {
+                h = t_end - t;
+            }
+            if h <= 4.0 * f64::EPSILON * t.abs().max(1.0) * 16.0 {
+                return Err(fail(
+                    t,
+                    &y,
+                    format!("step size collapsed to {h:.3e} s in {}", mode.phase),
+                ));
+            }
+            let mut rhs = |tt: f64, yy: &[f64; N], dy: &mut [f64; N]| {
+                model.rhs(&mode, tt, yy, dy).map(|_| ())
+            };
+            let attempt = rk::attempt(&mut rhs, t, &y, &f, h, opts.rtol, opts.atol);
+            stats.rhs_evals += 6;
+            let a = match attempt {
+                Ok(a) => a,
+                Err(_) => {
+                    // The right-hand side failed inside the step: shrink and retry.
+                    stats.rejected += 1;
+                    h *= 0.25;
+                    continue;
+                }
+            };
+            if a.err > 1.0 {
+                stats.rejected += 1;
+                h = rk::next_step(h, a.err).min(h * 0.9);
+                continue;
+            }
+            stats.steps += 1;
+            let t_new = if last { t_end } else { t + h };
+            // Event detection: sample g at interior points and the end.
+            let mut found: Option<(usize, f64, f64, f64, f64)> = None; // (idx, ta, ga, tb, gb)
+            let m = opts.event_samples;
+            let mut ta = t;
+            let mut ga = g_prev;
+            let mut g_end = g_prev;
+            for j in 1..=m + 1 {
+                let tj = if j == m + 1 {
+                    t_new
+                } else {
+                    t + h * j as f64 / (m + 1) as f64
+                };
+                let yj = if j == m + 1 {
+                    a.y_new
+                } else {
+                    a.dense.eval(tj)
+                };
+                let (gj, _) = event_values(model, &mode, tj, &yj)
+                    .map_err(|e| fail(tj, &yj, e.to_string()))?;
+                stats.event_evals += 1;
+                for k in 0..3 {
+                    if found.is_none() && ga[k] > 0.0 && gj[k] <= 0.0 {
+                        found = Some((k, ta, ga[k], tj, gj[k]));
+                    }
+                }
+                if found.is_some() {
+                    // Earliest crossing among functions: refine all that crossed in this sub-interval.
+                    let mut best = found.unwrap();
+                    let mut best_t = f64::INFINITY;
+                    for k in 0..3 {
+                        if ga[k] > 0.0 && gj[k] <= 0.0 {
+                            let dense = a.dense;
+                            let tk = illinois_right(
+                                |tt| {
+                                    let yy = dense.eval(tt);
+                                    event_values(model, &mode, tt, &yy).map(|(g, _)| g[k])
+                                },
+                                ta,
+                                tj,
+                                ga[k],
+                                gj[k],
+                            )
+                            .map_err(|e| fail(tj, &yj, e.to_string()))?;
+                            if tk < best_t {
+                                best_t = tk;
+                                best = (k, ta, ga[k], tk, 0.0);
+                            }
+                        }
+                    }
+                    found = Some(best);
+                    break;
+                }
+                // Keep the last strictly positive value as the left bracket end (arming).
+                for k in 0..3 {
+                    if gj[k] > 0.0 || ga[k] <= 0.0 {
+                        ga[k] = gj[k];
+                    }
+                }
+                ta = tj;
+                g_end = gj;
+            }
+            // Output samples up to the (possibly truncated) step end.
+            let t_stop = match found {
+                Some((_, _, _, te, _)) => te,
+                None => t_new,
+            };
+            while next_out < out_times.len() && out_times[next_out] <= t_stop {
+                let to = out_times[next_out];
+                let mut yo = if to == t_new && found.is_none() {
+                    a.y_new
+                } else {
+                    a.dense.eval(to)
+                };
+                model
+                    .complete(&mode, to, &mut yo)
+                    .map_err(|e| fail(to, &yo, e.to_string()))?;
+                run.t_s.push(to);
+                run.y.push(yo);
+                run.phase.push(mode.phase);
+                next_out += 1;
+            }
+            match found {
+                None => {
+                    t = t_new;
+                    y = a.y_new;
+                    f = a.f_new;
+                    g_prev = g_end;
+                    h = rk::next_step(h, a.err);
+                }
+                Some((k, _, _, te, _)) => {
+                    let mut ye = if te >= t_new {
+                        a.y_new
+                    } else {
+                        a.dense.eval(te)
+                    };
+                    model
+                        .complete(&mode, te, &mut ye)
+                        .map_err(|e| fail(te, &ye, e.to_string()))?;
+                    if k == 2 {
+                        let (_, c) = event_values(model, &mode, te, &ye)
+                            .map_err(|e| fail(te, &ye, e.to_string()))?;
+                        return Err(fail(
+                            te,
+                            &ye,
+                            format!(
+                                "contact lost in {}: normal force N fell to {:.3e} N (the model assumes the lip tip stays on the glass)",
+                                mode.phase, c.normal
+                            ),
+                        ));
+                    }
+                    let from = mode.phase;
+                    let new_mode = decide_after_event(model, &mode, k, te, &mut ye)
+                        .map_err(|e| fail(te, &ye, e.to_string()))?;
+                    stats.event_evals += 1;
+                    run.transitions.push(Transition {
+                        t_s: te,
+                        from,
+                        to: new_mode.phase,
+                    });
+                    run.transition_states.push(ye);
+                    if run.transitions.len() > opts.max_transitions {
+                        return Err(fail(
+                            te,
+                            &ye,
+                            format!("more than {} transitions", opts.max_transitions),
+                        ));
+                    }
+                    if te - last_transition_t <= 1e-12 * te.abs().max(1.0) {
+                        quick_transitions += 1;
+                        if quick_transitions > 50 {
+                            return Err(fail(
+                                te,
+                                &ye,
+                                "transitions accumulate (more than 50 within 1e-12 s of each other): a Zeno point; the event-driven method cannot pass it".into(),
+                            ));
+                        }
+                    } else {
+                        quick_transitions = 0;
+                    }
+                    last_transition_t = te;
+                    t = te;
+                    y = ye;
+                    mode = new_mode;
+                    // Keep the step size of the last accepted step (a fresh phase starts smooth).
+                    h = h.max(1e-12 * span);
+                    continue 'phases;
+                }
+            }
+        }
+    }
+    run.stats = stats;
+    run.y_end = y;
+    run.mode_end = mode;
+    Ok(run)
+}
+
+/// Chooses the phase after event `k` of `mode` at `(t, y)`, and makes `y` consistent with it.
+fn decide_after_event<M: StickSlipModel<N>, const N: usize>(
+    model: &M,
+    mode: &Mode,
+    k: usize,
+    t: f64,
+    y: &mut [f64; N],
+) -> std::result::Result<Mode, ModelFault> {
+    match mode.phase.slip_dir() {
+        Some(s) => {
+            // Slip velocity reached zero: stick if static friction can hold the contact (seed eq. 5),
+            // otherwise the slip reverses directly (physics.md §1.8, "slip reversal without sticking").
+            let anchor = model.contact_position(t, y);
+            let mut ys = *y;
+            model.enter_stick(t, &mut ys, anchor);
+            let stick = Mode {
+                phase: Phase::Stick,
+                anchor,
+            };
+            model.complete(&stick, t, &mut ys)?;
+            let mut dy = [0.0; N];
+            let c = model.rhs(&stick, t, &ys, &mut dy)?;
+            if c.friction.abs() <= c.limit {
+                *y = ys;
+                Ok(stick)
+            } else {
+                // The force needed to hold exceeds the limit: slip opposite to that force.
+                let s_new = -c.friction.signum();
+                let s_new = if s_new == 0.0 { -s } else { s_new };
+                *y = ys;
+                Ok(Mode {
+                    phase: Phase::slip(s_new),
+                    anchor: 0.0,
+                })
+            }
+        }
+        None => {
+            // Static friction reached +limit (k = 0) or −limit (k = 1): slip against it.
+            let s_new = if k == 0 { -1.0 } else { 1.0 };
+            Ok(Mode {
+                phase: Phase::slip(s_new),
+                anchor: 0.0,
+            })
+        }
+    }
+}
