@@ -117,7 +117,7 @@ fn main() {
                     "  max |v3 diff| {maxv3:e} m, |u diff| {maxu:e} m, |theta| {maxth:e}, phase mismatches {phase_mismatch}"
                 );
                 println!("  first sample theta {} vs {}", sim.theta_rad[0], th[0]);
-                for i in [8500usize, 8700, 8800, 8850] {
+                for i in [8800usize] {
                     println!(
                         "   i {i} t {:.5} th {:.8e} ref {:.8e}  v3-v {:.6e} ref {:.6e} u {:.6e} ref {:.6e} st {} ref {}",
                         sim.t_s[i],
