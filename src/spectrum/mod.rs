@@ -1,1 +1,31 @@
-//! Spectral estimation (filled in by the spectrum work).
+//! Spectral estimation: Welch PSD, peak picking, spectrogram.
+//!
+//! One estimator serves measured and simulated traces alike (physics.md §4, "compare like with
+//! like"). Conventions follow `scipy.signal.welch` exactly (see [`welch`](welch::welch) and
+//! `shared/crates.md` §5), so results can be cross-checked in Python; the parity tests in
+//! `tests/spectrum.rs` hold to 1e-10 relative.
+//!
+//! * [`window`]: periodic and symmetric Hann windows, their sums.
+//! * [`welch`](mod@welch): [`WelchConfig`], [`WelchPlan`] (plan once, process many), [`welch()`],
+//!   NaN-aware [`welch_gappy`].
+//! * [`resample`]: [`resample_uniform`] for jittered frame times, [`median_rate_hz`].
+//! * [`peaks`]: [`find_peak`], [`top_peaks`]: largest local maximum with parabolic interpolation of
+//!   the log PSD (J.O. Smith, SASP).
+//! * [`stft`]: [`spectrogram()`] and its [`Spectrogram::ridge`].
+//!
+//! Units: frequencies in Hz, times in s, PSD in (signal units)²/Hz, one-sided.
+//!
+//! References: P.D. Welch, IEEE Trans. Audio Electroacoust. 15(2):70–73, 1967; SciPy
+//! `scipy.signal.welch` (1.17); J.O. Smith, *Spectral Audio Signal Processing*, CCRMA.
+
+pub mod peaks;
+pub mod resample;
+pub mod stft;
+pub mod welch;
+pub mod window;
+
+pub use peaks::{Peak, find_peak, parabolic_vertex, top_peaks};
+pub use resample::{median_rate_hz, resample_uniform};
+pub use stft::{Spectrogram, spectrogram};
+pub use welch::{Detrend, GapReport, Psd, WelchConfig, WelchPlan, welch, welch_gappy};
+pub use window::{WindowSums, hann_periodic, hann_symmetric};
