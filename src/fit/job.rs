@@ -1,0 +1,354 @@
+//! The fit job file (TOML): which recording, which blade, which parameters to free, and settings.
+//!
+//! Paths inside a job are relative to the job file. Example: `fits/reversal.toml`.
+
+use super::features::{BandSpec, SignalKind, default_bands};
+use crate::import::ImportSpec;
+use crate::model::BladeParams;
+use crate::simulate::SolverOptions;
+use crate::{Error, Result};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// A fit job as written in TOML.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct FitJob {
+    /// Name used for outputs (`fits/<name>.result.toml`, `reports/<name>/`); default: file stem.
+    #[serde(default)]
+    pub name: Option<String>,
+    pub recording: RecordingSection,
+    /// Blade parameter file (TOML with [`BladeParams`] fields); the freed parameters' values in it
+    /// are ignored by the fit.
+    pub blade: PathBuf,
+    #[serde(default)]
+    pub spectrum: SpectrumSection,
+    /// Integrator settings for every model evaluation; default rtol 1e-8, atol 1e-10.
+    #[serde(default = "fit_solver_default")]
+    pub solver: SolverOptions,
+    pub fit: FitSection,
+    /// Optional true parameters (for synthetic recordings), to report relative errors.
+    #[serde(default)]
+    pub truth: Option<TruthSection>,
+}
+
+fn fit_solver_default() -> SolverOptions {
+    SolverOptions {
+        rtol: 1e-8,
+        atol: 1e-10,
+        ..SolverOptions::default()
+    }
+}
+
+/// Where the recording is and how to read it.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RecordingSection {
+    pub file: PathBuf,
+    /// Import settings (format, fps, scale, roles); `t0_s` puts frame 1 on the model's clock,
+    /// where the drive is `v = a(1 − cos ωt)`.
+    pub import: ImportSpec,
+}
+
+/// Spectral estimator settings shared by measurement and model.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SpectrumSection {
+    pub signal: SignalKind,
+    pub bands: Vec<BandSpec>,
+    /// Longest gap (samples) filled by linear interpolation before Welch; longer gaps split the
+    /// record.
+    pub max_fill: usize,
+}
+
+impl Default for SpectrumSection {
+    fn default() -> Self {
+        SpectrumSection {
+            signal: SignalKind::TipRelX,
+            bands: default_bands(),
+            max_fill: 5,
+        }
+    }
+}
+
+/// Cost weights (see [`super::cost_of`]).
+#[derive(Debug, Clone, Copy, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Weights {
+    /// Weight of the squared log peak-frequency error in units of 1 % (`(Δln f / 0.01)²`).
+    pub peak: f64,
+    /// Weight of the squared log peak-level error in units of a factor 2.
+    pub level: f64,
+    /// Weight of the mean squared log-PSD difference across each band.
+    pub shape: f64,
+}
+
+impl Default for Weights {
+    fn default() -> Self {
+        Weights {
+            peak: 1.0,
+            level: 1.0,
+            shape: 1.0,
+        }
+    }
+}
+
+/// Which parameters to fit and how.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct FitSection {
+    /// Parameter name → `[lower, upper]` bounds. Names: see [`PARAM_NAMES`].
+    pub parameters: BTreeMap<String, [f64; 2]>,
+    /// Particles of the global particle-swarm stage.
+    #[serde(default = "d_particles")]
+    pub particles: usize,
+    /// Iterations of the particle-swarm stage.
+    #[serde(default = "d_swarm")]
+    pub swarm_iterations: u64,
+    /// Iterations of the Nelder–Mead polish.
+    #[serde(default = "d_polish")]
+    pub polish_iterations: u64,
+    /// Seed of the swarm's random generator (the fit is reproducible for a given seed).
+    #[serde(default = "d_seed")]
+    pub seed: u64,
+    #[serde(default)]
+    pub weights: Weights,
+}
+
+fn d_particles() -> usize {
+    12
+}
+fn d_swarm() -> u64 {
+    8
+}
+fn d_polish() -> u64 {
+    40
+}
+fn d_seed() -> u64 {
+    1
+}
+
+/// True parameter values from a JSON file (e.g. the sample's `truth.json`).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TruthSection {
+    pub json: PathBuf,
+    /// Parameter name → JSON pointer (RFC 6901), e.g. `A = "/params/A"`.
+    pub keys: BTreeMap<String, String>,
+}
+
+/// Parameters a job may free, with their field in [`BladeParams`].
+pub const PARAM_NAMES: &[(&str, &str)] = &[
+    ("A", "friction A (seed eq. 4), 1"),
+    ("B", "friction B, s/m"),
+    ("C", "friction C, 1"),
+    ("k1", "neck stiffness k1, N·m/rad"),
+    ("k0", "head spring k0, N/m"),
+    ("k2", "lip stiffness k2, N·m/rad"),
+    ("c0", "head damper c0, N·s/m"),
+    ("c1", "neck damper c1, N·m·s/rad"),
+    ("c2", "lip damper c2, N·m·s/rad"),
+    ("hd", "preload compression h_d, m"),
+];
+
+/// Reads parameter `name` of `p` (`None` for an unknown name).
+pub fn get_param(p: &BladeParams, name: &str) -> Option<f64> {
+    use crate::model::FrictionLaw::Exponential;
+    let (a, b, c) = match p.friction {
+        Exponential { a, b_s_per_m, c } => (a, b_s_per_m, c),
+        _ => (f64::NAN, f64::NAN, f64::NAN),
+    };
+    Some(match name {
+        "A" => a,
+        "B" => b,
+        "C" => c,
+        "k1" => p.k1_nm_per_rad,
+        "k0" => p.k0_n_per_m,
+        "k2" => p.k2_nm_per_rad,
+        "c0" => p.c0_ns_per_m,
+        "c1" => p.c1_nms_per_rad,
+        "c2" => p.c2_nms_per_rad,
+        "hd" => p.hd_m,
+        _ => return None,
+    })
+}
+
+/// Sets parameter `name` of `p` (false for an unknown name).
+pub fn set_param(p: &mut BladeParams, name: &str, v: f64) -> bool {
+    use crate::model::FrictionLaw::Exponential;
+    match name {
+        "A" | "B" | "C" => {
+            if let Exponential { a, b_s_per_m, c } = &mut p.friction {
+                match name {
+                    "A" => *a = v,
+                    "B" => *b_s_per_m = v,
+                    _ => *c = v,
+                }
+            } else {
+                return false;
+            }
+        }
+        "k1" => p.k1_nm_per_rad = v,
+        "k0" => p.k0_n_per_m = v,
+        "k2" => p.k2_nm_per_rad = v,
+        "c0" => p.c0_ns_per_m = v,
+        "c1" => p.c1_nms_per_rad = v,
+        "c2" => p.c2_nms_per_rad = v,
+        "hd" => p.hd_m = v,
+        _ => return false,
+    }
+    true
+}
+
+/// 1-based line of the first occurrence of `needle` in `text` (0 if absent).
+pub(crate) fn line_of(text: &str, needle: &str) -> usize {
+    text.find(needle)
+        .map(|i| text[..i].matches('\n').count() + 1)
+        .unwrap_or(0)
+}
+
+/// Parses TOML `text` from `path` into `T`, turning syntax and schema errors into
+/// [`Error::Parse`] with line and column.
+pub fn parse_toml<T: serde::de::DeserializeOwned>(path: &Path, text: &str) -> Result<T> {
+    toml::from_str(text).map_err(|e| {
+        let (line, col) = match e.span() {
+            Some(sp) => {
+                let before = &text[..sp.start.min(text.len())];
+                let line = before.matches('\n').count() + 1;
+                let col = before.rsplit('\n').next().map(|s| s.chars().count()).unwrap_or(0) + 1;
+                (line, col)
+            }
+            None => (0, 0),
+        };
+        Error::parse(path, line, col, e.message().to_string())
+    })
+}
+
+/// Reads a file to a string, naming it on failure.
+pub fn read_text(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).map_err(|e| Error::io(path, "cannot read", e))
+}
+
+/// A loaded, validated job with its paths resolved.
+#[derive(Debug, Clone)]
+pub struct LoadedJob {
+    pub job: FitJob,
+    pub name: String,
+    pub path: PathBuf,
+    pub recording_path: PathBuf,
+    pub blade: BladeParams,
+    /// Freed parameters in a fixed order: (name, lower, upper).
+    pub free: Vec<(String, f64, f64)>,
+    /// True values of freed parameters, when the job names a truth file.
+    pub truth: BTreeMap<String, f64>,
+}
+
+impl LoadedJob {
+    /// Loads and validates the job at `path`.
+    ///
+    /// # Errors
+    /// [`Error::Io`] for unreadable files; [`Error::Parse`] (file, line, column) for TOML syntax,
+    /// unknown fields, an unknown parameter name or bounds the wrong way round.
+    pub fn load(path: &Path) -> Result<LoadedJob> {
+        let text = read_text(path)?;
+        let job: FitJob = parse_toml(path, &text)?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let name = job.name.clone().unwrap_or_else(|| {
+            path.file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "fit".into())
+        });
+        let blade_path = dir.join(&job.blade);
+        let blade_text = read_text(&blade_path)?;
+        let blade: BladeParams = parse_toml(&blade_path, &blade_text)?;
+        blade
+            .validate()
+            .map_err(|m| Error::input(&blade_path, m))?;
+        let mut free = Vec::new();
+        for (pname, [lo, hi]) in &job.fit.parameters {
+            let line = line_of(&text, &format!("{pname} ="))
+                .max(line_of(&text, &format!("{pname}=")));
+            if get_param(&blade, pname).is_none() {
+                return Err(Error::parse(
+                    path,
+                    line,
+                    1,
+                    format!(
+                        "[fit.parameters]: unknown parameter '{pname}' (known: {})",
+                        PARAM_NAMES.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
+                    ),
+                ));
+            }
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                return Err(Error::parse(
+                    path,
+                    line,
+                    1,
+                    format!("[fit.parameters]: bounds of '{pname}' must be finite with lower < upper (got [{lo}, {hi}])"),
+                ));
+            }
+            if *lo < 0.0 {
+                return Err(Error::parse(
+                    path,
+                    line,
+                    1,
+                    format!("[fit.parameters]: '{pname}' is a physical magnitude; its lower bound must be >= 0 (got {lo})"),
+                ));
+            }
+            free.push((pname.clone(), *lo, *hi));
+        }
+        if free.is_empty() {
+            return Err(Error::parse(
+                path,
+                line_of(&text, "[fit"),
+                1,
+                "[fit.parameters] frees no parameter",
+            ));
+        }
+        if job.fit.particles < 2 {
+            return Err(Error::parse(
+                path,
+                line_of(&text, "particles"),
+                1,
+                "[fit] particles must be >= 2",
+            ));
+        }
+        job.solver.validate()?;
+        for b in &job.spectrum.bands {
+            if !(b.range_hz[0] >= 0.0 && b.range_hz[0] < b.range_hz[1]) || b.nperseg < 8 {
+                return Err(Error::parse(
+                    path,
+                    line_of(&text, &b.name),
+                    1,
+                    format!(
+                        "[spectrum] band '{}': need 0 <= lower < upper and nperseg >= 8 (got {:?}, nperseg {})",
+                        b.name, b.range_hz, b.nperseg
+                    ),
+                ));
+            }
+        }
+        let mut truth = BTreeMap::new();
+        if let Some(t) = &job.truth {
+            let tp = dir.join(&t.json);
+            let v: serde_json::Value = serde_json::from_str(&read_text(&tp)?).map_err(|e| {
+                Error::parse(&tp, e.line(), e.column(), format!("not valid JSON: {e}"))
+            })?;
+            for (k, ptr) in &t.keys {
+                let x = v.pointer(ptr).and_then(|x| x.as_f64()).ok_or_else(|| {
+                    Error::input(&tp, format!("no number at JSON pointer {ptr} (for '{k}')"))
+                })?;
+                truth.insert(k.clone(), x);
+            }
+        }
+        Ok(LoadedJob {
+            recording_path: dir.join(&job.recording.file),
+            job,
+            name,
+            path: path.to_path_buf(),
+            blade,
+            free,
+            truth,
+        })
+    }
+}
