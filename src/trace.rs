@@ -17,6 +17,17 @@ pub struct PointTrack {
     pub y_m: Vec<f64>,
 }
 
+impl PointTrack {
+    /// Number of samples where x or y is NaN (the point was not tracked there).
+    pub fn nan_samples(&self) -> usize {
+        self.x_m
+            .iter()
+            .zip(&self.y_m)
+            .filter(|(x, y)| x.is_nan() || y.is_nan())
+            .count()
+    }
+}
+
 /// A set of tracked points sharing one time axis.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Trace {
@@ -52,5 +63,36 @@ impl Trace {
                     + p.y_m.iter().filter(|v| v.is_nan()).count()
             })
             .sum()
+    }
+
+    /// Check the invariants stated on the fields: every point has `len()` samples in x and y, and
+    /// `t_s` is finite and strictly increasing.
+    ///
+    /// # Errors
+    /// A sentence naming the first violation (point name and lengths, or the sample index and times).
+    pub fn check(&self) -> Result<(), String> {
+        let n = self.t_s.len();
+        for p in &self.points {
+            if p.x_m.len() != n || p.y_m.len() != n {
+                return Err(format!(
+                    "point {:?} has {} x and {} y samples, the time axis has {n}",
+                    p.name,
+                    p.x_m.len(),
+                    p.y_m.len()
+                ));
+            }
+        }
+        if let Some(i) = self.t_s.iter().position(|t| !t.is_finite()) {
+            return Err(format!("time sample {i} is {}", self.t_s[i]));
+        }
+        if let Some(i) = self.t_s.windows(2).position(|w| w[1] <= w[0]) {
+            return Err(format!(
+                "time is not strictly increasing: sample {} is {} s after {} s",
+                i + 1,
+                self.t_s[i + 1],
+                self.t_s[i]
+            ));
+        }
+        Ok(())
     }
 }

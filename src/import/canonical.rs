@@ -1,0 +1,418 @@
+//! The canonical trace CSV: what wiperlab writes after an import and reads back bit for bit.
+//!
+//! ```text
+//! t_s,head_x_m,head_y_m,tip_x_m,tip_y_m[,<other>_x_m,<other>_y_m ...]
+//! 0,3.061379e-6,-1.904484e-4,-1.401455e-3,-5.999148e-3
+//! ```
+//! * Comma delimited, `.` decimal, LF line ends, one header line, one row per sample.
+//! * `t_s` in seconds, positions in metres, physical y up (the [`Trace`] conventions).
+//! * Columns: `head` and `tip` first when present, then the other points in trace order.
+//! * Numbers: Rust's shortest representation that parses back to the same `f64` (plain decimal for
+//!   1e-4 ≤ |v| < 1e15, otherwise `1.5e-5` style); missing = `NaN`.
+//! * Names containing `,` or `"` are quoted per RFC 4180 (the `csv` crate).
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::import::quote_cell;
+use crate::trace::{PointTrack, Trace};
+
+/// Shortest round-trip text of `v`: plain decimal in [1e-4, 1e15), exponent form otherwise,
+/// `NaN` for any NaN.
+fn format_f64(v: f64) -> String {
+    if v.is_nan() {
+        "NaN".to_owned()
+    } else if v == 0.0 || (1e-4..1e15).contains(&v.abs()) || v.is_infinite() {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+fn csv_error(path: &Path, action: &'static str, e: csv::Error) -> Error {
+    let line = e.position().map_or(0, |p| p.line() as usize);
+    match e.into_kind() {
+        csv::ErrorKind::Io(io) => Error::io(path, action, io),
+        csv::ErrorKind::Utf8 { err, .. } => Error::parse(
+            path,
+            line,
+            err.field() + 1,
+            format!("invalid UTF-8 in field {}", err.field() + 1),
+        ),
+        other => Error::parse(path, line, 0, format!("{other:?}")),
+    }
+}
+
+/// The column order of the canonical CSV: indices into `trace.points`, `head` and `tip` first.
+fn column_order(trace: &Trace) -> Vec<usize> {
+    let mut order: Vec<usize> = ["head", "tip"]
+        .iter()
+        .filter_map(|r| trace.points.iter().position(|p| p.name == *r))
+        .collect();
+    for i in 0..trace.points.len() {
+        if !order.contains(&i) {
+            order.push(i);
+        }
+    }
+    order
+}
+
+/// Write `trace` as the canonical CSV (module docs) to `path`, replacing an existing file.
+///
+/// # Errors
+/// * [`Error::Input`] naming `path` if the trace breaks its invariants ([`Trace::check`]: a point
+///   with a different number of samples than `t_s`, non-increasing or non-finite time), a point
+///   name is empty, or two points share a name;
+/// * [`Error::Io`] if the file cannot be created or written.
+pub fn write_trace_csv(path: &Path, trace: &Trace) -> Result<()> {
+    trace
+        .check()
+        .map_err(|m| Error::input(path, format!("cannot write trace: {m}")))?;
+    for (i, p) in trace.points.iter().enumerate() {
+        if p.name.is_empty() {
+            return Err(Error::input(
+                path,
+                "cannot write trace: a point has no name",
+            ));
+        }
+        if trace.points[..i].iter().any(|q| q.name == p.name) {
+            return Err(Error::input(
+                path,
+                format!("cannot write trace: two points are named {:?}", p.name),
+            ));
+        }
+    }
+    let order = column_order(trace);
+    let file = std::fs::File::create(path).map_err(|e| Error::io(path, "create", e))?;
+    let mut w = csv::WriterBuilder::new()
+        .terminator(csv::Terminator::Any(b'\n'))
+        .from_writer(std::io::BufWriter::new(file));
+    let mut header = vec!["t_s".to_owned()];
+    for &i in &order {
+        let name = &trace.points[i].name;
+        header.push(format!("{name}_x_m"));
+        header.push(format!("{name}_y_m"));
+    }
+    w.write_record(&header)
+        .map_err(|e| csv_error(path, "write", e))?;
+    let mut row: Vec<String> = Vec::with_capacity(header.len());
+    for (k, &t) in trace.t_s.iter().enumerate() {
+        row.clear();
+        row.push(format_f64(t));
+        for &i in &order {
+            let p = &trace.points[i];
+            row.push(format_f64(p.x_m[k]));
+            row.push(format_f64(p.y_m[k]));
+        }
+        w.write_record(&row)
+            .map_err(|e| csv_error(path, "write", e))?;
+    }
+    w.flush().map_err(|e| Error::io(path, "write", e))?;
+    Ok(())
+}
+
+/// Read a canonical trace CSV (module docs) written by [`write_trace_csv`] or by hand.
+///
+/// Cells `NaN` (any case) or empty are missing values. Returns the points in column order; time
+/// must be finite and strictly increasing.
+///
+/// # Errors
+/// * [`Error::Io`] — cannot open/read `path`;
+/// * [`Error::Input`] — empty file or no data rows;
+/// * [`Error::Parse`] — header not `t_s` followed by `<name>_x_m,<name>_y_m` pairs (line 1 and the
+///   column), a row with a different field count (line, column 0), a non-number cell
+///   (`file:line:column: field head_x_m: expected a number or NaN, found "abc"`), a missing or
+///   non-increasing time.
+pub fn read_trace_csv(path: &Path) -> Result<Trace> {
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, "open", e))?;
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .from_reader(std::io::BufReader::new(file));
+    let mut records = reader.records();
+    let header = match records.next() {
+        Some(r) => r.map_err(|e| csv_error(path, "read", e))?,
+        None => {
+            return Err(Error::input(
+                path,
+                "empty file: expected a header t_s,<name>_x_m,<name>_y_m,...",
+            ));
+        }
+    };
+    let header_line = header.position().map_or(1, |p| p.line() as usize);
+    let names: Vec<&str> = header
+        .iter()
+        .enumerate()
+        .map(|(i, h)| {
+            if i == 0 {
+                h.trim_start_matches('\u{feff}')
+            } else {
+                h
+            }
+        })
+        .collect();
+    if names.first().copied() != Some("t_s") {
+        return Err(Error::parse(
+            path,
+            header_line,
+            1,
+            format!(
+                "expected the first column t_s, found {}",
+                quote_cell(names.first().copied().unwrap_or(""))
+            ),
+        ));
+    }
+    if names.len().is_multiple_of(2) {
+        return Err(Error::parse(
+            path,
+            header_line,
+            names.len(),
+            "expected t_s followed by pairs <name>_x_m,<name>_y_m: odd number of position columns",
+        ));
+    }
+    let mut points: Vec<PointTrack> = Vec::new();
+    for (k, pair) in names[1..].chunks(2).enumerate() {
+        let col = 2 + 2 * k;
+        let Some(name) = pair[0].strip_suffix("_x_m").filter(|n| !n.is_empty()) else {
+            return Err(Error::parse(
+                path,
+                header_line,
+                col,
+                format!("expected <name>_x_m, found {}", quote_cell(pair[0])),
+            ));
+        };
+        if pair[1].strip_suffix("_y_m") != Some(name) {
+            return Err(Error::parse(
+                path,
+                header_line,
+                col + 1,
+                format!("expected {name}_y_m, found {}", quote_cell(pair[1])),
+            ));
+        }
+        if points.iter().any(|p| p.name == name) {
+            return Err(Error::parse(
+                path,
+                header_line,
+                col,
+                format!("point {name:?} appears twice"),
+            ));
+        }
+        points.push(PointTrack {
+            name: name.to_owned(),
+            x_m: Vec::new(),
+            y_m: Vec::new(),
+        });
+    }
+
+    let mut t_s: Vec<f64> = Vec::new();
+    for (row, record) in records.enumerate() {
+        let record = record.map_err(|e| csv_error(path, "read", e))?;
+        let line = record
+            .position()
+            .map_or(header_line + 1 + row, |p| p.line() as usize);
+        if record.len() != names.len() {
+            return Err(Error::parse(
+                path,
+                line,
+                0,
+                format!(
+                    "expected {} fields like the header, found {}",
+                    names.len(),
+                    record.len()
+                ),
+            ));
+        }
+        let cell = |j: usize| -> Result<f64> {
+            let text = record.get(j).unwrap_or("").trim();
+            if text.is_empty() || text.eq_ignore_ascii_case("nan") {
+                return Ok(f64::NAN);
+            }
+            text.parse::<f64>()
+                .ok()
+                .filter(|v| !v.is_nan())
+                .ok_or_else(|| {
+                    Error::parse(
+                        path,
+                        line,
+                        j + 1,
+                        format!(
+                            "field {}: expected a number or NaN, found {}",
+                            names[j],
+                            quote_cell(text)
+                        ),
+                    )
+                })
+        };
+        let t = cell(0)?;
+        if !t.is_finite() {
+            return Err(Error::parse(
+                path,
+                line,
+                1,
+                format!("field t_s: expected a finite time, found {t}"),
+            ));
+        }
+        if let Some(&prev) = t_s.last()
+            && t <= prev
+        {
+            return Err(Error::parse(
+                path,
+                line,
+                1,
+                format!("field t_s: time {t} s is not after the previous row's {prev} s"),
+            ));
+        }
+        t_s.push(t);
+        for (k, p) in points.iter_mut().enumerate() {
+            p.x_m.push(cell(1 + 2 * k)?);
+            p.y_m.push(cell(2 + 2 * k)?);
+        }
+    }
+    if t_s.is_empty() {
+        return Err(Error::input(path, "no data rows after the header"));
+    }
+    Ok(Trace { t_s, points })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    struct Temp(PathBuf);
+    impl Temp {
+        fn path(name: &str) -> Temp {
+            Temp(std::env::temp_dir().join(format!(
+                "wiperlab_canonical_{}_{name}.csv",
+                std::process::id()
+            )))
+        }
+    }
+    impl Drop for Temp {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_file(&self.0);
+        }
+    }
+
+    #[test]
+    fn formats_round_trip() {
+        for v in [
+            0.0,
+            -0.0,
+            1e-4,
+            9.999999999999999e-5,
+            0.1 + 0.2,
+            -3.401361196808672E-6,
+            1.5e-5,
+            f64::MIN_POSITIVE,
+            5e-324,
+            f64::MAX,
+            1e15,
+            123456.789,
+        ] {
+            let s = format_f64(v);
+            assert_eq!(
+                s.parse::<f64>().unwrap().to_bits(),
+                v.to_bits(),
+                "{v} -> {s}"
+            );
+        }
+        assert_eq!(format_f64(f64::NAN), "NaN");
+        assert_eq!(format_f64(1.5e-5), "1.5e-5");
+        assert_eq!(format_f64(0.25), "0.25");
+    }
+
+    #[test]
+    fn round_trip_orders_roles_first_and_keeps_nan() {
+        let trace = Trace {
+            t_s: vec![0.0, 1e-4, 1e-4 + 1e-4 * (1.0 + f64::EPSILON)],
+            points: vec![
+                PointTrack {
+                    name: "marker, left".into(),
+                    x_m: vec![1.0, 2.0, 3.0],
+                    y_m: vec![f64::NAN, 0.1, 0.2],
+                },
+                PointTrack {
+                    name: "tip".into(),
+                    x_m: vec![-1e-300, f64::NAN, 0.3],
+                    y_m: vec![-0.006, f64::NAN, -0.0],
+                },
+                PointTrack {
+                    name: "head".into(),
+                    x_m: vec![0.1 + 0.2, 1e20, -7.5e-12],
+                    y_m: vec![1.0 / 3.0, 2.0 / 3.0, f64::NAN],
+                },
+            ],
+        };
+        let f = Temp::path("rt");
+        write_trace_csv(&f.0, &trace).unwrap();
+        let text = std::fs::read_to_string(&f.0).unwrap();
+        assert!(
+            text.starts_with(
+                "t_s,head_x_m,head_y_m,tip_x_m,tip_y_m,\"marker, left_x_m\",\"marker, left_y_m\"\n"
+            ),
+            "{text}"
+        );
+        let back = read_trace_csv(&f.0).unwrap();
+        let names: Vec<_> = back.points.iter().map(|p| p.name.as_str()).collect();
+        assert_eq!(names, ["head", "tip", "marker, left"]);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&back.t_s), bits(&trace.t_s));
+        for p in &trace.points {
+            let q = back.point(&p.name).unwrap();
+            assert_eq!(bits(&q.x_m), bits(&p.x_m), "{}", p.name);
+            assert_eq!(bits(&q.y_m), bits(&p.y_m), "{}", p.name);
+        }
+    }
+
+    #[test]
+    fn write_rejects_broken_traces() {
+        let f = Temp::path("broken");
+        let trace = Trace {
+            t_s: vec![0.0, 1.0],
+            points: vec![PointTrack {
+                name: "head".into(),
+                x_m: vec![0.0],
+                y_m: vec![0.0, 0.0],
+            }],
+        };
+        let msg = write_trace_csv(&f.0, &trace).unwrap_err().to_string();
+        assert!(msg.contains("\"head\" has 1 x and 2 y samples"), "{msg}");
+    }
+
+    #[test]
+    fn read_errors_name_line_and_column() {
+        let f = Temp::path("errs");
+        let cases = [
+            (
+                "time,a_x_m,a_y_m\n0,1,2\n",
+                ":1:1: expected the first column t_s",
+            ),
+            ("t_s,a_x_m,b_y_m\n0,1,2\n", ":1:3: expected a_y_m"),
+            ("t_s,a_x_m\n0,1\n", ":1:2: expected t_s followed by pairs"),
+            (
+                "t_s,a_x_m,a_y_m\n0,1,2\n1,x,2\n",
+                ":3:2: field a_x_m: expected a number or NaN, found \"x\"",
+            ),
+            ("t_s,a_x_m,a_y_m\n0,1,2\n1,1\n", ":3:0: expected 3 fields"),
+            (
+                "t_s,a_x_m,a_y_m\n0,1,2\n0,1,2\n",
+                ":3:1: field t_s: time 0 s is not after",
+            ),
+            (
+                "t_s,a_x_m,a_y_m\nNaN,1,2\n",
+                ":2:1: field t_s: expected a finite time",
+            ),
+            ("t_s,a_x_m,a_y_m\n", "no data rows"),
+            ("", "empty file"),
+        ];
+        for (content, needle) in cases {
+            std::fs::write(&f.0, content).unwrap();
+            let msg = read_trace_csv(&f.0).unwrap_err().to_string();
+            assert!(msg.contains(needle), "{content:?}: {msg}");
+        }
+        std::fs::write(&f.0, "t_s,a_x_m,a_y_m\r\n0,,nan\r\n").unwrap();
+        let t = read_trace_csv(&f.0).unwrap();
+        assert!(t.points[0].x_m[0].is_nan() && t.points[0].y_m[0].is_nan());
+    }
+}

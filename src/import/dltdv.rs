@@ -1,0 +1,472 @@
+//! DLTdv `*xypts.csv` reader (FORMATS.md §3; DLTdv5–8, Hedrick lab).
+//!
+//! Layout: one header line `pt{i}_cam{j}_X,pt{i}_cam{j}_Y,...` (point-major: all cameras of pt1,
+//! then pt2, …), then one row per video frame — row 1 is frame 1, there is no frame or time column.
+//! Comma delimited, `.` decimal, `%.6f` pixel coordinates, the text `NaN` where a point was not
+//! digitised.
+//!
+//! Conversion (one camera, [`ImportSpec::camera`]):
+//! * t = `t0_s` + (frame − 1)/`fps_hz` (frame 1-based);
+//! * x_m = (x_px − origin_x)·`m_per_px`;
+//! * y_m = −(y_px − origin_y)·`m_per_px` when `y_down` (default: image rows, origin top-left),
+//!   else (y_px − origin_y)·`m_per_px` (DLTdv5–7 measure y from the bottom edge; FORMATS.md §3).
+//!
+//! Points are named `pt{i}`; roles are assigned by [`super::read_trace`].
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::import::{Format, ImportSpec, parse_finite, quote_cell};
+use crate::trace::{PointTrack, Trace};
+
+/// Which coordinate a DLTdv column holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Axis {
+    X,
+    Y,
+}
+
+/// Parse a DLTdv column name `pt{i}_cam{j}_X` / `_Y` into `(i, j, axis)` (i, j ≥ 1).
+pub(crate) fn parse_header_name(name: &str) -> Option<(usize, usize, Axis)> {
+    let rest = name.trim().strip_prefix("pt")?;
+    let (point, rest) = rest.split_once("_cam")?;
+    let (camera, axis) = rest.split_once('_')?;
+    let number = |s: &str| {
+        if !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit()) {
+            s.parse::<usize>().ok().filter(|&n| n >= 1)
+        } else {
+            None
+        }
+    };
+    let axis = match axis {
+        "X" => Axis::X,
+        "Y" => Axis::Y,
+        _ => return None,
+    };
+    Some((number(point)?, number(camera)?, axis))
+}
+
+/// One point's column indices (0-based) for the selected camera.
+struct PointColumns {
+    point: usize,
+    x: Option<usize>,
+    y: Option<usize>,
+}
+
+fn csv_error(path: &Path, e: csv::Error) -> Error {
+    let line = e.position().map_or(0, |p| p.line() as usize);
+    match e.into_kind() {
+        csv::ErrorKind::Io(io) => Error::io(path, "read", io),
+        csv::ErrorKind::Utf8 { err, .. } => Error::parse(
+            path,
+            line,
+            err.field() + 1,
+            format!("invalid UTF-8 in field {}", err.field() + 1),
+        ),
+        other => Error::parse(path, line, 0, format!("{other:?}")),
+    }
+}
+
+/// Read a DLTdv `xypts.csv` into a [`Trace`] with points `pt1`, `pt2`, … in metres (y up unless
+/// `y_down = false`) and times from `fps_hz`. Uses `fps_hz`, `m_per_px` (both required),
+/// `origin_px`, `y_down`, `camera` and `t0_s` of `spec`; ignores `points`.
+///
+/// Returns N = number of data rows ≥ 1 samples; every point of the camera, NaN where DLTdv wrote
+/// `NaN`.
+///
+/// # Errors
+/// * [`Error::Io`] — cannot open/read `path`;
+/// * [`Error::Input`] — `fps_hz` or `m_per_px` missing (the message names the field), empty file,
+///   header without data rows, no columns for the requested camera (lists the cameras present);
+/// * [`Error::Parse`] — a header cell that is not `pt{i}_cam{j}_X|Y` (line 1), a row whose field
+///   count differs from the header (`line`, column 0), or a cell that is neither a finite number nor
+///   `NaN` (`file:line:column: field pt2_cam1_X: expected a number or NaN, found "abc"`);
+/// * [`Error::Config`] — settings out of range ([`ImportSpec::validate`]).
+pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
+    spec.validate(Format::Dltdv)?;
+    let fps = spec.fps_hz.ok_or_else(|| {
+        Error::input(
+            path,
+            "a DLTdv xypts file has no time column: set fps_hz (camera frames per second) in the \
+             import spec",
+        )
+    })?;
+    let scale = spec.m_per_px.ok_or_else(|| {
+        Error::input(
+            path,
+            "a DLTdv xypts file is in pixels: set m_per_px (metres per pixel) in the import spec",
+        )
+    })?;
+    let [ox, oy] = spec.origin_px;
+    let y_sign = if spec.y_down.unwrap_or(true) {
+        -1.0
+    } else {
+        1.0
+    };
+
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, "open", e))?;
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .from_reader(std::io::BufReader::new(file));
+    let mut records = reader.records();
+
+    let header = match records.next() {
+        Some(r) => r.map_err(|e| csv_error(path, e))?,
+        None => {
+            return Err(Error::input(
+                path,
+                "empty file: expected a DLTdv header line pt1_cam1_X,pt1_cam1_Y,...",
+            ));
+        }
+    };
+    let header_line = header.position().map_or(1, |p| p.line() as usize);
+    let names: Vec<String> = header
+        .iter()
+        .enumerate()
+        .map(|(i, h)| {
+            // The csv reader does not strip a BOM from the first field.
+            let h = if i == 0 {
+                h.trim_start_matches('\u{feff}')
+            } else {
+                h
+            };
+            h.trim().to_owned()
+        })
+        .collect();
+    let mut points: Vec<PointColumns> = Vec::new();
+    let mut cameras: Vec<usize> = Vec::new();
+    for (col, name) in names.iter().enumerate() {
+        let Some((point, camera, axis)) = parse_header_name(name) else {
+            return Err(Error::parse(
+                path,
+                header_line,
+                col + 1,
+                format!(
+                    "expected a DLTdv column name pt{{i}}_cam{{j}}_X or pt{{i}}_cam{{j}}_Y, found {}",
+                    quote_cell(name)
+                ),
+            ));
+        };
+        if !cameras.contains(&camera) {
+            cameras.push(camera);
+        }
+        if camera != spec.camera {
+            continue;
+        }
+        let idx = match points.iter().position(|p| p.point == point) {
+            Some(i) => i,
+            None => {
+                points.push(PointColumns {
+                    point,
+                    x: None,
+                    y: None,
+                });
+                points.len() - 1
+            }
+        };
+        let slot = match axis {
+            Axis::X => &mut points[idx].x,
+            Axis::Y => &mut points[idx].y,
+        };
+        if slot.is_some() {
+            return Err(Error::parse(
+                path,
+                header_line,
+                col + 1,
+                format!("column {name} appears twice"),
+            ));
+        }
+        *slot = Some(col);
+    }
+    if points.is_empty() {
+        cameras.sort_unstable();
+        let list: Vec<String> = cameras.iter().map(|c| format!("cam{c}")).collect();
+        return Err(Error::input(
+            path,
+            format!(
+                "no columns for camera {} (camera = {}); cameras in the file: {}",
+                spec.camera,
+                spec.camera,
+                list.join(", ")
+            ),
+        ));
+    }
+    let mut columns = Vec::with_capacity(points.len());
+    for p in &points {
+        match (p.x, p.y) {
+            (Some(x), Some(y)) => columns.push((p.point, x, y)),
+            (None, _) => {
+                return Err(Error::parse(
+                    path,
+                    header_line,
+                    0,
+                    format!("pt{}_cam{}_X is missing", p.point, spec.camera),
+                ));
+            }
+            (_, None) => {
+                return Err(Error::parse(
+                    path,
+                    header_line,
+                    0,
+                    format!("pt{}_cam{}_Y is missing", p.point, spec.camera),
+                ));
+            }
+        }
+    }
+
+    let mut t_s = Vec::new();
+    let mut xs: Vec<Vec<f64>> = vec![Vec::new(); columns.len()];
+    let mut ys: Vec<Vec<f64>> = vec![Vec::new(); columns.len()];
+    let mut values = vec![f64::NAN; names.len()];
+    for (row, record) in records.enumerate() {
+        let record = record.map_err(|e| csv_error(path, e))?;
+        let line = record
+            .position()
+            .map_or(header_line + 1 + row, |p| p.line() as usize);
+        if record.len() != names.len() {
+            return Err(Error::parse(
+                path,
+                line,
+                0,
+                format!(
+                    "expected {} fields like the header, found {}",
+                    names.len(),
+                    record.len()
+                ),
+            ));
+        }
+        for (col, cell) in record.iter().enumerate() {
+            let cell = cell.trim();
+            values[col] = if cell.eq_ignore_ascii_case("nan") {
+                f64::NAN
+            } else {
+                parse_finite(cell).ok_or_else(|| {
+                    Error::parse(
+                        path,
+                        line,
+                        col + 1,
+                        format!(
+                            "field {}: expected a number or NaN, found {}",
+                            names[col],
+                            quote_cell(cell)
+                        ),
+                    )
+                })?
+            };
+        }
+        for (k, &(_, cx, cy)) in columns.iter().enumerate() {
+            xs[k].push((values[cx] - ox) * scale);
+            ys[k].push(y_sign * (values[cy] - oy) * scale);
+        }
+        t_s.push(spec.t0_s + row as f64 / fps);
+    }
+    if t_s.is_empty() {
+        return Err(Error::input(
+            path,
+            "no data rows after the header (DLTdv writes one row per video frame)",
+        ));
+    }
+    let points = columns
+        .iter()
+        .zip(xs.into_iter().zip(ys))
+        .map(|(&(point, _, _), (x_m, y_m))| PointTrack {
+            name: format!("pt{point}"),
+            x_m,
+            y_m,
+        })
+        .collect();
+    Ok(Trace { t_s, points })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    /// A temp file that removes itself; unique per test name and process.
+    struct Temp(PathBuf);
+    impl Temp {
+        fn new(name: &str, content: &str) -> Temp {
+            let path = std::env::temp_dir().join(format!(
+                "wiperlab_dltdv_{}_{name}_xypts.csv",
+                std::process::id()
+            ));
+            std::fs::write(&path, content).unwrap();
+            Temp(path)
+        }
+    }
+    impl Drop for Temp {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_file(&self.0);
+        }
+    }
+
+    fn spec() -> ImportSpec {
+        ImportSpec {
+            fps_hz: Some(100.0),
+            m_per_px: Some(0.5),
+            origin_px: [10.0, 20.0],
+            ..ImportSpec::default()
+        }
+    }
+
+    #[test]
+    fn header_names() {
+        assert_eq!(parse_header_name("pt12_cam3_Y"), Some((12, 3, Axis::Y)));
+        for bad in [
+            "pt1_cam1_Z",
+            "pt_cam1_X",
+            "pt0_cam1_X",
+            "pt1_X",
+            "p1_cam1_X",
+            "pt1_cam+1_X",
+        ] {
+            assert_eq!(parse_header_name(bad), None, "{bad}");
+        }
+    }
+
+    #[test]
+    fn converts_pixels_frames_and_nan() {
+        let f = Temp::new(
+            "convert",
+            "pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y\n\
+             12.000000,16.000000,NaN,NaN\n\
+             10.000000,20.000000,11.000000,22.000000\n",
+        );
+        let t = read(&f.0, &spec()).unwrap();
+        assert_eq!(t.t_s, [0.0, 0.01]);
+        let p1 = t.point("pt1").unwrap();
+        // (12 − 10)·0.5 = 1; y down: −(16 − 20)·0.5 = 2.
+        assert_eq!((p1.x_m[0], p1.y_m[0]), (1.0, 2.0));
+        let p2 = t.point("pt2").unwrap();
+        assert!(p2.x_m[0].is_nan() && p2.y_m[0].is_nan());
+        assert_eq!((p2.x_m[1], p2.y_m[1]), (0.5, -1.0));
+    }
+
+    #[test]
+    fn y_up_and_t0_and_second_camera() {
+        let f = Temp::new(
+            "cam2",
+            "pt1_cam1_X,pt1_cam1_Y,pt1_cam2_X,pt1_cam2_Y\n1,2,30,40\n1,2,NaN,NaN\n1,2,31,41\n",
+        );
+        let s = ImportSpec {
+            camera: 2,
+            y_down: Some(false),
+            t0_s: 5.0,
+            ..spec()
+        };
+        let t = read(&f.0, &s).unwrap();
+        assert_eq!(t.t_s, [5.0, 5.01, 5.02]);
+        let p = t.point("pt1").unwrap();
+        assert_eq!((p.x_m[0], p.y_m[0]), (10.0, 10.0));
+        assert!(p.x_m[1].is_nan());
+        let err = read(
+            &f.0,
+            &ImportSpec {
+                camera: 3,
+                ..spec()
+            },
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(err.contains("cameras in the file: cam1, cam2"), "{err}");
+    }
+
+    #[test]
+    fn bad_number_names_line_column_and_field() {
+        let f = Temp::new(
+            "badnum",
+            "pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y\n1,2,3,4\n1,2,abc,4\n",
+        );
+        let err = read(&f.0, &spec()).unwrap_err();
+        assert!(matches!(
+            err,
+            Error::Parse {
+                line: 3,
+                column: 3,
+                ..
+            }
+        ));
+        let msg = err.to_string();
+        assert!(
+            msg.ends_with(":3:3: field pt2_cam1_X: expected a number or NaN, found \"abc\""),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn empty_cell_and_inf_are_errors() {
+        let f = Temp::new("emptycell", "pt1_cam1_X,pt1_cam1_Y\n1,\n");
+        let msg = read(&f.0, &spec()).unwrap_err().to_string();
+        assert!(msg.contains(":2:2: field pt1_cam1_Y"), "{msg}");
+        let f = Temp::new("inf", "pt1_cam1_X,pt1_cam1_Y\nInf,1\n");
+        let msg = read(&f.0, &spec()).unwrap_err().to_string();
+        assert!(msg.contains(":2:1:"), "{msg}");
+    }
+
+    #[test]
+    fn wrong_field_count_names_line() {
+        let f = Temp::new("count", "pt1_cam1_X,pt1_cam1_Y\n1,2\n1,2\n1,2,3\n");
+        let err = read(&f.0, &spec()).unwrap_err();
+        let msg = err.to_string();
+        assert!(matches!(err, Error::Parse { line: 4, .. }), "{msg}");
+        assert!(
+            msg.contains("expected 2 fields like the header, found 3"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn bad_header_and_empty_files() {
+        let f = Temp::new("hdr", "pt1_cam1_X,frame\n1,2\n");
+        let msg = read(&f.0, &spec()).unwrap_err().to_string();
+        assert!(msg.contains(":1:2: expected a DLTdv column name"), "{msg}");
+        let f = Temp::new("noy", "pt1_cam1_X\n1\n");
+        let msg = read(&f.0, &spec()).unwrap_err().to_string();
+        assert!(msg.contains("pt1_cam1_Y is missing"), "{msg}");
+        let f = Temp::new("empty", "");
+        let msg = read(&f.0, &spec()).unwrap_err().to_string();
+        assert!(msg.contains("empty file"), "{msg}");
+        let f = Temp::new("norows", "pt1_cam1_X,pt1_cam1_Y\n");
+        let msg = read(&f.0, &spec()).unwrap_err().to_string();
+        assert!(msg.contains("no data rows"), "{msg}");
+    }
+
+    #[test]
+    fn crlf_and_bom_are_accepted() {
+        let f = Temp::new(
+            "crlf",
+            "\u{feff}pt1_cam1_X,pt1_cam1_Y\r\n1,2\r\nNaN,NaN\r\n",
+        );
+        let t = read(&f.0, &spec()).unwrap();
+        assert_eq!(t.len(), 2);
+        assert_eq!(t.nan_count(), 2);
+    }
+
+    #[test]
+    fn missing_fps_or_scale_is_named() {
+        let f = Temp::new("nofps", "pt1_cam1_X,pt1_cam1_Y\n1,2\n");
+        let err = read(
+            &f.0,
+            &ImportSpec {
+                fps_hz: None,
+                ..spec()
+            },
+        )
+        .unwrap_err();
+        assert!(matches!(err, Error::Input { .. }));
+        let msg = err.to_string();
+        assert!(msg.contains("fps_hz") && msg.contains("nofps"), "{msg}");
+        let msg = read(
+            &f.0,
+            &ImportSpec {
+                m_per_px: None,
+                ..spec()
+            },
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(msg.contains("m_per_px"), "{msg}");
+    }
+}
