@@ -333,6 +333,10 @@ pub fn read_trace_with_summary(path: &Path, spec: &ImportSpec) -> Result<(Trace,
         Format::Tracker => tracker::read(path, spec)?,
     };
     let trace = assign_roles(path, raw, &spec.points)?;
+    // The readers guarantee this; checked once more because t0_s is added to every time.
+    trace
+        .check()
+        .map_err(|m| Error::input(path, format!("imported trace is inconsistent: {m}")))?;
     let mut summary = describe(&trace);
     summary.format = Some(format);
     Ok((trace, summary))
@@ -407,7 +411,7 @@ pub struct ImportSummary {
     pub n_frames: usize,
     /// `(point name, NaN samples)` in trace order; a sample counts as NaN when x or y is NaN.
     pub points: Vec<(String, usize)>,
-    /// First and last sample time in s (NaN for an empty trace).
+    /// First sample time in s (NaN for an empty trace).
     pub t_first_s: f64,
     /// Last sample time in s (NaN for an empty trace).
     pub t_last_s: f64,
