@@ -1,1 +1,3 @@
-//! SVG figures (filled in by the plotting work).
+//! SVG figures.
+pub mod figures;
+pub mod plot;

@@ -1,0 +1,277 @@
+//! The figures and text summaries each command writes (composition only; drawing is in
+//! [`super::plot`]).
+
+use super::plot::{ChartOpts, Marker, Series, heatmap, line_chart};
+use crate::fit::features::Features;
+use crate::fit::{FitOutcome, FitResult};
+use crate::model::FrictionLaw;
+use crate::simulate::blade::BladeSimulation;
+use crate::{Error, Result};
+use std::fmt::Write as _;
+use std::path::Path;
+
+fn peak_markers(f: &Features) -> Vec<Marker> {
+    f.bands
+        .iter()
+        .filter_map(|b| b.peak)
+        .map(|p| Marker {
+            x: p.freq_hz,
+            y: p.level,
+            label: format!("{:.2} Hz", p.freq_hz),
+        })
+        .collect()
+}
+
+/// PSD with the peaks of every band marked, and a spectrogram, for one signal.
+pub fn spectrum_figures(dir: &Path, name: &str, x: &[f64], fs_hz: f64, f: &Features) -> Result<()> {
+    let b0 = &f.bands[0];
+    let (fr, ps): (Vec<f64>, Vec<f64>) = b0
+        .full_freq_hz
+        .iter()
+        .zip(&b0.full_psd)
+        .skip(1)
+        .map(|(a, b)| (*a, *b))
+        .unzip();
+    line_chart(
+        &dir.join(format!("psd_{name}.svg")),
+        &format!("Welch PSD of {name} (Hann, nperseg {})", b0.spec.nperseg),
+        "frequency [Hz]",
+        "PSD [m²/Hz]",
+        &[Series::line(name, fr, ps)],
+        &ChartOpts {
+            log_y: true,
+            markers: peak_markers(f),
+            ..ChartOpts::default()
+        },
+    )?;
+    let finite: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();
+    let nper = (finite.len() / 16).clamp(16, 1024).next_power_of_two().min(finite.len());
+    if finite.len() >= 32 {
+        let sg = crate::spectrum::spectrogram(&finite, fs_hz, nper, nper * 3 / 4, nper)?;
+        heatmap(
+            &dir.join(format!("spectrogram_{name}.svg")),
+            &format!("spectrogram of {name} (Hann, nperseg {nper}, 75 % overlap)"),
+            "time from first sample [s]",
+            "frequency [Hz]",
+            &sg.t_s,
+            &sg.freq_hz,
+            &sg.density,
+            true,
+        )?;
+    }
+    Ok(())
+}
+
+/// Writes a simulation: canonical trace CSV, transitions CSV, and SVGs of the tip and head motion.
+pub fn write_simulation(dir: &Path, sim: &BladeSimulation) -> Result<()> {
+    crate::import::canonical::write_trace_csv(&dir.join("trace.csv"), &sim.to_trace())?;
+    let tpath = dir.join("transitions.csv");
+    let mut s = String::from("t_s,from,to\n");
+    for t in &sim.transitions {
+        let _ = writeln!(s, "{:.17e},{},{}", t.t_s, t.from, t.to);
+    }
+    std::fs::write(&tpath, s).map_err(|e| Error::io(&tpath, "cannot write", e))?;
+    let rel: Vec<f64> = sim.v3_m.iter().zip(&sim.v_m).map(|(a, b)| (a - b) * 1e3).collect();
+    let phase: Vec<f64> = sim.phase.iter().map(|p| p.code() as f64).collect();
+    line_chart(
+        &dir.join("tip_relative.svg"),
+        "lip tip relative to head (model)",
+        "t [s]",
+        "v3 − v [mm]",
+        &[Series::line("v3 − v", sim.t_s.clone(), rel)],
+        &ChartOpts::default(),
+    )?;
+    line_chart(
+        &dir.join("phase.svg"),
+        "contact phase (1 slip+, 0 stick, −1 slip−)",
+        "t [s]",
+        "phase",
+        &[Series::line("phase", sim.t_s.clone(), phase)],
+        &ChartOpts::default(),
+    )?;
+    line_chart(
+        &dir.join("head_drop.svg"),
+        "head drop u (model)",
+        "t [s]",
+        "u [mm]",
+        &[Series::line(
+            "u",
+            sim.t_s.clone(),
+            sim.u_m.iter().map(|u| u * 1e3).collect(),
+        )],
+        &ChartOpts::default(),
+    )
+}
+
+/// The fit's figures: traces, PSDs per band with peaks, the friction law, the cost history.
+pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
+    let meas = o.signal.extract(&o.measured_trace)?;
+    let model = o.signal.extract(&o.best_sim.to_trace())?;
+    let t = &o.measured_trace.t_s;
+    // Remove each signal's mean so measured (camera frame) and model (model frame) share an axis.
+    let demean = |x: &[f64]| {
+        let f: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();
+        let m = f.iter().sum::<f64>() / f.len().max(1) as f64;
+        x.iter().map(|v| (v - m) * 1e3).collect::<Vec<f64>>()
+    };
+    line_chart(
+        &dir.join("traces_tip.svg"),
+        "tip x − head x: measured and fitted model (means removed)",
+        "t [s] (model clock)",
+        "tip − head [mm]",
+        &[
+            Series::line("measured", t.clone(), demean(&meas)),
+            Series::line("model", o.best_sim.t_s.clone(), demean(&model)),
+        ],
+        &ChartOpts::default(),
+    )?;
+    let head_meas = o
+        .measured_trace
+        .point("head")
+        .map(|p| demean(&p.y_m))
+        .unwrap_or_default();
+    let head_model: Vec<f64> = demean(&o.best_sim.u_m.iter().map(|u| -u).collect::<Vec<_>>());
+    line_chart(
+        &dir.join("traces_head.svg"),
+        "head y: measured and fitted model (means removed)",
+        "t [s] (model clock)",
+        "head y [mm]",
+        &[
+            Series::line("measured", t.clone(), head_meas),
+            Series::line("model", o.best_sim.t_s.clone(), head_model),
+        ],
+        &ChartOpts::default(),
+    )?;
+    for (d, m) in o.measured.bands.iter().zip(&o.model.bands) {
+        let mut markers = Vec::new();
+        if let Some(p) = d.peak {
+            markers.push(Marker {
+                x: p.freq_hz,
+                y: p.level,
+                label: format!("measured {:.2} Hz", p.freq_hz),
+            });
+        }
+        if let Some(p) = m.peak {
+            markers.push(Marker {
+                x: p.freq_hz,
+                y: p.level,
+                label: format!("model {:.2} Hz", p.freq_hz),
+            });
+        }
+        line_chart(
+            &dir.join(format!("psd_{}.svg", d.spec.name)),
+            &format!(
+                "Welch PSD, {} band (nperseg {}), measured and model",
+                d.spec.name, d.spec.nperseg
+            ),
+            "frequency [Hz]",
+            "PSD [m²/Hz]",
+            &[
+                Series::line("measured", d.freq_hz.clone(), d.psd.clone()),
+                Series::line("model", m.freq_hz.clone(), m.psd.clone()),
+            ],
+            &ChartOpts {
+                log_y: true,
+                markers,
+                ..ChartOpts::default()
+            },
+        )?;
+    }
+    // Friction law μ_d(v) fitted, and the truth when known.
+    let v: Vec<f64> = (0..=200).map(|i| i as f64 * 0.2 / 200.0).collect();
+    let mut series = vec![Series::line(
+        "fitted",
+        v.clone(),
+        v.iter().map(|x| o.best_params.friction.mu_slip(*x)).collect(),
+    )];
+    let truth = |n: &str| o.result.parameters.iter().find(|p| p.name == n).and_then(|p| p.true_value);
+    if let (Some(a), Some(b), Some(c)) = (truth("A"), truth("B"), truth("C")) {
+        let law = FrictionLaw::Exponential {
+            a,
+            b_s_per_m: b,
+            c,
+        };
+        series.push(Series::line(
+            "true",
+            v.clone(),
+            v.iter().map(|x| law.mu_slip(*x)).collect(),
+        ));
+    }
+    line_chart(
+        &dir.join("friction_law.svg"),
+        "dynamic friction coefficient μ_d = A e^(−B|v|) + C (seed eq. 4)",
+        "slip speed |v̇3| [m/s]",
+        "μ",
+        &series,
+        &ChartOpts::default(),
+    )?;
+    let (it, c): (Vec<f64>, Vec<f64>) = o
+        .result
+        .history
+        .iter()
+        .map(|h| (h.evaluations as f64, h.best_cost))
+        .unzip();
+    line_chart(
+        &dir.join("cost.svg"),
+        "best cost against model evaluations (swarm, then Nelder–Mead)",
+        "model evaluations",
+        "best cost",
+        &[Series::line("best cost", it, c)],
+        &ChartOpts {
+            log_y: true,
+            ..ChartOpts::default()
+        },
+    )
+}
+
+/// A human-readable summary of a fit result.
+pub fn fit_summary(r: &FitResult) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "fit '{}': cost {:.4}, {} model evaluations ({} failed), {} swarm + {} polish iterations, {:.1} s on {} threads (rtol {:e})",
+        r.job,
+        r.cost,
+        r.model_evaluations,
+        r.failed_evaluations,
+        r.swarm_iterations,
+        r.polish_iterations,
+        r.wall_time_s,
+        r.threads,
+        r.solver_rtol
+    );
+    let _ = writeln!(s, "  {:<6} {:>14} {:>12} {:>14} {:>10}  determined", "param", "fitted", "± 1σ", "true", "rel err");
+    for p in &r.parameters {
+        let _ = writeln!(
+            s,
+            "  {:<6} {:>14.6e} {:>12.3e} {:>14} {:>10}  {}",
+            p.name,
+            p.value,
+            p.std_error,
+            p.true_value.map(|t| format!("{t:.6e}")).unwrap_or_else(|| "-".into()),
+            p.rel_error.map(|e| format!("{:+.2}%", 100.0 * e)).unwrap_or_else(|| "-".into()),
+            if p.determined { "yes" } else { "NO" }
+        );
+    }
+    for pk in &r.peaks {
+        let _ = writeln!(
+            s,
+            "  peak {:<5} measured {:>9.3} Hz  model {:>9.3} Hz  ({:+.2}%)",
+            pk.band,
+            pk.measured_hz,
+            pk.model_hz,
+            100.0 * pk.rel_diff
+        );
+    }
+    if !r.undetermined.is_empty() {
+        let _ = writeln!(
+            s,
+            "  warning: the data leave {} undetermined (flat cost in that direction; see the correlation matrix)",
+            r.undetermined.join(", ")
+        );
+    }
+    if let Some(f) = &r.first_failure {
+        let _ = writeln!(s, "  note: {} evaluations failed; first: {f}", r.failed_evaluations);
+    }
+    s
+}
