@@ -272,9 +272,7 @@ pub fn run(cli: Cli) -> Result<()> {
             let n = ((win.1 - win.0) * fps).floor() as usize + 1;
             let times: Vec<f64> = (0..n).map(|k| win.0 + k as f64 / fps).collect();
             let form = if stick == "baumgarte" {
-                StickForm::Baumgarte {
-                    omega_b_per_s: 1e4,
-                }
+                StickForm::Baumgarte { omega_b_per_s: 1e4 }
             } else {
                 StickForm::Reduced
             };

@@ -124,9 +124,9 @@ fn sample_agreement_with_independent_implementation() {
     let mut smooth_dth: f64 = 0.0;
     let mut all_dth: f64 = 0.0;
     let mut all_dtip: f64 = 0.0;
-    for i in 0..times.len() {
+    for (i, &ti) in times.iter().enumerate() {
         let d = (sim.theta_rad[i] - clean.theta[i]).abs();
-        if times[i] < 1.80 {
+        if ti < 1.80 {
             smooth_dth = smooth_dth.max(d);
         }
         all_dth = all_dth.max(d);

@@ -146,10 +146,7 @@ pub fn features(x: &[f64], fs_hz: f64, bands: &[BandSpec], max_fill: usize) -> R
             full_psd: psd.density,
         });
     }
-    Ok(Features {
-        bands: out,
-        filled,
-    })
+    Ok(Features { bands: out, filled })
 }
 
 /// Estimate of the measurement's white-noise floor (PSD units) in a band: the 10th percentile of
@@ -157,7 +154,11 @@ pub fn features(x: &[f64], fs_hz: f64, bands: &[BandSpec], max_fill: usize) -> R
 /// floor to the model's PSD before comparing log-PSDs keeps the comparison like with like.
 pub fn noise_floor(b: &BandFeatures) -> f64 {
     let n = b.psd.len();
-    let mut upper: Vec<f64> = b.psd[n / 2..].iter().copied().filter(|p| p.is_finite()).collect();
+    let mut upper: Vec<f64> = b.psd[n / 2..]
+        .iter()
+        .copied()
+        .filter(|p| p.is_finite())
+        .collect();
     if upper.is_empty() {
         return 0.0;
     }

@@ -216,7 +216,12 @@ pub fn parse_toml<T: serde::de::DeserializeOwned>(path: &Path, text: &str) -> Re
             Some(sp) => {
                 let before = &text[..sp.start.min(text.len())];
                 let line = before.matches('\n').count() + 1;
-                let col = before.rsplit('\n').next().map(|s| s.chars().count()).unwrap_or(0) + 1;
+                let col = before
+                    .rsplit('\n')
+                    .next()
+                    .map(|s| s.chars().count())
+                    .unwrap_or(0)
+                    + 1;
                 (line, col)
             }
             None => (0, 0),
@@ -262,13 +267,11 @@ impl LoadedJob {
         let blade_path = dir.join(&job.blade);
         let blade_text = read_text(&blade_path)?;
         let blade: BladeParams = parse_toml(&blade_path, &blade_text)?;
-        blade
-            .validate()
-            .map_err(|m| Error::input(&blade_path, m))?;
+        blade.validate().map_err(|m| Error::input(&blade_path, m))?;
         let mut free = Vec::new();
         for (pname, [lo, hi]) in &job.fit.parameters {
-            let line = line_of(&text, &format!("{pname} ="))
-                .max(line_of(&text, &format!("{pname}=")));
+            let line =
+                line_of(&text, &format!("{pname} =")).max(line_of(&text, &format!("{pname}=")));
             if get_param(&blade, pname).is_none() {
                 return Err(Error::parse(
                     path,
@@ -276,7 +279,11 @@ impl LoadedJob {
                     1,
                     format!(
                         "[fit.parameters]: unknown parameter '{pname}' (known: {})",
-                        PARAM_NAMES.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
+                        PARAM_NAMES
+                            .iter()
+                            .map(|(n, _)| *n)
+                            .collect::<Vec<_>>()
+                            .join(", ")
                     ),
                 ));
             }
@@ -285,7 +292,9 @@ impl LoadedJob {
                     path,
                     line,
                     1,
-                    format!("[fit.parameters]: bounds of '{pname}' must be finite with lower < upper (got [{lo}, {hi}])"),
+                    format!(
+                        "[fit.parameters]: bounds of '{pname}' must be finite with lower < upper (got [{lo}, {hi}])"
+                    ),
                 ));
             }
             if *lo < 0.0 {
@@ -293,7 +302,9 @@ impl LoadedJob {
                     path,
                     line,
                     1,
-                    format!("[fit.parameters]: '{pname}' is a physical magnitude; its lower bound must be >= 0 (got {lo})"),
+                    format!(
+                        "[fit.parameters]: '{pname}' is a physical magnitude; its lower bound must be >= 0 (got {lo})"
+                    ),
                 ));
             }
             free.push((pname.clone(), *lo, *hi));

@@ -129,7 +129,13 @@ impl SpectralProblem {
     pub fn cost_of(&self, model: &Features) -> f64 {
         let w = &self.weights;
         let mut total = 0.0;
-        for ((d, m), floor) in self.measured.bands.iter().zip(&model.bands).zip(&self.floors) {
+        for ((d, m), floor) in self
+            .measured
+            .bands
+            .iter()
+            .zip(&model.bands)
+            .zip(&self.floors)
+        {
             match (d.peak, m.peak) {
                 (Some(pd), Some(pm)) => {
                     let df = (pm.freq_hz / pd.freq_hz).ln() / 0.01;
@@ -201,7 +207,11 @@ struct HistoryObserver {
 }
 
 impl<I: State<Float = f64>> Observe<I> for HistoryObserver {
-    fn observe_iter(&mut self, state: &I, _kv: &KV) -> std::result::Result<(), argmin::core::Error> {
+    fn observe_iter(
+        &mut self,
+        state: &I,
+        _kv: &KV,
+    ) -> std::result::Result<(), argmin::core::Error> {
         self.log
             .lock()
             .unwrap_or_else(|e| e.into_inner())
@@ -425,7 +435,11 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let mut simplex = vec![swarm_best.clone()];
     for i in 0..n {
         let mut v = swarm_best.clone();
-        v[i] = if v[i] + 0.05 <= 1.0 { v[i] + 0.05 } else { v[i] - 0.05 };
+        v[i] = if v[i] + 0.05 <= 1.0 {
+            v[i] + 0.05
+        } else {
+            v[i] - 0.05
+        };
         simplex.push(v);
     }
     let nm = NelderMead::new(simplex)

@@ -166,7 +166,7 @@ impl BladeParams {
 }
 
 /// How the stick phase (constraint `v3 = const`) is integrated.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 #[serde(tag = "form", rename_all = "snake_case", deny_unknown_fields)]
 pub enum StickForm {
     /// All four coordinates integrated, the constraint enforced at acceleration level with
@@ -175,13 +175,8 @@ pub enum StickForm {
     Baumgarte { omega_b_per_s: f64 },
     /// Drift-free reduced form: only θ is integrated; φ = arcsin((v3* − v − l1 sin θ)/l2) and φ̇
     /// follow from the constraint exactly (physics.md §1.4, "drift-free alternative").
+    #[default]
     Reduced,
-}
-
-impl Default for StickForm {
-    fn default() -> Self {
-        StickForm::Reduced
-    }
 }
 
 /// The drive `v = a(1 − cos ωt)` and its first two derivatives.
@@ -311,7 +306,8 @@ impl Blade {
         }
         let det0 = a0.determinant();
         let det = a.determinant();
-        if !(det * det0 > 0.0) || det.abs() < 1e-9 * det0.abs() {
+        let same_sign = det * det0 > 0.0;
+        if !same_sign || det.abs() < 1e-9 * det0.abs() {
             return Err(ModelFault::Singular(format!(
                 "slip equations singular (Painlevé-type): det with friction {det:.3e}, frictionless {det0:.3e}, μ = {mu:.4}"
             )));
@@ -394,7 +390,8 @@ impl Blade {
         let (v, vd, _) = self.drive(t);
         let (sth, cth) = theta.sin_cos();
         let arg = (anchor - v - l1 * sth) / l2;
-        if !(arg.abs() < 1.0) {
+        let reachable = arg.abs() < 1.0;
+        if !reachable {
             return Err(ModelFault::Geometry(format!(
                 "stick constraint has no lip angle: sin φ = {arg:.6} (the head moved beyond the lip's reach)"
             )));

@@ -45,7 +45,10 @@ pub fn spectrum_figures(dir: &Path, name: &str, x: &[f64], fs_hz: f64, f: &Featu
         },
     )?;
     let finite: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();
-    let nper = (finite.len() / 16).clamp(16, 1024).next_power_of_two().min(finite.len());
+    let nper = (finite.len() / 16)
+        .clamp(16, 1024)
+        .next_power_of_two()
+        .min(finite.len());
     if finite.len() >= 32 {
         let sg = crate::spectrum::spectrogram(&finite, fs_hz, nper, nper * 3 / 4, nper)?;
         heatmap(
@@ -71,7 +74,12 @@ pub fn write_simulation(dir: &Path, sim: &BladeSimulation) -> Result<()> {
         let _ = writeln!(s, "{:.17e},{},{}", t.t_s, t.from, t.to);
     }
     std::fs::write(&tpath, s).map_err(|e| Error::io(&tpath, "cannot write", e))?;
-    let rel: Vec<f64> = sim.v3_m.iter().zip(&sim.v_m).map(|(a, b)| (a - b) * 1e3).collect();
+    let rel: Vec<f64> = sim
+        .v3_m
+        .iter()
+        .zip(&sim.v_m)
+        .map(|(a, b)| (a - b) * 1e3)
+        .collect();
     let phase: Vec<f64> = sim.phase.iter().map(|p| p.code() as f64).collect();
     line_chart(
         &dir.join("tip_relative.svg"),
@@ -182,15 +190,19 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
     let mut series = vec![Series::line(
         "fitted",
         v.clone(),
-        v.iter().map(|x| o.best_params.friction.mu_slip(*x)).collect(),
+        v.iter()
+            .map(|x| o.best_params.friction.mu_slip(*x))
+            .collect(),
     )];
-    let truth = |n: &str| o.result.parameters.iter().find(|p| p.name == n).and_then(|p| p.true_value);
+    let truth = |n: &str| {
+        o.result
+            .parameters
+            .iter()
+            .find(|p| p.name == n)
+            .and_then(|p| p.true_value)
+    };
     if let (Some(a), Some(b), Some(c)) = (truth("A"), truth("B"), truth("C")) {
-        let law = FrictionLaw::Exponential {
-            a,
-            b_s_per_m: b,
-            c,
-        };
+        let law = FrictionLaw::Exponential { a, b_s_per_m: b, c };
         series.push(Series::line(
             "true",
             v.clone(),
@@ -240,7 +252,11 @@ pub fn fit_summary(r: &FitResult) -> String {
         r.threads,
         r.solver_rtol
     );
-    let _ = writeln!(s, "  {:<6} {:>14} {:>12} {:>14} {:>10}  determined", "param", "fitted", "± 1σ", "true", "rel err");
+    let _ = writeln!(
+        s,
+        "  {:<6} {:>14} {:>12} {:>14} {:>10}  determined",
+        "param", "fitted", "± 1σ", "true", "rel err"
+    );
     for p in &r.parameters {
         let _ = writeln!(
             s,
@@ -248,8 +264,12 @@ pub fn fit_summary(r: &FitResult) -> String {
             p.name,
             p.value,
             p.std_error,
-            p.true_value.map(|t| format!("{t:.6e}")).unwrap_or_else(|| "-".into()),
-            p.rel_error.map(|e| format!("{:+.2}%", 100.0 * e)).unwrap_or_else(|| "-".into()),
+            p.true_value
+                .map(|t| format!("{t:.6e}"))
+                .unwrap_or_else(|| "-".into()),
+            p.rel_error
+                .map(|e| format!("{:+.2}%", 100.0 * e))
+                .unwrap_or_else(|| "-".into()),
             if p.determined { "yes" } else { "NO" }
         );
     }
@@ -271,7 +291,11 @@ pub fn fit_summary(r: &FitResult) -> String {
         );
     }
     if let Some(f) = &r.first_failure {
-        let _ = writeln!(s, "  note: {} evaluations failed; first: {f}", r.failed_evaluations);
+        let _ = writeln!(
+            s,
+            "  note: {} evaluations failed; first: {f}",
+            r.failed_evaluations
+        );
     }
     s
 }

@@ -330,7 +330,8 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
     opts: &SolverOptions,
 ) -> Result<Run<N>> {
     opts.validate()?;
-    if !(t_end > t0) {
+    let forward = t_end > t0;
+    if !forward {
         return Err(Error::Config(format!(
             "simulation window must have t_end > t0 (got {t0} .. {t_end})"
         )));

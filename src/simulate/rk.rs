@@ -186,7 +186,7 @@ mod tests {
         let mut t = 0.0;
         let mut y = [1.0, 0.0];
         let mut f = [0.0, -1.0];
-        let mut h = 1e-3;
+        let mut h: f64 = 1e-3;
         let mut max_dense_err: f64 = 0.0;
         while t < 10.0 {
             h = h.min(10.0 - t);
@@ -208,31 +208,30 @@ mod tests {
         assert!(max_dense_err < 1e-8, "dense error {max_dense_err}");
     }
 
+    fn oscillator(_t: f64, y: &[f64; 2], dy: &mut [f64; 2]) -> Result<(), ()> {
+        dy[0] = y[1];
+        dy[1] = -y[0];
+        Ok(())
+    }
+
+    /// One-period error of `n` fixed steps on y'' = −y (exact: back to (1, 0)).
+    fn one_period_error(n: usize) -> f64 {
+        let h = 2.0 * std::f64::consts::PI / n as f64;
+        let (mut y, mut t) = ([1.0, 0.0], 0.0);
+        let mut rhs = oscillator;
+        for _ in 0..n {
+            let mut f = [0.0; 2];
+            oscillator(t, &y, &mut f).unwrap();
+            y = attempt(&mut rhs, t, &y, &f, h, 1.0, 1.0).unwrap().y_new;
+            t += h;
+        }
+        (y[0] - 1.0).abs().max(y[1].abs())
+    }
+
     /// Order check: halving a fixed step divides the one-period error by ≈ 2⁵ = 32.
     #[test]
     fn fifth_order_convergence() {
-        let mut rhs = |_t: f64, y: &[f64; 2], dy: &mut [f64; 2]| -> Result<(), ()> {
-            dy[0] = y[1];
-            dy[1] = -y[0];
-            Ok(())
-        };
-        let err_for =
-            |n: usize, rhs: &mut dyn FnMut(f64, &[f64; 2], &mut [f64; 2]) -> Result<(), ()>| {
-                let h = 2.0 * std::f64::consts::PI / n as f64;
-                let mut y = [1.0, 0.0];
-                let mut t = 0.0;
-                for _ in 0..n {
-                    let mut f = [0.0; 2];
-                    rhs(t, &y, &mut f).unwrap();
-                    let mut r = |t: f64, y: &[f64; 2], d: &mut [f64; 2]| rhs(t, y, d);
-                    y = attempt(&mut r, t, &y, &f, h, 1.0, 1.0).unwrap().y_new;
-                    t += h;
-                }
-                (y[0] - 1.0).abs().max(y[1].abs())
-            };
-        let e1 = err_for(50, &mut rhs);
-        let e2 = err_for(100, &mut rhs);
-        let order = (e1 / e2).log2();
+        let order = (one_period_error(50) / one_period_error(100)).log2();
         assert!((order - 5.0).abs() < 0.3, "observed order {order}");
     }
 }
