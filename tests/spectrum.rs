@@ -121,7 +121,14 @@ fn spectrogram_matches_scipy() {
     let (fs, x) = signal();
     let (comments, rows) = read_csv("spectrogram.csv");
     let num = |k: &str| config_value(&comments, k).parse::<usize>().unwrap();
-    let sg = spectrogram(&x[..num("n")], fs, num("nperseg"), num("noverlap"), num("nfft")).unwrap();
+    let sg = spectrogram(
+        &x[..num("n")],
+        fs,
+        num("nperseg"),
+        num("noverlap"),
+        num("nfft"),
+    )
+    .unwrap();
     assert_eq!(rows.len(), sg.n_times() * sg.n_freqs());
     let mut worst: f64 = 0.0;
     for (idx, r) in rows.iter().enumerate() {
@@ -282,7 +289,10 @@ fn welch_gappy_equals_welch_without_nan_and_errors_on_bad_input() {
     assert_eq!((rep.filled, rep.dropped, rep.runs), (0, 0, 1));
 
     let e = welch_gappy(&[f64::NAN; 5000], fs, &cfg, 10).unwrap_err();
-    assert!(matches!(e, Error::Numerics(ref m) if m.contains("NaN")), "{e}");
+    assert!(
+        matches!(e, Error::Numerics(ref m) if m.contains("NaN")),
+        "{e}"
+    );
     let e = welch_gappy(&[], fs, &cfg, 10).unwrap_err();
     assert!(matches!(e, Error::Numerics(_)), "{e}");
     // Every run shorter than nperseg: the message names the longest run (700 samples).

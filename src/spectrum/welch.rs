@@ -583,7 +583,10 @@ mod tests {
         let cfg = WelchConfig::new(16);
         for x in [vec![], vec![1.0; 15]] {
             let e = welch(&x, 100.0, &cfg).unwrap_err();
-            assert!(matches!(e, Error::Numerics(ref m) if m.contains("nperseg = 16")), "{e}");
+            assert!(
+                matches!(e, Error::Numerics(ref m) if m.contains("nperseg = 16")),
+                "{e}"
+            );
         }
         let mut x = vec![0.5; 64];
         x[10] = f64::NAN;
