@@ -362,3 +362,69 @@ fn spectrogram_ridge_follows_chirp() {
     eprintln!("chirp ridge: worst error {worst:.2} Hz (bin {bin:.2} Hz)");
     assert!(worst < bin, "{worst} Hz");
 }
+
+/// Outside check against the independent estimator of `shared/sample/truth.json`
+/// (`estimator.description`; `peaks.clean_10kfps.v3rel`): one Hann-windowed, linearly detrended
+/// segment over the whole window, largest local maximum per band, parabolic interpolation on the log
+/// spectrum. Ours uses the periodic Hann (theirs the symmetric one, `numpy.hanning`) on a PSD rather
+/// than |X|; p is the same on ln PSD and ln |X|, so only the window differs (one sample in 18 869).
+/// Measured: 1.2e-3 bin (0.6 mHz) at the broad 49 Hz peak, ~1e-5 bin at 884 Hz; the same numpy
+/// computation with the symmetric window reproduces the truth file to 1e-7 Hz, and with the periodic
+/// one gives our value, so the window is the whole difference. Asserted: 2.5e-3 bin, and our power
+/// prominence ≈ the square of their magnitude prominence (2 %; medians of |X|² and |X| differ only
+/// in how an even count is averaged). Skipped (with a message) when `shared/` is not beside
+/// the repository.
+#[test]
+fn matches_independent_estimator_on_sample() {
+    use std::io::Read;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/sample");
+    let (Ok(gz), Ok(truth)) = (
+        std::fs::read(root.join("clean_10kfps.csv.gz")),
+        std::fs::read_to_string(root.join("truth.json")),
+    ) else {
+        eprintln!("shared/sample not found beside the repository: skipped");
+        return;
+    };
+    let mut text = String::new();
+    flate2::read::GzDecoder::new(&gz[..])
+        .read_to_string(&mut text)
+        .unwrap();
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |n: &str| head.iter().position(|h| *h == n).unwrap();
+    let (iv, iv3) = (col("v"), col("v3"));
+    let x: Vec<f64> = lines
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            f[iv3].parse::<f64>().unwrap() - f[iv].parse::<f64>().unwrap()
+        })
+        .collect();
+    let truth: serde_json::Value = serde_json::from_str(&truth).unwrap();
+    let want = &truth["peaks"]["clean_10kfps"]["v3rel"];
+    let fs = want["fs_Hz"].as_f64().unwrap();
+    assert_eq!(x.len() as u64, want["n_samples"].as_u64().unwrap());
+    let n = x.len();
+    let cfg = WelchConfig::new(n)
+        .with_noverlap(0)
+        .unwrap()
+        .with_detrend(Detrend::Linear);
+    let psd = welch(&x, fs, &cfg).unwrap();
+    let df = fs / n as f64;
+    for (band, key) in [((30.0, 300.0), "low"), ((500.0, 5000.0), "high")] {
+        let pk = find_peak(&psd.freq_hz, &psd.density, band).unwrap();
+        let f_ref = want[format!("{key}_Hz")].as_f64().unwrap();
+        let prom_ref = want[format!("{key}_prominence")].as_f64().unwrap();
+        eprintln!(
+            "sample v3−v {key}: {:.4} Hz vs independent {:.4} Hz ({:.1e} bin); prominence √{:.2} = \
+             {:.3} vs {:.3}",
+            pk.freq_hz,
+            f_ref,
+            (pk.freq_hz - f_ref).abs() / df,
+            pk.prominence,
+            pk.prominence.sqrt(),
+            prom_ref
+        );
+        assert!((pk.freq_hz - f_ref).abs() < 2.5e-3 * df);
+        assert!((pk.prominence.sqrt() / prom_ref - 1.0).abs() < 0.02);
+    }
+}

@@ -1,3 +1,7 @@
-//! SVG figures.
+//! Report stage: figures from results computed upstream; it computes nothing.
+//!
+//! * [`plot`]: SVG line charts (traces, PSDs with peak markers) and spectrogram heat maps.
+//! * [`figures`]: which figures each command writes.
+
 pub mod figures;
 pub mod plot;

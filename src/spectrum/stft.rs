@@ -4,7 +4,7 @@
 //!
 //! `scipy.signal.spectrogram` defaults to a Tukey(0.25) window and `noverlap = nperseg/8`; we do
 //! **not** inherit those. Every slice here is computed exactly like one segment of
-//! [`welch`](super::welch):
+//! [`welch`](fn@super::welch):
 //!
 //! * periodic Hann window of length `nperseg` ([`hann_periodic`](super::hann_periodic));
 //! * segments start every `nperseg − noverlap` samples; only full segments are used;
