@@ -118,3 +118,51 @@ fn bad_input_gives_one_line_and_exit_2() {
         &["does_not_exist.csv"],
     );
 }
+
+#[test]
+fn tracker_pendulum_frequency_within_1_percent() {
+    // ../shared/realdata/tracker/8047.txt: Tracker export of a 1.474 m pendulum; the author measured
+    // T = 2.421 s (SOURCES.md, report2/PeriodVsLength.txt of the source repository).
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let file = root.join("../shared/realdata/tracker/8047.txt");
+    if !file.exists() {
+        eprintln!(
+            "skipped: ../shared not found (tests that read ../shared need the project's shared folder beside the clone)"
+        );
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("wiperlab_spec_{}", std::process::id()));
+    let out = wiperlab()
+        .args([
+            "spectrum",
+            &file.display().to_string(),
+            "--band",
+            "0.2:1.0",
+            "--out-dir",
+            &dir.display().to_string(),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let line = text
+        .lines()
+        .find(|l| l.contains("point_x"))
+        .expect("point_x line");
+    let f: f64 = line
+        .split("peak ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let f_ref = 1.0 / 2.421;
+    assert!(((f - f_ref) / f_ref).abs() < 0.01, "{f} Hz vs {f_ref} Hz");
+    assert!(dir.join("psd_point_x.svg").exists());
+}
