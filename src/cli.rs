@@ -34,7 +34,9 @@ pub struct ImportArgs {
     #[arg(long)]
     pub m_per_px: Option<f64>,
     /// Pixel coordinates X,Y of the physical origin (DLTdv).
-    #[arg(long, value_delimiter = ',', num_args = 2)]
+    // No `num_args = 2`: clap checks num_args before splitting on the delimiter, so it would reject
+    // the documented `--origin-px 200,300`; the count is checked in `import_spec`.
+    #[arg(long, value_delimiter = ',')]
     pub origin_px: Option<Vec<f64>>,
     /// Name of the tracked point that is the head.
     #[arg(long)]
@@ -78,7 +80,8 @@ pub enum Command {
         /// Blade parameter TOML (see data/reversal/blade_true.toml).
         params: PathBuf,
         /// Window T0,T1 in s on the model clock (default: fastest forward to fastest backward).
-        #[arg(long, value_delimiter = ',', num_args = 2)]
+        // No `num_args = 2` (see `origin_px`); the count is checked in `run`.
+        #[arg(long, value_delimiter = ',')]
         window: Option<Vec<f64>>,
         /// Output sampling rate, Hz.
         #[arg(long, default_value_t = 10000.0)]
@@ -125,7 +128,13 @@ fn import_spec(a: &ImportArgs) -> Result<ImportSpec> {
         spec.m_per_px = a.m_per_px;
     }
     if let Some(o) = &a.origin_px {
-        spec.origin_px = [o[0], o[1]];
+        let &[x, y] = o.as_slice() else {
+            return Err(Error::Config(format!(
+                "--origin-px: expected X,Y in pixels, e.g. 200,300 (got {} values)",
+                o.len()
+            )));
+        };
+        spec.origin_px = [x, y];
     }
     if let Some(h) = &a.head {
         spec.points.insert("head".into(), h.clone());
@@ -263,7 +272,15 @@ pub fn run(cli: Cli) -> Result<()> {
             let p: BladeParams = parse_toml(&params, &read_text(&params)?)?;
             p.validate().map_err(|m| Error::input(&params, m))?;
             let win = match window {
-                Some(w) => (w[0], w[1]),
+                Some(w) => match w.as_slice() {
+                    &[t0, t1] => (t0, t1),
+                    _ => {
+                        return Err(Error::Config(format!(
+                            "--window: expected T0,T1 in s, e.g. 1.83,1.85 (got {} values)",
+                            w.len()
+                        )));
+                    }
+                },
                 None => default_window(&p),
             };
             if !(fps > 0.0 && fps.is_finite()) {

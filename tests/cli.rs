@@ -1,0 +1,588 @@
+//! The `wiperlab` binary as a user runs it: the main job end to end, `simulate`, `import`, and the
+//! one-line `error: ...` messages (exit code 2) for bad input.
+//!
+//! Every command runs with the crate root as working directory, so the relative paths of the
+//! shipped job (`fits/reversal.toml`) work; outputs go to temp dirs wherever the CLI allows.
+//! Reference numbers name their source (mostly `data/reversal/truth.json`, written by the
+//! independent implementation that made the sample recording).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::{Duration, SystemTime};
+
+/// The crate root (working directory of every command).
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Runs `wiperlab args...` in the crate root.
+fn wiperlab(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_wiperlab"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("cannot start the wiperlab binary")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Asserts exit code 0 and returns stdout.
+fn ok(o: &Output, what: &str) -> String {
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{what} failed\nstdout:\n{}\nstderr:\n{}",
+        stdout(o),
+        stderr(o)
+    );
+    stdout(o)
+}
+
+/// A directory in the system temp dir, unique per process and `name`, removed on drop.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(name: &str) -> TempDir {
+        let p = std::env::temp_dir().join(format!("wiperlab_cli_{}_{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&p);
+        std::fs::create_dir_all(&p).expect("create temp dir");
+        TempDir(p)
+    }
+
+    fn join(&self, rel: &str) -> PathBuf {
+        self.0.join(rel)
+    }
+
+    /// Writes `content` to `<dir>/<rel>` and returns the path.
+    fn write(&self, rel: &str, content: &str) -> PathBuf {
+        let p = self.join(rel);
+        std::fs::write(&p, content).expect("write temp file");
+        p
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("UTF-8 temp path")
+}
+
+/// `data/reversal/truth.json`, parsed.
+fn truth() -> serde_json::Value {
+    let text = std::fs::read_to_string(root().join("data/reversal/truth.json"))
+        .expect("read data/reversal/truth.json");
+    serde_json::from_str(&text).expect("parse truth.json")
+}
+
+fn num(v: &serde_json::Value, ptr: &str) -> f64 {
+    v.pointer(ptr)
+        .and_then(serde_json::Value::as_f64)
+        .unwrap_or_else(|| panic!("no number at {ptr} in {v}"))
+}
+
+/// 1-based line of the first occurrence of `needle` in `text`.
+fn line_of(text: &str, needle: &str) -> usize {
+    let i = text
+        .find(needle)
+        .unwrap_or_else(|| panic!("{needle:?} not in the text"));
+    text[..i].matches('\n').count() + 1
+}
+
+/// `text` with the single occurrence of `old` replaced by `new`.
+fn edit(text: &str, old: &str, new: &str) -> String {
+    assert_eq!(
+        text.matches(old).count(),
+        1,
+        "{old:?} must occur exactly once"
+    );
+    text.replacen(old, new, 1)
+}
+
+/// The shipped main job `fits/reversal.toml`, with its relative `../data/reversal/...` paths made
+/// absolute so that a copy works from a temp dir.
+fn job_text() -> String {
+    let text =
+        std::fs::read_to_string(root().join("fits/reversal.toml")).expect("read the main job");
+    let data = root().join("data");
+    // blade, recording file and truth json
+    assert_eq!(text.matches("\"../data/").count(), 3, "{text}");
+    text.replace("\"../data/", &format!("\"{}/", data.display()))
+}
+
+/// Asserts a bad-input failure: exit code 2 and exactly one stderr line `error: ...` containing
+/// every string of `must_contain`. Returns that line.
+fn input_error(o: &Output, must_contain: &[&str]) -> String {
+    let err = stderr(o);
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "expected exit code 2 (input error)\nstdout:\n{}\nstderr:\n{err}",
+        stdout(o)
+    );
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 1, "expected one stderr line, got:\n{err}");
+    let line = lines[0];
+    assert!(line.starts_with("error: "), "{line}");
+    for m in must_contain {
+        assert!(line.contains(m), "{line:?} does not contain {m:?}");
+    }
+    line.to_string()
+}
+
+/// The `LINE:COL` that follows `<path>:` in an error line.
+fn line_col(msg: &str, path: &Path) -> (usize, usize) {
+    let prefix = format!("{}:", path.display());
+    let i = msg
+        .find(&prefix)
+        .unwrap_or_else(|| panic!("{msg:?} does not name {prefix}"));
+    let mut it = msg[i + prefix.len()..].splitn(3, ':');
+    let mut next = || -> usize {
+        it.next()
+            .and_then(|x| x.parse().ok())
+            .unwrap_or_else(|| panic!("{msg:?}: expected {prefix}LINE:COL:"))
+    };
+    (next(), next())
+}
+
+fn assert_svg(path: &Path) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(text.contains("<svg"), "{} is not an SVG", path.display());
+}
+
+/// Asserts `path` was written at or after `since` (the repo ships older copies of these files).
+fn assert_fresh(path: &Path, since: SystemTime) {
+    let m = std::fs::metadata(path)
+        .and_then(|m| m.modified())
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    // 1 s slack for coarse file-system clocks; the fit itself takes ~20 s.
+    assert!(
+        m + Duration::from_secs(1) >= since,
+        "{} was not rewritten by this run",
+        path.display()
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// The main job
+// ---------------------------------------------------------------------------------------------
+
+/// `wiperlab fit fits/reversal.toml --json` (about 20 s in release on 2 cores). Writes
+/// `fits/reversal.result.toml` and `reports/reversal/*.svg` in the repo, as the job documents.
+#[test]
+fn main_job_end_to_end() {
+    let started = SystemTime::now();
+    let o = wiperlab(&["fit", "fits/reversal.toml", "--json"]);
+    let out = ok(&o, "the main job");
+    let json_line = out
+        .lines()
+        .find(|l| l.starts_with('{'))
+        .unwrap_or_else(|| panic!("no JSON object on stdout:\n{out}"));
+    let r: serde_json::Value = serde_json::from_str(json_line).expect("stdout is JSON");
+    assert_eq!(r["job"], "reversal");
+
+    // Peaks: the fitted model's within 2 % of the recording's (the issue's requirement).
+    let peaks = r["peaks"].as_array().expect("peaks array");
+    let peak = |band: &str| -> (f64, f64) {
+        let p = peaks
+            .iter()
+            .find(|p| p["band"] == band)
+            .unwrap_or_else(|| panic!("no peak for band {band} in {peaks:?}"));
+        (num(p, "/measured_hz"), num(p, "/model_hz"))
+    };
+    for band in ["low", "high"] {
+        let (meas, model) = peak(band);
+        let rel = (model - meas) / meas;
+        println!(
+            "band {band}: measured {meas:.3} Hz, model {model:.3} Hz ({:+.3} %)",
+            rel * 100.0
+        );
+        assert!(
+            rel.abs() <= 0.02,
+            "band {band}: model {model} Hz vs measured {meas} Hz ({:+.2} %)",
+            rel * 100.0
+        );
+    }
+    // The measured peaks themselves. data/reversal/truth.json /peaks/recording/v3rel reports
+    // low_Hz 49.002 and high_Hz 887.612 (README: "49.0 Hz and 887.6 Hz") with a different estimator
+    // (one Hann window over the whole record, not Welch), hence ranges rather than equality.
+    let truth = truth();
+    let (low, _) = peak("low");
+    let (high, _) = peak("high");
+    assert!((45.0..=55.0).contains(&low), "measured low {low} Hz");
+    assert!((850.0..=920.0).contains(&high), "measured high {high} Hz");
+    println!(
+        "truth.json recording peaks (one-window estimator): low {:.3} Hz, high {:.3} Hz",
+        num(&truth, "/peaks/recording/v3rel/low_Hz"),
+        num(&truth, "/peaks/recording/v3rel/high_Hz")
+    );
+
+    // Parameters: every freed one reported against the truth (job [truth] keys -> truth.json /params).
+    let params = r["parameters"].as_array().expect("parameters array");
+    for name in ["A", "B", "C", "k1"] {
+        let p = params
+            .iter()
+            .find(|p| p["name"] == name)
+            .unwrap_or_else(|| panic!("parameter {name} missing from {params:?}"));
+        let value = num(p, "/value");
+        let true_value = num(p, "/true_value");
+        let rel = num(p, "/rel_error");
+        assert!(value.is_finite() && rel.is_finite(), "{name}: {p}");
+        // truth.json /params/<name>: the values the sample was generated with.
+        let want = num(&truth, &format!("/params/{name}"));
+        assert!(
+            (true_value - want).abs() <= 1e-12 * want.abs(),
+            "{name}: true_value {true_value} but truth.json has {want}"
+        );
+        println!("{name}: fitted {value:.6e}, true {true_value:.6e}, rel error {rel:+.4}");
+    }
+
+    // The result file beside the job: rewritten by this run, valid TOML, the same result.
+    let result_path = root().join("fits/reversal.result.toml");
+    assert_fresh(&result_path, started);
+    let text = std::fs::read_to_string(&result_path).expect("read the result TOML");
+    let t: toml::Table = toml::from_str(&text).expect("the result is valid TOML");
+    assert_eq!(t["job"].as_str(), Some("reversal"));
+    let cost_toml = t["cost"].as_float().expect("cost");
+    let cost_json = num(&r, "/cost");
+    assert!(
+        (cost_toml - cost_json).abs() <= 1e-12 * cost_json.abs(),
+        "cost in TOML {cost_toml} vs JSON {cost_json}"
+    );
+    assert_eq!(
+        t["parameters"].as_array().map(Vec::len),
+        Some(params.len()),
+        "parameters in the TOML"
+    );
+
+    // The report figures.
+    for fig in [
+        "traces_tip",
+        "traces_head",
+        "psd_low",
+        "psd_high",
+        "friction_law",
+        "cost",
+    ] {
+        let p = root().join(format!("reports/reversal/{fig}.svg"));
+        assert_svg(&p);
+        assert_fresh(&p, started);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad input: exit code 2, one line naming the file (and line, column, field where there are any)
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn missing_job_file() {
+    let dir = TempDir::new("missing_job");
+    let job = dir.join("no_such_job.toml");
+    let o = wiperlab(&["fit", s(&job), "--quiet"]);
+    input_error(&o, &[s(&job), "cannot read"]);
+}
+
+#[test]
+fn job_with_toml_syntax_error() {
+    let dir = TempDir::new("syntax");
+    // An unterminated string on the `name` line.
+    let text = edit(&job_text(), "name = \"reversal\"", "name = \"reversal");
+    let job = dir.write("job.toml", &text);
+    let o = wiperlab(&["fit", s(&job), "--quiet"]);
+    let msg = input_error(&o, &[s(&job)]);
+    let (line, col) = line_col(&msg, &job);
+    assert_eq!(line, line_of(&text, "name = \"reversal"), "{msg}");
+    assert!(col >= 1, "{msg}");
+    assert!(!dir.join("reversal.result.toml").exists());
+}
+
+#[test]
+fn job_with_unknown_parameter() {
+    let dir = TempDir::new("unknown_param");
+    let text = edit(&job_text(), "C = [0.1, 1.0]", "C = [0.1, 1.0]\nZ = [0, 1]");
+    let job = dir.write("job.toml", &text);
+    let o = wiperlab(&["fit", s(&job), "--quiet"]);
+    let msg = input_error(&o, &[s(&job), "unknown parameter 'Z'"]);
+    let (line, _) = line_col(&msg, &job);
+    assert_eq!(line, line_of(&text, "Z = [0, 1]"), "{msg}");
+    assert!(!dir.join("reversal.result.toml").exists());
+}
+
+#[test]
+fn job_with_bounds_the_wrong_way_round() {
+    let dir = TempDir::new("bounds");
+    let text = edit(&job_text(), "k1 = [0.005, 0.15]", "k1 = [0.1, 0.01]");
+    let job = dir.write("job.toml", &text);
+    let o = wiperlab(&["fit", s(&job), "--quiet"]);
+    let msg = input_error(&o, &[s(&job), "'k1'", "lower < upper"]);
+    let (line, _) = line_col(&msg, &job);
+    assert_eq!(line, line_of(&text, "k1 = [0.1, 0.01]"), "{msg}");
+    assert!(!dir.join("reversal.result.toml").exists());
+}
+
+/// The first 20 lines of the sample DLTdv file with `abc` in line 5 (4th data row), column 3
+/// (`pt2_cam1_X`, header `pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y`).
+fn bad_dltdv(dir: &TempDir) -> PathBuf {
+    let text =
+        std::fs::read_to_string(root().join("data/reversal/wiper_reversal_sample_xypts.csv"))
+            .expect("read the sample DLTdv file");
+    let mut lines: Vec<String> = text.lines().take(20).map(str::to_string).collect();
+    assert_eq!(lines[0], "pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y");
+    let mut cells: Vec<&str> = lines[4].split(',').collect();
+    cells[2] = "abc";
+    lines[4] = cells.join(",");
+    dir.write("bad_xypts.csv", &(lines.join("\n") + "\n"))
+}
+
+#[test]
+fn job_with_non_number_in_the_recording() {
+    let dir = TempDir::new("bad_recording_job");
+    let csv = bad_dltdv(&dir);
+    let old = format!(
+        "file = \"{}\"",
+        root()
+            .join("data/reversal/wiper_reversal_sample_xypts.csv")
+            .display()
+    );
+    let text = edit(&job_text(), &old, &format!("file = \"{}\"", csv.display()));
+    let job = dir.write("job.toml", &text);
+    let o = wiperlab(&["fit", s(&job), "--quiet"]);
+    let msg = input_error(&o, &[":5:3:", "pt2_cam1_X", "\"abc\""]);
+    assert_eq!(line_col(&msg, &csv), (5, 3), "{msg}");
+    assert!(!dir.join("reversal.result.toml").exists());
+}
+
+#[test]
+fn import_with_non_number_in_the_recording() {
+    let dir = TempDir::new("bad_recording_import");
+    let csv = bad_dltdv(&dir);
+    let out = dir.join("t.csv");
+    let o = wiperlab(&[
+        "import",
+        s(&csv),
+        "--format",
+        "dltdv",
+        "--fps",
+        "10000",
+        "--m-per-px",
+        "1.5e-5",
+        "--origin-px",
+        "200,300",
+        "-o",
+        s(&out),
+    ]);
+    let msg = input_error(&o, &["pt2_cam1_X", "\"abc\""]);
+    assert_eq!(line_col(&msg, &csv), (5, 3), "{msg}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn import_missing_file() {
+    let dir = TempDir::new("import_missing");
+    let f = dir.join("no_such_xypts.csv");
+    let o = wiperlab(&["import", s(&f)]);
+    input_error(&o, &[s(&f)]);
+}
+
+#[test]
+fn simulate_negative_mass() {
+    let dir = TempDir::new("negative_mass");
+    let text = std::fs::read_to_string(root().join("data/reversal/blade_true.toml"))
+        .expect("read blade_true.toml");
+    let text = edit(&text, "head_mass_kg = 0.15\n", "head_mass_kg = -0.15\n");
+    let params = dir.write("blade.toml", &text);
+    let out_dir = dir.join("out");
+    let o = wiperlab(&["simulate", s(&params), "--out-dir", s(&out_dir)]);
+    // validate() runs after deserialisation, so this message names the file and the field but
+    // carries no line number.
+    input_error(&o, &[s(&params), "head_mass_kg", "-0.15"]);
+    assert!(!out_dir.exists(), "no outputs for rejected parameters");
+}
+
+#[test]
+fn simulate_window_needs_two_values() {
+    let dir = TempDir::new("window_one_value");
+    let out_dir = dir.join("out");
+    let o = wiperlab(&[
+        "simulate",
+        "data/reversal/blade_true.toml",
+        "--window",
+        "1.83",
+        "--out-dir",
+        s(&out_dir),
+    ]);
+    input_error(&o, &["--window", "T0,T1"]);
+}
+
+// ---------------------------------------------------------------------------------------------
+// simulate and import
+// ---------------------------------------------------------------------------------------------
+
+/// Rows of a CSV file after its header, split on commas.
+fn csv_rows(path: &Path) -> (String, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header = lines.next().unwrap_or_default().to_string();
+    let rows = lines
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn simulate_writes_outputs() {
+    let dir = TempDir::new("simulate");
+    let out = ok(
+        &wiperlab(&[
+            "simulate",
+            "data/reversal/blade_true.toml",
+            "--window",
+            "1.83,1.85",
+            "--out-dir",
+            s(&dir.0),
+        ]),
+        "simulate",
+    );
+
+    let (header, rows) = csv_rows(&dir.join("trace.csv"));
+    assert!(header.starts_with("t_s,head_x_m,"), "{header}");
+    let ncol = header.split(',').count();
+    // 0.02 s at the default 10 kHz: 201 samples.
+    assert!(rows.len() > 100 && rows.len() <= 201, "{} rows", rows.len());
+    for r in &rows {
+        assert_eq!(r.len(), ncol, "{r:?}");
+        assert!(
+            r.iter().all(|c| c.parse::<f64>().is_ok_and(f64::is_finite)),
+            "{r:?}"
+        );
+    }
+    let t: Vec<f64> = rows.iter().map(|r| r[0].parse().unwrap()).collect();
+    assert!((t[0] - 1.83).abs() < 1e-9 && *t.last().unwrap() <= 1.85 + 1e-9);
+    assert!(t.windows(2).all(|w| w[1] > w[0]));
+
+    let (header, rows) = csv_rows(&dir.join("transitions.csv"));
+    assert_eq!(header, "t_s,from,to");
+    assert!(rows.len() >= 2, "{} transitions", rows.len());
+    let phases = ["slip+", "slip-", "stick"];
+    for r in &rows {
+        assert_eq!(r.len(), 3, "{r:?}");
+        let t: f64 = r[0].parse().expect("transition time");
+        assert!((1.83..=1.85).contains(&t), "{r:?}");
+        assert!(
+            phases.contains(&r[1].as_str()) && phases.contains(&r[2].as_str()),
+            "{r:?}"
+        );
+        assert_ne!(r[1], r[2], "{r:?}");
+    }
+    for w in rows.windows(2) {
+        assert_eq!(w[0][2], w[1][1], "transitions must chain: {w:?}");
+    }
+    // The summary line counts the same transitions.
+    assert!(
+        out.contains(&format!("{} transitions", rows.len())),
+        "{out}"
+    );
+
+    for fig in ["tip_relative", "phase", "head_drop"] {
+        assert_svg(&dir.join(&format!("{fig}.svg")));
+    }
+}
+
+const SAMPLE_IMPORT: [&str; 13] = [
+    "import",
+    "data/reversal/wiper_reversal_sample_xypts.csv",
+    "--format",
+    "dltdv",
+    "--fps",
+    "10000",
+    "--m-per-px",
+    "1.5e-5",
+    "--origin-px",
+    "200,300",
+    "--head",
+    "pt1",
+    "--tip",
+];
+
+#[test]
+fn import_describe_and_convert() {
+    // truth.json /camera: 18869 frames (n_frames) at fps 10000; dropped frames per point listed in
+    // /camera/dropped with points "both", "head" or "tip".
+    let truth = truth();
+    let n_frames = num(&truth, "/camera/n_frames") as usize;
+    assert_eq!(n_frames, 18869);
+    let dropped = truth["camera"]["dropped"].as_array().expect("dropped");
+    let nan_of = |role: &str| {
+        dropped
+            .iter()
+            .filter(|d| d["points"] == "both" || d["points"] == role)
+            .count()
+    };
+
+    let dir = TempDir::new("import");
+    let out = dir.join("t.csv");
+    let mut args = SAMPLE_IMPORT.to_vec();
+    args.extend(["pt2", "-o", s(&out)]);
+    ok(&wiperlab(&args), "import");
+    let (header, rows) = csv_rows(&out);
+    assert_eq!(header, "t_s,head_x_m,head_y_m,tip_x_m,tip_y_m");
+    assert_eq!(rows.len(), n_frames);
+    // First data row of the xypts file: 200.204092,312.696557,106.569660,699.943223 (px), mapped
+    // with x = (X - 200)·1.5e-5, y = -(Y - 300)·1.5e-5 (y up, README "Camera and coordinates").
+    let first: Vec<f64> = rows[0].iter().map(|c| c.parse().unwrap()).collect();
+    let want = [
+        0.0,
+        (200.204092 - 200.0) * 1.5e-5,
+        -(312.696557 - 300.0) * 1.5e-5,
+        (106.569660 - 200.0) * 1.5e-5,
+        -(699.943223 - 300.0) * 1.5e-5,
+    ];
+    for (g, w) in first.iter().zip(want) {
+        assert!(
+            (g - w).abs() < 1e-12,
+            "first row {first:?}, expected {want:?}"
+        );
+    }
+    // Last frame at (18869 - 1)/10000 s.
+    let t_last: f64 = rows.last().unwrap()[0].parse().unwrap();
+    assert!((t_last - 1.8868).abs() < 1e-9, "{t_last}");
+    // Dropped points are empty or NaN cells: count them per role.
+    let missing = |col: usize| {
+        rows.iter()
+            .filter(|r| r[col].parse::<f64>().map_or(true, f64::is_nan))
+            .count()
+    };
+    assert_eq!(missing(1), nan_of("head"), "head NaN rows");
+    assert_eq!(missing(3), nan_of("tip"), "tip NaN rows");
+
+    let mut args = SAMPLE_IMPORT.to_vec();
+    args.extend(["pt2", "--describe"]);
+    let desc = ok(&wiperlab(&args), "import --describe");
+    assert!(desc.contains(&format!("{n_frames} frames")), "{desc}");
+    assert!(
+        desc.contains(&format!(
+            "head: {} tracked, {} NaN",
+            n_frames - nan_of("head"),
+            nan_of("head")
+        )),
+        "{desc}"
+    );
+    assert!(
+        desc.contains(&format!(
+            "tip: {} tracked, {} NaN",
+            n_frames - nan_of("tip"),
+            nan_of("tip")
+        )),
+        "{desc}"
+    );
+}
