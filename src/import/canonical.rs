@@ -14,7 +14,7 @@
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::import::quote_cell;
+use crate::import::{csv_error, quote_cell, record_line};
 use crate::trace::{PointTrack, Trace};
 
 /// Shortest round-trip text of `v`: plain decimal in [1e-4, 1e15), exponent form otherwise,
@@ -26,20 +26,6 @@ fn format_f64(v: f64) -> String {
         format!("{v}")
     } else {
         format!("{v:e}")
-    }
-}
-
-fn csv_error(path: &Path, action: &'static str, e: csv::Error) -> Error {
-    let line = e.position().map_or(0, |p| p.line() as usize);
-    match e.into_kind() {
-        csv::ErrorKind::Io(io) => Error::io(path, action, io),
-        csv::ErrorKind::Utf8 { err, .. } => Error::parse(
-            path,
-            line,
-            err.field() + 1,
-            format!("invalid UTF-8 in field {}", err.field() + 1),
-        ),
-        other => Error::parse(path, line, 0, format!("{other:?}")),
     }
 }
 
@@ -207,21 +193,7 @@ pub fn read_trace_csv(path: &Path) -> Result<Trace> {
     let mut t_s: Vec<f64> = Vec::new();
     for (row, record) in records.enumerate() {
         let record = record.map_err(|e| csv_error(path, "read", e))?;
-        let line = record
-            .position()
-            .map_or(header_line + 1 + row, |p| p.line() as usize);
-        if record.len() != names.len() {
-            return Err(Error::parse(
-                path,
-                line,
-                0,
-                format!(
-                    "expected {} fields like the header, found {}",
-                    names.len(),
-                    record.len()
-                ),
-            ));
-        }
+        let line = record_line(path, &record, header_line + 1 + row, names.len())?;
         let cell = |j: usize| -> Result<f64> {
             let text = record.get(j).unwrap_or("").trim();
             if text.is_empty() || text.eq_ignore_ascii_case("nan") {
@@ -277,21 +249,9 @@ pub fn read_trace_csv(path: &Path) -> Result<Trace> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::PathBuf;
 
-    struct Temp(PathBuf);
-    impl Temp {
-        fn path(name: &str) -> Temp {
-            Temp(std::env::temp_dir().join(format!(
-                "wiperlab_canonical_{}_{name}.csv",
-                std::process::id()
-            )))
-        }
-    }
-    impl Drop for Temp {
-        fn drop(&mut self) {
-            let _ = std::fs::remove_file(&self.0);
-        }
+    fn temp_path(name: &str) -> crate::import::TempFile {
+        crate::import::TempFile::at(&format!("canonical_{name}.csv"))
     }
 
     #[test]
@@ -344,7 +304,7 @@ mod tests {
                 },
             ],
         };
-        let f = Temp::path("rt");
+        let f = temp_path("rt");
         write_trace_csv(&f.0, &trace).unwrap();
         let text = std::fs::read_to_string(&f.0).unwrap();
         assert!(
@@ -367,7 +327,7 @@ mod tests {
 
     #[test]
     fn write_rejects_broken_traces() {
-        let f = Temp::path("broken");
+        let f = temp_path("broken");
         let trace = Trace {
             t_s: vec![0.0, 1.0],
             points: vec![PointTrack {
@@ -382,7 +342,7 @@ mod tests {
 
     #[test]
     fn read_errors_name_line_and_column() {
-        let f = Temp::path("errs");
+        let f = temp_path("errs");
         let cases = [
             (
                 "time,a_x_m,a_y_m\n0,1,2\n",

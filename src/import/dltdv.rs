@@ -16,7 +16,7 @@
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::import::{Format, ImportSpec, parse_finite, quote_cell};
+use crate::import::{Format, ImportSpec, csv_error, parse_finite, quote_cell, record_line};
 use crate::trace::{PointTrack, Trace};
 
 /// Which coordinate a DLTdv column holds.
@@ -51,20 +51,6 @@ struct PointColumns {
     point: usize,
     x: Option<usize>,
     y: Option<usize>,
-}
-
-fn csv_error(path: &Path, e: csv::Error) -> Error {
-    let line = e.position().map_or(0, |p| p.line() as usize);
-    match e.into_kind() {
-        csv::ErrorKind::Io(io) => Error::io(path, "read", io),
-        csv::ErrorKind::Utf8 { err, .. } => Error::parse(
-            path,
-            line,
-            err.field() + 1,
-            format!("invalid UTF-8 in field {}", err.field() + 1),
-        ),
-        other => Error::parse(path, line, 0, format!("{other:?}")),
-    }
 }
 
 /// Read a DLTdv `xypts.csv` into a [`Trace`] with points `pt1`, `pt2`, … in metres (y up unless
@@ -112,7 +98,7 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
     let mut records = reader.records();
 
     let header = match records.next() {
-        Some(r) => r.map_err(|e| csv_error(path, e))?,
+        Some(r) => r.map_err(|e| csv_error(path, "read", e))?,
         None => {
             return Err(Error::input(
                 path,
@@ -220,22 +206,8 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
     let mut ys: Vec<Vec<f64>> = vec![Vec::new(); columns.len()];
     let mut values = vec![f64::NAN; names.len()];
     for (row, record) in records.enumerate() {
-        let record = record.map_err(|e| csv_error(path, e))?;
-        let line = record
-            .position()
-            .map_or(header_line + 1 + row, |p| p.line() as usize);
-        if record.len() != names.len() {
-            return Err(Error::parse(
-                path,
-                line,
-                0,
-                format!(
-                    "expected {} fields like the header, found {}",
-                    names.len(),
-                    record.len()
-                ),
-            ));
-        }
+        let record = record.map_err(|e| csv_error(path, "read", e))?;
+        let line = record_line(path, &record, header_line + 1 + row, names.len())?;
         for (col, cell) in record.iter().enumerate() {
             let cell = cell.trim();
             values[col] = if cell.eq_ignore_ascii_case("nan") {
@@ -282,24 +254,9 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::PathBuf;
 
-    /// A temp file that removes itself; unique per test name and process.
-    struct Temp(PathBuf);
-    impl Temp {
-        fn new(name: &str, content: &str) -> Temp {
-            let path = std::env::temp_dir().join(format!(
-                "wiperlab_dltdv_{}_{name}_xypts.csv",
-                std::process::id()
-            ));
-            std::fs::write(&path, content).unwrap();
-            Temp(path)
-        }
-    }
-    impl Drop for Temp {
-        fn drop(&mut self) {
-            let _ = std::fs::remove_file(&self.0);
-        }
+    fn temp(name: &str, content: &str) -> crate::import::TempFile {
+        crate::import::TempFile::new(&format!("dltdv_{name}_xypts.csv"), content)
     }
 
     fn spec() -> ImportSpec {
@@ -328,7 +285,7 @@ mod tests {
 
     #[test]
     fn converts_pixels_frames_and_nan() {
-        let f = Temp::new(
+        let f = temp(
             "convert",
             "pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y\n\
              12.000000,16.000000,NaN,NaN\n\
@@ -346,7 +303,7 @@ mod tests {
 
     #[test]
     fn y_up_and_t0_and_second_camera() {
-        let f = Temp::new(
+        let f = temp(
             "cam2",
             "pt1_cam1_X,pt1_cam1_Y,pt1_cam2_X,pt1_cam2_Y\n1,2,30,40\n1,2,NaN,NaN\n1,2,31,41\n",
         );
@@ -375,7 +332,7 @@ mod tests {
 
     #[test]
     fn bad_number_names_line_column_and_field() {
-        let f = Temp::new(
+        let f = temp(
             "badnum",
             "pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y\n1,2,3,4\n1,2,abc,4\n",
         );
@@ -397,17 +354,17 @@ mod tests {
 
     #[test]
     fn empty_cell_and_inf_are_errors() {
-        let f = Temp::new("emptycell", "pt1_cam1_X,pt1_cam1_Y\n1,\n");
+        let f = temp("emptycell", "pt1_cam1_X,pt1_cam1_Y\n1,\n");
         let msg = read(&f.0, &spec()).unwrap_err().to_string();
         assert!(msg.contains(":2:2: field pt1_cam1_Y"), "{msg}");
-        let f = Temp::new("inf", "pt1_cam1_X,pt1_cam1_Y\nInf,1\n");
+        let f = temp("inf", "pt1_cam1_X,pt1_cam1_Y\nInf,1\n");
         let msg = read(&f.0, &spec()).unwrap_err().to_string();
         assert!(msg.contains(":2:1:"), "{msg}");
     }
 
     #[test]
     fn wrong_field_count_names_line() {
-        let f = Temp::new("count", "pt1_cam1_X,pt1_cam1_Y\n1,2\n1,2\n1,2,3\n");
+        let f = temp("count", "pt1_cam1_X,pt1_cam1_Y\n1,2\n1,2\n1,2,3\n");
         let err = read(&f.0, &spec()).unwrap_err();
         let msg = err.to_string();
         assert!(matches!(err, Error::Parse { line: 4, .. }), "{msg}");
@@ -419,23 +376,23 @@ mod tests {
 
     #[test]
     fn bad_header_and_empty_files() {
-        let f = Temp::new("hdr", "pt1_cam1_X,frame\n1,2\n");
+        let f = temp("hdr", "pt1_cam1_X,frame\n1,2\n");
         let msg = read(&f.0, &spec()).unwrap_err().to_string();
         assert!(msg.contains(":1:2: expected a DLTdv column name"), "{msg}");
-        let f = Temp::new("noy", "pt1_cam1_X\n1\n");
+        let f = temp("noy", "pt1_cam1_X\n1\n");
         let msg = read(&f.0, &spec()).unwrap_err().to_string();
         assert!(msg.contains("pt1_cam1_Y is missing"), "{msg}");
-        let f = Temp::new("empty", "");
+        let f = temp("empty", "");
         let msg = read(&f.0, &spec()).unwrap_err().to_string();
         assert!(msg.contains("empty file"), "{msg}");
-        let f = Temp::new("norows", "pt1_cam1_X,pt1_cam1_Y\n");
+        let f = temp("norows", "pt1_cam1_X,pt1_cam1_Y\n");
         let msg = read(&f.0, &spec()).unwrap_err().to_string();
         assert!(msg.contains("no data rows"), "{msg}");
     }
 
     #[test]
     fn crlf_and_bom_are_accepted() {
-        let f = Temp::new(
+        let f = temp(
             "crlf",
             "\u{feff}pt1_cam1_X,pt1_cam1_Y\r\n1,2\r\nNaN,NaN\r\n",
         );
@@ -446,7 +403,7 @@ mod tests {
 
     #[test]
     fn missing_fps_or_scale_is_named() {
-        let f = Temp::new("nofps", "pt1_cam1_X,pt1_cam1_Y\n1,2\n");
+        let f = temp("nofps", "pt1_cam1_X,pt1_cam1_Y\n1,2\n");
         let err = read(
             &f.0,
             &ImportSpec {

@@ -528,6 +528,73 @@ pub(crate) fn quote_cell(s: &str) -> String {
     }
 }
 
+/// Turns a `csv` crate error into ours: I/O errors name `action`, others give the line (and the
+/// field for invalid UTF-8).
+pub(crate) fn csv_error(path: &Path, action: &'static str, e: csv::Error) -> Error {
+    let line = e.position().map_or(0, |p| p.line() as usize);
+    match e.into_kind() {
+        csv::ErrorKind::Io(io) => Error::io(path, action, io),
+        csv::ErrorKind::Utf8 { err, .. } => Error::parse(
+            path,
+            line,
+            err.field() + 1,
+            format!("invalid UTF-8 in field {}", err.field() + 1),
+        ),
+        other => Error::parse(path, line, 0, format!("{other:?}")),
+    }
+}
+
+/// The 1-based file line of a data record (`fallback_line` when the reader does not know it),
+/// after checking that it has `n_fields` fields like the header.
+pub(crate) fn record_line(
+    path: &Path,
+    record: &csv::StringRecord,
+    fallback_line: usize,
+    n_fields: usize,
+) -> Result<usize> {
+    let line = record
+        .position()
+        .map_or(fallback_line, |p| p.line() as usize);
+    if record.len() != n_fields {
+        return Err(Error::parse(
+            path,
+            line,
+            0,
+            format!(
+                "expected {n_fields} fields like the header, found {}",
+                record.len()
+            ),
+        ));
+    }
+    Ok(line)
+}
+
+/// A file in the temp directory that removes itself, for the readers' unit tests.
+#[cfg(test)]
+pub(crate) struct TempFile(pub std::path::PathBuf);
+
+#[cfg(test)]
+impl TempFile {
+    /// `wiperlab_<pid>_<file_name>` in the temp directory, not yet written.
+    pub(crate) fn at(file_name: &str) -> TempFile {
+        TempFile(std::env::temp_dir().join(format!("wiperlab_{}_{file_name}", std::process::id())))
+    }
+
+    /// The same, written with `content`.
+    pub(crate) fn new(file_name: &str, content: &str) -> TempFile {
+        let f = TempFile::at(file_name);
+        std::fs::write(&f.0, content).expect("write temp file");
+        f
+    }
+}
+
+#[cfg(test)]
+impl Drop for TempFile {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -359,27 +359,13 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::PathBuf;
 
-    struct Temp(PathBuf);
-    impl Temp {
-        fn new(name: &str, content: &str) -> Temp {
-            let path = std::env::temp_dir().join(format!(
-                "wiperlab_tracker_{}_{name}.txt",
-                std::process::id()
-            ));
-            std::fs::write(&path, content).unwrap();
-            Temp(path)
-        }
-    }
-    impl Drop for Temp {
-        fn drop(&mut self) {
-            let _ = std::fs::remove_file(&self.0);
-        }
+    fn temp(name: &str, content: &str) -> crate::import::TempFile {
+        crate::import::TempFile::new(&format!("tracker_{name}.txt"), content)
     }
 
     fn read_str(name: &str, content: &str) -> Result<Trace> {
-        let f = Temp::new(name, content);
+        let f = temp(name, content);
         read(&f.0, &ImportSpec::default())
     }
 
@@ -466,7 +452,7 @@ mod tests {
 
     #[test]
     fn decimal_comma_semicolon() {
-        let f = Temp::new("comma", "t;x;y;\n0,0;1,5;\u{2212}2,25\n0,1;;\n");
+        let f = temp("comma", "t;x;y;\n0,0;1,5;\u{2212}2,25\n0,1;;\n");
         let spec = ImportSpec {
             decimal_comma: true,
             units_to_m: 0.01,
@@ -487,7 +473,7 @@ mod tests {
 
     #[test]
     fn decimal_comma_with_comma_delimiter_is_refused() {
-        let f = Temp::new("commacomma", "t,x,y\n0,1,2\n");
+        let f = temp("commacomma", "t,x,y\n0,1,2\n");
         let spec = ImportSpec {
             decimal_comma: true,
             ..ImportSpec::default()
@@ -563,7 +549,7 @@ mod tests {
 
     #[test]
     fn fps_is_a_check_only() {
-        let f = Temp::new("fps", "t\tx\ty\n0\t1\t2\n0.1\t1\t2\n0.2\t1\t2\n");
+        let f = temp("fps", "t\tx\ty\n0\t1\t2\n0.1\t1\t2\n0.2\t1\t2\n");
         let ok = ImportSpec {
             fps_hz: Some(10.0),
             y_down: Some(true),
