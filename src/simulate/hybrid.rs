@@ -433,11 +433,11 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
             stats.steps += 1;
             let t_new = if last { t_end } else { t + h };
             // Event detection: sample g at interior points and the end.
-            let mut found: Option<(usize, f64, f64, f64, f64)> = None; // (idx, ta, ga, tb, gb)
+            // Earliest located crossing in this step: (event function, time).
+            let mut found: Option<(usize, f64)> = None;
             let m = opts.event_samples;
             let mut ta = t;
             let mut ga = g_prev;
-            let mut g_end = g_prev;
             for j in 1..=m + 1 {
                 let tj = if j == m + 1 {
                     t_new
@@ -452,52 +452,36 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                 let (gj, _) = event_values(model, &mode, tj, &yj)
                     .map_err(|e| fail(tj, &yj, e.to_string()))?;
                 stats.event_evals += 1;
+                // Refine every function that crossed in [ta, tj]; keep the earliest. A function
+                // starting at exactly 0 (just after a transition) is armed by its first positive
+                // sample.
                 for k in 0..3 {
-                    if found.is_none() && ga[k] > 0.0 && gj[k] <= 0.0 {
-                        found = Some((k, ta, ga[k], tj, gj[k]));
+                    if ga[k] > 0.0 && gj[k] <= 0.0 {
+                        let dense = a.dense;
+                        let tk = illinois_right(
+                            |tt| {
+                                let yy = dense.eval(tt);
+                                event_values(model, &mode, tt, &yy).map(|(g, _)| g[k])
+                            },
+                            ta,
+                            tj,
+                            ga[k],
+                            gj[k],
+                        )
+                        .map_err(|e| fail(tj, &yj, e.to_string()))?;
+                        if found.is_none_or(|(_, te)| tk < te) {
+                            found = Some((k, tk));
+                        }
                     }
                 }
                 if found.is_some() {
-                    // Earliest crossing among functions: refine all that crossed in this sub-interval.
-                    let mut best = found.unwrap();
-                    let mut best_t = f64::INFINITY;
-                    for k in 0..3 {
-                        if ga[k] > 0.0 && gj[k] <= 0.0 {
-                            let dense = a.dense;
-                            let tk = illinois_right(
-                                |tt| {
-                                    let yy = dense.eval(tt);
-                                    event_values(model, &mode, tt, &yy).map(|(g, _)| g[k])
-                                },
-                                ta,
-                                tj,
-                                ga[k],
-                                gj[k],
-                            )
-                            .map_err(|e| fail(tj, &yj, e.to_string()))?;
-                            if tk < best_t {
-                                best_t = tk;
-                                best = (k, ta, ga[k], tk, 0.0);
-                            }
-                        }
-                    }
-                    found = Some(best);
                     break;
                 }
-                // Keep the last strictly positive value as the left bracket end (arming).
-                for k in 0..3 {
-                    if gj[k] > 0.0 || ga[k] <= 0.0 {
-                        ga[k] = gj[k];
-                    }
-                }
                 ta = tj;
-                g_end = gj;
+                ga = gj;
             }
             // Output samples up to the (possibly truncated) step end.
-            let t_stop = match found {
-                Some((_, _, _, te, _)) => te,
-                None => t_new,
-            };
+            let t_stop = found.map_or(t_new, |(_, te)| te);
             while next_out < out_times.len() && out_times[next_out] <= t_stop {
                 let to = out_times[next_out];
                 let mut yo = if to == t_new && found.is_none() {
@@ -518,10 +502,10 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                     t = t_new;
                     y = a.y_new;
                     f = a.f_new;
-                    g_prev = g_end;
+                    g_prev = ga;
                     h = rk::next_step(h, a.err);
                 }
-                Some((k, _, _, te, _)) => {
+                Some((k, te)) => {
                     let mut ye = if te >= t_new {
                         a.y_new
                     } else {
