@@ -183,14 +183,6 @@ impl SpectralProblem {
     }
 }
 
-impl CostFunction for SpectralProblem {
-    type Param = Vec<f64>;
-    type Output = f64;
-    fn cost(&self, u: &Self::Param) -> std::result::Result<f64, argmin::core::Error> {
-        Ok(self.cost_at(u))
-    }
-}
-
 /// Best cost after each iteration of each stage.
 #[derive(Debug, Clone, Serialize)]
 pub struct HistoryPoint {
@@ -295,6 +287,7 @@ pub struct FitOutcome {
     pub signal: SignalKind,
 }
 
+/// The problem as argmin sees it: shared by the swarm's threads and both stages.
 #[derive(Clone)]
 struct Shared(Arc<SpectralProblem>);
 
@@ -471,7 +464,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     if let Some(pb) = &pb {
         pb.set_message("curvature");
     }
-    let (cost0, sigma_u, corr) = curvature(&problem, &best_u);
+    let (sigma_u, corr) = curvature(&problem, &best_u);
 
     if let Some(pb) = &pb {
         pb.finish_and_clear();
@@ -480,7 +473,6 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let best_sim = problem.simulate(&best_params)?;
     let model = problem.model_features(&best_sim)?;
     let cost = problem.cost_of(&model);
-    debug_assert!(cost.is_finite() && cost0.is_finite());
 
     let parameters: Vec<FittedParam> = free
         .iter()
@@ -566,9 +558,9 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
 }
 
 /// Finite-difference curvature of the cost at `u0` (step 0.03 in normalised units, stencil kept
-/// inside the box). Returns the cost at `u0`, the 1σ half-widths in normalised units from the
+/// inside the box). Returns the 1σ half-widths in normalised units from the
 /// covariance `2 H⁻¹` (cost read as χ²), and the correlation matrix.
-fn curvature(problem: &SpectralProblem, u0: &[f64]) -> (f64, Vec<f64>, Vec<Vec<f64>>) {
+fn curvature(problem: &SpectralProblem, u0: &[f64]) -> (Vec<f64>, Vec<Vec<f64>>) {
     use rayon::prelude::*;
     let n = u0.len();
     let d = 0.03;
@@ -617,7 +609,7 @@ fn curvature(problem: &SpectralProblem, u0: &[f64]) -> (f64, Vec<f64>, Vec<Vec<f
             let corr = (0..n)
                 .map(|i| (0..n).map(|j| cov[(i, j)] / (sig[i] * sig[j])).collect())
                 .collect();
-            (f0, sig, corr)
+            (sig, corr)
         }
         None => {
             let sig = (0..n)
@@ -629,7 +621,7 @@ fn curvature(problem: &SpectralProblem, u0: &[f64]) -> (f64, Vec<f64>, Vec<Vec<f
                     }
                 })
                 .collect();
-            (f0, sig, vec![vec![f64::NAN; n]; n])
+            (sig, vec![vec![f64::NAN; n]; n])
         }
     }
 }
