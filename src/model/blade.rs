@@ -79,6 +79,27 @@ pub struct BladeParams {
     pub drive_a_m: f64,
     /// Drive angular frequency ω, rad/s.
     pub drive_omega_rad_per_s: f64,
+    /// Optional shoulder contact: past a contact angle the neck bears on the blade's shoulder and
+    /// stiffens (absent: a single neck stiffness `k1`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shoulder: Option<Shoulder>,
+}
+
+/// Piecewise neck stiffness from shoulder contact (seed: the measured ~900 Hz component lies far
+/// above the free neck's 195 Hz "because the neck touches the shoulder"; physics.md §2.3 point 2,
+/// "a bilinear k1(θ) … is the physically motivated extension").
+///
+/// The neck moment is `k1·θ` for `|θ| ≤ θ_c` and `sign θ·[k1·θ_c + k1_contact·(|θ| − θ_c)]` beyond:
+/// continuous in θ, with a kink in stiffness at `|θ| = θ_c`, located exactly as a switching event by
+/// the integrator ([`crate::simulate::hybrid::StickSlipModel::switching_surfaces`]). The shoulder is
+/// symmetric (one on each side of the neck), since the blade leans either way around a reversal.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Shoulder {
+    /// Neck angle at which the neck touches the shoulder, θ_c > 0, rad.
+    pub contact_angle_rad: f64,
+    /// Neck stiffness while touching, N·m/rad (the free stiffness is `k1_nm_per_rad`).
+    pub k1_contact_nm_per_rad: f64,
 }
 
 /// The mass coefficients of eqs. (1)–(3) (dimensional; see the module docs).
@@ -123,6 +144,27 @@ impl BladeParams {
         (self.k1_nm_per_rad / self.mass_coefficients().mth).sqrt() / std::f64::consts::TAU
     }
 
+    /// Neck moment `k1(θ)·θ` on the branch `touching` (the shoulder's, if any, when true), N·m.
+    /// Each branch's formula is used beyond its own range too (the integrator freezes the branch
+    /// within a step).
+    #[inline]
+    pub fn neck_moment_nm(&self, theta: f64, touching: bool) -> f64 {
+        match self.shoulder {
+            Some(sh) if touching => {
+                let c = sh.contact_angle_rad;
+                theta.signum()
+                    * (self.k1_nm_per_rad * c + sh.k1_contact_nm_per_rad * (theta.abs() - c))
+            }
+            _ => self.k1_nm_per_rad * theta,
+        }
+    }
+
+    /// Whether the neck touches the shoulder at angle θ (`|θ| > θ_c`).
+    pub fn touches_shoulder(&self, theta: f64) -> bool {
+        self.shoulder
+            .is_some_and(|sh| theta.abs() > sh.contact_angle_rad)
+    }
+
     /// Static preload N0 = k0·h_d, N.
     pub fn preload_n(&self) -> f64 {
         self.k0_n_per_m * self.hd_m
@@ -155,6 +197,20 @@ impl BladeParams {
                 return Err(format!(
                     "blade parameter {name} = {v} must be finite and {}",
                     if strictly { "> 0" } else { ">= 0" }
+                ));
+            }
+        }
+        if let Some(sh) = self.shoulder {
+            if !(sh.contact_angle_rad.is_finite() && sh.contact_angle_rad > 0.0) {
+                return Err(format!(
+                    "blade parameter shoulder.contact_angle_rad = {} must be finite and > 0",
+                    sh.contact_angle_rad
+                ));
+            }
+            if !(sh.k1_contact_nm_per_rad.is_finite() && sh.k1_contact_nm_per_rad > 0.0) {
+                return Err(format!(
+                    "blade parameter shoulder.k1_contact_nm_per_rad = {} must be finite and > 0",
+                    sh.k1_contact_nm_per_rad
                 ));
             }
         }
@@ -241,7 +297,12 @@ impl Blade {
     /// Rows (1)–(3) of the equations of motion as `A·[θ̈, φ̈, N]ᵀ + a_f·f = b`; returns
     /// `(A, a_f, b)` with `a_f` the coefficients of the friction force.
     #[inline]
-    fn rows(&self, t: f64, y: &[f64; 4]) -> (Matrix3<f64>, Vector3<f64>, Vector3<f64>) {
+    fn rows(
+        &self,
+        t: f64,
+        y: &[f64; 4],
+        touching: bool,
+    ) -> (Matrix3<f64>, Vector3<f64>, Vector3<f64>) {
         let p = &self.params;
         let m = &self.mc;
         let (l1, l2) = (p.l1_m, p.l2_m);
@@ -262,7 +323,7 @@ impl Blade {
             + m.ma * vdd * cth
             - p.k2_nm_per_rad * (ph - th)
             - p.c2_nms_per_rad * (phd - thd)
-            + p.k1_nm_per_rad * th
+            + p.neck_moment_nm(th, touching)
             + p.c1_nms_per_rad * thd;
         let a21 = m.mc * cd - m.mb * l1 * sth * sph;
         let a22 = m.mph - m.mb * l2 * sph * sph;
@@ -297,7 +358,18 @@ impl Blade {
     /// the opposite sign to the frictionless one (a Painlevé-type inconsistency: no unique slip
     /// solution).
     pub fn slip_dynamics(&self, s: f64, t: f64, y: &[f64; 4]) -> Result<Dynamics, ModelFault> {
-        let (a0, af, b) = self.rows(t, y);
+        self.slip_dynamics_on(s, t, y, self.params.touches_shoulder(y[0]))
+    }
+
+    /// [`Blade::slip_dynamics`] on a given shoulder branch (`touching`).
+    pub fn slip_dynamics_on(
+        &self,
+        s: f64,
+        t: f64,
+        y: &[f64; 4],
+        touching: bool,
+    ) -> Result<Dynamics, ModelFault> {
+        let (a0, af, b) = self.rows(t, y, touching);
         let mu = self.params.friction.mu_slip(self.tip_velocity(t, y));
         // f = −s μ N: fold into the N column.
         let mut a = a0;
@@ -334,7 +406,19 @@ impl Blade {
         anchor: f64,
         omega_b: f64,
     ) -> Result<Dynamics, ModelFault> {
-        let (a3, af, b3) = self.rows(t, y);
+        self.stick_dynamics_on(t, y, anchor, omega_b, self.params.touches_shoulder(y[0]))
+    }
+
+    /// [`Blade::stick_dynamics`] on a given shoulder branch (`touching`).
+    pub fn stick_dynamics_on(
+        &self,
+        t: f64,
+        y: &[f64; 4],
+        anchor: f64,
+        omega_b: f64,
+        touching: bool,
+    ) -> Result<Dynamics, ModelFault> {
+        let (a3, af, b3) = self.rows(t, y, touching);
         let (l1, l2) = (self.params.l1_m, self.params.l2_m);
         let (sth, cth) = y[0].sin_cos();
         let (sph, cph) = y[1].sin_cos();
@@ -456,14 +540,15 @@ impl StickSlipModel<4> for Blade {
         y: &[f64; 4],
         dy: &mut [f64; 4],
     ) -> Result<Contact, ModelFault> {
+        let touching = mode.region & 1 != 0;
         let d = match (mode.phase, self.stick_form) {
             (Phase::Stick, StickForm::Baumgarte { omega_b_per_s }) => {
-                self.stick_dynamics(t, y, mode.anchor, omega_b_per_s)?
+                self.stick_dynamics_on(t, y, mode.anchor, omega_b_per_s, touching)?
             }
             (Phase::Stick, StickForm::Reduced) => {
                 let (phi, phi_d) = self.constrained_lip(t, y[0], y[2], mode.anchor)?;
                 let yc = [y[0], phi, y[2], phi_d];
-                let d = self.stick_dynamics(t, &yc, mode.anchor, 0.0)?;
+                let d = self.stick_dynamics_on(t, &yc, mode.anchor, 0.0, touching)?;
                 dy[0] = y[2];
                 dy[1] = 0.0;
                 dy[2] = d.theta_dd;
@@ -474,7 +559,7 @@ impl StickSlipModel<4> for Blade {
                     limit: self.mu_s * d.normal_n,
                 });
             }
-            (phase, _) => self.slip_dynamics(phase.slip_dir().unwrap_or(1.0), t, y)?,
+            (phase, _) => self.slip_dynamics_on(phase.slip_dir().unwrap_or(1.0), t, y, touching)?,
         };
         dy[0] = y[2];
         dy[1] = y[3];
@@ -510,6 +595,19 @@ impl StickSlipModel<4> for Blade {
             y[3] = phi_d;
         }
         Ok(())
+    }
+
+    fn switching_surfaces(&self) -> usize {
+        usize::from(self.params.shoulder.is_some())
+    }
+
+    /// `|θ| − θ_c`: positive while the neck touches the shoulder.
+    #[inline]
+    fn switching_function(&self, _i: usize, _t: f64, y: &[f64; 4]) -> f64 {
+        match self.params.shoulder {
+            Some(sh) => y[0].abs() - sh.contact_angle_rad,
+            None => 0.0,
+        }
     }
 
     fn describe(&self, t: f64, y: &[f64; 4]) -> String {

@@ -1,6 +1,6 @@
 //! Simulating the blade over a drive window, sampled at given (camera) times.
 
-use super::hybrid::{Mode, Phase, SolverOptions, Stats, Transition, integrate};
+use super::hybrid::{Mode, Phase, SolverOptions, Stats, Switch, Transition, integrate};
 use crate::model::blade::{Blade, BladeParams, StickForm};
 use crate::trace::{PointTrack, Trace};
 use crate::{Error, Result};
@@ -20,6 +20,8 @@ pub struct BladeSimulation {
     pub phi_rad: Vec<f64>,
     pub phase: Vec<Phase>,
     pub transitions: Vec<Transition>,
+    /// Crossings of the shoulder-contact angle (empty without a shoulder).
+    pub switches: Vec<Switch>,
     pub stats: Stats,
     /// Tip link length l1 + l2 (the tip's height below the upright head), m.
     pub reach_m: f64,
@@ -84,18 +86,7 @@ pub fn simulate_blade(
     } else {
         Phase::SlipNeg
     };
-    let run = integrate(
-        &blade,
-        t0,
-        y0,
-        Mode {
-            phase: s0,
-            anchor: 0.0,
-        },
-        t1,
-        sample_times,
-        opts,
-    )?;
+    let run = integrate(&blade, t0, y0, Mode::new(s0, 0.0), t1, sample_times, opts)?;
     let n = run.t_s.len();
     let mut sim = BladeSimulation {
         t_s: run.t_s,
@@ -106,6 +97,7 @@ pub fn simulate_blade(
         phi_rad: Vec::with_capacity(n),
         phase: run.phase,
         transitions: run.transitions,
+        switches: run.switches,
         stats: run.stats,
         reach_m: params.l1_m + params.l2_m,
     };
