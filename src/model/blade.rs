@@ -622,3 +622,211 @@ impl StickSlipModel<4> for Blade {
         )
     }
 }
+
+/// The 1-DOF head model: the neck and lip locked into one rigid link (φ ≡ θ, length l1 + l2),
+/// hinged at the head on the neck spring `k1`, tip on the glass; the head moves vertically on its
+/// spring `k0`, driven through the tip friction. It keeps the head's low mode and drops the
+/// neck–lip mode, so it explains a low band only (and integrates with far larger steps).
+///
+/// Equations: the principle of virtual work with δφ = δθ, i.e. the sum of rows (1) and (2) of the
+/// full model at φ = θ, φ̈ = θ̈ (the lip spring k2 and damper c2 carry no load), plus row (3) for N.
+/// Slip solves `[θ̈, N]` (2×2, with the same Painlevé check as the full model); stick is kinematic:
+/// θ = arcsin((v3* − v)/(l1 + l2)) and N, f follow from the two rows.
+///
+/// The state keeps the full model's layout `[θ, φ, θ̇, φ̇]` with φ = θ, φ̇ = θ̇, so the same simulator
+/// and observables serve both.
+#[derive(Debug, Clone, Copy)]
+pub struct LockedBlade {
+    pub blade: Blade,
+}
+
+impl LockedBlade {
+    /// The locked-link model of `params`.
+    pub fn new(params: BladeParams) -> Self {
+        LockedBlade {
+            blade: Blade::new(params, StickForm::Reduced),
+        }
+    }
+
+    fn reach(&self) -> f64 {
+        self.blade.params.l1_m + self.blade.params.l2_m
+    }
+
+    /// `[θ̈, N, f]` in slip direction `s`, or with `stick_anchor` the stick forces.
+    fn dynamics(
+        &self,
+        t: f64,
+        th: f64,
+        thd: f64,
+        slip: Option<f64>,
+        touching: bool,
+    ) -> Result<Dynamics, ModelFault> {
+        let y = [th, th, thd, thd];
+        let (a, af, b) = self.blade.rows(t, &y, touching);
+        // Generalised coordinate θ: sum rows 1 and 2 (virtual work with δφ = δθ).
+        let s_th = a[(0, 0)] + a[(0, 1)] + a[(1, 0)] + a[(1, 1)];
+        let s_n = a[(0, 2)] + a[(1, 2)];
+        let s_f = af[0] + af[1];
+        let s_b = b[0] + b[1];
+        let (n_th, n_b) = (a[(2, 0)] + a[(2, 1)], b[2]);
+        match slip {
+            Some(s) => {
+                let mu = self
+                    .blade
+                    .params
+                    .friction
+                    .mu_slip(self.slip_velocity_of(t, th, thd));
+                // [s_th, s_n − s μ s_f; n_th, 1] [θ̈, N] = [s_b, n_b]
+                let c = s_n - s * mu * s_f;
+                let det0 = s_th - s_n * n_th;
+                let det = s_th - c * n_th;
+                if det * det0 <= 0.0 || det.abs() < 1e-9 * det0.abs() {
+                    return Err(ModelFault::Singular(format!(
+                        "locked-link slip equations singular (Painlevé-type): det with friction {det:.3e}, frictionless {det0:.3e}, μ = {mu:.4}"
+                    )));
+                }
+                let thdd = (s_b - c * n_b) / det;
+                let n = n_b - n_th * thdd;
+                Ok(Dynamics {
+                    theta_dd: thdd,
+                    phi_dd: thdd,
+                    normal_n: n,
+                    friction_n: -s * mu * n,
+                })
+            }
+            None => {
+                let l = self.reach();
+                let (st, ct) = th.sin_cos();
+                let (_, _, vdd) = self.blade.drive(t);
+                let thdd = (-vdd + l * st * thd * thd) / (l * ct);
+                let n = n_b - n_th * thdd;
+                let f = (s_b - s_th * thdd - s_n * n) / s_f;
+                Ok(Dynamics {
+                    theta_dd: thdd,
+                    phi_dd: thdd,
+                    normal_n: n,
+                    friction_n: f,
+                })
+            }
+        }
+    }
+
+    fn slip_velocity_of(&self, t: f64, th: f64, thd: f64) -> f64 {
+        self.blade.drive(t).1 + self.reach() * th.cos() * thd
+    }
+
+    /// Link angle and rate that hold the tip at `anchor` at time `t`.
+    fn stuck_angle(&self, t: f64, anchor: f64) -> Result<(f64, f64), ModelFault> {
+        let l = self.reach();
+        let (v, vd, _) = self.blade.drive(t);
+        let arg = (anchor - v) / l;
+        if arg.abs() >= 1.0 {
+            return Err(ModelFault::Geometry(format!(
+                "stick constraint has no link angle: sin θ = {arg:.6} (the head moved beyond the link's reach)"
+            )));
+        }
+        let th = arg.asin();
+        Ok((th, -vd / (l * th.cos())))
+    }
+
+    /// Quasi-static slip equilibrium at `t` (θ̇ = 0, θ̈ = 0), by Newton's method on θ̈.
+    pub fn slip_equilibrium(&self, t: f64) -> Result<[f64; 4], ModelFault> {
+        let (_, vd, _) = self.blade.drive(t);
+        let s = if vd >= 0.0 { 1.0 } else { -1.0 };
+        let touching = |th: f64| self.blade.params.touches_shoulder(th);
+        let acc = |th: f64| -> Result<f64, ModelFault> {
+            Ok(self.dynamics(t, th, 0.0, Some(s), touching(th))?.theta_dd)
+        };
+        let mut th = 0.0f64;
+        for _ in 0..200 {
+            let f0 = acc(th)?;
+            let e = 1e-7;
+            let d = (acc(th + e)? - f0) / e;
+            if d == 0.0 || !d.is_finite() {
+                break;
+            }
+            let dx = (-f0 / d).clamp(-0.2, 0.2);
+            th += dx;
+            if dx.abs() < 1e-15 {
+                break;
+            }
+        }
+        let f = acc(th)?;
+        let scale = self.blade.params.k1_nm_per_rad / self.blade.mc.mth;
+        if !(f.abs() < 1e-8 * scale) {
+            return Err(ModelFault::Geometry(format!(
+                "no quasi-static slip equilibrium of the locked link at t = {t} s (residual {f:.3e} rad/s²)"
+            )));
+        }
+        Ok([th, th, 0.0, 0.0])
+    }
+}
+
+impl StickSlipModel<4> for LockedBlade {
+    fn rhs(
+        &self,
+        mode: &Mode,
+        t: f64,
+        y: &[f64; 4],
+        dy: &mut [f64; 4],
+    ) -> Result<Contact, ModelFault> {
+        let touching = mode.region & 1 != 0;
+        let (th, thd) = match mode.phase {
+            Phase::Stick => self.stuck_angle(t, mode.anchor)?,
+            _ => (y[0], y[2]),
+        };
+        let d = self.dynamics(t, th, thd, mode.phase.slip_dir(), touching)?;
+        if mode.phase == Phase::Stick {
+            *dy = [0.0; 4];
+        } else {
+            *dy = [thd, thd, d.theta_dd, d.theta_dd];
+        }
+        Ok(Contact {
+            normal: d.normal_n,
+            friction: d.friction_n,
+            limit: self.blade.mu_s * d.normal_n,
+        })
+    }
+
+    fn slip_velocity(&self, t: f64, y: &[f64; 4]) -> f64 {
+        self.slip_velocity_of(t, y[0], y[2])
+    }
+
+    fn contact_position(&self, t: f64, y: &[f64; 4]) -> f64 {
+        self.blade.drive(t).0 + self.reach() * y[0].sin()
+    }
+
+    fn enter_stick(&self, t: f64, y: &mut [f64; 4], _anchor: f64) {
+        let (_, vd, _) = self.blade.drive(t);
+        let thd = -vd / (self.reach() * y[0].cos());
+        y[1] = y[0];
+        y[2] = thd;
+        y[3] = thd;
+    }
+
+    fn complete(&self, mode: &Mode, t: f64, y: &mut [f64; 4]) -> Result<(), ModelFault> {
+        if mode.phase == Phase::Stick {
+            let (th, thd) = self.stuck_angle(t, mode.anchor)?;
+            *y = [th, th, thd, thd];
+        }
+        Ok(())
+    }
+
+    fn switching_surfaces(&self) -> usize {
+        self.blade.switching_surfaces()
+    }
+
+    fn switching_function(&self, i: usize, t: f64, y: &[f64; 4]) -> f64 {
+        self.blade.switching_function(i, t, y)
+    }
+
+    fn describe(&self, t: f64, y: &[f64; 4]) -> String {
+        format!(
+            "locked link: θ = φ = {:.6e} rad, θ̇ = {:.6e} rad/s, v3 = {:.9e} m, v̇3 = {:.6e} m/s",
+            y[0],
+            y[2],
+            self.contact_position(t, y),
+            self.slip_velocity(t, y)
+        )
+    }
+}
