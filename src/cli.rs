@@ -321,8 +321,7 @@ pub fn run(cli: Cli) -> Result<()> {
             let outcome = crate::fit::run_fit(&loaded, !quiet && !json)?;
             let fits_dir = job.parent().unwrap_or(Path::new("."));
             let result_path = fits_dir.join(format!("{}.result.toml", loaded.name));
-            let toml_text = toml::to_string_pretty(&outcome.result)
-                .map_err(|e| Error::Numerics(format!("cannot serialise the result: {e}")))?;
+            let toml_text = outcome.result.to_toml()?;
             std::fs::write(&result_path, toml_text)
                 .map_err(|e| Error::io(&result_path, "cannot write", e))?;
             let report_dir = Path::new("reports").join(&loaded.name);
