@@ -110,6 +110,17 @@ pub enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Write the report page reports/<job>/index.html from fits/<job>.result.toml (fitting first
+    /// if the result is missing).
+    Report {
+        job: PathBuf,
+        /// Run the fit again even if the result file exists.
+        #[arg(long)]
+        refit: bool,
+        /// No progress bar when fitting.
+        #[arg(long)]
+        quiet: bool,
+    },
 }
 
 fn import_spec(a: &ImportArgs) -> Result<ImportSpec> {
@@ -163,6 +174,35 @@ fn stem(p: &Path) -> String {
     p.file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "out".into())
+}
+
+/// `<job dir>/<name>.result.toml`.
+fn result_path(job: &LoadedJob) -> PathBuf {
+    job.path
+        .parent()
+        .unwrap_or(Path::new("."))
+        .join(format!("{}.result.toml", job.name))
+}
+
+/// `reports/<name>/` (relative to the working directory).
+fn report_dir(job: &LoadedJob) -> PathBuf {
+    Path::new("reports").join(&job.name)
+}
+
+/// Runs the fit, writes the result TOML and the fit's figures; returns the result and both paths.
+fn fit_and_write(
+    job: &LoadedJob,
+    progress: bool,
+) -> Result<(crate::fit::FitResult, PathBuf, PathBuf)> {
+    let outcome = crate::fit::run_fit(job, progress)?;
+    let result_path = result_path(job);
+    let toml_text = outcome.result.to_toml()?;
+    std::fs::write(&result_path, toml_text)
+        .map_err(|e| Error::io(&result_path, "cannot write", e))?;
+    let report_dir = report_dir(job);
+    create_dir(&report_dir)?;
+    crate::report::figures::fit_figures(&report_dir, &outcome)?;
+    Ok((outcome.result, result_path, report_dir))
 }
 
 /// Runs the parsed command.
@@ -327,30 +367,56 @@ pub fn run(cli: Cli) -> Result<()> {
         }
         Command::Fit { job, json, quiet } => {
             let loaded = LoadedJob::load(&job)?;
-            let outcome = crate::fit::run_fit(&loaded, !quiet && !json)?;
-            let fits_dir = job.parent().unwrap_or(Path::new("."));
-            let result_path = fits_dir.join(format!("{}.result.toml", loaded.name));
-            let toml_text = toml::to_string_pretty(&outcome.result)
-                .map_err(|e| Error::Numerics(format!("cannot serialise the result: {e}")))?;
-            std::fs::write(&result_path, toml_text)
-                .map_err(|e| Error::io(&result_path, "cannot write", e))?;
-            let report_dir = Path::new("reports").join(&loaded.name);
-            create_dir(&report_dir)?;
-            crate::report::figures::fit_figures(&report_dir, &outcome)?;
+            let (result, result_path, report_dir) = fit_and_write(&loaded, !quiet && !json)?;
             if json {
                 println!(
                     "{}",
-                    serde_json::to_string(&outcome.result)
-                        .map_err(|e| Error::Numerics(e.to_string()))?
+                    serde_json::to_string(&result).map_err(|e| Error::Numerics(e.to_string()))?
                 );
             } else {
-                print!("{}", crate::report::figures::fit_summary(&outcome.result));
+                print!("{}", crate::report::figures::fit_summary(&result));
                 println!(
                     "wrote {} and figures in {}",
                     result_path.display(),
                     report_dir.display()
                 );
+                println!(
+                    "report page: `wiperlab report {}` writes {}",
+                    job.display(),
+                    report_dir.join(crate::report::html::INDEX).display()
+                );
             }
+            Ok(())
+        }
+        Command::Report { job, refit, quiet } => {
+            let loaded = LoadedJob::load(&job)?;
+            let result_path = result_path(&loaded);
+            let report_dir = report_dir(&loaded);
+            let result = if refit || !result_path.exists() {
+                if !refit {
+                    eprintln!("{} not found: running the fit first", result_path.display());
+                }
+                fit_and_write(&loaded, !quiet)?.0
+            } else {
+                crate::fit::FitResult::read(&result_path)?
+            };
+            let summary = crate::report::html::write_report(
+                &result,
+                &crate::report::html::ReportPaths {
+                    job: job.clone(),
+                    result: result_path,
+                    recording: loaded.recording_path.clone(),
+                    dir: report_dir,
+                },
+            )?;
+            for w in &summary.warnings {
+                eprintln!("warning: {w}");
+            }
+            println!(
+                "wrote {} ({} figures); open it in a browser",
+                summary.path.display(),
+                summary.figures.len()
+            );
             Ok(())
         }
     }

@@ -12,6 +12,9 @@
 
 pub mod features;
 pub mod job;
+pub mod result;
+
+pub use result::{FitResult, FittedParam, HistoryPoint, Interval, ModelTrial, PeakComparison};
 
 use crate::model::BladeParams;
 use crate::model::blade::StickForm;
@@ -183,15 +186,6 @@ impl SpectralProblem {
     }
 }
 
-/// Best cost after each iteration of each stage.
-#[derive(Debug, Clone, Serialize)]
-pub struct HistoryPoint {
-    pub stage: String,
-    pub iteration: u64,
-    pub best_cost: f64,
-    pub evaluations: usize,
-}
-
 struct HistoryObserver {
     stage: &'static str,
     log: Arc<Mutex<Vec<HistoryPoint>>>,
@@ -215,64 +209,6 @@ impl<I: State<Float = f64>> Observe<I> for HistoryObserver {
             });
         Ok(())
     }
-}
-
-/// A fitted parameter with its uncertainty and, for synthetic data, the truth.
-#[derive(Debug, Clone, Serialize)]
-pub struct FittedParam {
-    pub name: String,
-    pub value: f64,
-    pub lower: f64,
-    pub upper: f64,
-    /// 1σ from the cost's curvature (cost read as χ² with the module's scales); indicative.
-    pub std_error: f64,
-    /// False when the data do not pin the parameter down (1σ wider than 10 % of its search range,
-    /// or no positive curvature).
-    pub determined: bool,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub true_value: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub rel_error: Option<f64>,
-}
-
-/// Measured against model peak in one band.
-#[derive(Debug, Clone, Serialize)]
-pub struct PeakComparison {
-    pub band: String,
-    pub measured_hz: f64,
-    pub model_hz: f64,
-    /// (model − measured)/measured.
-    pub rel_diff: f64,
-    pub measured_level: f64,
-    pub model_level: f64,
-}
-
-/// Everything a fit reports; written as `fits/<job>.result.toml` and, with `--json`, to stdout.
-#[derive(Debug, Clone, Serialize)]
-pub struct FitResult {
-    pub job: String,
-    pub recording: String,
-    pub wiperlab_version: String,
-    pub cost: f64,
-    pub parameters: Vec<FittedParam>,
-    pub peaks: Vec<PeakComparison>,
-    /// Names of parameters the data leave undetermined.
-    pub undetermined: Vec<String>,
-    /// Correlation matrix of the freed parameters (row-major, order of `parameters`); NaN where the
-    /// curvature matrix is not positive definite.
-    pub correlation: Vec<Vec<f64>>,
-    pub swarm_iterations: u64,
-    pub polish_iterations: u64,
-    pub model_evaluations: usize,
-    pub failed_evaluations: usize,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub first_failure: Option<String>,
-    pub wall_time_s: f64,
-    pub threads: usize,
-    pub solver_rtol: f64,
-    pub solver_atol: f64,
-    pub transitions_in_best_model: usize,
-    pub history: Vec<HistoryPoint>,
 }
 
 /// The result plus what the report draws.
@@ -328,6 +264,11 @@ fn sampling_rate(trace: &Trace, fps: Option<f64>) -> Result<f64> {
 /// `progress`: show a progress bar on stderr (hidden automatically when stderr is not a terminal).
 pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let started = std::time::Instant::now();
+    // Provenance: the recording's hash and the effective settings (job with defaults filled in).
+    let input_sha256 = result::sha256_file(&job.recording_path)?;
+    let settings = toml::to_string_pretty(&job.job)
+        .or_else(|_| job::read_text(&job.path))
+        .unwrap_or_default();
     let spec = &job.job.recording.import;
     let trace = crate::import::read_trace(&job.recording_path, spec)?;
     let fs_hz = sampling_rate(&trace, spec.fps_hz)?;
@@ -490,6 +431,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
                 determined: su.is_finite() && *su < 0.1,
                 true_value: truth,
                 rel_error: truth.map(|t| (value - t) / t),
+                interval: None,
             }
         })
         .collect();
@@ -521,6 +463,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         job: job.name.clone(),
         recording: job.recording_path.display().to_string(),
         wiperlab_version: env!("CARGO_PKG_VERSION").into(),
+        model: "blade2dof".into(),
         cost,
         parameters,
         peaks,
@@ -540,6 +483,10 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         solver_rtol: job.job.solver.rtol,
         solver_atol: job.job.solver.atol,
         transitions_in_best_model: best_sim.transitions.len(),
+        model_trials: Vec::new(),
+        warnings: Vec::new(),
+        input_sha256,
+        settings,
         history: history.lock().unwrap_or_else(|e| e.into_inner()).clone(),
     };
     Ok(FitOutcome {

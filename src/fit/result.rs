@@ -1,0 +1,291 @@
+//! What a fit reports: [`FitResult`] and its parts, written as `fits/<job>.result.toml` by
+//! `wiperlab fit` (and as JSON with `--json`) and read back by `wiperlab report`.
+//!
+//! Every type here is `Serialize + Deserialize`. Fields added after the first release carry
+//! `#[serde(default)]`, so result files written before them still load (with the field empty).
+
+use crate::{Error, Result};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Best cost after each iteration of each stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HistoryPoint {
+    pub stage: String,
+    pub iteration: u64,
+    pub best_cost: f64,
+    pub evaluations: usize,
+}
+
+/// A confidence interval of one fitted parameter, in the parameter's own unit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Interval {
+    pub lo: f64,
+    pub hi: f64,
+    /// Coverage probability, e.g. 0.68 for a 1σ-equivalent interval.
+    pub level: f64,
+    /// How it was obtained: `"profile"` (cost profile), `"bootstrap"` or `"curvature"`.
+    pub method: String,
+}
+
+/// A fitted parameter with its uncertainty and, for synthetic data, the truth.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FittedParam {
+    pub name: String,
+    pub value: f64,
+    pub lower: f64,
+    pub upper: f64,
+    /// 1σ from the cost's curvature (cost read as χ² with the module's scales); indicative.
+    pub std_error: f64,
+    /// False when the data do not pin the parameter down (1σ wider than 10 % of its search range,
+    /// or no positive curvature).
+    pub determined: bool,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub true_value: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rel_error: Option<f64>,
+    /// Confidence interval, when the fit computed one (profile, bootstrap or curvature).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interval: Option<Interval>,
+}
+
+/// Measured against model peak in one band.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PeakComparison {
+    pub band: String,
+    pub measured_hz: f64,
+    pub model_hz: f64,
+    /// (model − measured)/measured.
+    pub rel_diff: f64,
+    pub measured_level: f64,
+    pub model_level: f64,
+}
+
+/// One model of the hierarchy tried on the recording (speed against error at the level of the
+/// model).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModelTrial {
+    /// Model name, e.g. `"blade2dof"`.
+    pub model: String,
+    /// Parameters freed in this trial.
+    pub parameters: Vec<String>,
+    /// Best cost reached (same cost function for every trial).
+    pub cost: f64,
+    /// Wall-clock time of the trial, s.
+    pub wall_time_s: f64,
+    pub model_evaluations: usize,
+    /// True for the model whose parameters the result reports.
+    pub chosen: bool,
+    /// Why it was (not) chosen, with numbers.
+    pub reason: String,
+}
+
+fn default_model() -> String {
+    "blade2dof".into()
+}
+
+/// Everything a fit reports; written as `fits/<job>.result.toml` and, with `--json`, to stdout.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitResult {
+    pub job: String,
+    pub recording: String,
+    pub wiperlab_version: String,
+    /// Name of the model whose parameters are reported (default `"blade2dof"`, the 2-DOF blade).
+    #[serde(default = "default_model")]
+    pub model: String,
+    pub cost: f64,
+    pub parameters: Vec<FittedParam>,
+    pub peaks: Vec<PeakComparison>,
+    /// Names of parameters the data leave undetermined.
+    pub undetermined: Vec<String>,
+    /// Correlation matrix of the freed parameters (row-major, order of `parameters`); NaN where the
+    /// curvature matrix is not positive definite.
+    pub correlation: Vec<Vec<f64>>,
+    pub swarm_iterations: u64,
+    pub polish_iterations: u64,
+    pub model_evaluations: usize,
+    pub failed_evaluations: usize,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first_failure: Option<String>,
+    pub wall_time_s: f64,
+    pub threads: usize,
+    pub solver_rtol: f64,
+    pub solver_atol: f64,
+    pub transitions_in_best_model: usize,
+    /// Models tried, when the fit compared several (empty: only `model` was fitted).
+    #[serde(default)]
+    pub model_trials: Vec<ModelTrial>,
+    /// Warnings for the reader (undetermined parameters, bounds reached, ...), one sentence each.
+    #[serde(default)]
+    pub warnings: Vec<String>,
+    /// SHA-256 (lower-case hex) of the recording file the fit read; empty if not recorded.
+    #[serde(default)]
+    pub input_sha256: String,
+    /// The job file's text as the fit read it (settings provenance); empty if not recorded.
+    #[serde(default)]
+    pub settings: String,
+    pub history: Vec<HistoryPoint>,
+}
+
+impl FitResult {
+    /// Reads a result file written by `wiperlab fit`.
+    ///
+    /// # Errors
+    /// [`Error::Io`] if unreadable; [`Error::Parse`] (line, column) if not a result TOML.
+    pub fn read(path: &Path) -> Result<FitResult> {
+        let text = super::job::read_text(path)?;
+        super::job::parse_toml(path, &text)
+    }
+
+    /// The result as TOML text (`fits/<job>.result.toml`).
+    pub fn to_toml(&self) -> Result<String> {
+        toml::to_string_pretty(self)
+            .map_err(|e| Error::Numerics(format!("cannot serialise the result: {e}")))
+    }
+}
+
+/// SHA-256 (FIPS 180-4) of a file's bytes, lower-case hex.
+///
+/// # Errors
+/// [`Error::Io`] naming the file if it cannot be read.
+pub fn sha256_file(path: &Path) -> Result<String> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, "cannot read", e))?;
+    Ok(sha256_hex(&bytes))
+}
+
+/// SHA-256 of `bytes`, lower-case hex (64 characters).
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    use sha2::Digest;
+    use std::fmt::Write as _;
+    let digest = sha2::Sha256::digest(bytes);
+    let mut s = String::with_capacity(64);
+    for b in digest.iter() {
+        let _ = write!(s, "{b:02x}");
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sha256_fips_180_2_vectors() {
+        // FIPS 180-2, Appendix B.1 ("abc") and B.2 (the 448-bit message); empty string: NIST CSRC
+        // example values for SHA-256.
+        assert_eq!(
+            sha256_hex(b"abc"),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+        );
+        assert_eq!(
+            sha256_hex(b"abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1"
+        );
+        assert_eq!(
+            sha256_hex(b""),
+            "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855"
+        );
+    }
+
+    fn sample() -> FitResult {
+        FitResult {
+            job: "j".into(),
+            recording: "r.csv".into(),
+            wiperlab_version: "0.1.0".into(),
+            model: "blade2dof".into(),
+            cost: 1.5,
+            parameters: vec![FittedParam {
+                name: "k1".into(),
+                value: 0.03,
+                lower: 0.005,
+                upper: 0.15,
+                std_error: 0.001,
+                determined: true,
+                true_value: Some(0.029),
+                rel_error: Some(0.03 / 0.029 - 1.0),
+                interval: Some(Interval {
+                    lo: 0.028,
+                    hi: 0.032,
+                    level: 0.68,
+                    method: "profile".into(),
+                }),
+            }],
+            peaks: vec![PeakComparison {
+                band: "low".into(),
+                measured_hz: 49.0,
+                model_hz: 49.5,
+                rel_diff: 0.5 / 49.0,
+                measured_level: 1e-9,
+                model_level: 2e-9,
+            }],
+            undetermined: vec![],
+            correlation: vec![vec![f64::NAN]],
+            swarm_iterations: 1,
+            polish_iterations: 2,
+            model_evaluations: 3,
+            failed_evaluations: 0,
+            first_failure: None,
+            wall_time_s: 0.5,
+            threads: 2,
+            solver_rtol: 1e-8,
+            solver_atol: 1e-10,
+            transitions_in_best_model: 10,
+            model_trials: vec![ModelTrial {
+                model: "head1dof".into(),
+                parameters: vec!["k0".into()],
+                cost: 3.0,
+                wall_time_s: 0.1,
+                model_evaluations: 5,
+                chosen: false,
+                reason: "cost 3.0 > 1.5".into(),
+            }],
+            warnings: vec!["w".into()],
+            input_sha256: "ab".into(),
+            settings: "name = \"j\"\n".into(),
+            history: vec![HistoryPoint {
+                stage: "swarm".into(),
+                iteration: 0,
+                best_cost: 2.0,
+                evaluations: 3,
+            }],
+        }
+    }
+
+    #[test]
+    fn toml_round_trip_keeps_every_field_nan_included() {
+        let r = sample();
+        let back: FitResult = toml::from_str(&r.to_toml().unwrap()).unwrap();
+        assert!(back.correlation[0][0].is_nan());
+        let mut a = r.clone();
+        let mut b = back;
+        a.correlation.clear();
+        b.correlation.clear();
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn results_without_the_new_fields_still_load() {
+        // A result as written before `model`, `interval`, `model_trials`, `warnings`,
+        // `input_sha256` and `settings` existed.
+        let mut t: toml::Table = toml::from_str(&sample().to_toml().unwrap()).unwrap();
+        for k in [
+            "model",
+            "model_trials",
+            "warnings",
+            "input_sha256",
+            "settings",
+        ] {
+            assert!(t.remove(k).is_some(), "{k}");
+        }
+        t["parameters"].as_array_mut().unwrap()[0]
+            .as_table_mut()
+            .unwrap()
+            .remove("interval")
+            .unwrap();
+        let r: FitResult = toml::from_str(&toml::to_string(&t).unwrap()).unwrap();
+        assert_eq!(r.model, "blade2dof");
+        assert!(r.model_trials.is_empty() && r.warnings.is_empty());
+        assert!(r.input_sha256.is_empty() && r.settings.is_empty());
+        assert_eq!(r.parameters[0].interval, None);
+    }
+}

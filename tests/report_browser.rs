@@ -1,0 +1,423 @@
+//! The report page (`wiperlab report JOB` → `reports/<job>/index.html`) opened in a real browser.
+//!
+//! Each test runs a quick fit (4 particles, 1 swarm iteration, 3 Nelder–Mead iterations, C and k1
+//! free: about 30 model runs, a few seconds) of the shipped recording `data/reversal/` in its own
+//! temp dir, writes the page, and loads it in headless Chromium (`/usr/bin/chromium`, Debian's
+//! `chromium` package, installed by `.ci/run`). The page's inline figure check writes, on the
+//! window's `load` event, how many `<img class="figure">` loaded (`naturalWidth > 0`) into
+//! `#figure-check`; the tests read it from `chromium --headless --dump-dom`.
+//!
+//! Without Chromium the browser part of each test prints why it is skipped and the rest still runs;
+//! with `WIPERLAB_REQUIRE_BROWSER=1` (set by `.ci/run`) a missing Chromium fails instead.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A temp dir, unique per process and name, removed on drop.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(name: &str) -> TempDir {
+        let d = std::env::temp_dir().join(format!(
+            "wiperlab_report_browser_{}_{name}",
+            std::process::id()
+        ));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).expect("create temp dir");
+        TempDir(d)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// The quick job, named `quick`, with absolute paths into `data/reversal/`. Import settings are the
+/// shipped main job's (`fits/reversal.toml`; t0_s from data/reversal/truth.json camera.t0_s). The
+/// blade is the true one (A and B at the sample's values) and C, k1 are searched near the truth, so
+/// that a handful of model runs keep contact; the page, not the fit's accuracy, is under test.
+fn write_quick_job(dir: &Path) -> PathBuf {
+    let data = root().join("data/reversal");
+    let text = format!(
+        r#"name = "quick"
+blade = "{data}/blade_true.toml"
+
+[recording]
+file = "{data}/wiper_reversal_sample_xypts.csv"
+
+[recording.import]
+format = "dltdv"
+fps_hz = 10000.0
+m_per_px = 1.5e-5
+origin_px = [200.0, 300.0]
+t0_s = 0.9434198694385137
+
+[recording.import.points]
+head = "pt1"
+tip = "pt2"
+
+[spectrum]
+signal = "tip_rel_x"
+
+[[spectrum.bands]]
+name = "low"
+range_hz = [30.0, 300.0]
+nperseg = 4096
+
+[[spectrum.bands]]
+name = "high"
+range_hz = [500.0, 5000.0]
+nperseg = 2048
+
+[fit]
+particles = 4
+swarm_iterations = 1
+polish_iterations = 3
+seed = 3
+
+[fit.parameters]
+C = [0.4, 0.7]
+k1 = [0.02, 0.04]
+
+[truth]
+json = "{data}/truth.json"
+keys = {{ C = "/params/C", k1 = "/params/k1" }}
+"#,
+        data = data.display()
+    );
+    let p = dir.join("quick.toml");
+    std::fs::write(&p, text).expect("write the quick job");
+    p
+}
+
+/// Runs `wiperlab args...` with working directory `cwd`.
+fn wiperlab(cwd: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_wiperlab"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("cannot start the wiperlab binary")
+}
+
+fn ok(o: &Output, what: &str) -> (String, String) {
+    let (out, err) = (
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    );
+    assert!(
+        o.status.success(),
+        "{what} failed ({:?})\nstdout:\n{out}\nstderr:\n{err}",
+        o.status
+    );
+    (out, err)
+}
+
+/// The SVG file names in `dir`, sorted.
+fn svgs(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.ends_with(".svg"))
+        .collect();
+    v.sort();
+    v
+}
+
+/// Headless Chromium, or `None` after printing why the browser check is skipped.
+fn chromium() -> Option<PathBuf> {
+    let candidates = [
+        std::env::var_os("WIPERLAB_CHROMIUM").map(PathBuf::from),
+        Some(PathBuf::from("/usr/bin/chromium")),
+        Some(PathBuf::from("/usr/bin/chromium-browser")),
+    ];
+    if let Some(p) = candidates.into_iter().flatten().find(|p| p.is_file()) {
+        return Some(p);
+    }
+    let why = "no Chromium at $WIPERLAB_CHROMIUM, /usr/bin/chromium or /usr/bin/chromium-browser \
+               (install Debian's `chromium`; .ci/run does)";
+    if std::env::var_os("WIPERLAB_REQUIRE_BROWSER").is_some_and(|v| v == "1") {
+        panic!("WIPERLAB_REQUIRE_BROWSER=1 but {why}");
+    }
+    println!("skipped the browser check: {why}");
+    None
+}
+
+/// The DOM of `page` after its `load` event, from `chromium --headless --dump-dom` (own profile
+/// dir, so parallel tests do not share one; killed after 120 s).
+fn dump_dom(chromium: &Path, page: &Path, profile: &Path) -> String {
+    let url = format!("file://{}", page.canonicalize().unwrap().display());
+    let mut child = Command::new(chromium)
+        .args([
+            "--headless",
+            "--no-sandbox", // root in CI containers; the page is our own local file
+            "--disable-gpu",
+            "--no-first-run",
+            "--allow-file-access-from-files",
+            &format!("--user-data-dir={}", profile.display()),
+            "--virtual-time-budget=20000",
+            "--dump-dom",
+            &url,
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("cannot start chromium");
+    let started = Instant::now();
+    loop {
+        if child.try_wait().expect("wait for chromium").is_some() {
+            break;
+        }
+        if started.elapsed() > Duration::from_secs(120) {
+            let _ = child.kill();
+            panic!("chromium did not finish within 120 s on {url}");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let o = child.wait_with_output().expect("chromium output");
+    let dom = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        dom.contains("</html>"),
+        "chromium returned no DOM for {url} ({:?}); stderr:\n{}",
+        o.status,
+        String::from_utf8_lossy(&o.stderr)
+    );
+    dom
+}
+
+/// The figure check's outcome as the page's script left it in the DOM.
+#[derive(Debug, PartialEq)]
+struct Check {
+    status: String,
+    loaded: usize,
+    total: usize,
+    broken: Vec<String>,
+}
+
+fn attr(tag: &str, name: &str) -> Option<String> {
+    let key = format!(" {name}=\"");
+    let i = tag.find(&key)? + key.len();
+    let j = tag[i..].find('"')? + i;
+    Some(tag[i..j].to_string())
+}
+
+fn figure_check(dom: &str) -> Check {
+    let i = dom
+        .find("id=\"figure-check\"")
+        .unwrap_or_else(|| panic!("no #figure-check in the DOM:\n{dom}"));
+    let start = dom[..i].rfind('<').unwrap();
+    let end = dom[i..].find('>').unwrap() + i;
+    let tag = &dom[start..end];
+    let n = |k: &str| -> usize {
+        attr(tag, k)
+            .unwrap_or_else(|| panic!("figure check did not run (no {k}): {tag}"))
+            .parse()
+            .unwrap()
+    };
+    Check {
+        status: attr(tag, "data-status").unwrap_or_default(),
+        loaded: n("data-loaded"),
+        total: n("data-total"),
+        broken: attr(tag, "data-broken")
+            .unwrap_or_default()
+            .split_whitespace()
+            .map(String::from)
+            .collect(),
+    }
+}
+
+/// The figures `wiperlab fit` writes for a two-band job (src/report/html.rs `fit_figure_list`).
+const FIT_FIGURES: [&str; 6] = [
+    "cost.svg",
+    "friction_law.svg",
+    "psd_high.svg",
+    "psd_low.svg",
+    "traces_head.svg",
+    "traces_tip.svg",
+];
+
+/// Quick fit with `wiperlab fit` (checks the report hint), then `wiperlab report` on the existing
+/// result; the page holds the tables, the SHA-256 of the recording, and every figure loads.
+#[test]
+fn report_page_after_a_quick_fit_loads_every_figure_in_chromium() {
+    let tmp = TempDir::new("ok");
+    let job = write_quick_job(&tmp.0);
+    let job_s = job.to_str().unwrap();
+    let (out, _) = ok(&wiperlab(&tmp.0, &["fit", job_s, "--quiet"]), "quick fit");
+    assert!(
+        out.contains("wiperlab report") && out.contains("reports/quick/index.html"),
+        "fit prints no report hint:\n{out}"
+    );
+    let result = tmp.0.join("quick.result.toml");
+    let before = std::fs::read(&result).expect("fit wrote the result");
+
+    let (out, err) = ok(&wiperlab(&tmp.0, &["report", job_s]), "report");
+    assert!(
+        !err.contains("running the fit"),
+        "report refitted although the result exists:\n{err}"
+    );
+    assert_eq!(
+        std::fs::read(&result).unwrap(),
+        before,
+        "report rewrote the result"
+    );
+    let dir = tmp.0.join("reports/quick");
+    let page = dir.join("index.html");
+    assert!(out.contains("index.html (6 figures)"), "{out}");
+    assert_eq!(svgs(&dir), FIT_FIGURES);
+    let html = std::fs::read_to_string(&page).unwrap();
+
+    // Tables: a row per freed parameter, per band; one model only.
+    for needle in [
+        "<td class=\"l\">C</td>",
+        "<td class=\"l\">k1</td>",
+        "<td class=\"l\">low</td>",
+        "<td class=\"l\">high</td>",
+        "Only one model (blade2dof) was fitted",
+        "rtol 1e-8, atol 1e-10", // the job's defaults (src/fit/job.rs fit_solver_default)
+        "low 30.00–300.0 Hz (Welch, Hann, nperseg 4096)",
+        "particle swarm 4 particles × 1 iterations (seed 3)",
+    ] {
+        assert!(html.contains(needle), "page lacks {needle:?}");
+    }
+    // Every figure is linked once; nothing is fetched from elsewhere.
+    for f in FIT_FIGURES {
+        assert_eq!(
+            html.matches(&format!("src=\"{f}\"")).count(),
+            1,
+            "link to {f}"
+        );
+    }
+    for external in ["http://", "https://", "//cdn", "<link "] {
+        assert!(!html.contains(external), "external resource {external:?}");
+    }
+    // Provenance: the recording's SHA-256 at fit time, checked against coreutils' sha256sum.
+    let rec = root().join("data/reversal/wiper_reversal_sample_xypts.csv");
+    match Command::new("sha256sum").arg(&rec).output() {
+        Ok(o) if o.status.success() => {
+            let want = String::from_utf8_lossy(&o.stdout)
+                .split_whitespace()
+                .next()
+                .unwrap()
+                .to_string();
+            assert!(
+                html.contains(&format!("<code id=\"sha256-fit\">{want}</code>")),
+                "no fit-time SHA-256 {want}"
+            );
+            assert!(html.contains(&format!("<code id=\"sha256-now\">{want}</code>")));
+        }
+        _ => println!("sha256sum not available: SHA-256 not cross-checked"),
+    }
+
+    let Some(chromium) = chromium() else { return };
+    let dom = dump_dom(&chromium, &page, &tmp.0.join("profile"));
+    let check = figure_check(&dom);
+    println!("figure check: {check:?}");
+    assert_eq!(
+        check,
+        Check {
+            status: "ok".into(),
+            loaded: FIT_FIGURES.len(),
+            total: FIT_FIGURES.len(),
+            broken: vec![],
+        }
+    );
+}
+
+/// The check must be able to fail: a page whose link points at a missing file, and a figure whose
+/// SVG is cut in half, are both reported broken by name. (Also: `report` without a result fits
+/// first.)
+#[test]
+fn browser_check_catches_a_broken_link_and_a_corrupt_svg() {
+    let tmp = TempDir::new("broken");
+    let job = write_quick_job(&tmp.0);
+    let (_, err) = ok(
+        &wiperlab(&tmp.0, &["report", job.to_str().unwrap(), "--quiet"]),
+        "report without a result",
+    );
+    assert!(err.contains("running the fit first"), "{err}");
+    assert!(tmp.0.join("quick.result.toml").is_file());
+    let dir = tmp.0.join("reports/quick");
+    let page = dir.join("index.html");
+    let html = std::fs::read_to_string(&page).unwrap();
+
+    let Some(chromium) = chromium() else { return };
+    // 1. A broken link, in a copy of the page beside the original.
+    let bad_link = dir.join("broken_link.html");
+    assert_eq!(html.matches("src=\"psd_high.svg\"").count(), 1);
+    std::fs::write(
+        &bad_link,
+        html.replace("src=\"psd_high.svg\"", "src=\"psd_missing.svg\""),
+    )
+    .unwrap();
+    let check = figure_check(&dump_dom(&chromium, &bad_link, &tmp.0.join("p1")));
+    println!("broken link: {check:?}");
+    assert_eq!(check.status, "broken");
+    assert_eq!((check.loaded, check.total), (5, 6));
+    assert_eq!(check.broken, ["psd_missing.svg"]);
+
+    // 2. A corrupt figure: the original page, with traces_tip.svg truncated (unclosed XML).
+    let svg = dir.join("traces_tip.svg");
+    let text = std::fs::read_to_string(&svg).unwrap();
+    std::fs::write(&svg, &text[..text.len() / 2]).unwrap();
+    let check = figure_check(&dump_dom(&chromium, &page, &tmp.0.join("p2")));
+    println!("corrupt SVG: {check:?}");
+    assert_eq!(check.status, "broken");
+    assert_eq!((check.loaded, check.total), (5, 6));
+    assert_eq!(check.broken, ["traces_tip.svg"]);
+}
+
+/// Text from results is escaped: a warning and a model-comparison row carrying markup appear as
+/// text, and the browser still sees only the six real figures (an unescaped `<img class="figure">`
+/// would be a seventh, broken one). Also renders the model-comparison table.
+#[test]
+fn report_escapes_text_from_the_result() {
+    let tmp = TempDir::new("escape");
+    let job = write_quick_job(&tmp.0);
+    let job_s = job.to_str().unwrap();
+    ok(&wiperlab(&tmp.0, &["fit", job_s, "--quiet"]), "quick fit");
+    let result = tmp.0.join("quick.result.toml");
+    let mut t: toml::Table = toml::from_str(&std::fs::read_to_string(&result).unwrap()).unwrap();
+    let evil = r#"<img class="figure" src="injected.svg"> & "quotes""#;
+    t.insert("warnings".into(), toml::Value::Array(vec![evil.into()]));
+    let trial = |model: &str, cost: f64, chosen: bool| {
+        let mut m = toml::Table::new();
+        m.insert("model".into(), model.into());
+        m.insert("parameters".into(), toml::Value::Array(vec!["k1".into()]));
+        m.insert("cost".into(), cost.into());
+        m.insert("wall_time_s".into(), 1.25.into());
+        m.insert("model_evaluations".into(), 30.into());
+        m.insert("chosen".into(), chosen.into());
+        m.insert("reason".into(), format!("<b>cost {cost}</b>").into());
+        toml::Value::Table(m)
+    };
+    t.insert(
+        "model_trials".into(),
+        toml::Value::Array(vec![
+            trial("head1dof", 7.5, false),
+            trial("blade2dof", 1.5, true),
+        ]),
+    );
+    std::fs::write(&result, toml::to_string(&t).unwrap()).unwrap();
+
+    ok(&wiperlab(&tmp.0, &["report", job_s]), "report");
+    let page = tmp.0.join("reports/quick/index.html");
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(!html.contains("injected.svg\">"), "unescaped markup");
+    assert!(html.contains(
+        "<li>&lt;img class=&quot;figure&quot; src=&quot;injected.svg&quot;&gt; &amp; &quot;quotes&quot;</li>"
+    ));
+    assert!(html.contains("&lt;b&gt;cost 7.5&lt;/b&gt;"));
+    assert!(html.contains("<tr class=\"chosen\"><td class=\"l\">blade2dof</td>"));
+    assert!(!html.contains("Only one model"));
+
+    let Some(chromium) = chromium() else { return };
+    let check = figure_check(&dump_dom(&chromium, &page, &tmp.0.join("profile")));
+    assert_eq!((check.status.as_str(), check.total), ("ok", 6), "{check:?}");
+}
