@@ -2,9 +2,9 @@
 
 use super::hybrid::{Mode, Phase, SolverOptions, Stats, Switch, Transition, integrate};
 use crate::model::blade::{Blade, BladeParams, LockedBlade, StickForm};
-use serde::{Deserialize, Serialize};
 use crate::trace::{PointTrack, Trace};
 use crate::{Error, Result};
+use serde::{Deserialize, Serialize};
 
 /// A simulated reversal: the observables at each sample time, the transitions and the counters.
 /// All vectors have the length of `t_s`.
