@@ -123,6 +123,31 @@ pub struct FitSection {
     /// Bounds of the shoulder-contact parameters freed by the `blade2dof+shoulder` candidate.
     #[serde(default)]
     pub shoulder: Option<ShoulderBounds>,
+    /// Confidence intervals by parametric bootstrap (see [`crate::fit::bootstrap_intervals`]).
+    #[serde(default)]
+    pub uncertainty: UncertaintySection,
+}
+
+/// Settings of the parametric bootstrap that gives each fitted parameter an interval.
+#[derive(Debug, Clone, Copy, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct UncertaintySection {
+    /// Bootstrap replicates (0: no intervals, only the curvature's 1σ).
+    pub bootstrap: usize,
+    /// Nelder–Mead iterations of each replicate's refit (started from the optimum).
+    pub polish_iterations: u64,
+    /// Seed of the replicates' noise.
+    pub seed: u64,
+}
+
+impl Default for UncertaintySection {
+    fn default() -> Self {
+        UncertaintySection {
+            bootstrap: 0,
+            polish_iterations: 30,
+            seed: 7,
+        }
+    }
 }
 
 /// Bounds `[lower, upper]` of the shoulder parameters (see [`crate::model::Shoulder`]).

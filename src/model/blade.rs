@@ -753,7 +753,7 @@ impl LockedBlade {
         }
         let f = acc(th)?;
         let scale = self.blade.params.k1_nm_per_rad / self.blade.mc.mth;
-        if !(f.abs() < 1e-8 * scale) {
+        if f.abs().is_nan() || f.abs() >= 1e-8 * scale {
             return Err(ModelFault::Geometry(format!(
                 "no quasi-static slip equilibrium of the locked link at t = {t} s (residual {f:.3e} rad/s²)"
             )));
