@@ -134,7 +134,10 @@ pub struct FitSection {
 pub struct UncertaintySection {
     /// Bootstrap replicates (0: no intervals, only the curvature's 1σ).
     pub bootstrap: usize,
-    /// Nelder–Mead iterations of each replicate's refit (started from the optimum).
+    /// Re-run the whole estimator (swarm and polish) on each replicate; otherwise only a
+    /// Nelder–Mead polish from the optimum.
+    pub full_refit: bool,
+    /// Nelder–Mead iterations of a polish-only replicate.
     pub polish_iterations: u64,
     /// Seed of the replicates' noise.
     pub seed: u64,
@@ -144,6 +147,7 @@ impl Default for UncertaintySection {
     fn default() -> Self {
         UncertaintySection {
             bootstrap: 0,
+            full_refit: true,
             polish_iterations: 30,
             seed: 7,
         }

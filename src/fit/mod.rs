@@ -378,7 +378,6 @@ fn fit_candidate(
         free.push(FreeParam::new("k1c", sb.k1c[0], sb.k1c[1]));
         free.push(FreeParam::new("theta_c", sb.theta_c[0], sb.theta_c[1]));
     }
-    let n = free.len();
     if let Some(pb) = pb {
         pb.set_message(format!("{} swarm", candidate.name()));
     }
@@ -408,69 +407,14 @@ fn fit_candidate(
         progress: pb.clone(),
     });
     let history = Arc::new(Mutex::new(Vec::new()));
-    let fit_err = |e: argmin::core::Error| Error::Fit(e.to_string());
-
-    // Stage 1: particle swarm over [0, 1]^n.
-    let pso = ParticleSwarm::new((vec![0.0; n], vec![1.0; n]), fit.particles)
-        .with_rng_generator(rand::rngs::StdRng::seed_from_u64(fit.seed));
-    let res = Executor::new(Shared(problem.clone()), pso)
-        .configure(|s| s.max_iters(fit.swarm_iterations))
-        .add_observer(
-            HistoryObserver {
-                stage: "swarm",
-                log: history.clone(),
-                evals: evaluations.clone(),
-            },
-            ObserverMode::Always,
-        )
-        .run()
-        .map_err(fit_err)?;
-    let swarm_best = res
-        .state()
-        .get_best_param()
-        .map(|p| p.position.clone())
-        .ok_or_else(|| Error::Fit("particle swarm returned no particle".into()))?;
-    let swarm_iters = res.state().get_iter();
-
-    // Stage 2: Nelder–Mead polish from the best particle.
-    if let Some(pb) = pb {
-        pb.set_message(format!("{} polish", candidate.name()));
-    }
-    let mut simplex = vec![swarm_best.clone()];
-    for i in 0..n {
-        let mut v = swarm_best.clone();
-        v[i] = if v[i] + 0.05 <= 1.0 {
-            v[i] + 0.05
-        } else {
-            v[i] - 0.05
-        };
-        simplex.push(v);
-    }
-    let nm = NelderMead::new(simplex)
-        .with_sd_tolerance(1e-3)
-        .map_err(fit_err)?;
-    let res = Executor::new(Shared(problem.clone()), nm)
-        .configure(|s| s.max_iters(fit.polish_iterations))
-        .add_observer(
-            HistoryObserver {
-                stage: "polish",
-                log: history.clone(),
-                evals: evaluations.clone(),
-            },
-            ObserverMode::Always,
-        )
-        .run()
-        .map_err(fit_err)?;
-    let best_u: Vec<f64> = res
-        .state()
-        .get_best_param()
-        .cloned()
-        .unwrap_or(swarm_best)
-        .iter()
-        .map(|u| u.clamp(0.0, 1.0))
-        .collect();
-    let polish_iters = res.state().get_iter();
-    let cost = res.state().get_best_cost();
+    let (best_u, swarm_iters, polish_iters, cost) = optimise(
+        &problem,
+        fit.particles,
+        fit.swarm_iterations,
+        fit.polish_iterations,
+        fit.seed,
+        Some((&history, pb, candidate)),
+    )?;
 
     // Curvature of the cost at the optimum → standard errors, correlations, identifiability.
     if let Some(pb) = pb {
@@ -491,6 +435,101 @@ fn fit_candidate(
         history,
         cost,
     })
+}
+
+/// The estimator: a particle swarm over `[0, 1]^n` (`particles`, `swarm_iterations`; 0 iterations
+/// skips it and starts from the problem's centre), then a Nelder–Mead polish from the best particle.
+/// Returns `(best_u, swarm iterations, polish iterations, best cost)`.
+#[allow(clippy::type_complexity)]
+fn optimise(
+    problem: &Arc<SpectralProblem>,
+    particles: usize,
+    swarm_iterations: u64,
+    polish_iterations: u64,
+    seed: u64,
+    log: Option<(
+        &Arc<Mutex<Vec<HistoryPoint>>>,
+        &Option<indicatif::ProgressBar>,
+        Candidate,
+    )>,
+) -> Result<(Vec<f64>, u64, u64, f64)> {
+    let n = problem.free.len();
+    let fit_err = |e: argmin::core::Error| Error::Fit(e.to_string());
+    let evaluations = problem.evaluations.clone();
+    let observer = |stage: &'static str| {
+        log.map(|(h, _, _)| HistoryObserver {
+            stage,
+            log: h.clone(),
+            evals: evaluations.clone(),
+        })
+    };
+    if let Some((_, Some(pb), c)) = log {
+        pb.set_message(format!("{} swarm", c.name()));
+    }
+    let pso = ParticleSwarm::new((vec![0.0; n], vec![1.0; n]), particles)
+        .with_rng_generator(rand::rngs::StdRng::seed_from_u64(seed));
+    let mut ex =
+        Executor::new(Shared(problem.clone()), pso).configure(|s| s.max_iters(swarm_iterations));
+    if let Some(o) = observer("swarm") {
+        ex = ex.add_observer(o, ObserverMode::Always);
+    }
+    let res = ex.run().map_err(fit_err)?;
+    let swarm_best = res
+        .state()
+        .get_best_param()
+        .map(|p| p.position.clone())
+        .ok_or_else(|| Error::Fit("particle swarm returned no particle".into()))?;
+    let swarm_iters = res.state().get_iter();
+    let (u, polish_iters, cost) = polish(
+        problem,
+        &swarm_best,
+        0.05,
+        polish_iterations,
+        observer("polish"),
+    )?;
+    if let Some((_, Some(pb), c)) = log {
+        pb.set_message(format!("{} polish", c.name()));
+    }
+    Ok((u, swarm_iters, polish_iters, cost))
+}
+
+/// Nelder–Mead from `start` with an initial simplex of edge `step` (normalised units).
+fn polish(
+    problem: &Arc<SpectralProblem>,
+    start: &[f64],
+    step: f64,
+    iterations: u64,
+    observer: Option<HistoryObserver>,
+) -> Result<(Vec<f64>, u64, f64)> {
+    let fit_err = |e: argmin::core::Error| Error::Fit(e.to_string());
+    let n = start.len();
+    let mut simplex = vec![start.to_vec()];
+    for i in 0..n {
+        let mut v = start.to_vec();
+        v[i] = if v[i] + step <= 1.0 {
+            v[i] + step
+        } else {
+            v[i] - step
+        };
+        simplex.push(v);
+    }
+    let nm = NelderMead::new(simplex)
+        .with_sd_tolerance(1e-3)
+        .map_err(fit_err)?;
+    let mut ex = Executor::new(Shared(problem.clone()), nm).configure(|s| s.max_iters(iterations));
+    if let Some(o) = observer {
+        ex = ex.add_observer(o, ObserverMode::Always);
+    }
+    let res = ex.run().map_err(fit_err)?;
+    let u: Vec<f64> = res
+        .state()
+        .get_best_param()
+        .cloned()
+        .unwrap_or_else(|| start.to_vec())
+        .iter()
+        .map(|u| u.clamp(0.0, 1.0))
+        .collect();
+    Ok((u, res.state().get_iter(), res.state().get_best_cost()))
 }
 
 /// Akaike's information criterion with the cost read as −2 ln L (a χ² on the cost's scales):
@@ -703,7 +742,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         if let Some(pb) = &pb {
             pb.set_message("bootstrap");
         }
-        let intervals = bootstrap_intervals(problem, &cf.best_u, &best_sim, &fit.uncertainty)?;
+        let intervals = bootstrap_intervals(problem, &cf.best_u, &best_sim, fit)?;
         for (p, iv) in parameters.iter_mut().zip(intervals) {
             p.interval = Some(iv);
         }
@@ -780,9 +819,12 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
 /// 2. the measurement's white noise is estimated from the noise floor `P` of the last band
 ///    ([`features::noise_floor`]; a one-sided density of white noise of variance σ² is `2σ²/fs`, so
 ///    `σ = √(P·fs/2)`);
-/// 3. each replicate adds fresh Gaussian noise of that σ, recomputes the measured features, and refits
-///    by Nelder–Mead from the optimum (replicates run in parallel with rayon);
-/// 4. the interval is the 15.87th to 84.13th percentile of the replicates' estimates.
+/// 3. each replicate adds fresh Gaussian noise of that σ, recomputes the measured features, and
+///    re-runs the estimator: the whole fit (swarm and polish, `full_refit = true`) or only a
+///    Nelder–Mead polish from the optimum (cheaper, but blind to the swarm's own scatter, so the
+///    intervals come out too narrow: README, "Uncertainty"); replicates run in parallel with rayon;
+/// 4. the interval is the basic bootstrap interval `[2θ̂ − q(84.13 %), 2θ̂ − q(15.87 %)]` of the
+///    replicates' estimates `θ*` (Davison & Hinkley 1997, eq. 5.6), which corrects the replicates' bias.
 ///
 /// What it covers: the spread from tracking noise and spectral estimation. What it does not: the
 /// optimiser ending in a different local minimum of the (rough) stick–slip cost surface, which can
@@ -795,8 +837,9 @@ pub fn bootstrap_intervals(
     problem: &SpectralProblem,
     best_u: &[f64],
     best_sim: &BladeSimulation,
-    settings: &job::UncertaintySection,
+    fit: &job::FitSection,
 ) -> Result<Vec<Interval>> {
+    let settings = &fit.uncertainty;
     use rand_distr::{Distribution, Normal};
     use rayon::prelude::*;
     let mut x_model = problem.signal.extract(&best_sim.to_trace())?;
@@ -844,28 +887,20 @@ pub fn bootstrap_intervals(
                 first_failure: Mutex::new(None),
                 progress: problem.progress.clone(),
             };
-            let mut simplex = vec![best_u.to_vec()];
-            for i in 0..n {
-                let mut v = best_u.to_vec();
-                v[i] = if v[i] + 0.02 <= 1.0 {
-                    v[i] + 0.02
-                } else {
-                    v[i] - 0.02
-                };
-                simplex.push(v);
-            }
-            let nm = NelderMead::new(simplex)
-                .with_sd_tolerance(1e-4)
-                .map_err(|e| Error::Fit(e.to_string()))?;
-            let res = Executor::new(Shared(Arc::new(rep)), nm)
-                .configure(|s| s.max_iters(settings.polish_iterations))
-                .run()
-                .map_err(|e| Error::Fit(e.to_string()))?;
-            let u = res
-                .state()
-                .get_best_param()
-                .cloned()
-                .unwrap_or_else(|| best_u.to_vec());
+            let rep = Arc::new(rep);
+            let u = if settings.full_refit {
+                optimise(
+                    &rep,
+                    fit.particles,
+                    fit.swarm_iterations,
+                    fit.polish_iterations,
+                    fit.seed.wrapping_add(1 + r as u64),
+                    None,
+                )?
+                .0
+            } else {
+                polish(&rep, best_u, 0.05, settings.polish_iterations, None)?.0
+            };
             Ok(problem
                 .free
                 .iter()
@@ -880,12 +915,16 @@ pub fn bootstrap_intervals(
         .map(|i| {
             let mut v: Vec<f64> = estimates.iter().map(|e| e[i]).collect();
             v.sort_by(|a, b| a.total_cmp(b));
+            // Basic (reverse-percentile) interval: θ* − θ̂ stands in for θ̂ − θ, which corrects the
+            // bias the replicates show (Davison & Hinkley 1997, *Bootstrap Methods*, eq. 5.6).
+            let est = problem.free[i].value(best_u[i]);
             Interval {
-                lo: percentile(&v, 0.158_655),
-                hi: percentile(&v, 0.841_345),
+                lo: 2.0 * est - percentile(&v, 0.841_345),
+                hi: 2.0 * est - percentile(&v, 0.158_655),
                 level: 0.6827,
                 method: format!(
-                    "parametric bootstrap, {b} replicates (best-fit model + white noise σ = {sigma:.3e} from the measured floor; Nelder–Mead refit)"
+                    "basic parametric bootstrap, {b} replicates (best-fit model + white noise σ = {sigma:.3e} from the measured floor; {})",
+                    if settings.full_refit { "full refit" } else { "Nelder–Mead polish from the optimum" }
                 ),
             }
         })
