@@ -18,7 +18,12 @@ pub struct FitJob {
     /// Name used for outputs (`fits/<name>.result.toml`, `reports/<name>/`); default: file stem.
     #[serde(default)]
     pub name: Option<String>,
-    pub recording: RecordingSection,
+    /// The recording to fit; a job gives either this or `[targets]`.
+    #[serde(default)]
+    pub recording: Option<RecordingSection>,
+    /// Target peak frequencies instead of a recording (e.g. the seed paper's own numbers).
+    #[serde(default)]
+    pub targets: Option<TargetsSection>,
     /// Blade parameter file (TOML with [`BladeParams`] fields); the freed parameters' values in it
     /// are ignored by the fit.
     pub blade: PathBuf,
@@ -38,6 +43,45 @@ fn fit_solver_default() -> SolverOptions {
         rtol: 1e-8,
         atol: 1e-10,
         ..SolverOptions::default()
+    }
+}
+
+/// Target frequencies to reach instead of a recording.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TargetsSection {
+    /// Where the numbers come from (shown in the result and report).
+    pub source: String,
+    /// Sampling rate of the simulated signal, Hz (default 20 kHz).
+    #[serde(default = "d_target_fps")]
+    pub fps_hz: f64,
+    /// One target per band of `[spectrum]`, by band name.
+    pub peaks: Vec<TargetPeak>,
+}
+
+fn d_target_fps() -> f64 {
+    20_000.0
+}
+
+/// A band's target: one frequency, or a range the model's peak should fall in.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TargetPeak {
+    pub band: String,
+    #[serde(default)]
+    pub freq_hz: Option<f64>,
+    #[serde(default)]
+    pub range_hz: Option<[f64; 2]>,
+}
+
+impl TargetPeak {
+    /// The target's range (a single frequency is a zero-width range).
+    pub fn range(&self) -> [f64; 2] {
+        match (self.freq_hz, self.range_hz) {
+            (Some(f), _) => [f, f],
+            (None, Some(r)) => r,
+            (None, None) => [f64::NAN, f64::NAN],
+        }
     }
 }
 
@@ -435,6 +479,53 @@ impl LoadedJob {
                 }
             }
         }
+        match (&job.recording, &job.targets) {
+            (Some(_), None) => {}
+            (None, Some(t)) => {
+                for tp in &t.peaks {
+                    let line = line_of(&text, &format!("\"{}\"", tp.band));
+                    if !job.spectrum.bands.iter().any(|b| b.name == tp.band) {
+                        return Err(Error::parse(
+                            path,
+                            line,
+                            1,
+                            format!(
+                                "[targets] peak for band '{}', which [spectrum] does not define",
+                                tp.band
+                            ),
+                        ));
+                    }
+                    let [lo, hi] = tp.range();
+                    if tp.freq_hz.is_some() == tp.range_hz.is_some() || !(lo > 0.0 && lo <= hi) {
+                        return Err(Error::parse(
+                            path,
+                            line,
+                            1,
+                            format!(
+                                "[targets] band '{}': give exactly one of freq_hz = F or range_hz = [LO, HI] with 0 < LO <= HI",
+                                tp.band
+                            ),
+                        ));
+                    }
+                }
+                if !(t.fps_hz.is_finite() && t.fps_hz > 0.0) {
+                    return Err(Error::parse(
+                        path,
+                        line_of(&text, "fps_hz"),
+                        1,
+                        "[targets] fps_hz must be > 0",
+                    ));
+                }
+            }
+            _ => {
+                return Err(Error::parse(
+                    path,
+                    1,
+                    1,
+                    "a fit job gives either [recording] (a tracked recording) or [targets] (frequencies to reach), and exactly one of them",
+                ));
+            }
+        }
         job.solver.validate()?;
         for b in &job.spectrum.bands {
             if !(b.range_hz[0] >= 0.0 && b.range_hz[0] < b.range_hz[1]) || b.nperseg < 8 {
@@ -463,7 +554,11 @@ impl LoadedJob {
             }
         }
         Ok(LoadedJob {
-            recording_path: dir.join(&job.recording.file),
+            recording_path: match &job.recording {
+                Some(r) => dir.join(&r.file),
+                // A target job's input is the job file itself (its hash is the provenance).
+                None => path.to_path_buf(),
+            },
             job,
             name,
             path: path.to_path_buf(),

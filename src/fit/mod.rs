@@ -78,6 +78,8 @@ impl FreeParam {
 pub struct SpectralProblem {
     /// Which model of the hierarchy is simulated.
     pub model: ModelKind,
+    /// Target ranges per band (a target job): the cost is then [`target_cost`].
+    pub targets: Option<Vec<[f64; 2]>>,
     pub base: BladeParams,
     pub free: Vec<FreeParam>,
     pub measured: Features,
@@ -133,6 +135,9 @@ impl SpectralProblem {
 
     /// The cost of model features against the measurement (see the module docs).
     pub fn cost_of(&self, model: &Features) -> f64 {
+        if let Some(t) = &self.targets {
+            return target_cost(t, model);
+        }
         let w = &self.weights;
         let mut total = 0.0;
         for ((d, m), floor) in self
@@ -330,6 +335,8 @@ pub fn smallest_capable_model(bands: &[BandSpec]) -> ModelKind {
 
 /// The measured side of a fit, shared by every candidate.
 struct Measurement {
+    /// Target ranges per band (a target job), instead of measured peaks.
+    targets: Option<Vec<[f64; 2]>>,
     trace: Trace,
     x: Vec<f64>,
     fs_hz: f64,
@@ -385,6 +392,7 @@ fn fit_candidate(
     let trace = &meas.trace;
     let problem = Arc::new(SpectralProblem {
         model: candidate.kind,
+        targets: meas.targets.clone(),
         base,
         free: free.clone(),
         measured: Features {
@@ -538,25 +546,18 @@ pub fn aic(cost: f64, k: usize) -> f64 {
     cost + 2.0 * k as f64
 }
 
-/// Runs the job: import, measured features, then for each candidate model a particle swarm,
-/// Nelder–Mead and the curvature; the candidate with the lowest [`aic`] is reported.
-///
-/// `progress`: show a progress bar on stderr (hidden automatically when stderr is not a terminal).
-pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
-    let started = std::time::Instant::now();
-    // Provenance: the recording's hash and the effective settings (job with defaults filled in).
-    let input_sha256 = result::sha256_file(&job.recording_path)?;
-    let settings = toml::to_string_pretty(&job.job)
-        .or_else(|_| job::read_text(&job.path))
-        .unwrap_or_default();
-    let spec = &job.job.recording.import;
+/// Reads the recording and its features.
+fn measure_recording(job: &LoadedJob, spec: &crate::import::ImportSpec) -> Result<Measurement> {
     let trace = crate::import::read_trace(&job.recording_path, spec)?;
     let fs_hz = sampling_rate(&trace, spec.fps_hz)?;
     let signal = job.job.spectrum.signal;
     let x = signal.extract(&trace)?;
-    let bands = job.job.spectrum.bands.clone();
-    let max_fill = job.job.spectrum.max_fill;
-    let measured = features(&x, fs_hz, &bands, max_fill)?;
+    let measured = features(
+        &x,
+        fs_hz,
+        &job.job.spectrum.bands,
+        job.job.spectrum.max_fill,
+    )?;
     for b in &measured.bands {
         if b.peak.is_none() {
             return Err(Error::input(
@@ -571,13 +572,98 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         }
     }
     let floors: Vec<f64> = measured.bands.iter().map(noise_floor).collect();
-    let meas = Measurement {
+    Ok(Measurement {
         trace,
         x,
         fs_hz,
         measured,
         floors,
+        targets: None,
+    })
+}
+
+/// A target job's "measurement": the model's default reversal window sampled at the target rate, no
+/// recorded points, and per band the target range.
+fn measure_targets(job: &LoadedJob, t: &job::TargetsSection) -> Result<Measurement> {
+    let (t0, t1) = crate::simulate::blade::default_window(&job.blade);
+    let n = ((t1 - t0) * t.fps_hz).floor() as usize + 1;
+    let times: Vec<f64> = (0..n).map(|k| t0 + k as f64 / t.fps_hz).collect();
+    let mut targets = Vec::new();
+    let mut bands = Vec::new();
+    for b in &job.job.spectrum.bands {
+        let tp = t.peaks.iter().find(|p| p.band == b.name).ok_or_else(|| {
+            Error::Config(format!("[targets] gives no target for band '{}'", b.name))
+        })?;
+        let r = tp.range();
+        targets.push(r);
+        bands.push(features::BandFeatures {
+            spec: b.clone(),
+            freq_hz: Vec::new(),
+            psd: Vec::new(),
+            peak: Some(crate::spectrum::Peak {
+                freq_hz: (r[0] * r[1]).sqrt(),
+                level: f64::NAN,
+                bin: 0,
+                prominence: f64::NAN,
+            }),
+            full_freq_hz: Vec::new(),
+            full_psd: Vec::new(),
+        });
+    }
+    Ok(Measurement {
+        x: vec![0.0; n],
+        trace: Trace {
+            t_s: times,
+            points: Vec::new(),
+        },
+        fs_hz: t.fps_hz,
+        measured: Features { bands, filled: 0 },
+        floors: vec![0.0; job.job.spectrum.bands.len()],
+        targets: Some(targets),
+    })
+}
+
+/// Cost of a target job: per band, `(ln f_m/f_edge / 0.01)²` when the model's peak `f_m` lies outside
+/// the target range (`f_edge` the nearest edge; 0 inside), 100 when the model has no peak in the band.
+pub fn target_cost(targets: &[[f64; 2]], model: &Features) -> f64 {
+    targets
+        .iter()
+        .zip(&model.bands)
+        .map(|(r, b)| match b.peak {
+            Some(p) => {
+                let f = p.freq_hz;
+                let edge = f.clamp(r[0], r[1]);
+                let d = (f / edge).ln() / 0.01;
+                d * d
+            }
+            None => 1e4,
+        })
+        .sum()
+}
+
+/// Runs the job: import, measured features, then for each candidate model a particle swarm,
+/// Nelder–Mead and the curvature; the candidate with the lowest [`aic`] is reported.
+///
+/// `progress`: show a progress bar on stderr (hidden automatically when stderr is not a terminal).
+pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
+    let started = std::time::Instant::now();
+    // Provenance: the recording's hash and the effective settings (job with defaults filled in).
+    let input_sha256 = result::sha256_file(&job.recording_path)?;
+    let settings = toml::to_string_pretty(&job.job)
+        .or_else(|_| job::read_text(&job.path))
+        .unwrap_or_default();
+    let signal = job.job.spectrum.signal;
+    let bands = job.job.spectrum.bands.clone();
+    let meas = match (&job.job.recording, &job.job.targets) {
+        (Some(rec), _) => measure_recording(job, &rec.import)?,
+        (None, Some(t)) => measure_targets(job, t)?,
+        (None, None) => {
+            return Err(Error::Config(
+                "the job gives neither [recording] nor [targets]".into(),
+            ));
+        }
     };
+    let fs_hz = meas.fs_hz;
 
     let fit = &job.job.fit;
     let candidates: Vec<Candidate> = if fit.models.is_empty() {
@@ -723,11 +809,19 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         .bands
         .iter()
         .zip(&model.bands)
-        .map(|(d, m)| {
+        .enumerate()
+        .map(|(i, (d, m))| {
             let (pd, pm) = (d.peak, m.peak);
-            let fd = pd.map(|p| p.freq_hz).unwrap_or(f64::NAN);
             let fm = pm.map(|p| p.freq_hz).unwrap_or(f64::NAN);
+            let range = problem.targets.as_ref().map(|t| t[i]);
+            // Against a target range: the nearest edge (the model's own peak when inside).
+            let fd = match range {
+                Some(r) if fm.is_finite() => fm.clamp(r[0], r[1]),
+                Some(r) => (r[0] * r[1]).sqrt(),
+                None => pd.map(|p| p.freq_hz).unwrap_or(f64::NAN),
+            };
             PeakComparison {
+                target_range_hz: range.filter(|r| r[0] < r[1]),
                 band: d.spec.name.clone(),
                 measured_hz: fd,
                 model_hz: fm,
@@ -738,7 +832,12 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         })
         .collect();
     let mut parameters = parameters;
-    if fit.uncertainty.bootstrap > 0 {
+    let mut warnings = Vec::new();
+    if fit.uncertainty.bootstrap > 0 && problem.targets.is_some() {
+        warnings.push(
+            "no bootstrap intervals for a target job: targets carry no measurement noise".into(),
+        );
+    } else if fit.uncertainty.bootstrap > 0 {
         if let Some(pb) = &pb {
             pb.set_message("bootstrap");
         }
@@ -755,10 +854,9 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     if let Some(pb) = &pb {
         pb.finish_and_clear();
     }
-    let warnings = identifiability_warnings(&parameters, &cf.corr, &cf.best_u);
+    warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
     let evaluations = problem.evaluations.load(Ordering::Relaxed);
     let failures = problem.failures.load(Ordering::Relaxed);
-    let mut warnings = warnings;
     if failures * 10 > evaluations {
         warnings.push(format!(
             "{failures} of {evaluations} model evaluations failed (first: {}); the bounds reach parameter sets the model cannot simulate",
@@ -869,6 +967,7 @@ pub fn bootstrap_intervals(
             let floors: Vec<f64> = measured.bands.iter().map(noise_floor).collect();
             let rep = SpectralProblem {
                 model: problem.model,
+                targets: problem.targets.clone(),
                 base: problem.base,
                 free: problem.free.clone(),
                 measured,

@@ -113,7 +113,13 @@ pub fn write_simulation(dir: &Path, sim: &BladeSimulation) -> Result<()> {
 
 /// The fit's figures: traces, PSDs per band with peaks, the friction law, the cost history.
 pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
-    let meas = o.signal.extract(&o.measured_trace)?;
+    // A target job has no recorded points: its figures show the model against the target lines.
+    let targets_only = o.measured_trace.points.is_empty();
+    let meas = if targets_only {
+        Vec::new()
+    } else {
+        o.signal.extract(&o.measured_trace)?
+    };
     let model = o.signal.extract(&o.best_sim.to_trace())?;
     let t = &o.measured_trace.t_s;
     // Remove each signal's mean so measured (camera frame) and model (model frame) share an axis.
@@ -127,10 +133,18 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
         "tip x − head x: measured and fitted model (means removed)",
         "t [s] (model clock)",
         "tip − head [mm]",
-        &[
-            Series::line("measured", t.clone(), demean(&meas)),
-            Series::line("model", o.best_sim.t_s.clone(), demean(&model)),
-        ],
+        &if targets_only {
+            vec![Series::line(
+                "model",
+                o.best_sim.t_s.clone(),
+                demean(&model),
+            )]
+        } else {
+            vec![
+                Series::line("measured", t.clone(), demean(&meas)),
+                Series::line("model", o.best_sim.t_s.clone(), demean(&model)),
+            ]
+        },
         &ChartOpts::default(),
     )?;
     let head_meas = o
@@ -144,19 +158,37 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
         "head y: measured and fitted model (means removed)",
         "t [s] (model clock)",
         "head y [mm]",
-        &[
-            Series::line("measured", t.clone(), head_meas),
-            Series::line("model", o.best_sim.t_s.clone(), head_model),
-        ],
+        &if targets_only {
+            vec![Series::line("model", o.best_sim.t_s.clone(), head_model)]
+        } else {
+            vec![
+                Series::line("measured", t.clone(), head_meas),
+                Series::line("model", o.best_sim.t_s.clone(), head_model),
+            ]
+        },
         &ChartOpts::default(),
     )?;
     for (d, m) in o.measured.bands.iter().zip(&o.model.bands) {
         let mut markers = Vec::new();
-        if let Some(p) = d.peak {
+        if let Some(p) = d.peak.filter(|_| !targets_only) {
             markers.push(Marker {
                 x: p.freq_hz,
                 y: p.level,
                 label: format!("measured {:.2} Hz", p.freq_hz),
+            });
+        }
+        if let (true, Some(pk), Some(pm)) = (
+            targets_only,
+            o.result.peaks.iter().find(|p| p.band == d.spec.name),
+            m.peak,
+        ) {
+            markers.push(Marker {
+                x: pk.measured_hz,
+                y: pm.level,
+                label: match pk.target_range_hz {
+                    Some(r) => format!("target {:.0}–{:.0} Hz", r[0], r[1]),
+                    None => format!("target {:.2} Hz", pk.measured_hz),
+                },
             });
         }
         if let Some(p) = m.peak {
@@ -174,10 +206,14 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
             ),
             "frequency [Hz]",
             "PSD [m²/Hz]",
-            &[
-                Series::line("measured", d.freq_hz.clone(), d.psd.clone()),
-                Series::line("model", m.freq_hz.clone(), m.psd.clone()),
-            ],
+            &if targets_only {
+                vec![Series::line("model", m.freq_hz.clone(), m.psd.clone())]
+            } else {
+                vec![
+                    Series::line("measured", d.freq_hz.clone(), d.psd.clone()),
+                    Series::line("model", m.freq_hz.clone(), m.psd.clone()),
+                ]
+            },
             &ChartOpts {
                 log_y: true,
                 markers,
