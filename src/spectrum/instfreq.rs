@@ -32,7 +32,7 @@
 //! `σ_v = σ̂·fs/√(Σk²)`, `Σk² = h(h+1)(2h+1)/3`. A stick episode starts where `|v̇3|` falls below
 //! `enter_sigmas·σ_v` (default 2) and ends where it rises above `leave_sigmas·σ_v` (default 4); the
 //! hysteresis stops noise from splitting one long stick into many. On the shipped sample (σ = 0.1 px
-//! = 1.5 µm) this gives σ̂ = 1.49 µm, a threshold of 8.4 mm/s, and finds most true onsets within
+//! = 1.5 µm) this gives σ̂ = 1.49 µm, thresholds of 5.6 (enter) and 11.3 mm/s (leave), and finds most true onsets within
 //! ±0.3 ms; the numbers are measured in `tests/instfreq.rs` and stated in the README. Onsets slower
 //! than the threshold (the last cycles before the reversal, where the tip moves a few µm per cycle)
 //! are below the tracking noise and cannot be seen.
@@ -313,7 +313,9 @@ pub fn ridge_vs_speed(
         if !(peak_psd >= cfg.min_snr * (med + floor)) || peak_psd <= 0.0 {
             return;
         }
-        let end = start + cfg.nperseg - 1;
+        // Segment [start, start + nperseg): its centre is the slice time; the speed is taken
+        // between the first sample and the one after the last (the last one at the record's end).
+        let end = (start + cfg.nperseg).min(tip_x_m.len() - 1);
         let speed = mean_speed(tip_x_m, fs_hz, start, end, cfg.half_width);
         if speed.is_finite() {
             out.push(FreqSpeedPoint {
