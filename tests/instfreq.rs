@@ -256,3 +256,144 @@ fn model_onset_rate_matches_the_independent_transition_list() {
     assert!(mean < 0.01, "mean relative difference {mean}");
     assert!(worst < 0.02, "worst relative difference {worst}");
 }
+
+/// The sample's measured trace and the model at the sample's true parameters on its frames.
+fn sample_and_true_model() -> (
+    wiperlab::trace::Trace,
+    wiperlab::simulate::blade::BladeSimulation,
+    BladeParams,
+) {
+    let job = LoadedJob::load(&root().join("fits/reversal.toml")).unwrap();
+    let trace =
+        wiperlab::import::read_trace(&job.recording_path, &job.job.recording.import).unwrap();
+    let params: BladeParams = toml::from_str(
+        &std::fs::read_to_string(root().join("data/reversal/blade_true.toml")).unwrap(),
+    )
+    .unwrap();
+    let sim = simulate_blade(
+        &params,
+        (trace.t_s[0], *trace.t_s.last().unwrap()),
+        &trace.t_s,
+        &job.job.solver,
+        StickForm::Reduced,
+    )
+    .unwrap();
+    (trace, sim, params)
+}
+
+#[test]
+fn measured_and_true_model_agree_on_frequency_against_speed() {
+    use wiperlab::fit::features::SignalKind;
+    use wiperlab::fit::instfreq::{measured_freq_speed, model_freq_speed};
+    use wiperlab::spectrum::instfreq::{band_floor, bin_by_speed};
+    let (trace, sim, _) = sample_and_true_model();
+    let fs = 1e4;
+    let cfg = RidgeConfig::default();
+    let sig = SignalKind::TipRelX;
+    let meas = measured_freq_speed(&trace, fs, sig, &cfg, &StickDetector::default()).unwrap();
+    let x = sig.extract(&trace).unwrap();
+    let mask: Vec<bool> = x.iter().map(|v| !v.is_finite()).collect();
+    let floor = band_floor(&x, fs, &cfg).unwrap();
+    let model = model_freq_speed(&sim, fs, sig, &cfg, floor, &mask).unwrap();
+    let range = |p: &[wiperlab::spectrum::instfreq::FreqSpeedPoint]| {
+        let f = p.iter().map(|q| q.freq_hz);
+        let v = p.iter().map(|q| q.speed_m_per_s * 1e3);
+        (
+            f.clone().fold(f64::INFINITY, f64::min),
+            f.fold(0.0, f64::max),
+            v.clone().fold(f64::INFINITY, f64::min),
+            v.fold(0.0, f64::max),
+        )
+    };
+    for (name, fsp) in [("measured", &meas), ("model (true parameters)", &model)] {
+        let (f0, f1, v0, v1) = range(&fsp.ridge);
+        println!(
+            "{name}: {} ridge points, {f0:.0}–{f1:.0} Hz at {v0:.2}–{v1:.2} mm/s; {} onset-rate points",
+            fsp.ridge.len(),
+            fsp.onsets.len()
+        );
+    }
+    let vmax = meas
+        .ridge
+        .iter()
+        .map(|p| p.speed_m_per_s)
+        .fold(0.0, f64::max);
+    let bm = bin_by_speed(&meas.ridge, vmax, 8);
+    let bo = bin_by_speed(&model.ridge, vmax, 8);
+    let mut worst: f64 = 0.0;
+    for ((v, fd), (_, fm)) in bm.iter().zip(&bo) {
+        println!(
+            "  bin {:6.2} mm/s: measured {fd:6.1} Hz, model {fm:6.1} Hz",
+            v * 1e3
+        );
+        if fd.is_finite() {
+            assert!(fm.is_finite(), "model has no ridge point at {v} m/s");
+            worst = worst.max((fm / fd).ln().abs());
+        }
+    }
+    println!(
+        "  worst |ln(f_model/f_measured)| over the bins: {:.2} %",
+        100.0 * worst
+    );
+    assert!(meas.ridge.len() >= 15 && model.ridge.len() >= 15);
+    // Tolerance 3 %: the model here runs at the fit's rtol 1e-8 while the recording was made at
+    // rtol 1e-10, and data/reversal/README.md measures the reference's own high peak moving by
+    // 2.4 % between those tolerances (884.0 against 862.8 Hz); stick–slip timing is that sensitive.
+    assert!(worst < 0.03, "worst bin difference {worst}");
+}
+
+#[test]
+fn freq_speed_cost_prefers_the_true_neck_stiffness() {
+    use wiperlab::fit::features::SignalKind;
+    use wiperlab::fit::instfreq::TimeTargets;
+    use wiperlab::fit::job::Weights;
+    let (trace, sim, params) = sample_and_true_model();
+    let sig = SignalKind::TipRelX;
+    let x = sig.extract(&trace).unwrap();
+    let w = Weights {
+        freq_speed: 1.0,
+        trace: 1.0,
+        ..Weights::default()
+    };
+    let only = |freq_speed: f64, tr: f64| {
+        TimeTargets::for_job(
+            &Weights {
+                freq_speed,
+                trace: tr,
+                ..w
+            },
+            &trace,
+            &x,
+            1e4,
+            sig,
+        )
+        .unwrap()
+        .unwrap()
+    };
+    let (tf, tt) = (only(1.0, 0.0), only(0.0, 1.0));
+    let job = LoadedJob::load(&root().join("fits/reversal.toml")).unwrap();
+    let mut rows = vec![(1.0, tf.cost(&sim).unwrap(), tt.cost(&sim).unwrap())];
+    for factor in [0.8, 1.25] {
+        let mut p = params;
+        p.k1_nm_per_rad *= factor;
+        let s = simulate_blade(
+            &p,
+            (trace.t_s[0], *trace.t_s.last().unwrap()),
+            &trace.t_s,
+            &job.job.solver,
+            StickForm::Reduced,
+        )
+        .unwrap();
+        rows.push((factor, tf.cost(&s).unwrap(), tt.cost(&s).unwrap()));
+    }
+    for (f, cf, ct) in &rows {
+        println!("k1 × {f}: freq_speed term {cf:.2}, trace term {ct:.4}");
+    }
+    // At the true parameters every bin is within 3 % (previous test), so the term is below
+    // (3 %/1 %)² = 9. Moving k1 by −20 % / +25 % must raise it clearly (factor 3 asked; the free
+    // neck's frequency scales as √k1, ±10 %, but the stick–slip ridge moves less: measured 25 and
+    // 17 against 1.2). The trace term, dominated by the slow relative motion, must rise too.
+    assert!(rows[0].1 < 9.0, "{}", rows[0].1);
+    assert!(rows[1].1 > 3.0 * rows[0].1 && rows[2].1 > 3.0 * rows[0].1);
+    assert!(rows[1].2 > rows[0].2 && rows[2].2 > rows[0].2);
+}

@@ -11,6 +11,7 @@
 //! coordinates `u ∈ [0, 1]` (logarithmic for bounds spanning a factor ≥ 10).
 
 pub mod features;
+pub mod instfreq;
 pub mod job;
 
 use crate::model::BladeParams;
@@ -87,6 +88,8 @@ pub struct SpectralProblem {
     pub window: (f64, f64),
     pub solver: SolverOptions,
     pub weights: Weights,
+    /// Optional frequency-against-speed and trace-error terms (`None` when their weights are 0).
+    pub time_targets: Option<instfreq::TimeTargets>,
     pub evaluations: Arc<AtomicUsize>,
     pub failures: AtomicUsize,
     pub first_failure: Mutex<Option<String>>,
@@ -157,6 +160,15 @@ impl SpectralProblem {
         total
     }
 
+    /// Spectral cost of a simulation plus the optional time-domain terms ([`instfreq::TimeTargets`]).
+    pub fn total_cost(&self, sim: &BladeSimulation) -> Result<f64> {
+        let spectral = self.cost_of(&self.model_features(sim)?);
+        Ok(match &self.time_targets {
+            Some(t) => spectral + t.cost(sim)?,
+            None => spectral,
+        })
+    }
+
     /// Cost at normalised coordinates, with a quadratic penalty outside the box.
     pub fn cost_at(&self, u: &[f64]) -> f64 {
         let outside: f64 = u
@@ -168,8 +180,8 @@ impl SpectralProblem {
         if let Some(pb) = &self.progress {
             pb.inc(1);
         }
-        let c = match self.simulate(&p).and_then(|s| self.model_features(&s)) {
-            Ok(f) => self.cost_of(&f),
+        let c = match self.simulate(&p).and_then(|s| self.total_cost(&s)) {
+            Ok(c) => c,
             Err(e) => {
                 self.failures.fetch_add(1, Ordering::Relaxed);
                 let mut g = self.first_failure.lock().unwrap_or_else(|e| e.into_inner());
@@ -391,6 +403,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         window: (trace.t_s[0], *trace.t_s.last().unwrap_or(&trace.t_s[0])),
         solver: job.job.solver,
         weights: fit.weights,
+        time_targets: instfreq::TimeTargets::for_job(&fit.weights, &trace, &x, fs_hz, signal)?,
         evaluations: evaluations.clone(),
         failures: AtomicUsize::new(0),
         first_failure: Mutex::new(None),
@@ -472,7 +485,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let best_params = problem.params_at(&best_u);
     let best_sim = problem.simulate(&best_params)?;
     let model = problem.model_features(&best_sim)?;
-    let cost = problem.cost_of(&model);
+    let cost = problem.total_cost(&best_sim)?;
 
     let parameters: Vec<FittedParam> = free
         .iter()

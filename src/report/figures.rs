@@ -217,6 +217,7 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
         &series,
         &ChartOpts::default(),
     )?;
+    freq_vs_speed_figure(dir, o)?;
     let (it, c): (Vec<f64>, Vec<f64>) = o
         .result
         .history
@@ -234,6 +235,26 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
             ..ChartOpts::default()
         },
     )
+}
+
+/// `freq_vs_speed.svg`: instantaneous frequency against lip-tip speed, measurement and fitted model
+/// (see [`crate::fit::instfreq`]), with the default ridge and stick-detector settings.
+fn freq_vs_speed_figure(dir: &Path, o: &FitOutcome) -> Result<()> {
+    use crate::fit::instfreq::{freq_speed_figure, measured_freq_speed, model_freq_speed};
+    use crate::spectrum::instfreq::{RidgeConfig, StickDetector, band_floor};
+    let cfg = RidgeConfig::default();
+    let meas = measured_freq_speed(
+        &o.measured_trace,
+        o.fs_hz,
+        o.signal,
+        &cfg,
+        &StickDetector::default(),
+    )?;
+    let x = o.signal.extract(&o.measured_trace)?;
+    let mask: Vec<bool> = x.iter().map(|v| !v.is_finite()).collect();
+    let floor = band_floor(&x, o.fs_hz, &cfg)?;
+    let model = model_freq_speed(&o.best_sim, o.fs_hz, o.signal, &cfg, floor, &mask)?;
+    freq_speed_figure(dir, &meas, &model, cfg.band_hz)
 }
 
 /// A human-readable summary of a fit result.

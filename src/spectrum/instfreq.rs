@@ -239,7 +239,8 @@ fn for_each_slice(
     cfg: &RidgeConfig,
     mut f: impl FnMut(usize, &[f64], &[f64]),
 ) -> Result<()> {
-    if !(cfg.band_hz.0 >= 0.0 && cfg.band_hz.0 < cfg.band_hz.1) || !(cfg.min_snr >= 0.0) {
+    let valid = cfg.band_hz.0 >= 0.0 && cfg.band_hz.0 < cfg.band_hz.1 && cfg.min_snr >= 0.0;
+    if !valid {
         return Err(Error::Config(format!(
             "instantaneous frequency: need 0 <= band low < band high and min_snr >= 0 (got band {:?} Hz, min_snr {})",
             cfg.band_hz, cfg.min_snr
@@ -310,7 +311,8 @@ pub fn ridge_vs_speed(
         let mut band: Vec<f64> = in_band(freq, row, cfg.band_hz).map(|(_, p)| p).collect();
         let peak_psd = band.iter().copied().fold(0.0, f64::max);
         let med = median_in_place(&mut band);
-        if !(peak_psd >= cfg.min_snr * (med + floor)) || peak_psd <= 0.0 {
+        let strong = peak_psd > 0.0 && peak_psd >= cfg.min_snr * (med + floor);
+        if !strong {
             return;
         }
         // Segment [start, start + nperseg): its centre is the slice time; the speed is taken
@@ -445,7 +447,8 @@ pub fn onset_rate_vs_speed(
 ) -> Vec<FreqSpeedPoint> {
     let pos = |t: f64| -> f64 {
         let u = (t - t0_s) * fs_hz;
-        if !(u >= 0.0) || u > (tip_x_m.len().saturating_sub(1)) as f64 {
+        let inside = u >= 0.0 && u <= (tip_x_m.len().saturating_sub(1)) as f64;
+        if !inside {
             return f64::NAN;
         }
         let j = (u.floor() as usize).min(tip_x_m.len().saturating_sub(2));
