@@ -145,13 +145,15 @@ fn stick_onsets_found_on_the_sample() {
     let (matched, errs) = match_onsets(&truth, &det.onsets_s, 3e-4);
     let false_alarms = det.onsets_s.len() - matched;
     let mean_err = errs.iter().sum::<f64>() / errs.len().max(1) as f64;
+    let rms_err = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len().max(1) as f64).sqrt();
     println!(
-        "sample: σ̂ = {:.3} µm, threshold {:.2} mm/s; {} onsets detected, {matched}/{} true onsets within ±0.3 ms, {false_alarms} unmatched detections, mean timing error {:+.3} ms",
+        "sample: σ̂ = {:.3} µm, threshold {:.2} mm/s; {} onsets detected, {matched}/{} true onsets within ±0.3 ms, {false_alarms} unmatched detections, timing error mean {:+.3} ms, rms {:.3} ms",
         det.noise_m * 1e6,
         det.threshold_m_per_s * 1e3,
         det.onsets_s.len(),
         truth.len(),
-        mean_err * 1e3
+        mean_err * 1e3,
+        rms_err * 1e3
     );
     // Stated tolerance: at least 55 % of the true onsets found (the last cycles before the
     // reversal move the tip by a few µm per cycle, below the 1.5 µm noise), at least 80 % of the
@@ -336,6 +338,21 @@ fn measured_and_true_model_agree_on_frequency_against_speed() {
         100.0 * worst
     );
     assert!(meas.ridge.len() >= 15 && model.ridge.len() >= 15);
+    // The figure the fit writes, here with the true model: all four series are drawn.
+    let dir = std::env::temp_dir().join(format!("wiperlab_instfreq_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    wiperlab::fit::instfreq::freq_speed_figure(&dir, &meas, &model, cfg.band_hz).unwrap();
+    let svg = std::fs::read_to_string(dir.join("freq_vs_speed.svg")).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    for label in [
+        "measured: spectrogram ridge",
+        "model: spectrogram ridge",
+        "measured: 1/stick-onset interval",
+        "model: 1/stick-onset interval",
+    ] {
+        assert!(svg.contains(label), "{label} missing from the figure");
+    }
+    assert!(svg.matches("<circle").count() >= meas.ridge.len() + model.ridge.len());
     // Tolerance 3 %: the model here runs at the fit's rtol 1e-8 while the recording was made at
     // rtol 1e-10, and data/reversal/README.md measures the reference's own high peak moving by
     // 2.4 % between those tolerances (884.0 against 862.8 Hz); stick–slip timing is that sensitive.
