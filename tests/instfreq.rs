@@ -155,8 +155,8 @@ fn stick_onsets_found_on_the_sample() {
         mean_err * 1e3,
         rms_err * 1e3
     );
-    // Stated tolerance: at least 55 % of the true onsets found (the last cycles before the
-    // reversal move the tip by a few µm per cycle, below the 1.5 µm noise), at least 80 % of the
+    // Stated tolerance: at least 55 % of the true onsets found (sticks much shorter than the
+    // 0.7 ms slope window between fast slips after the reversal are averaged away), at least 80 % of the
     // detections are true onsets, and no systematic timing bias beyond one frame (0.1 ms).
     assert!(
         matched as f64 >= 0.55 * truth.len() as f64,
