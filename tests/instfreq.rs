@@ -168,6 +168,16 @@ fn stick_onsets_found_on_the_sample() {
         det.onsets_s.len()
     );
     assert!(mean_err.abs() < 1e-4, "mean timing error {mean_err} s");
+    // Before the reversal (truth.json params.t_reversal_s = 1.8868 s) the burst's sticks last
+    // 0.2–0.4 ms at 13–20 mm/s and the detector should find nearly all of them: at least 20 of 24.
+    let t_rev = 1.8868397388770275;
+    let pre: Vec<f64> = truth.iter().copied().filter(|t| *t < t_rev).collect();
+    let (pre_found, _) = match_onsets(&pre, &det.onsets_s, 3e-4);
+    println!(
+        "  before the reversal: {pre_found} of {} true onsets found",
+        pre.len()
+    );
+    assert!(pre_found >= 20, "{pre_found} of {}", pre.len());
 }
 
 #[test]
