@@ -424,3 +424,45 @@ fn freq_speed_cost_prefers_the_true_neck_stiffness() {
     assert!(rows[1].1 > 3.0 * rows[0].1 && rows[2].1 > 3.0 * rows[0].1);
     assert!(rows[1].2 > rows[0].2 && rows[2].2 > rows[0].2);
 }
+
+#[test]
+fn fit_job_with_freq_speed_and_trace_terms_runs_and_reports_them() {
+    use wiperlab::fit::instfreq::TimeTargets;
+    // The main job with both optional terms on and a tiny budget (this checks the plumbing, not
+    // the optimum): the reported cost must include the time-domain terms of the best model.
+    let text = std::fs::read_to_string(root().join("fits/reversal.toml"))
+        .unwrap()
+        .replace("\"../data/", &format!("\"{}/data/", root().display()))
+        .replace("name = \"reversal\"", "name = \"instfreq_terms\"")
+        .replace("particles = 24", "particles = 2")
+        .replace("swarm_iterations = 25", "swarm_iterations = 1")
+        .replace("polish_iterations = 60", "polish_iterations = 1")
+        + "\n[fit.weights]\nfreq_speed = 1.0\ntrace = 1.0\n";
+    let path =
+        std::env::temp_dir().join(format!("wiperlab_instfreq_job_{}.toml", std::process::id()));
+    std::fs::write(&path, text).unwrap();
+    let job = LoadedJob::load(&path);
+    let _ = std::fs::remove_file(&path);
+    let job = job.unwrap();
+    assert_eq!(job.job.fit.weights.freq_speed, 1.0);
+    assert_eq!(job.job.fit.weights.trace, 1.0);
+    let out = wiperlab::fit::run_fit(&job, false).unwrap();
+    let x = out.signal.extract(&out.measured_trace).unwrap();
+    let extra = TimeTargets::for_job(
+        &job.job.fit.weights,
+        &out.measured_trace,
+        &x,
+        out.fs_hz,
+        out.signal,
+    )
+    .unwrap()
+    .unwrap()
+    .cost(&out.best_sim)
+    .unwrap();
+    println!(
+        "tiny fit with both terms: cost {:.3}, of which time-domain terms {extra:.3}",
+        out.result.cost
+    );
+    assert!(extra > 0.0 && extra.is_finite());
+    assert!(out.result.cost >= extra, "{} < {extra}", out.result.cost);
+}
