@@ -312,6 +312,55 @@ mod tests {
     }
 
     #[test]
+    fn noise_free_trace_gives_a_note_not_an_error() {
+        use crate::trace::PointTrack;
+        // A tip held exactly still (no tracking noise, not even rounding: Δ²x = 0): no ridge (no
+        // high-frequency content) and no stick detection (the noise threshold cannot be set),
+        // said in the note. (A moving float trace has rounding noise, which sets a tiny threshold.)
+        let n = 2000;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 / 1e4).collect();
+        let tr = Trace {
+            t_s: t.clone(),
+            points: vec![
+                PointTrack {
+                    name: "head".into(),
+                    x_m: t.iter().map(|t| 0.01 * t).collect(),
+                    y_m: vec![0.0; n],
+                },
+                PointTrack {
+                    name: "tip".into(),
+                    x_m: vec![0.05; n],
+                    y_m: vec![0.0; n],
+                },
+            ],
+        };
+        let fsp = measured_freq_speed(
+            &tr,
+            1e4,
+            SignalKind::TipX,
+            &RidgeConfig::default(),
+            &StickDetector::default(),
+        )
+        .unwrap();
+        assert!(fsp.ridge.is_empty() && fsp.onsets.is_empty());
+        assert!(fsp.note.as_deref().unwrap_or("").contains("noise"));
+        // Without a tip point it is a configuration error naming the role.
+        let no_tip = Trace {
+            t_s: t,
+            points: vec![tr.points[0].clone()],
+        };
+        let e = measured_freq_speed(
+            &no_tip,
+            1e4,
+            SignalKind::HeadY,
+            &RidgeConfig::default(),
+            &StickDetector::default(),
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("'tip'"), "{e}");
+    }
+
+    #[test]
     fn zero_weights_build_nothing() {
         let tr = Trace {
             t_s: vec![0.0, 1.0],

@@ -157,7 +157,8 @@ pub struct RidgeConfig {
     /// FFT length (zero padding), samples.
     pub nfft: usize,
     /// A slice's ridge point is kept when its peak PSD is at least `min_snr` times the slice's
-    /// median PSD in the band plus the caller's noise floor.
+    /// median PSD in the band plus the caller's noise floor (plus a rounding floor
+    /// `(1e-12·max|x|)²/fs`, so a signal constant to rounding has no ridge).
     pub min_snr: f64,
     /// Gaps (NaN runs) of up to this many samples are filled by linear interpolation; slices that
     /// would straddle a longer gap are skipped.
@@ -313,7 +314,14 @@ pub fn ridge_vs_speed(
         let mut band: Vec<f64> = in_band(freq, row, cfg.band_hz).map(|(_, p)| p).collect();
         let peak_psd = band.iter().copied().fold(0.0, f64::max);
         let med = median_in_place(&mut band);
-        let strong = peak_psd > 0.0 && peak_psd >= cfg.min_snr * (med + floor);
+        // Rounding floor: a signal that is constant up to f64 rounding (relative 1e-12 of its
+        // magnitude) has no ridge, however its rounding residue is shaped.
+        let scale = signal[start..start + cfg.nperseg]
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold(0.0, |m: f64, v| m.max(v.abs()));
+        let rounding = (1e-12 * scale).powi(2) / fs_hz;
+        let strong = peak_psd > 0.0 && peak_psd >= cfg.min_snr * (med + floor + rounding);
         if !strong {
             return;
         }
