@@ -126,6 +126,12 @@ pub struct Weights {
     pub level: f64,
     /// Weight of the mean squared log-PSD difference across each band.
     pub shape: f64,
+    /// Weight of the instantaneous frequency against tip speed (spectrogram ridge, binned by
+    /// speed; `(Δln f / 0.01)²` per bin, see [`super::instfreq`]). Default 0: off.
+    pub freq_speed: f64,
+    /// Weight of the time-domain error of the job's signal (means removed, relative to the
+    /// measurement's variance; see [`super::instfreq::trace_error`]). Default 0: off.
+    pub trace: f64,
 }
 
 impl Default for Weights {
@@ -134,6 +140,8 @@ impl Default for Weights {
             peak: 1.0,
             level: 1.0,
             shape: 1.0,
+            freq_speed: 0.0,
+            trace: 0.0,
         }
     }
 }

@@ -11,6 +11,7 @@
 //! coordinates `u ∈ [0, 1]` (logarithmic for bounds spanning a factor ≥ 10).
 
 pub mod features;
+pub mod instfreq;
 pub mod job;
 pub mod result;
 
@@ -94,6 +95,8 @@ pub struct SpectralProblem {
     pub window: (f64, f64),
     pub solver: SolverOptions,
     pub weights: Weights,
+    /// Optional frequency-against-speed and trace-error terms (`None` when their weights are 0).
+    pub time_targets: Option<instfreq::TimeTargets>,
     pub evaluations: Arc<AtomicUsize>,
     pub failures: AtomicUsize,
     pub first_failure: Mutex<Option<String>>,
@@ -168,6 +171,15 @@ impl SpectralProblem {
         total
     }
 
+    /// Spectral cost of a simulation plus the optional time-domain terms ([`instfreq::TimeTargets`]).
+    pub fn total_cost(&self, sim: &BladeSimulation) -> Result<f64> {
+        let spectral = self.cost_of(&self.model_features(sim)?);
+        Ok(match &self.time_targets {
+            Some(t) => spectral + t.cost(sim)?,
+            None => spectral,
+        })
+    }
+
     /// Cost at normalised coordinates, with a quadratic penalty outside the box.
     pub fn cost_at(&self, u: &[f64]) -> f64 {
         let outside: f64 = u
@@ -179,8 +191,8 @@ impl SpectralProblem {
         if let Some(pb) = &self.progress {
             pb.inc(1);
         }
-        let c = match self.simulate(&p).and_then(|s| self.model_features(&s)) {
-            Ok(f) => self.cost_of(&f),
+        let c = match self.simulate(&p).and_then(|s| self.total_cost(&s)) {
+            Ok(c) => c,
             Err(e) => {
                 self.failures.fetch_add(1, Ordering::Relaxed);
                 let mut g = self.first_failure.lock().unwrap_or_else(|e| e.into_inner());
@@ -337,6 +349,8 @@ pub fn smallest_capable_model(bands: &[BandSpec]) -> ModelKind {
 struct Measurement {
     /// Target ranges per band (a target job), instead of measured peaks.
     targets: Option<Vec<[f64; 2]>>,
+    /// Time-domain objectives (frequency against tip speed, trace error) when weighted.
+    time_targets: Option<instfreq::TimeTargets>,
     trace: Trace,
     x: Vec<f64>,
     fs_hz: f64,
@@ -393,6 +407,7 @@ fn fit_candidate(
     let problem = Arc::new(SpectralProblem {
         model: candidate.kind,
         targets: meas.targets.clone(),
+        time_targets: meas.time_targets.clone(),
         base,
         free: free.clone(),
         measured: Features {
@@ -573,6 +588,13 @@ fn measure_recording(job: &LoadedJob, spec: &crate::import::ImportSpec) -> Resul
     }
     let floors: Vec<f64> = measured.bands.iter().map(noise_floor).collect();
     Ok(Measurement {
+        time_targets: instfreq::TimeTargets::for_job(
+            &job.job.fit.weights,
+            &trace,
+            &x,
+            fs_hz,
+            signal,
+        )?,
         trace,
         x,
         fs_hz,
@@ -620,6 +642,7 @@ fn measure_targets(job: &LoadedJob, t: &job::TargetsSection) -> Result<Measureme
         measured: Features { bands, filled: 0 },
         floors: vec![0.0; job.job.spectrum.bands.len()],
         targets: Some(targets),
+        time_targets: None,
     })
 }
 
@@ -781,7 +804,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let best_params = problem.params_at(&cf.best_u);
     let best_sim = problem.simulate(&best_params)?;
     let model = problem.model_features(&best_sim)?;
-    let cost = problem.cost_of(&model);
+    let cost = problem.total_cost(&best_sim)?;
 
     let parameters: Vec<FittedParam> = cf
         .free
@@ -968,6 +991,8 @@ pub fn bootstrap_intervals(
             let rep = SpectralProblem {
                 model: problem.model,
                 targets: problem.targets.clone(),
+                // The time-domain targets stay the recording's (they are not re-noised).
+                time_targets: problem.time_targets.clone(),
                 base: problem.base,
                 free: problem.free.clone(),
                 measured,

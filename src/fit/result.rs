@@ -221,6 +221,7 @@ mod tests {
                 rel_diff: 0.5 / 49.0,
                 measured_level: 1e-9,
                 model_level: 2e-9,
+                target_range_hz: None,
             }],
             undetermined: vec![],
             correlation: vec![vec![f64::NAN]],

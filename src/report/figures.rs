@@ -253,6 +253,7 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
         &series,
         &ChartOpts::default(),
     )?;
+    freq_vs_speed_figure(dir, o)?;
     let (it, c): (Vec<f64>, Vec<f64>) = o
         .result
         .history
@@ -270,6 +271,40 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
             ..ChartOpts::default()
         },
     )
+}
+
+/// `freq_vs_speed.svg`: instantaneous frequency against lip-tip speed, measurement and fitted model
+/// (see [`crate::fit::instfreq`]), with the default ridge and stick-detector settings. Not written
+/// when the recording has no `tip` point or neither estimator finds a point in the band.
+fn freq_vs_speed_figure(dir: &Path, o: &FitOutcome) -> Result<()> {
+    use crate::fit::instfreq::{freq_speed_figure, measured_freq_speed, model_freq_speed};
+    use crate::spectrum::instfreq::{RidgeConfig, StickDetector, band_floor};
+    if o.measured_trace.point("tip").is_none() {
+        return Ok(());
+    }
+    let cfg = RidgeConfig::default();
+    let meas = measured_freq_speed(
+        &o.measured_trace,
+        o.fs_hz,
+        o.signal,
+        &cfg,
+        &StickDetector::default(),
+    )?;
+    let x = o.signal.extract(&o.measured_trace)?;
+    let mask: Vec<bool> = x.iter().map(|v| !v.is_finite()).collect();
+    let floor = band_floor(&x, o.fs_hz, &cfg)?;
+    let model = model_freq_speed(&o.best_sim, o.fs_hz, o.signal, &cfg, floor, &mask)?;
+    let in_band = |p: &[crate::spectrum::instfreq::FreqSpeedPoint]| {
+        p.iter()
+            .any(|q| q.freq_hz >= cfg.band_hz.0 && q.freq_hz <= cfg.band_hz.1)
+    };
+    if [&meas.ridge, &meas.onsets, &model.ridge, &model.onsets]
+        .iter()
+        .all(|p| !in_band(p))
+    {
+        return Ok(());
+    }
+    freq_speed_figure(dir, &meas, &model, cfg.band_hz)
 }
 
 /// A human-readable summary of a fit result.
