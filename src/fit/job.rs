@@ -24,6 +24,10 @@ pub struct FitJob {
     /// Target peak frequencies instead of a recording (e.g. the seed paper's own numbers).
     #[serde(default)]
     pub targets: Option<TargetsSection>,
+    /// Further recordings of the same blade (e.g. other sweep speeds) fitted together with
+    /// `[recording]`: they share every freed parameter, each with its own drive.
+    #[serde(default)]
+    pub more_recordings: Vec<MoreRecording>,
     /// Blade parameter file (TOML with [`BladeParams`] fields); the freed parameters' values in it
     /// are ignored by the fit.
     pub blade: PathBuf,
@@ -93,6 +97,22 @@ pub struct RecordingSection {
     /// Import settings (format, fps, scale, roles); `t0_s` puts frame 1 on the model's clock,
     /// where the drive is `v = a(1 − cos ωt)`.
     pub import: ImportSpec,
+}
+
+/// Another recording in a joint fit: where it is, how to read it, and its drive.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MoreRecording {
+    /// Label used in the result's peak table (e.g. "slow").
+    pub name: String,
+    pub file: PathBuf,
+    pub import: ImportSpec,
+    /// Drive amplitude of this recording, m (default: the blade file's).
+    #[serde(default)]
+    pub drive_a_m: Option<f64>,
+    /// Drive angular frequency of this recording, rad/s (default: the blade file's).
+    #[serde(default)]
+    pub drive_omega_rad_per_s: Option<f64>,
 }
 
 /// Spectral estimator settings shared by measurement and model.
@@ -532,6 +552,34 @@ impl LoadedJob {
                     1,
                     "a fit job gives either [recording] (a tracked recording) or [targets] (frequencies to reach), and exactly one of them",
                 ));
+            }
+        }
+        if !job.more_recordings.is_empty() && job.recording.is_none() {
+            return Err(Error::parse(
+                path,
+                line_of(&text, "[[more_recordings]]"),
+                1,
+                "[[more_recordings]] needs a [recording] to join (not a [targets] job)",
+            ));
+        }
+        for m in &job.more_recordings {
+            for (what, v) in [
+                ("drive_a_m", m.drive_a_m),
+                ("drive_omega_rad_per_s", m.drive_omega_rad_per_s),
+            ] {
+                if let Some(x) = v
+                    && !(x.is_finite() && x > 0.0)
+                {
+                    return Err(Error::parse(
+                        path,
+                        line_of(&text, &m.name),
+                        1,
+                        format!(
+                            "[[more_recordings]] '{}': {what} must be > 0 (got {x})",
+                            m.name
+                        ),
+                    ));
+                }
             }
         }
         job.solver.validate()?;
