@@ -264,7 +264,7 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
     } else {
         1.0
     };
-    let scale = spec.units_to_m;
+    let scale = spec.units_to_m.unwrap_or(1.0);
     let label = |j: usize| -> String {
         match columns.iter().find(|(_, x, y)| *x == j || *y == j) {
             Some((name, _, _)) => format!("{} (track {name})", header[j]),
@@ -455,7 +455,7 @@ mod tests {
         let f = temp("comma", "t;x;y;\n0,0;1,5;\u{2212}2,25\n0,1;;\n");
         let spec = ImportSpec {
             decimal_comma: true,
-            units_to_m: 0.01,
+            units_to_m: Some(0.01),
             ..ImportSpec::default()
         };
         let t = read(&f.0, &spec).unwrap();
