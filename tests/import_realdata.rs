@@ -1,0 +1,281 @@
+//! One test per real tracking-tool export in `../shared/realdata` (skipped with a printed reason
+//! when `../shared` is absent): each is read through `wiperlab::import::read_trace_with_summary`
+//! and its row, point and gap counts are checked against counts made independently of wiperlab
+//! (SOURCES.md tables, or the awk one-off quoted at each test). Where SOURCES.md gives a dominant
+//! frequency, the spectrum of the imported trace must find it within the stated accuracy.
+//!
+//! DLTdv `xypts.csv` and the Tracker pendulums are covered in `tests/import.rs` and
+//! `tests/spectrum_realdata.rs`.
+
+mod common;
+
+use common::shared;
+use wiperlab::import::{Format, ImportSpec, read_trace_with_summary};
+use wiperlab::spectrum::{WelchConfig, find_peak, resample_uniform, welch_gappy};
+use wiperlab::trace::Trace;
+
+fn spec(format: Format) -> ImportSpec {
+    ImportSpec {
+        format: Some(format),
+        ..ImportSpec::default()
+    }
+}
+
+fn names(t: &Trace) -> Vec<&str> {
+    t.points.iter().map(|p| p.name.as_str()).collect()
+}
+
+fn nan_samples(t: &Trace) -> usize {
+    t.points.iter().map(|p| p.nan_samples()).sum()
+}
+
+/// Peak frequency (Hz) of `x` (uniformly sampled at `fs_hz`, NaN gaps ≤ 5 samples filled) in
+/// `band`: Welch with Hann segments of `nperseg`, zero-padded to `nfft`, parabolic interpolation.
+fn peak_hz(x: &[f64], fs_hz: f64, nperseg: usize, nfft: usize, band: (f64, f64)) -> f64 {
+    let cfg = WelchConfig::new(nperseg).with_nfft(nfft).unwrap();
+    let (psd, gaps) = welch_gappy(x, fs_hz, &cfg, 5).unwrap();
+    let p = find_peak(&psd.freq_hz, &psd.density, band).expect("a peak in the band");
+    println!(
+        "  peak {:.4} Hz (nperseg {nperseg}, nfft {nfft}; {} filled, {} dropped, {} runs)",
+        p.freq_hz, gaps.filled, gaps.dropped, gaps.runs
+    );
+    p.freq_hz
+}
+
+/// `pas_camera_01.txt`: SOURCES.md kinovea/ table — 5 markers, 500 data lines; each section has
+/// 100 rows (`awk '/^#/{s++} s>=1 && NF>0 && !/^#/{n[s]++} END{for(i in n) print i, n[i]}'`),
+/// all sections on the same 100 times, no missing value. Coordinates use decimal commas: the first
+/// row of `# métatarses` is `0.000 77,20 -21,97`.
+#[test]
+fn kinovea_txt_pas_camera_01() {
+    let Some(path) = shared("realdata/kinovea/pas_camera_01.txt") else {
+        return;
+    };
+    let s = ImportSpec {
+        units_to_m: Some(0.01),
+        ..ImportSpec::default()
+    };
+    let (t, sum) = read_trace_with_summary(&path, &s).unwrap();
+    assert_eq!(sum.format, Some(Format::KinoveaTxt), "detected by content");
+    assert_eq!(
+        names(&t),
+        ["métatarses", "tarse", "jarret", "hanche", "pointe dos"]
+    );
+    assert_eq!(t.len(), 100);
+    assert_eq!(nan_samples(&t), 0);
+    let m = t.point("métatarses").unwrap();
+    assert!((m.x_m[0] - 0.7720).abs() < 1e-12 && (m.y_m[0] + 0.2197).abs() < 1e-12);
+    assert_eq!(t.t_s[1], 0.008);
+}
+
+/// `trop_camera_03.txt`: SOURCES.md — 6 markers, 394 data lines; per section 59, 67, 67, 67, 67,
+/// 67 rows and 67 distinct times over all sections
+/// (`awk '/^#/{s++; next} NF>0{n[s]++; t[$1]=1} END{...}'`), so métatarses has 67 − 59 = 8 NaN
+/// samples and the others none.
+#[test]
+fn kinovea_txt_trop_camera_03() {
+    let Some(path) = shared("realdata/kinovea/trop_camera_03.txt") else {
+        return;
+    };
+    let s = ImportSpec {
+        units_to_m: Some(0.01),
+        ..ImportSpec::default()
+    };
+    let (t, sum) = read_trace_with_summary(&path, &s).unwrap();
+    assert_eq!(t.len(), 67);
+    assert_eq!(t.points.len(), 6);
+    assert_eq!(t.point("métatarses").unwrap().nan_samples(), 8);
+    assert_eq!(nan_samples(&t), 8);
+    assert_eq!(sum.points.iter().map(|p| p.1).sum::<usize>(), 8);
+    // Without a unit the import refuses rather than guessing cm or pixels.
+    let err = read_trace_with_summary(&path, &ImportSpec::default())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("units_to_m"), "{err}");
+}
+
+/// `v1.csv`: SOURCES.md — header `Time (ms),HEAD,Knee,ankle,food`, 126 rows at 40 ms steps
+/// (first row 40, last 5040: `head -2`, `tail -1`). Four scalar columns → four points whose x holds
+/// the value and whose y is NaN.
+#[test]
+fn kinovea_kinematics_v1() {
+    let Some(path) = shared("realdata/kinovea/v1.csv") else {
+        return;
+    };
+    let s = ImportSpec {
+        units_to_m: Some(1.0),
+        ..ImportSpec::default()
+    };
+    let (t, sum) = read_trace_with_summary(&path, &s).unwrap();
+    assert_eq!(sum.format, Some(Format::KinoveaKinematics));
+    assert_eq!(t.len(), 126);
+    assert_eq!(names(&t), ["HEAD", "Knee", "ankle", "food"]);
+    assert!((t.t_s[0] - 0.040).abs() < 1e-12 && (t.t_s[125] - 5.040).abs() < 1e-12);
+    assert!((sum.dt_median_s - 0.040).abs() < 1e-9);
+    assert_eq!(t.points[0].x_m[0], 65.1052398681641);
+    assert!(t.points.iter().all(|p| p.x_m.iter().all(|v| v.is_finite())));
+    assert!(t.points.iter().all(|p| p.y_m.iter().all(|v| v.is_nan())));
+}
+
+const DLC_IL5: &str = "realdata/deeplabcut/IL5-519-Cam2_2020-06-25_000124Track9DLC_resnet50_Austin2020_accuracy_testApr7shuffle3_1150000.csv";
+const DLC_AFAM: &str = "realdata/deeplabcut/AFAMcarollia_1Apr2021_0790C_Bane_Y20210401H145003.312743000_F1_croppedDLC_resnet50_Brown2021_accuracy_testJan28shuffle1_450000.csv";
+
+/// Count check of a DeepLabCut file: `rows` frames, 16 body parts, and the number of point
+/// samples with likelihood < 0.6, counted by
+/// `awk -F, 'NR>3{for(i=4;i<=NF;i+=3) if($i<0.6) c++} END{print c}'` — each becomes a NaN sample.
+fn dlc_counts(rel: &str, fps: f64, rows: usize, below: usize) -> Option<Trace> {
+    let path = shared(rel)?;
+    let s = ImportSpec {
+        fps_hz: Some(fps),
+        m_per_px: Some(1.0),
+        ..ImportSpec::default()
+    };
+    let (t, sum) = read_trace_with_summary(&path, &s).unwrap();
+    assert_eq!(sum.format, Some(Format::Deeplabcut));
+    assert_eq!(t.len(), rows);
+    assert_eq!(t.points.len(), 16);
+    assert_eq!(&names(&t)[..3], ["t3L", "wstL", "t5L"]);
+    assert_eq!(nan_samples(&t), below, "samples below the 0.6 cut-off");
+    assert!((t.t_s[1] - 1.0 / fps).abs() < 1e-15);
+    // Cut-off 0 keeps every point: the file has no NaN (SOURCES.md).
+    let all = ImportSpec {
+        min_likelihood: Some(0.0),
+        ..s
+    };
+    let t0 = wiperlab::import::read_trace(&path, &all).unwrap();
+    assert_eq!(nan_samples(&t0), 0);
+    Some(t0)
+}
+
+/// IL5 (800 fps, SOURCES.md): 431 rows, 1588 samples below 0.6. Wingbeat ≈ 12.5–13 Hz
+/// (SOURCES.md, independent FFT of wrist/digit y relative to the shoulder): the wrist's y minus the
+/// shoulder's y (subtracting the body point removes the ≈ 2 Hz translation peak) must peak in
+/// [12.5, 13.0] Hz. 431 samples are one Hann segment (bin 1.86 Hz), zero-padded to 8192.
+#[test]
+fn deeplabcut_il5_counts_and_wingbeat() {
+    let Some(t) = dlc_counts(DLC_IL5, 800.0, 431, 1588) else {
+        return;
+    };
+    let w = t.point("wstL").unwrap();
+    let s = t.point("shdL").unwrap();
+    let rel: Vec<f64> = w.y_m.iter().zip(&s.y_m).map(|(a, b)| a - b).collect();
+    let f = peak_hz(&rel, 800.0, 431, 8192, (5.0, 40.0));
+    assert!((12.5..=13.0).contains(&f), "wingbeat {f} Hz");
+}
+
+/// AFAM (700 fps, SOURCES.md): 116 rows, 484 samples below 0.6. Wingbeat ≈ 8.3–8.7 Hz
+/// (SOURCES.md: "only ~1.4 wingbeats, coarse"); with 116 samples the Hann main lobe is ±12 Hz
+/// wide, so only the count is checked, plus that the relative signal's peak lies in the 4–16 Hz
+/// octave around it.
+#[test]
+fn deeplabcut_afam_counts() {
+    let Some(t) = dlc_counts(DLC_AFAM, 700.0, 116, 484) else {
+        return;
+    };
+    let w = t.point("wstL").unwrap();
+    let s = t.point("shdL").unwrap();
+    let rel: Vec<f64> = w.y_m.iter().zip(&s.y_m).map(|(a, b)| a - b).collect();
+    let f = peak_hz(&rel, 700.0, 116, 8192, (1.0, 60.0));
+    println!("AFAM wingbeat estimate {f:.2} Hz (SOURCES.md ≈ 8.3–8.7 Hz, coarse)");
+    assert!((4.0..=16.0).contains(&f), "{f}");
+}
+
+/// SLEAP excerpt (SOURCES.md sleap/): header + frames 0–1 of 5 tracks, 4 nodes (Head, Thorax,
+/// Abdomen, Tail), no score columns: 2 frames × 20 points, no gaps; first value of the file
+/// `track_0,0,592.7771606445312,97.11058807373047`.
+#[test]
+fn sleap_excerpt() {
+    let Some(path) = shared("realdata/sleap/sleap_csv_example.EXCERPT_first11lines.csv") else {
+        return;
+    };
+    let s = ImportSpec {
+        fps_hz: Some(30.0),
+        m_per_px: Some(1.0),
+        y_down: Some(false),
+        ..ImportSpec::default()
+    };
+    let (t, sum) = read_trace_with_summary(&path, &s).unwrap();
+    assert_eq!(sum.format, Some(Format::Sleap));
+    assert_eq!(t.len(), 2);
+    assert_eq!(t.points.len(), 20);
+    assert_eq!(names(&t)[0], "track_0/Head");
+    assert_eq!(names(&t)[19], "track_4/Tail");
+    assert_eq!(nan_samples(&t), 0);
+    assert_eq!(t.points[0].x_m[0], 592.7771606445312);
+    assert_eq!(t.points[0].y_m[0], 97.11058807373047);
+    // No frame rate in the file: a clear error without one.
+    let err = read_trace_with_summary(&path, &spec(Format::Sleap))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("fps_hz"), "{err}");
+}
+
+/// TrackMate ≤ 6 (SOURCES.md trackmate/): 19819 rows, 118 tracks, frames 0–1073
+/// (`awk -F, 'NR>1{s[$3]++; if($9>m)m=$9} END{...}'`: 19819 spots, 118 track ids, last frame 1073;
+/// no track has two spots in one frame). One point per track over 1074 frames, so the NaN samples
+/// are 118 × 1074 − 19819 = 106913.
+#[test]
+fn trackmate_spots_in_tracks() {
+    let Some(path) = shared("realdata/trackmate/Spots in tracks statistics.csv") else {
+        return;
+    };
+    let s = ImportSpec {
+        fps_hz: Some(10.0),
+        m_per_px: Some(1e-6),
+        ..ImportSpec::default()
+    };
+    let (t, sum) = read_trace_with_summary(&path, &s).unwrap();
+    assert_eq!(sum.format, Some(Format::Trackmate));
+    assert_eq!(t.len(), 1074);
+    assert_eq!(t.points.len(), 118);
+    assert_eq!(nan_samples(&t), 118 * 1074 - 19819);
+    // First spot: `ID68,68,0,2.983,71.960,47.792,0,0,0,...` → track0 at frame 0, y flipped.
+    let p = t.point("track0").unwrap();
+    assert!((p.x_m[0] - 71.960e-6).abs() < 1e-15 && (p.y_m[0] + 47.792e-6).abs() < 1e-15);
+    // Uncalibrated time (POSITION_T = FRAME, no unit row): fps is required.
+    let err = read_trace_with_summary(&path, &spec(Format::Trackmate))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("fps_hz"), "{err}");
+}
+
+/// Every file above is detected by content (no `format` given).
+#[test]
+fn detects_every_new_format() {
+    let cases = [
+        ("realdata/kinovea/pas_camera_01.txt", Format::KinoveaTxt),
+        ("realdata/kinovea/v1.csv", Format::KinoveaKinematics),
+        (DLC_IL5, Format::Deeplabcut),
+        (
+            "realdata/sleap/sleap_csv_example.EXCERPT_first11lines.csv",
+            Format::Sleap,
+        ),
+        (
+            "realdata/trackmate/Spots in tracks statistics.csv",
+            Format::Trackmate,
+        ),
+    ];
+    for (rel, want) in cases {
+        let Some(path) = shared(rel) else { return };
+        assert_eq!(Format::detect(&path).unwrap(), want, "{rel}");
+    }
+}
+
+/// The pendulum 8047.txt (SOURCES.md: 4206 rows, x, y in m): the importer keeps Tracker's real
+/// frame times, and resampling to the median rate is a separate, explicit step whose grid is
+/// uniform.
+#[test]
+fn tracker_times_kept_and_resampling_explicit() {
+    let Some(path) = shared("realdata/tracker/8047.txt") else {
+        return;
+    };
+    let (t, sum) = read_trace_with_summary(&path, &ImportSpec::default()).unwrap();
+    assert_eq!(t.len(), 4206);
+    // SOURCES.md: real frame times vary 0.0317–0.0350 s around 1/30 s.
+    assert!(sum.dt_min_s < 0.0325 && sum.dt_max_s > 0.0345, "{sum}");
+    let fs = wiperlab::spectrum::median_rate_hz(&t.t_s);
+    let (t0, x) = resample_uniform(&t.t_s, &t.points[0].x_m, fs).unwrap();
+    assert_eq!(t0, t.t_s[0]);
+    let expect_n = ((t.t_s[4205] - t.t_s[0]) * fs).floor() as usize + 1;
+    assert!(x.len().abs_diff(expect_n) <= 1, "{} vs {expect_n}", x.len());
+}
