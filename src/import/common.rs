@@ -427,7 +427,10 @@ pub struct Table<'a> {
     pub delim: char,
     /// The header lines (`(line, cells)`), the last one being the column names.
     pub headers: Vec<(usize, Vec<String>)>,
-    /// Data rows `(line, cells)`, blank lines skipped, every row as wide as the last header line.
+    /// Column names used in messages and [`Table::find`]: the last header line, padded with empty
+    /// names to the table's width (a reader may replace them, e.g. TrackMate's feature keys).
+    pub names: Vec<String>,
+    /// Data rows `(line, cells)`, blank lines skipped, every row as wide as the widest header line.
     pub rows: Vec<(usize, Vec<String>)>,
 }
 
@@ -463,8 +466,10 @@ impl<'a> Table<'a> {
             }
             headers.push((line, cells));
         }
-        let width = headers.last().map_or(0, |h| h.1.len());
+        let width = headers.iter().map(|h| h.1.len()).max().unwrap_or(0);
         let header_line = headers.last().map_or(0, |h| h.0);
+        let mut names = headers.last().map_or_else(Vec::new, |h| h.1.clone());
+        names.resize(width, String::new());
         let mut rows = Vec::new();
         for &(line, text) in it {
             let mut cells = split_cells(text, delim);
@@ -504,13 +509,14 @@ impl<'a> Table<'a> {
             path,
             delim,
             headers,
+            names,
             rows,
         })
     }
 
     /// The column names (last header line).
     pub fn names(&self) -> &[String] {
-        self.headers.last().map_or(&[], |h| h.1.as_slice())
+        &self.names
     }
 
     /// Index of the column named `name` (exact, after trimming).

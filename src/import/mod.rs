@@ -1015,7 +1015,7 @@ mod tests {
     fn defaults_and_toml() {
         let spec: ImportSpec = toml::from_str("").unwrap();
         assert_eq!(spec, ImportSpec::default());
-        assert_eq!(spec.units_to_m, 1.0);
+        assert_eq!(spec.units_to_m, None);
         assert_eq!(spec.camera, 1);
         let spec: ImportSpec = toml::from_str(
             "format = \"tracker\"\nunits_to_m = 0.01\n[points]\nhead = \"mass A\"\n",
@@ -1025,7 +1025,7 @@ mod tests {
         assert_eq!(spec.points["head"], "mass A");
         let err = toml::from_str::<ImportSpec>("fps = 10.0\n").unwrap_err();
         assert!(err.to_string().contains("unknown field"), "{err}");
-        let err = toml::from_str::<ImportSpec>("format = \"kinovea\"\n").unwrap_err();
+        let err = toml::from_str::<ImportSpec>("format = \"proanalyst\"\n").unwrap_err();
         assert!(err.to_string().contains("unknown variant"), "{err}");
         // Serialise → deserialise is the identity (resolved configs are written beside artefacts).
         let spec = ImportSpec {
@@ -1062,7 +1062,7 @@ mod tests {
         );
         bad(
             ImportSpec {
-                units_to_m: -1.0,
+                units_to_m: Some(-1.0),
                 ..base.clone()
             },
             Format::Tracker,

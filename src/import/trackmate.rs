@@ -79,7 +79,9 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
         }
         n_header += 1;
     }
-    let table = Table::parse(path, &lines, n_header, ',')?;
+    let mut table = Table::parse(path, &lines, n_header, ',')?;
+    table.names = keys.clone();
+    table.names.resize(table.rows[0].1.len(), String::new());
     let hline = table.headers[0].0;
     let col = |key: &str| -> Result<usize> {
         keys.iter().position(|k| k == key).ok_or_else(|| {
