@@ -293,3 +293,116 @@ fn tracker_times_kept_and_resampling_explicit() {
     let expect_n = ((t.t_s[4205] - t.t_s[0]) * fs).floor() as usize + 1;
     assert!(x.len().abs_diff(expect_n) <= 1, "{} vs {expect_n}", x.len());
 }
+
+/// A generic-table spec from TOML.
+fn toml_spec(text: &str) -> ImportSpec {
+    toml::from_str(text).expect("valid import spec")
+}
+
+/// Damper JSON as a generic table: column 0 = t (s), 1 = displacement (in) (SOURCES.md friction/).
+const DAMPER_SPEC: &str = "format = \"generic\"\nunits_to_m = 0.0254\n[generic]\ntime = \"t\"\n\
+    columns = [\"t\", \"displacement\", \"force\", \"velocity\", \"act1\", \"act2\"]\n\
+    [generic.points]\ndisplacement = [\"displacement\"]\nforce = [\"force\"]\n";
+
+/// The friction damper's drive frequency from its displacement: SOURCES.md friction/ 1. — 1024 Hz,
+/// `rows` rows, dominant frequency = excitation frequency `drive_hz` (independent FFT). Welch with
+/// one Hann segment of `nperseg` (bin 1024/nperseg Hz), parabolic interpolation; must be within
+/// 1 % of the drive.
+fn damper(rel: &str, rows: usize, nperseg: usize, drive_hz: f64) {
+    let Some(path) = shared(rel) else { return };
+    let (t, sum) = read_trace_with_summary(&path, &toml_spec(DAMPER_SPEC)).unwrap();
+    println!("{sum}");
+    assert_eq!(t.len(), rows);
+    assert_eq!(sum.scalar, [true, true]);
+    assert_eq!(
+        sum.points,
+        [("displacement".into(), 0), ("force".into(), 0)]
+    );
+    assert!((sum.dt_median_s - 1.0 / 1024.0).abs() < 1e-12);
+    let x = &t.point("displacement").unwrap().x_m;
+    let f = peak_hz(x, 1024.0, nperseg, nperseg, (0.2, 5.0));
+    let f_force = peak_hz(
+        &t.point("force").unwrap().x_m,
+        1024.0,
+        nperseg,
+        nperseg,
+        (0.2, 5.0),
+    );
+    for f in [f, f_force] {
+        assert!(
+            ((f - drive_hz) / drive_hz).abs() <= 0.01,
+            "{rel}: {f} Hz vs drive {drive_hz} Hz"
+        );
+    }
+}
+
+#[test]
+fn friction_damper_1hz_drive() {
+    damper("realdata/friction/1Hz35lbtension.json", 10241, 8192, 1.0);
+}
+
+#[test]
+fn friction_damper_0_5hz_drive() {
+    damper("realdata/friction/0.5Hz35lbtension.json", 18433, 16384, 0.5);
+}
+
+/// Tribometer log (SOURCES.md friction/ 2.): 7196 data rows at 10 Hz, header on line 2 (line 1
+/// holds a bare CR), trailing commas, a 2-line `TotalTime` footer. `Timestamp` restarts in every
+/// step, so the time base is the row index / 10 Hz.
+#[test]
+fn tribometer_generic_table() {
+    let Some(path) = shared(
+        "realdata/friction/013_FX2_316SS_0.25in_Rotary_3N_4tests_75-300mm-s_6-15mm-radius_3min-each.csv",
+    ) else {
+        return;
+    };
+    let spec = toml_spec(
+        "format = \"generic\"\nfps_hz = 10.0\nunits_to_m = 1.0\n[generic]\nfooter_lines = 2\n\
+         [generic.points]\ncof = [\"DAQ.COF ()\"]\n",
+    );
+    let (t, sum) = read_trace_with_summary(&path, &spec).unwrap();
+    assert_eq!(t.len(), 7196);
+    assert_eq!(sum.points, [("cof".into(), 0)]);
+    assert_eq!(
+        t.points[0].x_m[0], 0.155274,
+        "first data row: 4,0.144,4,3.012628,0.4677829,0.155274"
+    );
+    // Without the footer setting the footer is a row error naming its line.
+    let no_footer = toml_spec(
+        "format = \"generic\"\nfps_hz = 10.0\nunits_to_m = 1.0\n[generic.points]\ncof = [\"DAQ.COF ()\"]\n",
+    );
+    let err = read_trace_with_summary(&path, &no_footer)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains(":7200:0: expected 10 fields"), "{err}");
+}
+
+/// NI export a3NI.csv (SOURCES.md friction/ 3.): UTF-8 BOM, 4-line preamble (names on line 3,
+/// units on line 4), 1078 rows at 2 kHz (`Interval,0.0005`). Mitsubishi a3MR.csv: header on line
+/// 4 (`Time,Analog 1,...`), unit row `ms,...`, 1024 rows at 0.667 ms.
+#[test]
+fn ni_and_servo_logs_generic_tables() {
+    let Some(ni) = shared("realdata/friction/a3NI.csv") else {
+        return;
+    };
+    let spec = toml_spec(
+        "format = \"generic\"\nunits_to_m = 1.0\n[generic]\ntime = \"Channel name\"\n\
+         skip_after_header = 1\n[generic.points]\nforce = [\"Force\"]\n",
+    );
+    let (t, sum) = read_trace_with_summary(&ni, &spec).unwrap();
+    assert_eq!(t.len(), 1078);
+    assert!((sum.dt_median_s - 0.0005).abs() < 1e-12);
+    let Some(mr) = shared("realdata/friction/a3MR.csv") else {
+        return;
+    };
+    let spec = toml_spec(
+        "format = \"generic\"\nunits_to_m = 1.0\ntime_to_s = 0.001\n[generic]\ntime = \"Time\"\n\
+         skip_after_header = 1\n[generic.points]\nspeed = [\"Analog 1\"]\n",
+    );
+    let (t, sum) = read_trace_with_summary(&mr, &spec).unwrap();
+    assert_eq!(t.len(), 1024);
+    assert!(
+        (sum.dt_median_s - 0.000666666).abs() < 1e-9,
+        "Sampling time interval(ms),0.667"
+    );
+}

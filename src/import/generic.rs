@@ -47,8 +47,21 @@ pub struct GenericColumns {
     /// Column holding a frame number (t = `t0_s` + frame/`fps_hz`); alternative to `time`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub frame: Option<String>,
-    /// Point name → `[x column, y column]`.
-    pub points: BTreeMap<String, [String; 2]>,
+    /// Point name → `[x column, y column]`, or `[column]` for a scalar signal (force, angle ...):
+    /// its value is stored as x, y is NaN.
+    pub points: BTreeMap<String, Vec<String>>,
+    /// Lines right after the header to skip (a unit row such as `ms,rpm,...`); default 0.
+    pub skip_after_header: usize,
+    /// Non-blank lines at the end of the file that are not data (a footer such as `TotalTime`);
+    /// default 0.
+    pub footer_lines: usize,
+    /// JSON input (a file starting with `{`): the key holding the array of rows (each an array of
+    /// numbers or null); default `"data"`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub json_key: Option<String>,
+    /// Column names for input without a header (JSON rows); default `"0"`, `"1"`, ...
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub columns: Option<Vec<String>>,
 }
 
 /// Read a generic table (module docs) into a [`RawTrace`] in file units.
@@ -77,14 +90,27 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
             "import: [generic] set time or frame, not both".into(),
         ));
     }
+    for (name, cols) in &map.points {
+        if cols.is_empty() || cols.len() > 2 {
+            return Err(Error::Config(format!(
+                "import: [generic.points] {name} = {cols:?}: expected [x column, y column] or \
+                 [column]"
+            )));
+        }
+    }
     let mut wanted: Vec<&str> = map
         .points
         .values()
-        .flat_map(|[x, y]| [x.as_str(), y.as_str()])
+        .flat_map(|c| c.iter().map(String::as_str))
         .collect();
     wanted.extend(map.time.as_deref());
     wanted.extend(map.frame.as_deref());
     let (text, _) = read_decoded(path)?;
+    if text.trim_start().starts_with('{') {
+        let json = json_rows(path, &text, map)?;
+        let lines: Vec<(usize, &str)> = json.iter().map(|(l, s)| (*l, s.as_str())).collect();
+        return from_lines(path, &lines, 0, ',', map, spec, &wanted, "JSON");
+    }
     let lines = numbered_lines(&text);
     let mut found = None;
     for (k, &(_, l)) in lines.iter().enumerate().take(MAX_PREAMBLE_LINES) {
@@ -109,7 +135,96 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
             ),
         ));
     };
-    let table = Table::parse(path, &lines[k..], 1, delim)?;
+    from_lines(path, &lines[k..], 0, delim, map, spec, &wanted, "table")
+}
+
+/// JSON `{ "<json_key>": [[...], ...] }` as CSV lines: a header (`columns` or `0`, `1`, ...), then
+/// one line per row numbered from 1 (the row index, which error messages call the line).
+fn json_rows(path: &Path, text: &str, map: &GenericColumns) -> Result<Vec<(usize, String)>> {
+    let v: serde_json::Value = serde_json::from_str(text)
+        .map_err(|e| Error::parse(path, e.line(), e.column(), format!("invalid JSON: {e}")))?;
+    let key = map.json_key.as_deref().unwrap_or("data");
+    let Some(rows) = v.get(key).and_then(|d| d.as_array()) else {
+        return Err(Error::input(
+            path,
+            format!("expected a JSON object with an array of rows under {key:?} (json_key)"),
+        ));
+    };
+    let width = rows.first().and_then(|r| r.as_array()).map_or(0, Vec::len);
+    let names: Vec<String> = match &map.columns {
+        Some(c) => c.clone(),
+        None => (0..width).map(|j| j.to_string()).collect(),
+    };
+    let mut out = vec![(0, names.join(","))];
+    for (i, r) in rows.iter().enumerate() {
+        let Some(cells) = r.as_array() else {
+            return Err(Error::parse(
+                path,
+                i + 1,
+                0,
+                format!("{key}[{i}]: expected an array of numbers, found {r}"),
+            ));
+        };
+        let mut line = Vec::with_capacity(cells.len());
+        for (j, c) in cells.iter().enumerate() {
+            match c {
+                serde_json::Value::Number(n) => line.push(n.to_string()),
+                serde_json::Value::Null => line.push(String::new()),
+                other => {
+                    return Err(Error::parse(
+                        path,
+                        i + 1,
+                        j + 1,
+                        format!("{key}[{i}][{j}]: expected a number or null, found {other}"),
+                    ));
+                }
+            }
+        }
+        out.push((i + 1, line.join(",")));
+    }
+    Ok(out)
+}
+
+/// The table from its header line `lines[0]` on (after `skip_after_header` and without
+/// `footer_lines`), mapped to a [`RawTrace`].
+#[allow(clippy::too_many_arguments)]
+fn from_lines(
+    path: &Path,
+    lines: &[(usize, &str)],
+    header: usize,
+    delim: char,
+    map: &GenericColumns,
+    spec: &ImportSpec,
+    wanted: &[&str],
+    what: &str,
+) -> Result<RawTrace> {
+    let mut body: Vec<(usize, &str)> = lines[header..]
+        .iter()
+        .copied()
+        .filter(|(_, l)| !l.trim().is_empty())
+        .collect();
+    if body.len() < 1 + map.skip_after_header + map.footer_lines {
+        return Err(Error::input(
+            path,
+            "no data rows between the header (+ skip_after_header) and the footer_lines",
+        ));
+    }
+    body.truncate(body.len() - map.footer_lines);
+    body.drain(1..1 + map.skip_after_header);
+    let table = Table::parse(path, &body, 1, delim)?;
+    for w in wanted {
+        if table.find(w).is_none() {
+            return Err(Error::parse(
+                path,
+                table.headers[0].0,
+                0,
+                format!(
+                    "expected a column {w:?}; columns: {}",
+                    table.names().join(", ")
+                ),
+            ));
+        }
+    }
     let dc = spec.decimal_comma;
     let idx = |name: &str| table.find(name).unwrap_or(0);
     let time = if let Some(tc) = &map.time {
@@ -134,12 +249,13 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
         RawTime::Frames((0..table.rows.len()).map(|r| r as f64).collect())
     };
     let mut points = Vec::new();
-    for (name, [x, y]) in &map.points {
-        points.push((
-            name.clone(),
-            table.numbers(idx(x), dc)?,
-            table.numbers(idx(y), dc)?,
-        ));
+    for (name, cols) in &map.points {
+        let x = table.numbers(idx(&cols[0]), dc)?;
+        let y = match cols.get(1) {
+            Some(c) => table.numbers(idx(c), dc)?,
+            None => vec![f64::NAN; x.len()],
+        };
+        points.push((name.clone(), x, y));
     }
     Ok(RawTrace {
         time,
@@ -147,7 +263,7 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
         units: RawUnits::Unknown,
         y_down_default: false,
         notes: vec![format!(
-            "generic table: header on line {}, delimiter {delim:?}, {} rows",
+            "generic {what}: header on line {}, delimiter {delim:?}, {} rows",
             table.headers[0].0,
             table.rows.len()
         )],

@@ -750,8 +750,12 @@ pub struct ImportSummary {
     pub format: Option<Format>,
     /// Number of time samples (frames).
     pub n_frames: usize,
-    /// `(point name, NaN samples)` in trace order; a sample counts as NaN when x or y is NaN.
+    /// `(point name, NaN samples)` in trace order; a sample counts as NaN when x or y is NaN (for a
+    /// scalar point, when x is NaN).
     pub points: Vec<(String, usize)>,
+    /// Per point: a scalar signal (a generic or Kinovea-kinematics column stored in x; y is NaN
+    /// throughout).
+    pub scalar: Vec<bool>,
     /// First sample time in s (NaN for an empty trace).
     pub t_first_s: f64,
     /// Last sample time in s (NaN for an empty trace).
@@ -794,8 +798,16 @@ pub fn describe(trace: &Trace) -> ImportSummary {
         points: trace
             .points
             .iter()
-            .map(|p| (p.name.clone(), p.nan_samples()))
+            .map(|p| {
+                let nan = if is_scalar(p) {
+                    p.x_m.iter().filter(|v| v.is_nan()).count()
+                } else {
+                    p.nan_samples()
+                };
+                (p.name.clone(), nan)
+            })
             .collect(),
+        scalar: trace.points.iter().map(is_scalar).collect(),
         t_first_s: t.first().copied().unwrap_or(f64::NAN),
         t_last_s: t.last().copied().unwrap_or(f64::NAN),
         dt_median_s,
@@ -806,11 +818,18 @@ pub fn describe(trace: &Trace) -> ImportSummary {
     }
 }
 
-/// `(number of NaN runs, longest run)` of a point (NaN where x or y is NaN).
+/// A scalar point: y NaN throughout while x has a value somewhere.
+fn is_scalar(p: &PointTrack) -> bool {
+    p.y_m.iter().all(|v| v.is_nan()) && p.x_m.iter().any(|v| !v.is_nan())
+}
+
+/// `(number of NaN runs, longest run)` of a point (NaN where x or y is NaN; for a scalar point,
+/// where x is NaN).
 pub fn gap_runs(p: &PointTrack) -> (usize, usize) {
+    let scalar = is_scalar(p);
     let (mut runs, mut longest, mut cur) = (0, 0, 0);
     for (x, y) in p.x_m.iter().zip(&p.y_m) {
-        if x.is_nan() || y.is_nan() {
+        if x.is_nan() || (!scalar && y.is_nan()) {
             if cur == 0 {
                 runs += 1;
             }
@@ -846,9 +865,14 @@ impl fmt::Display for ImportSummary {
             } else {
                 0.0
             };
+            let kind = if self.scalar.get(i) == Some(&true) {
+                " (scalar, value in x)"
+            } else {
+                ""
+            };
             write!(
                 f,
-                "  {name}: {} tracked, {nan} NaN ({pct:.2} %)",
+                "  {name}{kind}: {} tracked, {nan} NaN ({pct:.2} %)",
                 self.n_frames - nan
             )?;
             match self.gaps.get(i) {
