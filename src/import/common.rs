@@ -581,10 +581,12 @@ impl<'a> Table<'a> {
 /// either case) into `(base, is_x)`.
 pub fn xy_suffix(name: &str) -> Option<(&str, bool)> {
     let n = name.trim();
-    let (base, last) = n.split_at(n.len().checked_sub(1)?);
+    // The last character may be multi-byte (`ø`): split on a char boundary.
+    let last = n.chars().next_back()?;
+    let base = &n[..n.len() - last.len_utf8()];
     let is_x = match last {
-        "X" | "x" => true,
-        "Y" | "y" => false,
+        'X' | 'x' => true,
+        'Y' | 'y' => false,
         _ => return None,
     };
     let base = base.strip_suffix(['/', '.', '_', ' '])?;
@@ -655,6 +657,15 @@ mod tests {
             ["1,0", "2,0", "", "a\"b"]
         );
         assert_eq!(split_cells("a,b,", ','), ["a", "b", ""]);
+    }
+
+    #[test]
+    fn xy_suffixes() {
+        assert_eq!(xy_suffix("B/h/X"), Some(("B/h", true)));
+        assert_eq!(xy_suffix("Knee Y"), Some(("Knee", false)));
+        // Found by tests/import_fuzz.rs: a multi-byte last character used to panic.
+        assert_eq!(xy_suffix("B/h/ø"), None);
+        assert_eq!(xy_suffix("X"), None);
     }
 
     #[test]

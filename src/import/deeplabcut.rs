@@ -93,7 +93,8 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
                 groups.len() - 1
             }
         };
-        let slot = match coords[j].as_str() {
+        let coord = coords.get(j).map_or("", |s| s.as_str());
+        let slot = match coord {
             "x" => &mut groups[g].x,
             "y" => &mut groups[g].y,
             "likelihood" => &mut groups[g].l,
@@ -114,7 +115,7 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
                 path,
                 coords_line,
                 j + 1,
-                format!("column {} of {:?} appears twice", coords[j], groups[g].name),
+                format!("column {coord} of {:?} appears twice", groups[g].name),
             ));
         }
         *slot = Some(j);
@@ -138,7 +139,7 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
                 path,
                 coords_line,
                 0,
-                format!("body part {:?} lacks an x or y column", g.name),
+                format!("body part {:?}: expected an x and a y column", g.name),
             ));
         };
         let mut x = table.numbers(cx, false)?;

@@ -187,7 +187,10 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
                     path,
                     header_line,
                     0,
-                    format!("pt{}_cam{}_X is missing", p.point, spec.camera),
+                    format!(
+                        "pt{}_cam{}_X is missing (expected an X and a Y column per point)",
+                        p.point, spec.camera
+                    ),
                 ));
             }
             (_, None) => {
@@ -195,7 +198,10 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
                     path,
                     header_line,
                     0,
-                    format!("pt{}_cam{}_Y is missing", p.point, spec.camera),
+                    format!(
+                        "pt{}_cam{}_Y is missing (expected an X and a Y column per point)",
+                        p.point, spec.camera
+                    ),
                 ));
             }
         }

@@ -141,8 +141,14 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
 /// JSON `{ "<json_key>": [[...], ...] }` as CSV lines: a header (`columns` or `0`, `1`, ...), then
 /// one line per row numbered from 1 (the row index, which error messages call the line).
 fn json_rows(path: &Path, text: &str, map: &GenericColumns) -> Result<Vec<(usize, String)>> {
-    let v: serde_json::Value = serde_json::from_str(text)
-        .map_err(|e| Error::parse(path, e.line(), e.column(), format!("invalid JSON: {e}")))?;
+    let v: serde_json::Value = serde_json::from_str(text).map_err(|e| {
+        Error::parse(
+            path,
+            e.line().max(1),
+            e.column(),
+            format!("expected valid JSON: {e}"),
+        )
+    })?;
     let key = map.json_key.as_deref().unwrap_or("data");
     let Some(rows) = v.get(key).and_then(|d| d.as_array()) else {
         return Err(Error::input(

@@ -101,7 +101,7 @@ pub fn read_csv(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
             hline,
             0,
             format!(
-                "no <object>/<point>/X and .../Y column pair; columns: {}",
+                "expected an <object>/<point>/X and .../Y column pair; columns: {}",
                 names.join(", ")
             ),
         ));
@@ -256,7 +256,8 @@ pub fn read_txt(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
                 line,
                 1,
                 format!(
-                    "section {:?}: time {t} s is not after the previous row's {p} s",
+                    "section {:?}: time {t} s is not after the previous row's {p} s (expected \
+                     strictly increasing times)",
                     sec.name
                 ),
             ));

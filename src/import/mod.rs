@@ -929,9 +929,17 @@ pub(crate) fn csv_error(path: &Path, action: &'static str, e: csv::Error) -> Err
             path,
             line,
             err.field() + 1,
-            format!("invalid UTF-8 in field {}", err.field() + 1),
+            format!(
+                "invalid UTF-8 in field {}: expected UTF-8 text (re-save the file as UTF-8)",
+                err.field() + 1
+            ),
         ),
-        other => Error::parse(path, line, 0, format!("{other:?}")),
+        other => Error::parse(
+            path,
+            line.max(1),
+            0,
+            format!("expected a well-formed CSV record: {other:?}"),
+        ),
     }
 }
 

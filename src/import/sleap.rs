@@ -58,7 +58,7 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
                     path,
                     hline,
                     j + 1,
-                    format!("column {n} has no {node}.y partner"),
+                    format!("column {n}: expected a {node}.y column to go with it"),
                 ));
             };
             nodes.push((node.to_owned(), j, cy, table.find(&format!("{node}.score"))));

@@ -171,7 +171,7 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
                 path,
                 line,
                 0,
-                "unexpected line before the column row: a Tracker export has at most `#multi:` \
+                "unexpected line before the column row: expected at most `#multi:` \
                  and one track-name row there",
             ));
         }
@@ -253,7 +253,7 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
             column_line,
             0,
             format!(
-                "no track with both an x and a y column; columns: {}",
+                "expected a track with both an x and a y column; columns: {}",
                 header.join(", ")
             ),
         ));
@@ -309,7 +309,10 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
                 path,
                 line,
                 1,
-                format!("field t: time {t} s is not after the previous row's {p} s"),
+                format!(
+                    "field t: time {t} s is not after the previous row's {p} s (expected \
+                     strictly increasing times)"
+                ),
             ));
         }
         prev_t = Some(t);
@@ -598,7 +601,7 @@ mod tests {
         assert!(msg.contains("no data rows"), "{msg}");
         let msg = read_str("noxy", "t\tvx\n0\t1\n").unwrap_err().to_string();
         assert!(
-            msg.contains("no track with both an x and a y column"),
+            msg.contains("expected a track with both an x and a y column"),
             "{msg}"
         );
         let msg = read_str("two", "a\nb\nt\tx\ty\n0\t1\t2\n")

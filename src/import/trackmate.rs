@@ -80,6 +80,12 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
         n_header += 1;
     }
     let mut table = Table::parse(path, &lines, n_header, ',')?;
+    // The keys as the table split them (quotes honoured), so indices match the rows.
+    let keys: Vec<String> = table.headers[0]
+        .1
+        .iter()
+        .map(|s| s.trim().to_ascii_uppercase())
+        .collect();
     table.names = keys.clone();
     table.names.resize(table.rows[0].1.len(), String::new());
     let hline = table.headers[0].0;
