@@ -262,7 +262,18 @@ pub fn run(cli: Cli) -> Result<()> {
             let trace = read_any(&file, &import)?;
             let fs = crate::spectrum::median_rate_hz(&trace.t_s);
             let mut signals: Vec<(String, Vec<f64>)> = Vec::new();
+            // Frame-indexed files (t = frame/fps) are uniform already: resampling them would only
+            // smear each NaN over its neighbours through rounding of the grid.
+            let t0 = trace.t_s.first().copied().unwrap_or(0.0);
+            let already_uniform = trace
+                .t_s
+                .iter()
+                .enumerate()
+                .all(|(k, t)| (t - (t0 + k as f64 / fs)).abs() <= 1e-6 / fs);
             let uniform = |x: &[f64]| -> Result<Vec<f64>> {
+                if already_uniform {
+                    return Ok(x.to_vec());
+                }
                 Ok(crate::spectrum::resample_uniform(&trace.t_s, x, fs)?.1)
             };
             for p in &trace.points {
@@ -311,12 +322,20 @@ pub fn run(cli: Cli) -> Result<()> {
                 fs / nperseg as f64
             );
             let summary = crate::import::describe(&trace);
-            println!(
-                "  resampled: {} frame times (step {} … {} s) → {n} uniform samples at {fs:.6} Hz \
-                 by linear interpolation; gaps ≤ {max_fill} samples filled, longer ones split the \
-                 record",
-                summary.n_frames, summary.dt_min_s, summary.dt_max_s
-            );
+            if already_uniform {
+                println!(
+                    "  not resampled: the {} frame times are uniform (within 1e-6 of a step); \
+                     gaps ≤ {max_fill} samples filled, longer ones split the record",
+                    summary.n_frames
+                );
+            } else {
+                println!(
+                    "  resampled: {} frame times (step {} … {} s) → {n} uniform samples at \
+                     {fs:.6} Hz by linear interpolation; gaps ≤ {max_fill} samples filled, longer \
+                     ones split the record",
+                    summary.n_frames, summary.dt_min_s, summary.dt_max_s
+                );
+            }
             for (name, x) in &signals {
                 let f = match features(x, fs, &bands, max_fill) {
                     Ok(f) => f,
