@@ -220,8 +220,8 @@ fn rotation_to_the_sweep() {
         "{:?}",
         sum.notes
     );
-    for k in 0..n {
-        assert!((p.x_m[k] - s[k]).abs() < 1e-15, "x along the sweep");
+    for (k, sk) in s.iter().enumerate() {
+        assert!((p.x_m[k] - sk).abs() < 1e-15, "x along the sweep");
         assert!(p.y_m[k].abs() < 1e-15, "no motion across it");
     }
     let given = ImportSpec {
@@ -229,8 +229,8 @@ fn rotation_to_the_sweep() {
         ..ImportSpec::default()
     };
     let t2 = read_trace(&f.0, &given).unwrap();
-    for k in 0..n {
-        assert!((t2.points[0].x_m[k] - p.x_m[k]).abs() < 1e-15);
+    for (a, b) in t2.points[0].x_m.iter().zip(&p.x_m) {
+        assert!((a - b).abs() < 1e-15);
     }
     let err = read_trace(
         &f.0,

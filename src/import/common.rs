@@ -379,7 +379,7 @@ pub fn sniff_delimiter(line: &str) -> Option<char> {
 pub fn unique_name(taken: &[String], base: &str) -> String {
     let mut name = base.to_owned();
     let mut k = 1;
-    while taken.iter().any(|n| *n == name) {
+    while taken.contains(&name) {
         k += 1;
         name = format!("{base}_{k}");
     }

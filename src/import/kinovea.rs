@@ -200,7 +200,7 @@ pub fn read_txt(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
         if let Some((c0, b0)) = start {
             tokens.push((c0, &l[b0..]));
         }
-        if tokens.len() < 3 || tokens.len() % 2 == 0 {
+        if tokens.len() < 3 || tokens.len().is_multiple_of(2) {
             return Err(Error::parse(
                 path,
                 line,

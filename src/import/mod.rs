@@ -387,12 +387,12 @@ impl ImportSpec {
                 ));
             }
         }
-        if let Some(l) = self.min_likelihood {
-            if !(0.0..=1.0).contains(&l) {
-                return Err(Error::Config(format!(
-                    "import: min_likelihood must be in [0, 1], got {l}"
-                )));
-            }
+        if let Some(l) = self.min_likelihood
+            && !(0.0..=1.0).contains(&l)
+        {
+            return Err(Error::Config(format!(
+                "import: min_likelihood must be in [0, 1], got {l}"
+            )));
         }
         if self.n_cameras == 0 || (self.camera > self.n_cameras && format == Format::DltdvSparse) {
             return Err(Error::Config(format!(

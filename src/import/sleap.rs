@@ -20,6 +20,9 @@ use crate::import::common::{
 };
 use crate::import::deeplabcut::DEFAULT_MIN_LIKELIHOOD;
 
+/// One node's x and y over the frame axis.
+type Xy = (Vec<f64>, Vec<f64>);
+
 /// Largest ratio of frame range to rows accepted (beyond 10⁶ frames).
 pub(crate) const MAX_SPAN_PER_ROW: usize = 1000;
 
@@ -112,7 +115,7 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
     };
     // track → (x, y per node), in order of first appearance.
     let mut order: Vec<String> = Vec::new();
-    let mut tracks: BTreeMap<String, Vec<(Vec<f64>, Vec<f64>)>> = BTreeMap::new();
+    let mut tracks: BTreeMap<String, Vec<Xy>> = BTreeMap::new();
     let mut seen: BTreeMap<(String, usize), usize> = BTreeMap::new();
     let mut below = 0usize;
     let mut padding = 0usize;
