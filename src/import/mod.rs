@@ -6,8 +6,22 @@
 //! Supported inputs (layouts described in `shared/realdata/FORMATS.md`):
 //! * [`Format::Dltdv`] — DLTdv5–8 `*xypts.csv` (FORMATS.md §3): pixels, one row per frame, no time
 //!   column; needs [`ImportSpec::fps_hz`] and [`ImportSpec::m_per_px`]. Reader: [`dltdv`].
+//!   [`Format::DltdvSparse`] — the sparse `*xypts.tsv` save: [`dltdv_sparse`].
 //! * [`Format::Tracker`] — Open Source Physics Tracker "Export Data" / "Copy Data" text
 //!   (FORMATS.md §1): a `t` column in seconds and calibrated x, y per track. Reader: [`tracker`].
+//! * [`Format::KinoveaCsv`], [`Format::KinoveaTxt`], [`Format::KinoveaKinematics`] — Kinovea
+//!   trajectory CSV/TXT and kinematics CSV (§2): [`kinovea`].
+//! * [`Format::Deeplabcut`] (§4): [`deeplabcut`]; [`Format::Sleap`] (§5): [`sleap`];
+//!   [`Format::Trackmate`] (§6): [`trackmate`].
+//! * [`Format::Generic`] — any delimited table or JSON row array with user-mapped columns:
+//!   [`generic`].
+//!
+//! The readers other than DLTdv and Tracker return a [`common::RawTrace`] in file units;
+//! [`common::calibrate`] applies the time base (file times, or frame / `fps_hz`), the scale
+//! (`m_per_px`, two scale points, or `units_to_m`), origin and y flip in one place. Then every
+//! format gets roles ([`ImportSpec::points`]) and the optional rotation to the sweep
+//! (`sweep_angle_deg` / `sweep_from_head`). Text is UTF-8, or Windows-1252 when not UTF-8
+//! ([`common::decode`]).
 //!
 //! The canonical CSV that wiperlab itself writes and reads back is in [`canonical`].
 //!
@@ -229,16 +243,20 @@ impl Format {
 /// Meant to live in a TOML job or a sidecar next to the data (`deny_unknown_fields`, every field
 /// optional). Defaults: see [`ImportSpec::default`]. Which fields apply to which format:
 ///
-/// | field | DLTdv | Tracker |
-/// |---|---|---|
-/// | `fps_hz` | required: t = `t0_s` + (frame − 1)/`fps_hz` | optional check of the `t` column's median step (±1 %) |
-/// | `m_per_px` | required | must be absent (Tracker is calibrated) |
-/// | `origin_px` | subtracted from pixel coordinates | must be [0, 0] |
-/// | `y_down` | default true: y_m = −(y_px − origin_y)·`m_per_px` | default false; true flips y |
-/// | `units_to_m` | must be 1 | calibrated unit → m (cm: 0.01) |
-/// | `camera` | which `cam{j}` columns | must be 1 |
-/// | `decimal_comma` | must be false | `1,5` means 1.5 (not with a `,` delimiter) |
-/// | `t0_s` | time of frame 1 | added to the `t` column |
+/// | field | DLTdv (csv, sparse) | Tracker | other formats |
+/// |---|---|---|---|
+/// | `fps_hz` | required: t = `t0_s` + (frame − 1)/`fps_hz` | optional check of the `t` column's median step (±1 %) | required where the file has frame numbers only (DeepLabCut, SLEAP, TrackMate without a time unit, generic `frame`) |
+/// | `m_per_px` or `scale_points_px` + `scale_distance_m` | required | must be absent (Tracker is calibrated) | required for pixels; alternative to `units_to_m` when the file does not state its unit |
+/// | `origin_px` | subtracted from pixel coordinates | must be [0, 0] | subtracted in file units |
+/// | `y_down` | default true: y_m = −(y_px − origin_y)·`m_per_px` | default false; true flips y | default: true for DeepLabCut, SLEAP, TrackMate (image rows), false otherwise |
+/// | `units_to_m` | must be absent | calibrated unit → m (default 1; cm: 0.01) | required for Kinovea, TrackMate ≤ 6, generic unless `m_per_px`; overrides TrackMate's unit row |
+/// | `camera`, `n_cameras` | which `cam{j}` columns; sparse: cameras in the file | must be 1 | must be 1 |
+/// | `decimal_comma` | must be false | `1,5` means 1.5 (not with a `,` delimiter) | generic only (Kinovea detects it) |
+/// | `t0_s` | time of frame 1 | added to the `t` column | added to every time |
+/// | `time_to_s` | — | — | Kinovea CSV (required: unit not in the file), generic time column |
+/// | `min_likelihood` | — | — | DeepLabCut, SLEAP: below it → NaN (default 0.6) |
+/// | `sweep_angle_deg` / `sweep_from_head` | rotation so x runs along the sweep, every format | | |
+/// | `generic` | — | — | the column mapping of [`Format::Generic`] |
 ///
 /// ```toml
 /// format = "dltdv"            # optional, detected from content when absent

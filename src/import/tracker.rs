@@ -489,6 +489,28 @@ mod tests {
     }
 
     #[test]
+    fn space_and_comma_delimiters_with_trailing_delimiters() {
+        // FORMATS.md §1: SPACE and `,` are export-dialog delimiters; every name and value row
+        // ends with the delimiter.
+        let t = read_str(
+            "space",
+            "#multi:\n head  tip  \nt x y x y \n0.0 1.5E-3 2 3 4 \n0.1  2 3 4 \n",
+        )
+        .unwrap();
+        assert_eq!(names(&t), ["head", "tip"]);
+        assert_eq!(t.points[0].x_m[0], 1.5e-3);
+        assert!(t.points[0].x_m[1].is_nan(), "empty field between two spaces");
+        let t = read_str(
+            "comma",
+            "#multi:\r\n,head,,tip,,\r\nt,x,y,x,y,\r\n0.0,1,2,,,\r\n0.1,1,2,3,4,\r\n",
+        )
+        .unwrap();
+        assert_eq!(names(&t), ["head", "tip"]);
+        assert!(t.points[1].x_m[0].is_nan());
+        assert_eq!(t.points[1].y_m[1], 4.0);
+    }
+
+    #[test]
     fn bare_name_subscripts_and_func_column() {
         let t = read_str(
             "bare",
