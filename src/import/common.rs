@@ -203,6 +203,25 @@ pub fn parse_cell(cell: &str, decimal_comma: bool) -> std::result::Result<Option
     parse_finite(&text).map(Some).ok_or(())
 }
 
+/// Most samples (frames × points) a reader allocates: 2·10⁷ per coordinate (160 MB), e.g. a
+/// million frames of 20 points. A frame index or size beyond it is a corrupt file, refused with a
+/// message rather than an out-of-memory abort.
+pub const MAX_CELLS: usize = 20_000_000;
+
+/// [`Error::Input`] unless `frames × points ≤` [`MAX_CELLS`].
+pub fn check_cells(path: &Path, frames: usize, points: usize) -> Result<()> {
+    if frames.saturating_mul(points) > MAX_CELLS {
+        return Err(Error::input(
+            path,
+            format!(
+                "{frames} frames × {points} points exceed {MAX_CELLS} samples: expected a frame \
+                 range that fits the data (a corrupt frame number?)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Time axis as a reader found it.
 #[derive(Debug, Clone, PartialEq)]
 pub enum RawTime {

@@ -18,8 +18,8 @@ use crate::error::{Error, Result};
 use crate::import::ImportSpec;
 use crate::import::common::{RawTime, RawTrace, RawUnits, numbered_lines, read_decoded};
 
-/// Largest dense matrix accepted (rows × cols), far above any video (10⁸ values = 800 MB).
-const MAX_CELLS: usize = 100_000_000;
+/// Largest dense matrix accepted (rows × cols): 2·[`MAX_CELLS`](super::common::MAX_CELLS).
+const MAX_CELLS: usize = 2 * super::common::MAX_CELLS;
 
 /// Read a DLTdv sparse xypts file (module docs) into a [`RawTrace`] in pixels.
 ///

@@ -113,6 +113,13 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
         }
         v
     };
+    let n_tracks = table
+        .rows
+        .iter()
+        .map(|(_, c)| c[ct].trim())
+        .collect::<std::collections::BTreeSet<_>>()
+        .len();
+    crate::import::common::check_cells(path, n, n_tracks * nodes.len())?;
     // track → (x, y per node), in order of first appearance.
     let mut order: Vec<String> = Vec::new();
     let mut tracks: BTreeMap<String, Vec<Xy>> = BTreeMap::new();

@@ -499,7 +499,10 @@ mod tests {
         .unwrap();
         assert_eq!(names(&t), ["head", "tip"]);
         assert_eq!(t.points[0].x_m[0], 1.5e-3);
-        assert!(t.points[0].x_m[1].is_nan(), "empty field between two spaces");
+        assert!(
+            t.points[0].x_m[1].is_nan(),
+            "empty field between two spaces"
+        );
         let t = read_str(
             "comma",
             "#multi:\r\n,head,,tip,,\r\nt,x,y,x,y,\r\n0.0,1,2,,,\r\n0.1,1,2,3,4,\r\n",

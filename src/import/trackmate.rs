@@ -166,6 +166,12 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
             ),
         ));
     }
+    let n_tracks = tracked
+        .iter()
+        .filter_map(|&r| track_of[r])
+        .collect::<std::collections::BTreeSet<_>>()
+        .len();
+    crate::import::common::check_cells(path, n, n_tracks)?;
     let mut index: BTreeMap<i64, usize> = BTreeMap::new();
     let mut order: Vec<i64> = Vec::new();
     let mut pts: Vec<(Vec<f64>, Vec<f64>, Vec<usize>)> = Vec::new();
@@ -292,6 +298,22 @@ Label,Spot ID,Track ID,X,Y,T,Frame\n\
             "{:?}",
             raw.notes
         );
+    }
+
+    #[test]
+    fn corrupt_frame_is_refused_not_allocated() {
+        let mut text = String::from("Label,ID,TRACK_ID,POSITION_X,POSITION_Y,FRAME\n");
+        for id in 0..30 {
+            text.push_str(&format!("ID{id},{id},{id},1,2,0\n"));
+        }
+        text.push_str("IDx,99,0,1,2,900000\n");
+        let f = TempFile::new("tm_corrupt.csv", &text);
+        let spec = ImportSpec {
+            fps_hz: Some(10.0),
+            ..ImportSpec::default()
+        };
+        let err = read(&f.0, &spec).unwrap_err().to_string();
+        assert!(err.contains("exceed") && err.contains("corrupt"), "{err}");
     }
 
     #[test]
