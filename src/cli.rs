@@ -108,7 +108,7 @@ pub enum Command {
         out_dir: Option<PathBuf>,
         /// Longest gap (samples) filled by linear interpolation; longer gaps split the record
         /// into separate Welch runs.
-        #[arg(long, default_value_t = 5)]
+        #[arg(long, default_value_t = crate::import::FILL_MAX_SAMPLES)]
         max_fill: usize,
     },
     /// Simulate the blade model over its reversal window.

@@ -787,6 +787,9 @@ pub struct ImportSummary {
     /// Per point (trace order): `(gap runs, longest gap)` in samples; a gap is a maximal run of
     /// samples where x or y is NaN.
     pub gaps: Vec<(usize, usize)>,
+    /// Per point: NaN samples in interior gaps of at most [`FILL_MAX_SAMPLES`] samples — the ones
+    /// `wiperlab spectrum` fills by linear interpolation with its default `--max-fill`.
+    pub fillable: Vec<usize>,
     /// What the import did: time base, units and scale, y flip, rotation, encoding, thresholds,
     /// skipped rows (empty from [`describe`]).
     pub notes: Vec<String>,
@@ -832,8 +835,40 @@ pub fn describe(trace: &Trace) -> ImportSummary {
         dt_min_s: dt.first().copied().unwrap_or(f64::NAN),
         dt_max_s: dt.last().copied().unwrap_or(f64::NAN),
         gaps: trace.points.iter().map(gap_runs).collect(),
+        fillable: trace
+            .points
+            .iter()
+            .map(|p| fillable_samples(p, FILL_MAX_SAMPLES))
+            .collect(),
         notes: Vec::new(),
     }
+}
+
+/// The longest interior gap (samples) that `wiperlab spectrum` fills by default (`--max-fill`).
+pub const FILL_MAX_SAMPLES: usize = 5;
+
+/// NaN samples of `p` in interior runs (finite samples on both sides) of at most `max_fill`.
+pub fn fillable_samples(p: &PointTrack, max_fill: usize) -> usize {
+    let scalar = is_scalar(p);
+    let missing: Vec<bool> = p
+        .x_m
+        .iter()
+        .zip(&p.y_m)
+        .map(|(x, y)| x.is_nan() || (!scalar && y.is_nan()))
+        .collect();
+    let (mut total, mut run, mut seen_finite) = (0, 0, false);
+    for m in missing {
+        if m {
+            run += 1;
+        } else {
+            if seen_finite && run <= max_fill {
+                total += run;
+            }
+            run = 0;
+            seen_finite = true;
+        }
+    }
+    total
 }
 
 /// A scalar point: y NaN throughout while x has a value somewhere.
@@ -895,7 +930,13 @@ impl fmt::Display for ImportSummary {
             )?;
             match self.gaps.get(i) {
                 Some(&(runs, longest)) if runs > 0 => {
-                    writeln!(f, " in {runs} gaps, longest {longest} samples")?
+                    write!(f, " in {runs} gaps, longest {longest} samples")?;
+                    let fill = self.fillable.get(i).copied().unwrap_or(0);
+                    writeln!(
+                        f,
+                        "; {fill} in interior gaps ≤ {FILL_MAX_SAMPLES} samples (filled by \
+                         spectrum), the rest split the record"
+                    )?
                 }
                 _ => writeln!(f)?,
             }
@@ -1212,7 +1253,28 @@ mod tests {
         assert!((s.dt_median_s - 0.1).abs() < 1e-12);
         let text = s.to_string();
         assert_eq!(text.lines().count(), 2, "{text}");
-        assert!(text.contains("head: 2 tracked, 2 NaN (50.00 %)"), "{text}");
+        assert!(text.contains("head: 2 tracked, 2 NaN (50.00 %) in 1 gaps, longest 2 samples; 2 in interior gaps ≤ 5"), "{text}");
+        let long = PointTrack {
+            name: "p".into(),
+            x_m: vec![
+                f64::NAN,
+                1.0,
+                f64::NAN,
+                1.0,
+                f64::NAN,
+                f64::NAN,
+                f64::NAN,
+                f64::NAN,
+                f64::NAN,
+                f64::NAN,
+                1.0,
+                f64::NAN,
+            ],
+            y_m: vec![0.0; 12],
+        };
+        // Leading and trailing NaN are never filled; the 6-sample gap is longer than 5.
+        assert_eq!(fillable_samples(&long, 5), 1);
+        assert_eq!(fillable_samples(&long, 6), 7);
         let empty = describe(&Trace::default());
         assert!(empty.t_first_s.is_nan() && empty.dt_median_s.is_nan());
     }
