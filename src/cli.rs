@@ -107,6 +107,19 @@ pub enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Work–precision of the simulation methods (event-driven, Moreau–Jean, smoothed friction) on
+    /// the belt benchmark and the blade; writes work_precision.csv and SVG figures.
+    Bench {
+        /// Fewer settings and shorter timing loops (about half a minute).
+        #[arg(long)]
+        quick: bool,
+        /// Blade parameter TOML for the blade problems.
+        #[arg(long, default_value = "data/reversal/blade_true.toml")]
+        blade: PathBuf,
+        /// Output directory.
+        #[arg(long, default_value = "reports/bench")]
+        out_dir: PathBuf,
+    },
 }
 
 fn import_spec(a: &ImportArgs) -> Result<ImportSpec> {
@@ -314,6 +327,48 @@ pub fn run(cli: Cli) -> Result<()> {
                 sim.stats.rhs_evals,
                 dir.display()
             );
+            Ok(())
+        }
+        Command::Bench {
+            quick,
+            blade,
+            out_dir,
+        } => {
+            let params: crate::model::BladeParams = parse_toml(&blade, &read_text(&blade)?)?;
+            params.validate().map_err(Error::Config)?;
+            let rows = crate::bench::run_bench(&crate::bench::BenchOptions {
+                quick,
+                blade: params,
+            })?;
+            crate::bench::write_reports(&out_dir, &rows)?;
+            println!(
+                "{:<13} {:<44} {:>8} {:>10} {:>10} {:>10} {:>6} {:>10} {:>10}",
+                "problem",
+                "method",
+                "setting",
+                "value",
+                "wall_s",
+                "rhs",
+                "trans",
+                "t_err_s",
+                "trace_err"
+            );
+            for r in &rows {
+                println!(
+                    "{:<13} {:<44} {:>8} {:>10.1e} {:>10.3e} {:>10} {:>6} {:>10.2e} {:>10.2e} {}",
+                    r.problem,
+                    r.method,
+                    r.setting_name,
+                    r.setting,
+                    r.wall_s,
+                    r.rhs_evals,
+                    r.transitions,
+                    r.transition_err_s,
+                    r.trace_err_m,
+                    r.note
+                );
+            }
+            println!("wrote {}", out_dir.join("work_precision.csv").display());
             Ok(())
         }
         Command::Fit { job, json, quiet } => {

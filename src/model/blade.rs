@@ -241,7 +241,7 @@ impl Blade {
     /// Rows (1)–(3) of the equations of motion as `A·[θ̈, φ̈, N]ᵀ + a_f·f = b`; returns
     /// `(A, a_f, b)` with `a_f` the coefficients of the friction force.
     #[inline]
-    fn rows(&self, t: f64, y: &[f64; 4]) -> (Matrix3<f64>, Vector3<f64>, Vector3<f64>) {
+    pub(crate) fn rows(&self, t: f64, y: &[f64; 4]) -> (Matrix3<f64>, Vector3<f64>, Vector3<f64>) {
         let p = &self.params;
         let m = &self.mc;
         let (l1, l2) = (p.l1_m, p.l2_m);

@@ -4,5 +4,6 @@
 pub mod blade;
 pub mod hybrid;
 pub mod rk;
+pub mod timestep;
 
 pub use hybrid::{Phase, SolverOptions, Transition};
