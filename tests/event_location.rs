@@ -55,14 +55,25 @@ fn onset_error(opts: &SolverOptions) -> f64 {
 #[test]
 fn transition_time_error_falls_at_integrator_order() {
     let hs = [0.04, 0.02, 0.01, 0.005];
-    let errs: Vec<f64> = hs.iter().map(|&h| onset_error(&fixed_step(h)).abs()).collect();
+    let errs: Vec<f64> = hs
+        .iter()
+        .map(|&h| onset_error(&fixed_step(h)).abs())
+        .collect();
     for w in 0..hs.len() - 1 {
         let order = (errs[w] / errs[w + 1]).log2();
-        eprintln!("h = {}: err {:.3e}, observed order {order:.2}", hs[w], errs[w]);
+        eprintln!(
+            "h = {}: err {:.3e}, observed order {order:.2}",
+            hs[w], errs[w]
+        );
     }
     for w in 0..hs.len() - 1 {
         let order = (errs[w] / errs[w + 1]).log2();
-        assert!(order > 3.5 && order < 5.5, "order {order} between h = {} and {}", hs[w], hs[w + 1]);
+        assert!(
+            order > 3.5 && order < 5.5,
+            "order {order} between h = {} and {}",
+            hs[w],
+            hs[w + 1]
+        );
     }
     assert!((errs[2] / errs[3]).log2() > 4.5);
     // With adaptive steps the error follows the tolerance.
@@ -175,8 +186,16 @@ fn tangential_departures_take_the_consistent_direction() {
         phase: Phase::Stick,
         anchor: 0.0,
     };
-    let run = integrate(&belt, 0.0, [0.0, 0.2], mode, 30.0, &times, &SolverOptions::default())
-        .unwrap();
+    let run = integrate(
+        &belt,
+        0.0,
+        [0.0, 0.2],
+        mode,
+        30.0,
+        &times,
+        &SolverOptions::default(),
+    )
+    .unwrap();
     assert!(run.transitions.len() >= 5);
     for tr in &run.transitions {
         assert!(tr.to != Phase::SlipPos, "{tr:?}");
@@ -213,7 +232,10 @@ fn tangential_departures_take_the_consistent_direction() {
         .iter()
         .filter(|tr| tr.from == Phase::Stick)
         .count();
-    eprintln!("blade: {} transitions, {departures} departures", run.transitions.len());
+    eprintln!(
+        "blade: {} transitions, {departures} departures",
+        run.transitions.len()
+    );
     assert!(departures >= 3, "{departures} departures");
     let mut checked = 0;
     for ((t, y), ph) in run.t_s.iter().zip(&run.y).zip(&run.phase) {

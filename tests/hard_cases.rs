@@ -48,7 +48,11 @@ fn all_finite(sim: &BladeSimulation) -> bool {
 
 /// Largest difference between matched transition times of two runs (same count and phases).
 fn transition_gap(a: &BladeSimulation, b: &BladeSimulation) -> f64 {
-    assert_eq!(a.transitions.len(), b.transitions.len(), "transition counts");
+    assert_eq!(
+        a.transitions.len(),
+        b.transitions.len(),
+        "transition counts"
+    );
     a.transitions
         .iter()
         .zip(&b.transitions)
@@ -65,7 +69,10 @@ fn coulomb_period(m: f64, k: f64, vb: f64, fs: f64, fk: f64) -> f64 {
     2.0 / w * (std::f64::consts::PI - (w * (fs - fk) / k / vb).atan()) + 2.0 * (fs - fk) / (k * vb)
 }
 
-fn expect_simulation_error(r: wiperlab::Result<BladeSimulation>, window: (f64, f64)) -> (f64, String) {
+fn expect_simulation_error(
+    r: wiperlab::Result<BladeSimulation>,
+    window: (f64, f64),
+) -> (f64, String) {
     match r {
         Err(Error::Simulation {
             t_s,
@@ -73,12 +80,18 @@ fn expect_simulation_error(r: wiperlab::Result<BladeSimulation>, window: (f64, f
             state,
         }) => {
             eprintln!("stopped at t = {t_s}: {message}; state: {state}");
-            assert!(t_s.is_finite() && t_s >= window.0 && t_s <= window.1, "t_s {t_s}");
+            assert!(
+                t_s.is_finite() && t_s >= window.0 && t_s <= window.1,
+                "t_s {t_s}"
+            );
             assert!(state.contains("θ =") && state.contains("v3 ="), "{state}");
             (t_s, message)
         }
         Err(e) => panic!("expected Error::Simulation, got {e}"),
-        Ok(s) => panic!("expected Error::Simulation, got {} transitions", s.transitions.len()),
+        Ok(s) => panic!(
+            "expected Error::Simulation, got {} transitions",
+            s.transitions.len()
+        ),
     }
 }
 
@@ -159,14 +172,15 @@ fn stiff_neck_simulates_and_stick_forms_agree() {
         w,
         &times,
         &tight(),
-        StickForm::Baumgarte {
-            omega_b_per_s: 1e4,
-        },
+        StickForm::Baumgarte { omega_b_per_s: 1e4 },
     )
     .unwrap();
     assert!(all_finite(&a) && all_finite(&b));
     let gap = transition_gap(&a, &b);
-    eprintln!("stiff neck: {} transitions, gap {gap:.2e} s", a.transitions.len());
+    eprintln!(
+        "stiff neck: {} transitions, gap {gap:.2e} s",
+        a.transitions.len()
+    );
     assert!(!a.transitions.is_empty());
     assert!(gap < 1e-9, "gap {gap}");
 }
@@ -205,14 +219,15 @@ fn near_zero_damping() {
         w,
         &times,
         &tight(),
-        StickForm::Baumgarte {
-            omega_b_per_s: 1e4,
-        },
+        StickForm::Baumgarte { omega_b_per_s: 1e4 },
     )
     .unwrap();
     assert!(all_finite(&a) && all_finite(&b));
     let gap = transition_gap(&a, &b);
-    eprintln!("undamped blade: {} transitions, gap {gap:.2e} s", a.transitions.len());
+    eprintln!(
+        "undamped blade: {} transitions, gap {gap:.2e} s",
+        a.transitions.len()
+    );
     assert!(gap < 1e-9, "gap {gap}");
 }
 
@@ -240,7 +255,10 @@ fn seed_law_converges_to_coulomb_as_b_grows() {
             .unwrap()
             .unwrap();
         let err = (cyc.period_s - t_coulomb).abs() / t_coulomb;
-        eprintln!("B = {b:e}: T = {:.12}, rel err vs Coulomb {err:.3e}", cyc.period_s);
+        eprintln!(
+            "B = {b:e}: T = {:.12}, rel err vs Coulomb {err:.3e}",
+            cyc.period_s
+        );
         assert!(err < 0.5 * last, "B = {b}: {err} after {last}");
         last = err;
     }
@@ -277,11 +295,16 @@ fn lift_off_stops_where_normal_force_vanishes() {
     let y = run.y_end;
     let n = match run.mode_end.phase.slip_dir() {
         Some(s) => blade.slip_dynamics(s, t_lift - 1e-9, &y).unwrap().normal_n,
-        None => blade
-            .stick_dynamics(t_lift - 1e-9, &y, run.mode_end.anchor, 0.0)
-            .unwrap()
-            .normal_n,
+        None => {
+            blade
+                .stick_dynamics(t_lift - 1e-9, &y, run.mode_end.anchor, 0.0)
+                .unwrap()
+                .normal_n
+        }
     };
-    eprintln!("N just before lift-off: {n:.3e} N (preload {:.3e} N)", p.preload_n());
+    eprintln!(
+        "N just before lift-off: {n:.3e} N (preload {:.3e} N)",
+        p.preload_n()
+    );
     assert!(n >= 0.0 && n < 1e-3 * p.preload_n(), "N = {n}");
 }

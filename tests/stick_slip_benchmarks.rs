@@ -112,9 +112,15 @@ fn rk4_reference(belt: &Belt) -> Reference {
     let x_s = law.mu_static() * n / k;
     let (t1, x1) = rk4_henon_slip(&acc, x_s, vb, 2e-4);
     let (t2, x2) = rk4_henon_slip(&acc, x_s, vb, 1e-4);
-    assert!(rel(t1, t2) < 1e-11, "RK4 reference not converged: {t1} vs {t2}");
+    assert!(
+        rel(t1, t2) < 1e-11,
+        "RK4 reference not converged: {t1} vs {t2}"
+    );
     assert!((x1 - x2).abs() < 1e-11, "RK4 reference x_e: {x1} vs {x2}");
-    assert!((k * x2).abs() <= law.mu_static() * n, "reference must stick at x_e");
+    assert!(
+        (k * x2).abs() <= law.mu_static() * n,
+        "reference must stick at x_e"
+    );
     Reference {
         t_slip: t2,
         t_stick: (x_s - x2) / vb,
@@ -126,7 +132,14 @@ fn rk4_reference(belt: &Belt) -> Reference {
 /// ((v_b + ζω y0)/ω_d) sin ω_d t] in slip from x_s = (F_s − c v_b)/k. t_slip is the first upward
 /// root of ẏ(t) − v_b after 0, bracketed on a grid of ω_d t steps of 1e-3 and bisected to the ulp.
 /// Returns `None` if ẏ never returns to v_b within 50 periods (no stick–slip).
-fn damped_coulomb_reference(m: f64, k: f64, c: f64, vb: f64, fs: f64, fk: f64) -> Option<Reference> {
+fn damped_coulomb_reference(
+    m: f64,
+    k: f64,
+    c: f64,
+    vb: f64,
+    fs: f64,
+    fk: f64,
+) -> Option<Reference> {
     let w = (k / m).sqrt();
     let zeta = c / (2.0 * (k * m).sqrt());
     let wd = w * (1.0 - zeta * zeta).sqrt();
@@ -136,7 +149,8 @@ fn damped_coulomb_reference(m: f64, k: f64, c: f64, vb: f64, fs: f64, fk: f64) -
     let y = |t: f64| (-zeta * w * t).exp() * (y0 * (wd * t).cos() + b * (wd * t).sin());
     let yd = |t: f64| {
         (-zeta * w * t).exp()
-            * ((-zeta * w * y0 + wd * b) * (wd * t).cos() + (-zeta * w * b - wd * y0) * (wd * t).sin())
+            * ((-zeta * w * y0 + wd * b) * (wd * t).cos()
+                + (-zeta * w * b - wd * y0) * (wd * t).sin())
     };
     let g = |t: f64| yd(t) - vb;
     let dt = 1e-3 / wd;
@@ -178,7 +192,10 @@ fn check_cycle(name: &str, belt: &Belt, reference: Reference, t_end: f64) {
         rel(cyc.period_s, period)
     );
     assert!(rel(cyc.t_slip_s, reference.t_slip) < REL, "{name}: t_slip");
-    assert!(rel(cyc.t_stick_s, reference.t_stick) < REL, "{name}: t_stick");
+    assert!(
+        rel(cyc.t_stick_s, reference.t_stick) < REL,
+        "{name}: t_stick"
+    );
     assert!(rel(cyc.period_s, period) < REL, "{name}: period");
     assert!(
         (cyc.x_stick_onset_m - reference.x_e).abs() < REL * reference.x_e.abs().max(1e-3),
@@ -209,7 +226,12 @@ fn undamped_coulomb_belt_matches_closed_form_to_1e9() {
             t_stick,
             x_e,
         };
-        check_cycle(&format!("Coulomb k = {k:.3}"), &belt, reference, 4.5 * (t_slip + t_stick));
+        check_cycle(
+            &format!("Coulomb k = {k:.3}"),
+            &belt,
+            reference,
+            4.5 * (t_slip + t_stick),
+        );
         // The RK4 + Hénon reference method on a case with a closed form: validates the method
         // used below for the Leine and seed-law rows.
         let r = rk4_reference(&belt);
