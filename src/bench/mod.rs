@@ -541,3 +541,145 @@ pub fn write_reports(dir: &Path, rows: &[BenchRow]) -> Result<()> {
     }
     Ok(())
 }
+
+/// Spectral peaks of the blade at one tolerance.
+#[derive(Debug, Clone, Serialize)]
+pub struct SpectrumRow {
+    /// Which parameter file.
+    pub blade: String,
+    pub rtol: f64,
+    pub wall_s: f64,
+    pub transitions: usize,
+    /// Peak frequency per band (default fit bands: low, high), Hz; NaN if none.
+    pub low_peak_hz: f64,
+    pub high_peak_hz: f64,
+}
+
+/// The fit's spectral peaks (src/fit/features.rs: default bands, signal tip − head x, Welch) of the
+/// blade simulated over its default window at 10 kHz (the shipped recording's sampling), for each
+/// `rtol` (atol = rtol·1e-2).
+pub fn spectra_vs_rtol(
+    name: &str,
+    params: &BladeParams,
+    rtols: &[f64],
+) -> Result<Vec<SpectrumRow>> {
+    use crate::fit::features::{SignalKind, default_bands, features};
+    let (t0, t1) = default_window(params);
+    let fs = 10_000.0;
+    let n = ((t1 - t0) * fs).floor() as usize + 1;
+    let times: Vec<f64> = (0..n).map(|i| t0 + i as f64 / fs).collect();
+    let window = (t0, times[n - 1]);
+    let bands = default_bands();
+    let mut rows = Vec::new();
+    for &rtol in rtols {
+        let start = Instant::now();
+        let sim = crate::simulate::blade::simulate_blade(
+            params,
+            window,
+            &times,
+            &ed_opts(rtol),
+            StickForm::Reduced,
+        )?;
+        let wall = start.elapsed().as_secs_f64();
+        let x = SignalKind::TipRelX.extract(&sim.to_trace())?;
+        let f = features(&x, fs, &bands, 5)?;
+        let peak = |i: usize| f.bands[i].peak.as_ref().map_or(f64::NAN, |p| p.freq_hz);
+        rows.push(SpectrumRow {
+            blade: name.into(),
+            rtol,
+            wall_s: wall,
+            transitions: sim.transitions.len(),
+            low_peak_hz: peak(0),
+            high_peak_hz: peak(1),
+        });
+    }
+    Ok(rows)
+}
+
+/// Writes `spectra_vs_rtol.csv` and `spectra_vs_rtol.svg` (relative peak deviation from the
+/// tightest tolerance) into `dir`; returns the loosest rtol whose peaks are all within `rel` of the
+/// tightest run's, with every tighter rtol also within.
+pub fn write_spectra(dir: &Path, rows: &[SpectrumRow], rel: f64) -> Result<Option<f64>> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "create directory", e))?;
+    let path = dir.join("spectra_vs_rtol.csv");
+    let mut w = csv::Writer::from_path(&path)
+        .map_err(|e| Error::Numerics(format!("{}: {e}", path.display())))?;
+    for r in rows {
+        w.serialize(r)
+            .map_err(|e| Error::Numerics(format!("{}: {e}", path.display())))?;
+    }
+    w.flush().map_err(|e| Error::io(&path, "write CSV", e))?;
+    let mut names: Vec<&str> = Vec::new();
+    for r in rows {
+        if !names.contains(&r.blade.as_str()) {
+            names.push(&r.blade);
+        }
+    }
+    let mut series = Vec::new();
+    let mut rtols: Vec<f64> = rows.iter().map(|r| r.rtol).collect();
+    rtols.sort_by(f64::total_cmp);
+    rtols.dedup();
+    // For each rtol: is it, and every tighter one, within `rel` for every blade and band?
+    let mut ok_all = vec![true; rtols.len()];
+    for name in &names {
+        let sel: Vec<&SpectrumRow> = rows.iter().filter(|r| r.blade == *name).collect();
+        let Some(conv) = sel.iter().min_by(|a, b| a.rtol.total_cmp(&b.rtol)) else {
+            continue;
+        };
+        let dev = |r: &SpectrumRow| {
+            [
+                ((r.low_peak_hz - conv.low_peak_hz) / conv.low_peak_hz).abs(),
+                ((r.high_peak_hz - conv.high_peak_hz) / conv.high_peak_hz).abs(),
+            ]
+        };
+        for (k, rt) in rtols.iter().enumerate() {
+            let within = sel
+                .iter()
+                .filter(|r| r.rtol == *rt)
+                .all(|r| dev(r).iter().all(|d| *d <= rel));
+            ok_all[k] &= within;
+        }
+        let others: Vec<&&SpectrumRow> = sel.iter().filter(|r| r.rtol > conv.rtol).collect();
+        for (i, band) in ["low band peak", "high band peak"].iter().enumerate() {
+            let mut s = Series::line(
+                format!("{name}: {band}"),
+                others.iter().map(|r| r.rtol).collect(),
+                others.iter().map(|r| dev(r)[i].max(1e-9)).collect(),
+            );
+            s.style = crate::report::plot::SeriesStyle::LinePoints;
+            series.push(s);
+        }
+    }
+    let loose: Vec<f64> = rtols.iter().copied().skip(1).collect();
+    if !loose.is_empty() {
+        series.push(Series::line(
+            format!("{} % limit", rel * 100.0),
+            loose.clone(),
+            vec![rel; loose.len()],
+        ));
+        line_chart(
+            &dir.join("spectra_vs_rtol.svg"),
+            &format!(
+                "Fit spectral peaks vs rtol (relative to rtol {:e}; floor 1e-9 = identical)",
+                rtols[0]
+            ),
+            "rtol",
+            "|peak - converged| / converged",
+            &series,
+            &ChartOpts {
+                log_x: true,
+                log_y: true,
+                ..Default::default()
+            },
+        )?;
+    }
+    let mut best = None;
+    for (k, rt) in rtols.iter().enumerate() {
+        if ok_all[k] {
+            best = Some(*rt);
+        } else {
+            break;
+        }
+    }
+    Ok(best)
+}
