@@ -157,6 +157,24 @@ pub enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Work–precision of the simulation methods (event-driven, Moreau–Jean, smoothed friction) on
+    /// the belt benchmark and the blade; writes work_precision.csv and SVG figures.
+    Bench {
+        /// Fewer settings and shorter timing loops (about 10 s instead of 20 s).
+        #[arg(long)]
+        quick: bool,
+        /// Blade parameter TOMLs, comma-separated: the first is used for the work–precision problems,
+        /// all of them for the spectra-against-tolerance study.
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "data/reversal/blade_true.toml,data/reversal/blade.toml"
+        )]
+        blade: Vec<PathBuf>,
+        /// Output directory.
+        #[arg(long, default_value = "reports/bench")]
+        out_dir: PathBuf,
+    },
 }
 
 fn import_spec(a: &ImportArgs) -> Result<ImportSpec> {
@@ -466,6 +484,86 @@ pub fn run(cli: Cli) -> Result<()> {
                 sim.stats.rhs_evals,
                 dir.display()
             );
+            Ok(())
+        }
+        Command::Bench {
+            quick,
+            blade,
+            out_dir,
+        } => {
+            let mut blades = Vec::new();
+            for path in &blade {
+                let params: BladeParams = parse_toml(path, &read_text(path)?)?;
+                params.validate().map_err(Error::Config)?;
+                blades.push((path.display().to_string(), params));
+            }
+            let Some((_, params)) = blades.first() else {
+                return Err(Error::Config(
+                    "bench: --blade needs at least one file".into(),
+                ));
+            };
+            let rows = crate::bench::run_bench(&crate::bench::BenchOptions {
+                quick,
+                blade: *params,
+            })?;
+            crate::bench::write_reports(&out_dir, &rows)?;
+            println!(
+                "{:<13} {:<44} {:>8} {:>10} {:>10} {:>10} {:>6} {:>10} {:>10}",
+                "problem",
+                "method",
+                "setting",
+                "value",
+                "wall_s",
+                "rhs",
+                "trans",
+                "t_err_s",
+                "trace_err"
+            );
+            for r in &rows {
+                println!(
+                    "{:<13} {:<44} {:>8} {:>10.1e} {:>10.3e} {:>10} {:>6} {:>10.2e} {:>10.2e} {}",
+                    r.problem,
+                    r.method,
+                    r.setting_name,
+                    r.setting,
+                    r.wall_s,
+                    r.rhs_evals,
+                    r.transitions,
+                    r.transition_err_s,
+                    r.trace_err_m,
+                    r.note
+                );
+            }
+            println!("wrote {}", out_dir.join("work_precision.csv").display());
+            let rtols: Vec<f64> = if quick {
+                vec![1e-6, 1e-8, 1e-10, 1e-12]
+            } else {
+                (4..=13).map(|e| 10f64.powi(-e)).collect()
+            };
+            let mut spectra = Vec::new();
+            for (name, p) in &blades {
+                spectra.extend(crate::bench::spectra_vs_rtol(name, p, &rtols)?);
+            }
+            let loosest = crate::bench::write_spectra(&out_dir, &spectra, 0.002, 0.05)?;
+            println!(
+                "\n{:<32} {:>8} {:>9} {:>6} {:>12} {:>12}",
+                "blade", "rtol", "wall_s", "trans", "low_peak_hz", "high_peak_hz"
+            );
+            for r in &spectra {
+                println!(
+                    "{:<32} {:>8.0e} {:>9.3} {:>6} {:>12.3} {:>12.3}",
+                    r.blade, r.rtol, r.wall_s, r.transitions, r.low_peak_hz, r.high_peak_hz
+                );
+            }
+            match loosest {
+                Some(r) => println!(
+                    "loosest rtol with both peaks of every blade within 0.2 % of its tightest run (and the transition count within 5 %): {r:e}"
+                ),
+                None => println!(
+                    "no rtol has both peaks within 0.2 % (and the transition count within 5 %) of the tightest"
+                ),
+            }
+            println!("wrote {}", out_dir.join("spectra_vs_rtol.csv").display());
             Ok(())
         }
         Command::Fit { job, json, quiet } => {

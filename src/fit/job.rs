@@ -33,7 +33,10 @@ pub struct FitJob {
     pub blade: PathBuf,
     #[serde(default)]
     pub spectrum: SpectrumSection,
-    /// Integrator settings for every model evaluation; default rtol 1e-8, atol 1e-10.
+    /// Integrator settings for every model evaluation; default rtol 1e-7, atol 1e-9. The fit's
+    /// spectral peaks stay within 0.2 % of converged down to rtol 1e-6 (`wiperlab bench`,
+    /// reports/bench/spectra_vs_rtol.csv), but at 1e-6 the recovery in tests/fit_recovery.rs misses C
+    /// by 8 %; at 1e-7 it recovers C and k1 to 0.2 % (0.02 % at 1e-8).
     #[serde(default = "fit_solver_default")]
     pub solver: SolverOptions,
     pub fit: FitSection,
@@ -44,8 +47,8 @@ pub struct FitJob {
 
 fn fit_solver_default() -> SolverOptions {
     SolverOptions {
-        rtol: 1e-8,
-        atol: 1e-10,
+        rtol: 1e-7,
+        atol: 1e-9,
         ..SolverOptions::default()
     }
 }
