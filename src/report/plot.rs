@@ -784,8 +784,8 @@ fn heatmap_image(
     let png = png::encode_rgb(w, h, &rgb)?;
     Some(format!(
         "<image x=\"{x0}\" y=\"{y0}\" width=\"{w}\" height=\"{h}\" preserveAspectRatio=\"none\" \
-         href=\"data:image/png;base64,{}\"/>",
-        png::base64(&png)
+         href=\"{}\"/>",
+        png::data_uri(&png)
     ))
 }
 
