@@ -172,7 +172,7 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
         line_chart(
             &dir.join(format!("psd_{}.svg", d.spec.name)),
             &format!(
-                "Welch PSD, {} band (nperseg {}), measured and model",
+                "Welch PSD, {} band (nperseg {}): measured, model, model + noise floor",
                 d.spec.name, d.spec.nperseg
             ),
             "frequency [Hz]",
