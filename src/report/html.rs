@@ -648,6 +648,7 @@ pub fn write_report(r: &FitResult, paths: &ReportPaths) -> Result<ReportSummary>
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fit::result::sha256_hex;
 
     #[test]
     fn escape_covers_markup_and_quotes() {
@@ -668,6 +669,140 @@ mod tests {
         assert_eq!(num(f64::NAN, 3), "—");
         assert_eq!(num(0.0, 3), "0");
         assert_eq!(pct(-0.0245066), "-2.45 %");
+    }
+
+    fn result() -> FitResult {
+        use crate::fit::result::{FittedParam, Interval, PeakComparison};
+        let p = |name: &str, determined: bool, interval: Option<Interval>| FittedParam {
+            name: name.into(),
+            value: 0.03,
+            lower: 0.005,
+            upper: 0.15,
+            std_error: if determined { 0.001 } else { 0.2 },
+            determined,
+            true_value: Some(0.029),
+            rel_error: Some(0.03 / 0.029 - 1.0),
+            interval,
+        };
+        FitResult {
+            job: "unit".into(),
+            recording: "rec.csv".into(),
+            wiperlab_version: "0.1.0".into(),
+            model: "blade2dof".into(),
+            cost: 1.5,
+            parameters: vec![
+                p(
+                    "k1",
+                    true,
+                    Some(Interval {
+                        lo: 0.028,
+                        hi: 0.032,
+                        level: 0.68,
+                        method: "profile".into(),
+                    }),
+                ),
+                p("B", false, None),
+            ],
+            peaks: vec![PeakComparison {
+                band: "low".into(),
+                measured_hz: 49.0,
+                model_hz: 49.5,
+                rel_diff: 0.5 / 49.0,
+                measured_level: 1e-9,
+                model_level: 2e-9,
+            }],
+            undetermined: vec!["B".into()],
+            correlation: vec![vec![1.0, -0.9], vec![-0.9, 1.0]],
+            swarm_iterations: 1,
+            polish_iterations: 2,
+            model_evaluations: 30,
+            failed_evaluations: 2,
+            first_failure: Some("contact lost".into()),
+            wall_time_s: 0.5,
+            threads: 2,
+            solver_rtol: 1e-8,
+            solver_atol: 1e-10,
+            transitions_in_best_model: 10,
+            model_trials: vec![],
+            warnings: vec![],
+            input_sha256: sha256_hex(b"the recording at fit time"),
+            settings: String::new(),
+            history: vec![],
+        }
+    }
+
+    #[test]
+    fn page_tables_and_warnings_from_a_result() {
+        let dir = std::env::temp_dir().join(format!("wiperlab_html_unit_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let figs = dir.join("reports");
+        std::fs::create_dir_all(&figs).unwrap();
+        // Only two of the fit's figures, plus one extra SVG.
+        for f in ["cost.svg", "psd_low.svg", "extra.svg"] {
+            std::fs::write(figs.join(f), "<svg xmlns=\"http://www.w3.org/2000/svg\"/>").unwrap();
+        }
+        let rec = dir.join("rec.csv");
+        std::fs::write(&rec, "the recording changed since").unwrap();
+        let r = result();
+        let s = write_report(
+            &r,
+            &ReportPaths {
+                job: dir.join("job.toml"),
+                result: dir.join("unit.result.toml"),
+                recording: rec.clone(),
+                dir: figs.clone(),
+            },
+        )
+        .unwrap();
+        // Fit figures in fit_figure_list order, then the others by name.
+        assert_eq!(s.figures, ["psd_low.svg", "cost.svg", "extra.svg"]);
+        assert_eq!(
+            s.missing_figures,
+            ["traces_tip.svg", "traces_head.svg", "friction_law.svg"]
+        );
+        let has = |needle: &str| s.warnings.iter().any(|w| w.contains(needle));
+        assert!(has("leave B undetermined"), "{:?}", s.warnings);
+        assert!(has("2 of 30 model evaluations failed"), "{:?}", s.warnings);
+        assert!(has("figures missing"), "{:?}", s.warnings);
+        assert!(has("has changed since the fit"), "{:?}", s.warnings);
+        assert_eq!(s.warnings.len(), 4, "{:?}", s.warnings);
+        let html = std::fs::read_to_string(&s.path).unwrap();
+        assert!(html.contains("<td>[0.02800, 0.03200] (68 %, profile)</td>"));
+        assert!(html.contains("<td>+3.45 %</td>")); // 0.03/0.029 − 1
+        assert!(html.contains("<span class=\"warn\">NO</span>"));
+        assert!(html.contains("<td>-0.900</td>"));
+        assert!(html.contains(&format!(
+            "<code id=\"sha256-now\">{}</code>",
+            sha256_hex(b"the recording changed since")
+        )));
+        assert!(html.contains("Only one model (blade2dof) was fitted"));
+        assert!(html.contains("The result does not record the job's settings."));
+
+        // Unchanged recording, all figures present, nothing failed: no warnings at all.
+        std::fs::write(&rec, "the recording at fit time").unwrap();
+        for (f, _) in fit_figure_list(&r) {
+            std::fs::write(figs.join(f), "<svg xmlns=\"http://www.w3.org/2000/svg\"/>").unwrap();
+        }
+        let mut r = r;
+        r.parameters[1].determined = true;
+        r.failed_evaluations = 0;
+        let s = write_report(
+            &r,
+            &ReportPaths {
+                job: dir.join("job.toml"),
+                result: dir.join("unit.result.toml"),
+                recording: rec,
+                dir: figs,
+            },
+        )
+        .unwrap();
+        assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+        assert!(
+            std::fs::read_to_string(&s.path)
+                .unwrap()
+                .contains("<p id=\"warning-list\">None.</p>")
+        );
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
