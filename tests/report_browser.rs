@@ -421,3 +421,28 @@ fn report_escapes_text_from_the_result() {
     let check = figure_check(&dump_dom(&chromium, &page, &tmp.0.join("profile")));
     assert_eq!((check.status.as_str(), check.total), ("ok", 6), "{check:?}");
 }
+
+/// A result file that is not a fit result is a one-line input error naming the file, line and
+/// column (exit code 2), not a panic and not a silent refit.
+#[test]
+fn unreadable_result_is_a_clear_input_error() {
+    let tmp = TempDir::new("bad_result");
+    let job = write_quick_job(&tmp.0);
+    let result = tmp.0.join("quick.result.toml");
+    std::fs::write(&result, "job = \"quick\"\ncost = \"low\"\n").unwrap();
+    let o = wiperlab(&tmp.0, &["report", job.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "stderr:\n{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 1, "{err}");
+    assert!(
+        lines[0].starts_with(&format!("error: {}:2:", result.display())),
+        "{err}"
+    );
+    assert!(!tmp.0.join("reports/quick/index.html").exists());
+    assert_eq!(
+        std::fs::read_to_string(&result).unwrap(),
+        "job = \"quick\"\ncost = \"low\"\n",
+        "the result was overwritten"
+    );
+}
