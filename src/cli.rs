@@ -5,7 +5,7 @@ use crate::fit::job::{LoadedJob, parse_toml, read_text};
 use crate::import::{Format, ImportSpec};
 use crate::model::{BladeParams, StickForm};
 use crate::simulate::SolverOptions;
-use crate::simulate::blade::{default_window, simulate_blade};
+use crate::simulate::blade::{ModelKind, default_window, simulate_model};
 use crate::{Error, Result};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -93,6 +93,9 @@ pub enum Command {
         /// Stick-phase form: reduced (drift-free) or baumgarte.
         #[arg(long, default_value = "reduced", value_parser = ["reduced", "baumgarte"])]
         stick: String,
+        /// Model of the hierarchy: blade2dof (full head/neck/lip) or head1dof (neck and lip locked).
+        #[arg(long, default_value = "blade2dof", value_parser = ["blade2dof", "head1dof"])]
+        model: String,
         /// Output directory (default: reports/simulate/<params stem>).
         #[arg(long)]
         out_dir: Option<PathBuf>,
@@ -307,8 +310,14 @@ pub fn run(cli: Cli) -> Result<()> {
             rtol,
             atol,
             stick,
+            model,
             out_dir,
         } => {
+            let kind = if model == "head1dof" {
+                ModelKind::Head1dof
+            } else {
+                ModelKind::Blade2dof
+            };
             let p: BladeParams = parse_toml(&params, &read_text(&params)?)?;
             p.validate().map_err(|m| Error::input(&params, m))?;
             let win = match window {
@@ -339,7 +348,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 ..SolverOptions::default()
             };
             let t = std::time::Instant::now();
-            let sim = simulate_blade(&p, win, &times, &opts, form)?;
+            let sim = simulate_model(kind, &p, win, &times, &opts, form)?;
             let wall = t.elapsed().as_secs_f64();
             let dir = out_dir.unwrap_or_else(|| Path::new("reports/simulate").join(stem(&params)));
             create_dir(&dir)?;

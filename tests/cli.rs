@@ -226,6 +226,29 @@ fn main_job_end_to_end() {
         num(&truth, "/peaks/recording/v3rel/high_Hz")
     );
 
+    // The model hierarchy: the job lists three candidates. The sample was made by the full 2-DOF
+    // model without shoulder contact (data/reversal/README.md, truth.json /params), so the full model
+    // must be chosen: the head model cannot make the high band, and the shoulder's two extra
+    // parameters must not be claimed as needed.
+    let trials = r["model_trials"].as_array().expect("model_trials array");
+    assert_eq!(trials.len(), 3, "{trials:?}");
+    assert_eq!(r["model"], "blade2dof", "{trials:?}");
+    for t in trials {
+        println!(
+            "model {}: cost {:.4}, {:.1} s, chosen {}: {}",
+            t["model"],
+            num(t, "/cost"),
+            num(t, "/wall_time_s"),
+            t["chosen"],
+            t["reason"]
+        );
+    }
+    let head = trials
+        .iter()
+        .find(|t| t["model"] == "head1dof")
+        .expect("head1dof trial");
+    assert!(num(head, "/cost") > 10.0 * num(&r, "/cost"), "{head}");
+
     // Parameters: every freed one reported against the truth (job [truth] keys -> truth.json /params).
     let params = r["parameters"].as_array().expect("parameters array");
     for name in ["A", "B", "C", "k1"] {

@@ -114,7 +114,54 @@ pub struct FitSection {
     pub seed: u64,
     #[serde(default)]
     pub weights: Weights,
+    /// Models of the hierarchy to fit and compare, e.g. `["head1dof", "blade2dof",
+    /// "blade2dof+shoulder"]`. Empty (the default): only the smallest model that can produce every
+    /// band the job asks for (see [`crate::fit::smallest_capable_model`]). With several, each is
+    /// fitted and the one with the lowest Akaike criterion (cost + 2k) is reported.
+    #[serde(default)]
+    pub models: Vec<String>,
+    /// Bounds of the shoulder-contact parameters freed by the `blade2dof+shoulder` candidate.
+    #[serde(default)]
+    pub shoulder: Option<ShoulderBounds>,
+    /// Confidence intervals by parametric bootstrap (see [`crate::fit::bootstrap_intervals`]).
+    #[serde(default)]
+    pub uncertainty: UncertaintySection,
 }
+
+/// Settings of the parametric bootstrap that gives each fitted parameter an interval.
+#[derive(Debug, Clone, Copy, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct UncertaintySection {
+    /// Bootstrap replicates (0: no intervals, only the curvature's 1σ).
+    pub bootstrap: usize,
+    /// Nelder–Mead iterations of each replicate's refit (started from the optimum).
+    pub polish_iterations: u64,
+    /// Seed of the replicates' noise.
+    pub seed: u64,
+}
+
+impl Default for UncertaintySection {
+    fn default() -> Self {
+        UncertaintySection {
+            bootstrap: 0,
+            polish_iterations: 30,
+            seed: 7,
+        }
+    }
+}
+
+/// Bounds `[lower, upper]` of the shoulder parameters (see [`crate::model::Shoulder`]).
+#[derive(Debug, Clone, Copy, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShoulderBounds {
+    /// Neck stiffness while touching the shoulder, N·m/rad.
+    pub k1c: [f64; 2],
+    /// Contact angle, rad.
+    pub theta_c: [f64; 2],
+}
+
+/// Names of the candidate models a job may list in `[fit] models`.
+pub const MODEL_NAMES: &[&str] = &["head1dof", "blade2dof", "blade2dof+shoulder"];
 
 fn d_particles() -> usize {
     12
@@ -150,6 +197,14 @@ pub const PARAM_NAMES: &[(&str, &str)] = &[
     ("c1", "neck damper c1, N·m·s/rad"),
     ("c2", "lip damper c2, N·m·s/rad"),
     ("hd", "preload compression h_d, m"),
+    (
+        "k1c",
+        "neck stiffness touching the shoulder, N·m/rad (needs a [shoulder] in the blade)",
+    ),
+    (
+        "theta_c",
+        "shoulder contact angle, rad (needs a [shoulder] in the blade)",
+    ),
 ];
 
 /// Reads parameter `name` of `p` (`None` for an unknown name).
@@ -170,6 +225,8 @@ pub fn get_param(p: &BladeParams, name: &str) -> Option<f64> {
         "c1" => p.c1_nms_per_rad,
         "c2" => p.c2_nms_per_rad,
         "hd" => p.hd_m,
+        "k1c" => p.shoulder?.k1_contact_nm_per_rad,
+        "theta_c" => p.shoulder?.contact_angle_rad,
         _ => return None,
     })
 }
@@ -196,6 +253,11 @@ pub fn set_param(p: &mut BladeParams, name: &str, v: f64) -> bool {
         "c1" => p.c1_nms_per_rad = v,
         "c2" => p.c2_nms_per_rad = v,
         "hd" => p.hd_m = v,
+        "k1c" | "theta_c" => match &mut p.shoulder {
+            Some(sh) if name == "k1c" => sh.k1_contact_nm_per_rad = v,
+            Some(sh) => sh.contact_angle_rad = v,
+            None => return false,
+        },
         _ => return false,
     }
     true
@@ -272,6 +334,17 @@ impl LoadedJob {
         for (pname, [lo, hi]) in &job.fit.parameters {
             let line =
                 line_of(&text, &format!("{pname} =")).max(line_of(&text, &format!("{pname}=")));
+            if (pname == "k1c" || pname == "theta_c") && blade.shoulder.is_none() {
+                return Err(Error::parse(
+                    path,
+                    line,
+                    1,
+                    format!(
+                        "[fit.parameters]: '{pname}' is a shoulder parameter but the blade file {} has no [shoulder] section (or list \"blade2dof+shoulder\" in [fit] models with [fit.shoulder] bounds)",
+                        blade_path.display()
+                    ),
+                ));
+            }
             if get_param(&blade, pname).is_none() {
                 return Err(Error::parse(
                     path,
@@ -324,6 +397,39 @@ impl LoadedJob {
                 1,
                 "[fit] particles must be >= 2",
             ));
+        }
+        for m in &job.fit.models {
+            if !MODEL_NAMES.contains(&m.as_str()) {
+                return Err(Error::parse(
+                    path,
+                    line_of(&text, "models"),
+                    1,
+                    format!(
+                        "[fit] models: unknown model '{m}' (known: {})",
+                        MODEL_NAMES.join(", ")
+                    ),
+                ));
+            }
+            if m == "blade2dof+shoulder" && job.fit.shoulder.is_none() {
+                return Err(Error::parse(
+                    path,
+                    line_of(&text, "models"),
+                    1,
+                    "[fit] models lists \"blade2dof+shoulder\": give its bounds in [fit.shoulder] (k1c = [lo, hi], theta_c = [lo, hi])",
+                ));
+            }
+        }
+        if let Some(sb) = &job.fit.shoulder {
+            for (name, [lo, hi]) in [("k1c", sb.k1c), ("theta_c", sb.theta_c)] {
+                if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && lo < hi) {
+                    return Err(Error::parse(
+                        path,
+                        line_of(&text, "[fit.shoulder]"),
+                        1,
+                        format!("[fit.shoulder] {name}: need 0 < lower < upper (got [{lo}, {hi}])"),
+                    ));
+                }
+            }
         }
         job.solver.validate()?;
         for b in &job.spectrum.bands {

@@ -95,10 +95,7 @@ impl Belt {
         t_end_s: f64,
         opts: &SolverOptions,
     ) -> Result<Option<BeltCycle>> {
-        let mode = Mode {
-            phase: Phase::Stick,
-            anchor: x0_m,
-        };
+        let mode = Mode::new(Phase::Stick, x0_m);
         let run = integrate(
             self,
             0.0,

@@ -79,6 +79,27 @@ pub struct BladeParams {
     pub drive_a_m: f64,
     /// Drive angular frequency ω, rad/s.
     pub drive_omega_rad_per_s: f64,
+    /// Optional shoulder contact: past a contact angle the neck bears on the blade's shoulder and
+    /// stiffens (absent: a single neck stiffness `k1`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shoulder: Option<Shoulder>,
+}
+
+/// Piecewise neck stiffness from shoulder contact (seed: the measured ~900 Hz component lies far
+/// above the free neck's 195 Hz "because the neck touches the shoulder"; physics.md §2.3 point 2,
+/// "a bilinear k1(θ) … is the physically motivated extension").
+///
+/// The neck moment is `k1·θ` for `|θ| ≤ θ_c` and `sign θ·[k1·θ_c + k1_contact·(|θ| − θ_c)]` beyond:
+/// continuous in θ, with a kink in stiffness at `|θ| = θ_c`, located exactly as a switching event by
+/// the integrator ([`crate::simulate::hybrid::StickSlipModel::switching_surfaces`]). The shoulder is
+/// symmetric (one on each side of the neck), since the blade leans either way around a reversal.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Shoulder {
+    /// Neck angle at which the neck touches the shoulder, θ_c > 0, rad.
+    pub contact_angle_rad: f64,
+    /// Neck stiffness while touching, N·m/rad (the free stiffness is `k1_nm_per_rad`).
+    pub k1_contact_nm_per_rad: f64,
 }
 
 /// The mass coefficients of eqs. (1)–(3) (dimensional; see the module docs).
@@ -123,6 +144,27 @@ impl BladeParams {
         (self.k1_nm_per_rad / self.mass_coefficients().mth).sqrt() / std::f64::consts::TAU
     }
 
+    /// Neck moment `k1(θ)·θ` on the branch `touching` (the shoulder's, if any, when true), N·m.
+    /// Each branch's formula is used beyond its own range too (the integrator freezes the branch
+    /// within a step).
+    #[inline]
+    pub fn neck_moment_nm(&self, theta: f64, touching: bool) -> f64 {
+        match self.shoulder {
+            Some(sh) if touching => {
+                let c = sh.contact_angle_rad;
+                theta.signum()
+                    * (self.k1_nm_per_rad * c + sh.k1_contact_nm_per_rad * (theta.abs() - c))
+            }
+            _ => self.k1_nm_per_rad * theta,
+        }
+    }
+
+    /// Whether the neck touches the shoulder at angle θ (`|θ| > θ_c`).
+    pub fn touches_shoulder(&self, theta: f64) -> bool {
+        self.shoulder
+            .is_some_and(|sh| theta.abs() > sh.contact_angle_rad)
+    }
+
     /// Static preload N0 = k0·h_d, N.
     pub fn preload_n(&self) -> f64 {
         self.k0_n_per_m * self.hd_m
@@ -155,6 +197,20 @@ impl BladeParams {
                 return Err(format!(
                     "blade parameter {name} = {v} must be finite and {}",
                     if strictly { "> 0" } else { ">= 0" }
+                ));
+            }
+        }
+        if let Some(sh) = self.shoulder {
+            if !(sh.contact_angle_rad.is_finite() && sh.contact_angle_rad > 0.0) {
+                return Err(format!(
+                    "blade parameter shoulder.contact_angle_rad = {} must be finite and > 0",
+                    sh.contact_angle_rad
+                ));
+            }
+            if !(sh.k1_contact_nm_per_rad.is_finite() && sh.k1_contact_nm_per_rad > 0.0) {
+                return Err(format!(
+                    "blade parameter shoulder.k1_contact_nm_per_rad = {} must be finite and > 0",
+                    sh.k1_contact_nm_per_rad
                 ));
             }
         }
@@ -241,7 +297,12 @@ impl Blade {
     /// Rows (1)–(3) of the equations of motion as `A·[θ̈, φ̈, N]ᵀ + a_f·f = b`; returns
     /// `(A, a_f, b)` with `a_f` the coefficients of the friction force.
     #[inline]
-    fn rows(&self, t: f64, y: &[f64; 4]) -> (Matrix3<f64>, Vector3<f64>, Vector3<f64>) {
+    fn rows(
+        &self,
+        t: f64,
+        y: &[f64; 4],
+        touching: bool,
+    ) -> (Matrix3<f64>, Vector3<f64>, Vector3<f64>) {
         let p = &self.params;
         let m = &self.mc;
         let (l1, l2) = (p.l1_m, p.l2_m);
@@ -262,7 +323,7 @@ impl Blade {
             + m.ma * vdd * cth
             - p.k2_nm_per_rad * (ph - th)
             - p.c2_nms_per_rad * (phd - thd)
-            + p.k1_nm_per_rad * th
+            + p.neck_moment_nm(th, touching)
             + p.c1_nms_per_rad * thd;
         let a21 = m.mc * cd - m.mb * l1 * sth * sph;
         let a22 = m.mph - m.mb * l2 * sph * sph;
@@ -297,7 +358,18 @@ impl Blade {
     /// the opposite sign to the frictionless one (a Painlevé-type inconsistency: no unique slip
     /// solution).
     pub fn slip_dynamics(&self, s: f64, t: f64, y: &[f64; 4]) -> Result<Dynamics, ModelFault> {
-        let (a0, af, b) = self.rows(t, y);
+        self.slip_dynamics_on(s, t, y, self.params.touches_shoulder(y[0]))
+    }
+
+    /// [`Blade::slip_dynamics`] on a given shoulder branch (`touching`).
+    pub fn slip_dynamics_on(
+        &self,
+        s: f64,
+        t: f64,
+        y: &[f64; 4],
+        touching: bool,
+    ) -> Result<Dynamics, ModelFault> {
+        let (a0, af, b) = self.rows(t, y, touching);
         let mu = self.params.friction.mu_slip(self.tip_velocity(t, y));
         // f = −s μ N: fold into the N column.
         let mut a = a0;
@@ -334,7 +406,19 @@ impl Blade {
         anchor: f64,
         omega_b: f64,
     ) -> Result<Dynamics, ModelFault> {
-        let (a3, af, b3) = self.rows(t, y);
+        self.stick_dynamics_on(t, y, anchor, omega_b, self.params.touches_shoulder(y[0]))
+    }
+
+    /// [`Blade::stick_dynamics`] on a given shoulder branch (`touching`).
+    pub fn stick_dynamics_on(
+        &self,
+        t: f64,
+        y: &[f64; 4],
+        anchor: f64,
+        omega_b: f64,
+        touching: bool,
+    ) -> Result<Dynamics, ModelFault> {
+        let (a3, af, b3) = self.rows(t, y, touching);
         let (l1, l2) = (self.params.l1_m, self.params.l2_m);
         let (sth, cth) = y[0].sin_cos();
         let (sph, cph) = y[1].sin_cos();
@@ -456,14 +540,15 @@ impl StickSlipModel<4> for Blade {
         y: &[f64; 4],
         dy: &mut [f64; 4],
     ) -> Result<Contact, ModelFault> {
+        let touching = mode.region & 1 != 0;
         let d = match (mode.phase, self.stick_form) {
             (Phase::Stick, StickForm::Baumgarte { omega_b_per_s }) => {
-                self.stick_dynamics(t, y, mode.anchor, omega_b_per_s)?
+                self.stick_dynamics_on(t, y, mode.anchor, omega_b_per_s, touching)?
             }
             (Phase::Stick, StickForm::Reduced) => {
                 let (phi, phi_d) = self.constrained_lip(t, y[0], y[2], mode.anchor)?;
                 let yc = [y[0], phi, y[2], phi_d];
-                let d = self.stick_dynamics(t, &yc, mode.anchor, 0.0)?;
+                let d = self.stick_dynamics_on(t, &yc, mode.anchor, 0.0, touching)?;
                 dy[0] = y[2];
                 dy[1] = 0.0;
                 dy[2] = d.theta_dd;
@@ -474,7 +559,7 @@ impl StickSlipModel<4> for Blade {
                     limit: self.mu_s * d.normal_n,
                 });
             }
-            (phase, _) => self.slip_dynamics(phase.slip_dir().unwrap_or(1.0), t, y)?,
+            (phase, _) => self.slip_dynamics_on(phase.slip_dir().unwrap_or(1.0), t, y, touching)?,
         };
         dy[0] = y[2];
         dy[1] = y[3];
@@ -512,6 +597,19 @@ impl StickSlipModel<4> for Blade {
         Ok(())
     }
 
+    fn switching_surfaces(&self) -> usize {
+        usize::from(self.params.shoulder.is_some())
+    }
+
+    /// `|θ| − θ_c`: positive while the neck touches the shoulder.
+    #[inline]
+    fn switching_function(&self, _i: usize, _t: f64, y: &[f64; 4]) -> f64 {
+        match self.params.shoulder {
+            Some(sh) => y[0].abs() - sh.contact_angle_rad,
+            None => 0.0,
+        }
+    }
+
     fn describe(&self, t: f64, y: &[f64; 4]) -> String {
         format!(
             "θ = {:.6e} rad, φ = {:.6e} rad, θ̇ = {:.6e} rad/s, φ̇ = {:.6e} rad/s, v3 = {:.9e} m, v̇3 = {:.6e} m/s",
@@ -521,6 +619,214 @@ impl StickSlipModel<4> for Blade {
             y[3],
             self.tip_position(t, y),
             self.tip_velocity(t, y)
+        )
+    }
+}
+
+/// The 1-DOF head model: the neck and lip locked into one rigid link (φ ≡ θ, length l1 + l2),
+/// hinged at the head on the neck spring `k1`, tip on the glass; the head moves vertically on its
+/// spring `k0`, driven through the tip friction. It keeps the head's low mode and drops the
+/// neck–lip mode, so it explains a low band only (and integrates with far larger steps).
+///
+/// Equations: the principle of virtual work with δφ = δθ, i.e. the sum of rows (1) and (2) of the
+/// full model at φ = θ, φ̈ = θ̈ (the lip spring k2 and damper c2 carry no load), plus row (3) for N.
+/// Slip solves `[θ̈, N]` (2×2, with the same Painlevé check as the full model); stick is kinematic:
+/// θ = arcsin((v3* − v)/(l1 + l2)) and N, f follow from the two rows.
+///
+/// The state keeps the full model's layout `[θ, φ, θ̇, φ̇]` with φ = θ, φ̇ = θ̇, so the same simulator
+/// and observables serve both.
+#[derive(Debug, Clone, Copy)]
+pub struct LockedBlade {
+    pub blade: Blade,
+}
+
+impl LockedBlade {
+    /// The locked-link model of `params`.
+    pub fn new(params: BladeParams) -> Self {
+        LockedBlade {
+            blade: Blade::new(params, StickForm::Reduced),
+        }
+    }
+
+    fn reach(&self) -> f64 {
+        self.blade.params.l1_m + self.blade.params.l2_m
+    }
+
+    /// `[θ̈, N, f]` in slip direction `s`, or with `stick_anchor` the stick forces.
+    fn dynamics(
+        &self,
+        t: f64,
+        th: f64,
+        thd: f64,
+        slip: Option<f64>,
+        touching: bool,
+    ) -> Result<Dynamics, ModelFault> {
+        let y = [th, th, thd, thd];
+        let (a, af, b) = self.blade.rows(t, &y, touching);
+        // Generalised coordinate θ: sum rows 1 and 2 (virtual work with δφ = δθ).
+        let s_th = a[(0, 0)] + a[(0, 1)] + a[(1, 0)] + a[(1, 1)];
+        let s_n = a[(0, 2)] + a[(1, 2)];
+        let s_f = af[0] + af[1];
+        let s_b = b[0] + b[1];
+        let (n_th, n_b) = (a[(2, 0)] + a[(2, 1)], b[2]);
+        match slip {
+            Some(s) => {
+                let mu = self
+                    .blade
+                    .params
+                    .friction
+                    .mu_slip(self.slip_velocity_of(t, th, thd));
+                // [s_th, s_n − s μ s_f; n_th, 1] [θ̈, N] = [s_b, n_b]
+                let c = s_n - s * mu * s_f;
+                let det0 = s_th - s_n * n_th;
+                let det = s_th - c * n_th;
+                if det * det0 <= 0.0 || det.abs() < 1e-9 * det0.abs() {
+                    return Err(ModelFault::Singular(format!(
+                        "locked-link slip equations singular (Painlevé-type): det with friction {det:.3e}, frictionless {det0:.3e}, μ = {mu:.4}"
+                    )));
+                }
+                let thdd = (s_b - c * n_b) / det;
+                let n = n_b - n_th * thdd;
+                Ok(Dynamics {
+                    theta_dd: thdd,
+                    phi_dd: thdd,
+                    normal_n: n,
+                    friction_n: -s * mu * n,
+                })
+            }
+            None => {
+                let l = self.reach();
+                let (st, ct) = th.sin_cos();
+                let (_, _, vdd) = self.blade.drive(t);
+                let thdd = (-vdd + l * st * thd * thd) / (l * ct);
+                let n = n_b - n_th * thdd;
+                let f = (s_b - s_th * thdd - s_n * n) / s_f;
+                Ok(Dynamics {
+                    theta_dd: thdd,
+                    phi_dd: thdd,
+                    normal_n: n,
+                    friction_n: f,
+                })
+            }
+        }
+    }
+
+    fn slip_velocity_of(&self, t: f64, th: f64, thd: f64) -> f64 {
+        self.blade.drive(t).1 + self.reach() * th.cos() * thd
+    }
+
+    /// Link angle and rate that hold the tip at `anchor` at time `t`.
+    fn stuck_angle(&self, t: f64, anchor: f64) -> Result<(f64, f64), ModelFault> {
+        let l = self.reach();
+        let (v, vd, _) = self.blade.drive(t);
+        let arg = (anchor - v) / l;
+        if arg.abs() >= 1.0 {
+            return Err(ModelFault::Geometry(format!(
+                "stick constraint has no link angle: sin θ = {arg:.6} (the head moved beyond the link's reach)"
+            )));
+        }
+        let th = arg.asin();
+        Ok((th, -vd / (l * th.cos())))
+    }
+
+    /// Quasi-static slip equilibrium at `t` (θ̇ = 0, θ̈ = 0), by Newton's method on θ̈.
+    pub fn slip_equilibrium(&self, t: f64) -> Result<[f64; 4], ModelFault> {
+        let (_, vd, _) = self.blade.drive(t);
+        let s = if vd >= 0.0 { 1.0 } else { -1.0 };
+        let touching = |th: f64| self.blade.params.touches_shoulder(th);
+        let acc = |th: f64| -> Result<f64, ModelFault> {
+            Ok(self.dynamics(t, th, 0.0, Some(s), touching(th))?.theta_dd)
+        };
+        let mut th = 0.0f64;
+        for _ in 0..200 {
+            let f0 = acc(th)?;
+            let e = 1e-7;
+            let d = (acc(th + e)? - f0) / e;
+            if d == 0.0 || !d.is_finite() {
+                break;
+            }
+            let dx = (-f0 / d).clamp(-0.2, 0.2);
+            th += dx;
+            if dx.abs() < 1e-15 {
+                break;
+            }
+        }
+        let f = acc(th)?;
+        let scale = self.blade.params.k1_nm_per_rad / self.blade.mc.mth;
+        if f.abs().is_nan() || f.abs() >= 1e-8 * scale {
+            return Err(ModelFault::Geometry(format!(
+                "no quasi-static slip equilibrium of the locked link at t = {t} s (residual {f:.3e} rad/s²)"
+            )));
+        }
+        Ok([th, th, 0.0, 0.0])
+    }
+}
+
+impl StickSlipModel<4> for LockedBlade {
+    fn rhs(
+        &self,
+        mode: &Mode,
+        t: f64,
+        y: &[f64; 4],
+        dy: &mut [f64; 4],
+    ) -> Result<Contact, ModelFault> {
+        let touching = mode.region & 1 != 0;
+        let (th, thd) = match mode.phase {
+            Phase::Stick => self.stuck_angle(t, mode.anchor)?,
+            _ => (y[0], y[2]),
+        };
+        let d = self.dynamics(t, th, thd, mode.phase.slip_dir(), touching)?;
+        if mode.phase == Phase::Stick {
+            *dy = [0.0; 4];
+        } else {
+            *dy = [thd, thd, d.theta_dd, d.theta_dd];
+        }
+        Ok(Contact {
+            normal: d.normal_n,
+            friction: d.friction_n,
+            limit: self.blade.mu_s * d.normal_n,
+        })
+    }
+
+    fn slip_velocity(&self, t: f64, y: &[f64; 4]) -> f64 {
+        self.slip_velocity_of(t, y[0], y[2])
+    }
+
+    fn contact_position(&self, t: f64, y: &[f64; 4]) -> f64 {
+        self.blade.drive(t).0 + self.reach() * y[0].sin()
+    }
+
+    fn enter_stick(&self, t: f64, y: &mut [f64; 4], _anchor: f64) {
+        let (_, vd, _) = self.blade.drive(t);
+        let thd = -vd / (self.reach() * y[0].cos());
+        y[1] = y[0];
+        y[2] = thd;
+        y[3] = thd;
+    }
+
+    fn complete(&self, mode: &Mode, t: f64, y: &mut [f64; 4]) -> Result<(), ModelFault> {
+        if mode.phase == Phase::Stick {
+            let (th, thd) = self.stuck_angle(t, mode.anchor)?;
+            *y = [th, th, thd, thd];
+        }
+        Ok(())
+    }
+
+    fn switching_surfaces(&self) -> usize {
+        self.blade.switching_surfaces()
+    }
+
+    fn switching_function(&self, i: usize, t: f64, y: &[f64; 4]) -> f64 {
+        self.blade.switching_function(i, t, y)
+    }
+
+    fn describe(&self, t: f64, y: &[f64; 4]) -> String {
+        format!(
+            "locked link: θ = φ = {:.6e} rad, θ̇ = {:.6e} rad/s, v3 = {:.9e} m, v̇3 = {:.6e} m/s",
+            y[0],
+            y[2],
+            self.contact_position(t, y),
+            self.slip_velocity(t, y)
         )
     }
 }

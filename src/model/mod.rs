@@ -4,5 +4,5 @@ pub mod belt;
 pub mod blade;
 pub mod friction;
 
-pub use blade::{Blade, BladeParams, StickForm};
+pub use blade::{Blade, BladeParams, Shoulder, StickForm};
 pub use friction::FrictionLaw;

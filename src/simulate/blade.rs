@@ -1,9 +1,10 @@
 //! Simulating the blade over a drive window, sampled at given (camera) times.
 
-use super::hybrid::{Mode, Phase, SolverOptions, Stats, Transition, integrate};
-use crate::model::blade::{Blade, BladeParams, StickForm};
+use super::hybrid::{Mode, Phase, SolverOptions, Stats, Switch, Transition, integrate};
+use crate::model::blade::{Blade, BladeParams, LockedBlade, StickForm};
 use crate::trace::{PointTrack, Trace};
 use crate::{Error, Result};
+use serde::{Deserialize, Serialize};
 
 /// A simulated reversal: the observables at each sample time, the transitions and the counters.
 /// All vectors have the length of `t_s`.
@@ -20,6 +21,8 @@ pub struct BladeSimulation {
     pub phi_rad: Vec<f64>,
     pub phase: Vec<Phase>,
     pub transitions: Vec<Transition>,
+    /// Crossings of the shoulder-contact angle (empty without a shoulder).
+    pub switches: Vec<Switch>,
     pub stats: Stats,
     /// Tip link length l1 + l2 (the tip's height below the upright head), m.
     pub reach_m: f64,
@@ -58,6 +61,74 @@ pub fn default_window(params: &BladeParams) -> (f64, f64) {
     )
 }
 
+/// Which member of the model hierarchy to simulate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum ModelKind {
+    /// The 1-DOF head model: neck and lip locked into one link (no neck–lip mode), the head on its
+    /// spring ([`LockedBlade`]). Explains a low band only.
+    Head1dof,
+    /// The full 2-DOF head/neck/lip link model of the seed, eqs. (1)–(5) ([`Blade`]).
+    #[default]
+    Blade2dof,
+}
+
+impl ModelKind {
+    /// Every kind, smallest first.
+    pub const ALL: [ModelKind; 2] = [ModelKind::Head1dof, ModelKind::Blade2dof];
+
+    /// Name used in job files and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Head1dof => "head1dof",
+            ModelKind::Blade2dof => "blade2dof",
+        }
+    }
+
+    /// Degrees of freedom in slip.
+    pub fn dof(self) -> usize {
+        match self {
+            ModelKind::Head1dof => 1,
+            ModelKind::Blade2dof => 2,
+        }
+    }
+
+    /// Whether the model has a neck–lip mode, i.e. can produce a high (hundreds of Hz) band.
+    pub fn has_neck_mode(self) -> bool {
+        self == ModelKind::Blade2dof
+    }
+}
+
+/// Simulates the blade model `kind` from the quasi-static slip equilibrium at `window.0` to
+/// `window.1`, recording the state at `sample_times` (ascending, inside the window).
+///
+/// # Errors
+/// As [`simulate_blade`].
+pub fn simulate_model(
+    kind: ModelKind,
+    params: &BladeParams,
+    window: (f64, f64),
+    sample_times: &[f64],
+    opts: &SolverOptions,
+    stick_form: StickForm,
+) -> Result<BladeSimulation> {
+    match kind {
+        ModelKind::Blade2dof => simulate_blade(params, window, sample_times, opts, stick_form),
+        ModelKind::Head1dof => {
+            params.validate().map_err(Error::Config)?;
+            let model = LockedBlade::new(*params);
+            let y0 = model
+                .slip_equilibrium(window.0)
+                .map_err(|e| Error::Simulation {
+                    t_s: window.0,
+                    message: e.to_string(),
+                    state: "initial equilibrium".into(),
+                })?;
+            run_to_simulation(&model, &model.blade, y0, params, window, sample_times, opts)
+        }
+    }
+}
+
 /// Simulates the blade from the quasi-static slip equilibrium at `window.0` to `window.1`, recording
 /// the state at `sample_times` (ascending, inside the window).
 ///
@@ -73,29 +144,33 @@ pub fn simulate_blade(
 ) -> Result<BladeSimulation> {
     params.validate().map_err(Error::Config)?;
     let blade = Blade::new(*params, stick_form);
-    let (t0, t1) = window;
+    let t0 = window.0;
     let y0 = blade.slip_equilibrium(t0).map_err(|e| Error::Simulation {
         t_s: t0,
         message: e.to_string(),
         state: "initial equilibrium".into(),
     })?;
+    run_to_simulation(&blade, &blade, y0, params, window, sample_times, opts)
+}
+
+/// Integrates `model` (whose state has the blade's layout `[θ, φ, θ̇, φ̇]`) from `y0` and turns the run
+/// into observables with `blade`'s kinematics.
+fn run_to_simulation<M: crate::simulate::hybrid::StickSlipModel<4>>(
+    model: &M,
+    blade: &Blade,
+    y0: [f64; 4],
+    params: &BladeParams,
+    window: (f64, f64),
+    sample_times: &[f64],
+    opts: &SolverOptions,
+) -> Result<BladeSimulation> {
+    let (t0, t1) = window;
     let s0 = if blade.drive(t0).1 >= 0.0 {
         Phase::SlipPos
     } else {
         Phase::SlipNeg
     };
-    let run = integrate(
-        &blade,
-        t0,
-        y0,
-        Mode {
-            phase: s0,
-            anchor: 0.0,
-        },
-        t1,
-        sample_times,
-        opts,
-    )?;
+    let run = integrate(model, t0, y0, Mode::new(s0, 0.0), t1, sample_times, opts)?;
     let n = run.t_s.len();
     let mut sim = BladeSimulation {
         t_s: run.t_s,
@@ -106,6 +181,7 @@ pub fn simulate_blade(
         phi_rad: Vec::with_capacity(n),
         phase: run.phase,
         transitions: run.transitions,
+        switches: run.switches,
         stats: run.stats,
         reach_m: params.l1_m + params.l2_m,
     };

@@ -79,12 +79,29 @@ impl std::fmt::Display for Phase {
     }
 }
 
-/// A phase together with its data: in stick, `anchor` is the contact position held by the constraint.
+/// A phase together with its data: in stick, `anchor` is the contact position held by the constraint;
+/// `region` has bit `i` set while switching function `i` of the model is positive (see
+/// [`StickSlipModel::switching_surfaces`]); the right-hand side uses it to pick its smooth branch.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Mode {
     pub phase: Phase,
     pub anchor: f64,
+    pub region: u8,
 }
+
+impl Mode {
+    /// A mode in `phase` with `anchor` (used only in stick) and every switching bit clear.
+    pub fn new(phase: Phase, anchor: f64) -> Mode {
+        Mode {
+            phase,
+            anchor,
+            region: 0,
+        }
+    }
+}
+
+/// Largest number of switching surfaces a model may declare.
+pub const MAX_SWITCHING_SURFACES: usize = 2;
 
 /// Contact forces at one instant.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -151,6 +168,35 @@ pub trait StickSlipModel<const N: usize>: Sync {
 
     /// A one-line description of the state for error messages.
     fn describe(&self, t: f64, y: &[f64; N]) -> String;
+
+    /// Number of switching surfaces (at most [`MAX_SWITCHING_SURFACES`]): places where the
+    /// right-hand side changes formula without a change of phase, e.g. a kink in a stiffness
+    /// (the neck touching its shoulder). Default 0.
+    ///
+    /// The integrator keeps each surface's side in [`Mode::region`] (bit `i` set while
+    /// [`StickSlipModel::switching_function`] `i` is positive), never lets a step straddle a surface
+    /// (the right-hand side keeps using the current branch's formula, extended, until the crossing
+    /// is located on the dense output like a phase event), and restarts the step there on the other
+    /// branch. Crossings are listed in [`Run::switches`].
+    fn switching_surfaces(&self) -> usize {
+        0
+    }
+
+    /// Switching function `i` at `(t, y)`: positive on one side of the surface, negative on the other.
+    fn switching_function(&self, _i: usize, _t: f64, _y: &[f64; N]) -> f64 {
+        0.0
+    }
+}
+
+/// The region bits of `model` at `(t, y)`: bit `i` set where switching function `i` is positive.
+pub fn region_of<M: StickSlipModel<N>, const N: usize>(model: &M, t: f64, y: &[f64; N]) -> u8 {
+    let mut r = 0u8;
+    for i in 0..model.switching_surfaces().min(MAX_SWITCHING_SURFACES) {
+        if model.switching_function(i, t, y) > 0.0 {
+            r |= 1 << i;
+        }
+    }
+    r
 }
 
 /// Settings of the event-driven integrator.
@@ -227,6 +273,16 @@ pub struct Stats {
     pub event_evals: usize,
 }
 
+/// One crossing of a switching surface (no change of phase).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Switch {
+    pub t_s: f64,
+    /// Index of the surface.
+    pub surface: usize,
+    /// True when the switching function became positive (the region bit was set).
+    pub entered: bool,
+}
+
 /// Output of [`integrate`]: the state at each requested time, the transitions and the counters.
 #[derive(Debug, Clone)]
 pub struct Run<const N: usize> {
@@ -236,6 +292,8 @@ pub struct Run<const N: usize> {
     pub transitions: Vec<Transition>,
     /// State just after each transition (consistent with the new phase).
     pub transition_states: Vec<[f64; N]>,
+    /// Crossings of the model's switching surfaces, in time order.
+    pub switches: Vec<Switch>,
     pub stats: Stats,
     /// State and mode at the end time.
     pub y_end: [f64; N],
@@ -244,21 +302,37 @@ pub struct Run<const N: usize> {
 
 const NO_EVENT: f64 = f64::INFINITY;
 
-/// Event-function values in `mode` (`[g0, g1, g2]`, unused = +∞) and the contact forces.
+/// Number of event functions: three of the phase, then one per switching surface.
+const N_EVENTS: usize = 3 + MAX_SWITCHING_SURFACES;
+
+/// Event-function values in `mode` (`[g0, g1, g2, s0, s1]`, unused = +∞) and the contact forces.
+/// `s_i` is switching function `i` signed so that it is positive inside the current region.
 fn event_values<M: StickSlipModel<N>, const N: usize>(
     model: &M,
     mode: &Mode,
     t: f64,
     y: &[f64; N],
-) -> std::result::Result<([f64; 3], Contact), ModelFault> {
+) -> std::result::Result<([f64; N_EVENTS], Contact), ModelFault> {
     let mut yc = *y;
     model.complete(mode, t, &mut yc)?;
     let mut dy = [0.0; N];
     let c = model.rhs(mode, t, &yc, &mut dy)?;
-    let g = match mode.phase.slip_dir() {
-        Some(s) => [s * model.slip_velocity(t, &yc), NO_EVENT, c.normal],
-        None => [c.limit - c.friction, c.limit + c.friction, c.normal],
-    };
+    let mut g = [NO_EVENT; N_EVENTS];
+    match mode.phase.slip_dir() {
+        Some(s) => {
+            g[0] = s * model.slip_velocity(t, &yc);
+            g[2] = c.normal;
+        }
+        None => {
+            g[0] = c.limit - c.friction;
+            g[1] = c.limit + c.friction;
+            g[2] = c.normal;
+        }
+    }
+    for i in 0..model.switching_surfaces().min(MAX_SWITCHING_SURFACES) {
+        let si = model.switching_function(i, t, &yc);
+        g[3 + i] = if mode.region & (1 << i) != 0 { si } else { -si };
+    }
     Ok((g, c))
 }
 
@@ -348,6 +422,7 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
         phase: Vec::with_capacity(out_times.len()),
         transitions: Vec::new(),
         transition_states: Vec::new(),
+        switches: Vec::new(),
         stats,
         y_end: y0,
         mode_end: mode0,
@@ -359,6 +434,13 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
     model
         .complete(&mode, t, &mut y)
         .map_err(|e| fail(t, &y, e.to_string()))?;
+    if model.switching_surfaces() > MAX_SWITCHING_SURFACES {
+        return Err(Error::Config(format!(
+            "model declares {} switching surfaces; at most {MAX_SWITCHING_SURFACES} are supported",
+            model.switching_surfaces()
+        )));
+    }
+    mode.region = region_of(model, t, &y);
     // Emit outputs at exactly t0.
     while next_out < out_times.len() && out_times[next_out] <= t0 {
         run.t_s.push(out_times[next_out]);
@@ -455,8 +537,15 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                 // Refine every function that crossed in [ta, tj]; keep the earliest. A function
                 // starting at exactly 0 (just after a transition) is armed by its first positive
                 // sample.
-                for k in 0..3 {
-                    if ga[k] > 0.0 && gj[k] <= 0.0 {
+                for k in 0..N_EVENTS {
+                    // Phase events fire on g > 0 → g ≤ 0; a switching function also fires when it
+                    // leaves exactly 0 on the wrong side (a graze right after a switch).
+                    let crossed = if k < 3 {
+                        ga[k] > 0.0 && gj[k] <= 0.0
+                    } else {
+                        ga[k] >= 0.0 && gj[k] < 0.0
+                    };
+                    if crossed {
                         let dense = a.dense;
                         let tk = illinois_right(
                             |tt| {
@@ -514,6 +603,20 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                     model
                         .complete(&mode, te, &mut ye)
                         .map_err(|e| fail(te, &ye, e.to_string()))?;
+                    if k >= 3 {
+                        // A switching surface: same phase, the other branch of the right-hand side.
+                        let i = k - 3;
+                        mode.region ^= 1 << i;
+                        run.switches.push(Switch {
+                            t_s: te,
+                            surface: i,
+                            entered: mode.region & (1 << i) != 0,
+                        });
+                        t = te;
+                        y = ye;
+                        h = h.max(1e-12 * span);
+                        continue 'phases;
+                    }
                     if k == 2 {
                         let (_, c) = event_values(model, &mode, te, &ye)
                             .map_err(|e| fail(te, &ye, e.to_string()))?;
@@ -590,6 +693,7 @@ fn decide_after_event<M: StickSlipModel<N>, const N: usize>(
             let stick = Mode {
                 phase: Phase::Stick,
                 anchor,
+                region: mode.region,
             };
             model.complete(&stick, t, &mut ys)?;
             let mut dy = [0.0; N];
@@ -605,6 +709,7 @@ fn decide_after_event<M: StickSlipModel<N>, const N: usize>(
                 Ok(Mode {
                     phase: Phase::slip(s_new),
                     anchor: 0.0,
+                    region: mode.region,
                 })
             }
         }
@@ -614,6 +719,7 @@ fn decide_after_event<M: StickSlipModel<N>, const N: usize>(
             Ok(Mode {
                 phase: Phase::slip(s_new),
                 anchor: 0.0,
+                region: mode.region,
             })
         }
     }

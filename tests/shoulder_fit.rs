@@ -1,0 +1,132 @@
+//! Shoulder contact recovered by the fit: a recording the model made with a piecewise neck stiffness
+//! (at a tighter tolerance than the fit uses), written as a DLTdv file through the shipped sample's
+//! camera model (15 µm/px, origin (200, 300)), fitted with and without the shoulder. The shoulder
+//! candidate must win on AIC and recover k1_contact within 5 % (issue 6, "Done when"). The opposite
+//! case, a recording made without a shoulder, is the main job (tests/cli.rs asserts `blade2dof` wins).
+
+use std::fmt::Write as _;
+use wiperlab::fit::job::LoadedJob;
+use wiperlab::fit::run_fit;
+use wiperlab::model::{BladeParams, Shoulder, StickForm};
+use wiperlab::simulate::SolverOptions;
+use wiperlab::simulate::blade::{default_window, simulate_blade};
+
+#[test]
+fn fit_prefers_and_recovers_the_shoulder() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let base: BladeParams = toml::from_str(
+        &std::fs::read_to_string(root.join("data/reversal/blade_true.toml")).unwrap(),
+    )
+    .unwrap();
+    // Known parameters: a free neck 4x softer than the sample's, touching the shoulder at 0.06 rad
+    // (|θ| reaches ~0.12-0.15 rad in slip, data/reversal/clean_10kfps.csv.gz) with k1_contact = 0.03.
+    let (k1_free, theta_c, k1c) = (0.0075, 0.06, 0.03);
+    let mut truth = base;
+    truth.k1_nm_per_rad = k1_free;
+    truth.shoulder = Some(Shoulder {
+        contact_angle_rad: theta_c,
+        k1_contact_nm_per_rad: k1c,
+    });
+    let (t0, t1) = default_window(&truth);
+    let fps = 1e4;
+    let n = ((t1 - t0) * fps) as usize;
+    let times: Vec<f64> = (0..n).map(|k| t0 + k as f64 / fps).collect();
+    let sim = simulate_blade(
+        &truth,
+        (t0, *times.last().unwrap()),
+        &times,
+        &SolverOptions {
+            rtol: 1e-10,
+            atol: 1e-12,
+            ..SolverOptions::default()
+        },
+        StickForm::Reduced,
+    )
+    .unwrap();
+    assert!(
+        !sim.switches.is_empty(),
+        "the recording should touch the shoulder"
+    );
+    let dir = std::env::temp_dir().join(format!("wiperlab_shoulder_fit_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (s, a) = (1.5e-5, 0.1);
+    let mut csv = String::from("pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y\n");
+    for i in 0..n {
+        let _ = writeln!(
+            csv,
+            "{:.6},{:.6},{:.6},{:.6}",
+            200.0 + (sim.v_m[i] - a) / s,
+            300.0 + sim.u_m[i] / s,
+            200.0 + (sim.v3_m[i] - a) / s,
+            300.0 + (truth.l1_m + truth.l2_m) / s
+        );
+    }
+    std::fs::write(dir.join("rec_xypts.csv"), csv).unwrap();
+    std::fs::write(dir.join("blade.toml"), toml::to_string(&base).unwrap()).unwrap();
+    std::fs::write(
+        dir.join("truth.json"),
+        format!("{{\"k1\": {k1_free}, \"k1c\": {k1c}, \"theta_c\": {theta_c}}}"),
+    )
+    .unwrap();
+    let job = format!(
+        r#"name = "shoulder"
+blade = "blade.toml"
+[recording]
+file = "rec_xypts.csv"
+[recording.import]
+format = "dltdv"
+fps_hz = 10000.0
+m_per_px = 1.5e-5
+origin_px = [200.0, 300.0]
+t0_s = {t0:?}
+[recording.import.points]
+head = "pt1"
+tip = "pt2"
+[fit]
+particles = 10
+swarm_iterations = 8
+polish_iterations = 40
+seed = 3
+models = ["blade2dof", "blade2dof+shoulder"]
+[fit.shoulder]
+k1c = [0.01, 0.06]
+theta_c = [0.03, 0.1]
+[fit.parameters]
+k1 = [0.002, 0.05]
+[truth]
+json = "truth.json"
+keys = {{ k1 = "/k1", k1c = "/k1c", theta_c = "/theta_c" }}
+"#
+    );
+    std::fs::write(dir.join("job.toml"), job).unwrap();
+    let loaded = LoadedJob::load(&dir.join("job.toml")).unwrap();
+    let out = run_fit(&loaded, false).unwrap();
+    for t in &out.result.model_trials {
+        eprintln!(
+            "{}: cost {:.4}, {} evaluations, {:.1} s; {}",
+            t.model, t.cost, t.model_evaluations, t.wall_time_s, t.reason
+        );
+    }
+    for p in &out.result.parameters {
+        eprintln!(
+            "{}: fitted {:.6} true {:.6} rel err {:+.3}%",
+            p.name,
+            p.value,
+            p.true_value.unwrap(),
+            100.0 * p.rel_error.unwrap()
+        );
+    }
+    assert_eq!(out.result.model, "blade2dof+shoulder");
+    let k1c_fit = out
+        .result
+        .parameters
+        .iter()
+        .find(|p| p.name == "k1c")
+        .expect("k1c fitted");
+    assert!(
+        k1c_fit.rel_error.unwrap().abs() < 0.05,
+        "k1_contact off by {:+.2} %",
+        100.0 * k1c_fit.rel_error.unwrap()
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
