@@ -4,9 +4,10 @@
 //! Contents, in order: the fit summary; the parameter table (value, 1σ from the cost's curvature,
 //! confidence interval when the fit computed one, search bounds, determined or not, truth and
 //! relative error when known); measured against model spectral peaks; the model comparison
-//! (`model_trials`, or a line saying that only one model was fitted); the correlation matrix;
-//! warnings; every SVG figure of `reports/<job>/`; provenance (recording path and SHA-256 at fit
-//! time and now, wiperlab version, solver tolerances, bands, fit settings, dates).
+//! (`model_trials`, or with one trial or none a line saying that only one model was fitted, and
+//! why); the correlation matrix; warnings; every SVG figure of `reports/<job>/`; provenance
+//! (recording path and SHA-256 at fit time and now, wiperlab version, solver tolerances, bands, fit
+//! settings, dates).
 //!
 //! Figures are `<img src="NAME.svg">` links relative to the page (the SVGs sit beside it), so the
 //! page stays small and each figure is also a file of its own. Nothing is fetched from the network:
@@ -331,11 +332,21 @@ pub fn render_html(
 
     // Model comparison.
     h.push_str("<h2 id=\"models\">Model comparison</h2>\n");
-    if r.model_trials.is_empty() {
+    if r.model_trials.len() <= 1 {
         let _ = writeln!(
             h,
-            "<p id=\"model-comparison\">Only one model ({}) was fitted; no comparison.</p>",
-            e(&r.model)
+            "<p id=\"model-comparison\">Only one model ({}) was fitted; no comparison{}.</p>",
+            e(&r.model),
+            r.model_trials
+                .first()
+                .map(|t| format!(
+                    " (chosen as {}; cost {}, {} model evaluations, {} s)",
+                    e(&t.reason),
+                    num(t.cost, 5),
+                    t.model_evaluations,
+                    num(t.wall_time_s, 3)
+                ))
+                .unwrap_or_default()
         );
     } else {
         h.push_str(
