@@ -204,9 +204,9 @@ pub struct Provenance {
 const STYLE: &str = "body{font-family:sans-serif;max-width:1000px;margin:1.5em auto;padding:0 1em;\
 color:#222;line-height:1.4}h1{font-size:1.6em}h2{margin-top:1.6em;border-bottom:1px solid #ccc}\
 table{border-collapse:collapse;margin:.6em 0}th,td{border:1px solid #ccc;padding:.25em .6em;\
-text-align:right}th{background:#f2f2f2}td.l,th.l{text-align:left}tr.chosen td{font-weight:bold}\
+text-align:right;white-space:nowrap}th{background:#f2f2f2}td.l,th.l{text-align:left;white-space:normal}tr.chosen td{font-weight:bold}\
 .warn{color:#a33}.ok{color:#262}figure{margin:1.2em 0}figure img{max-width:100%;height:auto;\
-border:1px solid #ddd}figcaption{font-size:.9em;color:#444}pre{background:#f6f6f6;padding:.6em;\
+border:1px solid #ddd}figcaption,.note{font-size:.9em;color:#444}pre{background:#f6f6f6;padding:.6em;\
 overflow-x:auto;font-size:.85em}code{font-size:.9em}";
 
 /// The figure check run by the browser (see the module docs).
@@ -269,20 +269,27 @@ pub fn render_html(
          <th>fitted</th><th>± 1σ</th><th>interval</th><th>search bounds</th><th>determined</th>\
          <th>true</th><th>rel. error</th></tr>\n",
     );
+    let mut methods: Vec<String> = Vec::new();
     for p in &r.parameters {
         let meaning = PARAM_NAMES
             .iter()
             .find(|(n, _)| *n == p.name)
             .map(|(_, m)| *m)
             .unwrap_or("");
+        // The method is named once below the table (footnote number), not in every row.
         let interval = match &p.interval {
-            Some(i) => format!(
-                "[{}, {}] ({:.0} %, {})",
-                num(i.lo, 4),
-                num(i.hi, 4),
-                100.0 * i.level,
-                e(&i.method)
-            ),
+            Some(i) => {
+                if !methods.contains(&i.method) {
+                    methods.push(i.method.clone());
+                }
+                let k = methods.iter().position(|m| *m == i.method).unwrap_or(0) + 1;
+                format!(
+                    "[{}, {}] ({:.0} %)<sup>{k}</sup>",
+                    num(i.lo, 4),
+                    num(i.hi, 4),
+                    100.0 * i.level
+                )
+            }
             None => "—".into(),
         };
         let _ = writeln!(
@@ -308,6 +315,14 @@ pub fn render_html(
         );
     }
     h.push_str("</table>\n");
+    for (k, m) in methods.iter().enumerate() {
+        let _ = writeln!(
+            h,
+            "<p class=\"note\"><sup>{}</sup> Interval method: {}</p>",
+            k + 1,
+            e(m)
+        );
+    }
 
     // Peaks.
     h.push_str("<h2 id=\"peaks\">Measured against model peaks</h2>\n");
@@ -778,7 +793,8 @@ mod tests {
         assert!(has("has changed since the fit"), "{:?}", s.warnings);
         assert_eq!(s.warnings.len(), 4, "{:?}", s.warnings);
         let html = std::fs::read_to_string(&s.path).unwrap();
-        assert!(html.contains("<td>[0.02800, 0.03200] (68 %, profile)</td>"));
+        assert!(html.contains("<td>[0.02800, 0.03200] (68 %)<sup>1</sup></td>"));
+        assert!(html.contains("<sup>1</sup> Interval method: profile</p>"));
         assert!(html.contains("<td>+3.45 %</td>")); // 0.03/0.029 − 1
         assert!(html.contains("<span class=\"warn\">NO</span>"));
         assert!(html.contains("<td>-0.900</td>"));
