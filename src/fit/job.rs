@@ -18,7 +18,12 @@ pub struct FitJob {
     /// Name used for outputs (`fits/<name>.result.toml`, `reports/<name>/`); default: file stem.
     #[serde(default)]
     pub name: Option<String>,
-    pub recording: RecordingSection,
+    /// The recording to fit; a job gives either this or `[targets]`.
+    #[serde(default)]
+    pub recording: Option<RecordingSection>,
+    /// Target peak frequencies instead of a recording (e.g. the seed paper's own numbers).
+    #[serde(default)]
+    pub targets: Option<TargetsSection>,
     /// Blade parameter file (TOML with [`BladeParams`] fields); the freed parameters' values in it
     /// are ignored by the fit.
     pub blade: PathBuf,
@@ -38,6 +43,45 @@ fn fit_solver_default() -> SolverOptions {
         rtol: 1e-8,
         atol: 1e-10,
         ..SolverOptions::default()
+    }
+}
+
+/// Target frequencies to reach instead of a recording.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TargetsSection {
+    /// Where the numbers come from (shown in the result and report).
+    pub source: String,
+    /// Sampling rate of the simulated signal, Hz (default 20 kHz).
+    #[serde(default = "d_target_fps")]
+    pub fps_hz: f64,
+    /// One target per band of `[spectrum]`, by band name.
+    pub peaks: Vec<TargetPeak>,
+}
+
+fn d_target_fps() -> f64 {
+    20_000.0
+}
+
+/// A band's target: one frequency, or a range the model's peak should fall in.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TargetPeak {
+    pub band: String,
+    #[serde(default)]
+    pub freq_hz: Option<f64>,
+    #[serde(default)]
+    pub range_hz: Option<[f64; 2]>,
+}
+
+impl TargetPeak {
+    /// The target's range (a single frequency is a zero-width range).
+    pub fn range(&self) -> [f64; 2] {
+        match (self.freq_hz, self.range_hz) {
+            (Some(f), _) => [f, f],
+            (None, Some(r)) => r,
+            (None, None) => [f64::NAN, f64::NAN],
+        }
     }
 }
 
@@ -82,6 +126,12 @@ pub struct Weights {
     pub level: f64,
     /// Weight of the mean squared log-PSD difference across each band.
     pub shape: f64,
+    /// Weight of the instantaneous frequency against tip speed (spectrogram ridge, binned by
+    /// speed; `(Δln f / 0.01)²` per bin, see [`super::instfreq`]). Default 0: off.
+    pub freq_speed: f64,
+    /// Weight of the time-domain error of the job's signal (means removed, relative to the
+    /// measurement's variance; see [`super::instfreq::trace_error`]). Default 0: off.
+    pub trace: f64,
 }
 
 impl Default for Weights {
@@ -90,6 +140,8 @@ impl Default for Weights {
             peak: 1.0,
             level: 1.0,
             shape: 1.0,
+            freq_speed: 0.0,
+            trace: 0.0,
         }
     }
 }
@@ -134,7 +186,10 @@ pub struct FitSection {
 pub struct UncertaintySection {
     /// Bootstrap replicates (0: no intervals, only the curvature's 1σ).
     pub bootstrap: usize,
-    /// Nelder–Mead iterations of each replicate's refit (started from the optimum).
+    /// Re-run the whole estimator (swarm and polish) on each replicate; otherwise only a
+    /// Nelder–Mead polish from the optimum.
+    pub full_refit: bool,
+    /// Nelder–Mead iterations of a polish-only replicate.
     pub polish_iterations: u64,
     /// Seed of the replicates' noise.
     pub seed: u64,
@@ -144,6 +199,7 @@ impl Default for UncertaintySection {
     fn default() -> Self {
         UncertaintySection {
             bootstrap: 0,
+            full_refit: true,
             polish_iterations: 30,
             seed: 7,
         }
@@ -431,6 +487,53 @@ impl LoadedJob {
                 }
             }
         }
+        match (&job.recording, &job.targets) {
+            (Some(_), None) => {}
+            (None, Some(t)) => {
+                for tp in &t.peaks {
+                    let line = line_of(&text, &format!("\"{}\"", tp.band));
+                    if !job.spectrum.bands.iter().any(|b| b.name == tp.band) {
+                        return Err(Error::parse(
+                            path,
+                            line,
+                            1,
+                            format!(
+                                "[targets] peak for band '{}', which [spectrum] does not define",
+                                tp.band
+                            ),
+                        ));
+                    }
+                    let [lo, hi] = tp.range();
+                    if tp.freq_hz.is_some() == tp.range_hz.is_some() || !(lo > 0.0 && lo <= hi) {
+                        return Err(Error::parse(
+                            path,
+                            line,
+                            1,
+                            format!(
+                                "[targets] band '{}': give exactly one of freq_hz = F or range_hz = [LO, HI] with 0 < LO <= HI",
+                                tp.band
+                            ),
+                        ));
+                    }
+                }
+                if !(t.fps_hz.is_finite() && t.fps_hz > 0.0) {
+                    return Err(Error::parse(
+                        path,
+                        line_of(&text, "fps_hz"),
+                        1,
+                        "[targets] fps_hz must be > 0",
+                    ));
+                }
+            }
+            _ => {
+                return Err(Error::parse(
+                    path,
+                    1,
+                    1,
+                    "a fit job gives either [recording] (a tracked recording) or [targets] (frequencies to reach), and exactly one of them",
+                ));
+            }
+        }
         job.solver.validate()?;
         for b in &job.spectrum.bands {
             if !(b.range_hz[0] >= 0.0 && b.range_hz[0] < b.range_hz[1]) || b.nperseg < 8 {
@@ -459,7 +562,11 @@ impl LoadedJob {
             }
         }
         Ok(LoadedJob {
-            recording_path: dir.join(&job.recording.file),
+            recording_path: match &job.recording {
+                Some(r) => dir.join(&r.file),
+                // A target job's input is the job file itself (its hash is the provenance).
+                None => path.to_path_buf(),
+            },
             job,
             name,
             path: path.to_path_buf(),

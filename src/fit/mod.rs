@@ -11,6 +11,7 @@
 //! coordinates `u ∈ [0, 1]` (logarithmic for bounds spanning a factor ≥ 10).
 
 pub mod features;
+pub mod instfreq;
 pub mod job;
 pub mod result;
 
@@ -78,6 +79,8 @@ impl FreeParam {
 pub struct SpectralProblem {
     /// Which model of the hierarchy is simulated.
     pub model: ModelKind,
+    /// Target ranges per band (a target job): the cost is then [`target_cost`].
+    pub targets: Option<Vec<[f64; 2]>>,
     pub base: BladeParams,
     pub free: Vec<FreeParam>,
     pub measured: Features,
@@ -92,6 +95,8 @@ pub struct SpectralProblem {
     pub window: (f64, f64),
     pub solver: SolverOptions,
     pub weights: Weights,
+    /// Optional frequency-against-speed and trace-error terms (`None` when their weights are 0).
+    pub time_targets: Option<instfreq::TimeTargets>,
     pub evaluations: Arc<AtomicUsize>,
     pub failures: AtomicUsize,
     pub first_failure: Mutex<Option<String>>,
@@ -133,6 +138,9 @@ impl SpectralProblem {
 
     /// The cost of model features against the measurement (see the module docs).
     pub fn cost_of(&self, model: &Features) -> f64 {
+        if let Some(t) = &self.targets {
+            return target_cost(t, model);
+        }
         let w = &self.weights;
         let mut total = 0.0;
         for ((d, m), floor) in self
@@ -163,6 +171,15 @@ impl SpectralProblem {
         total
     }
 
+    /// Spectral cost of a simulation plus the optional time-domain terms ([`instfreq::TimeTargets`]).
+    pub fn total_cost(&self, sim: &BladeSimulation) -> Result<f64> {
+        let spectral = self.cost_of(&self.model_features(sim)?);
+        Ok(match &self.time_targets {
+            Some(t) => spectral + t.cost(sim)?,
+            None => spectral,
+        })
+    }
+
     /// Cost at normalised coordinates, with a quadratic penalty outside the box.
     pub fn cost_at(&self, u: &[f64]) -> f64 {
         let outside: f64 = u
@@ -174,8 +191,8 @@ impl SpectralProblem {
         if let Some(pb) = &self.progress {
             pb.inc(1);
         }
-        let c = match self.simulate(&p).and_then(|s| self.model_features(&s)) {
-            Ok(f) => self.cost_of(&f),
+        let c = match self.simulate(&p).and_then(|s| self.total_cost(&s)) {
+            Ok(c) => c,
             Err(e) => {
                 self.failures.fetch_add(1, Ordering::Relaxed);
                 let mut g = self.first_failure.lock().unwrap_or_else(|e| e.into_inner());
@@ -330,6 +347,10 @@ pub fn smallest_capable_model(bands: &[BandSpec]) -> ModelKind {
 
 /// The measured side of a fit, shared by every candidate.
 struct Measurement {
+    /// Target ranges per band (a target job), instead of measured peaks.
+    targets: Option<Vec<[f64; 2]>>,
+    /// Time-domain objectives (frequency against tip speed, trace error) when weighted.
+    time_targets: Option<instfreq::TimeTargets>,
     trace: Trace,
     x: Vec<f64>,
     fs_hz: f64,
@@ -378,7 +399,6 @@ fn fit_candidate(
         free.push(FreeParam::new("k1c", sb.k1c[0], sb.k1c[1]));
         free.push(FreeParam::new("theta_c", sb.theta_c[0], sb.theta_c[1]));
     }
-    let n = free.len();
     if let Some(pb) = pb {
         pb.set_message(format!("{} swarm", candidate.name()));
     }
@@ -386,6 +406,8 @@ fn fit_candidate(
     let trace = &meas.trace;
     let problem = Arc::new(SpectralProblem {
         model: candidate.kind,
+        targets: meas.targets.clone(),
+        time_targets: meas.time_targets.clone(),
         base,
         free: free.clone(),
         measured: Features {
@@ -408,69 +430,14 @@ fn fit_candidate(
         progress: pb.clone(),
     });
     let history = Arc::new(Mutex::new(Vec::new()));
-    let fit_err = |e: argmin::core::Error| Error::Fit(e.to_string());
-
-    // Stage 1: particle swarm over [0, 1]^n.
-    let pso = ParticleSwarm::new((vec![0.0; n], vec![1.0; n]), fit.particles)
-        .with_rng_generator(rand::rngs::StdRng::seed_from_u64(fit.seed));
-    let res = Executor::new(Shared(problem.clone()), pso)
-        .configure(|s| s.max_iters(fit.swarm_iterations))
-        .add_observer(
-            HistoryObserver {
-                stage: "swarm",
-                log: history.clone(),
-                evals: evaluations.clone(),
-            },
-            ObserverMode::Always,
-        )
-        .run()
-        .map_err(fit_err)?;
-    let swarm_best = res
-        .state()
-        .get_best_param()
-        .map(|p| p.position.clone())
-        .ok_or_else(|| Error::Fit("particle swarm returned no particle".into()))?;
-    let swarm_iters = res.state().get_iter();
-
-    // Stage 2: Nelder–Mead polish from the best particle.
-    if let Some(pb) = pb {
-        pb.set_message(format!("{} polish", candidate.name()));
-    }
-    let mut simplex = vec![swarm_best.clone()];
-    for i in 0..n {
-        let mut v = swarm_best.clone();
-        v[i] = if v[i] + 0.05 <= 1.0 {
-            v[i] + 0.05
-        } else {
-            v[i] - 0.05
-        };
-        simplex.push(v);
-    }
-    let nm = NelderMead::new(simplex)
-        .with_sd_tolerance(1e-3)
-        .map_err(fit_err)?;
-    let res = Executor::new(Shared(problem.clone()), nm)
-        .configure(|s| s.max_iters(fit.polish_iterations))
-        .add_observer(
-            HistoryObserver {
-                stage: "polish",
-                log: history.clone(),
-                evals: evaluations.clone(),
-            },
-            ObserverMode::Always,
-        )
-        .run()
-        .map_err(fit_err)?;
-    let best_u: Vec<f64> = res
-        .state()
-        .get_best_param()
-        .cloned()
-        .unwrap_or(swarm_best)
-        .iter()
-        .map(|u| u.clamp(0.0, 1.0))
-        .collect();
-    let polish_iters = res.state().get_iter();
-    let cost = res.state().get_best_cost();
+    let (best_u, swarm_iters, polish_iters, cost) = optimise(
+        &problem,
+        fit.particles,
+        fit.swarm_iterations,
+        fit.polish_iterations,
+        fit.seed,
+        Some((&history, pb, candidate)),
+    )?;
 
     // Curvature of the cost at the optimum → standard errors, correlations, identifiability.
     if let Some(pb) = pb {
@@ -493,31 +460,119 @@ fn fit_candidate(
     })
 }
 
+/// The estimator: a particle swarm over `[0, 1]^n` (`particles`, `swarm_iterations`; 0 iterations
+/// skips it and starts from the problem's centre), then a Nelder–Mead polish from the best particle.
+/// Returns `(best_u, swarm iterations, polish iterations, best cost)`.
+#[allow(clippy::type_complexity)]
+fn optimise(
+    problem: &Arc<SpectralProblem>,
+    particles: usize,
+    swarm_iterations: u64,
+    polish_iterations: u64,
+    seed: u64,
+    log: Option<(
+        &Arc<Mutex<Vec<HistoryPoint>>>,
+        &Option<indicatif::ProgressBar>,
+        Candidate,
+    )>,
+) -> Result<(Vec<f64>, u64, u64, f64)> {
+    let n = problem.free.len();
+    let fit_err = |e: argmin::core::Error| Error::Fit(e.to_string());
+    let evaluations = problem.evaluations.clone();
+    let observer = |stage: &'static str| {
+        log.map(|(h, _, _)| HistoryObserver {
+            stage,
+            log: h.clone(),
+            evals: evaluations.clone(),
+        })
+    };
+    if let Some((_, Some(pb), c)) = log {
+        pb.set_message(format!("{} swarm", c.name()));
+    }
+    let pso = ParticleSwarm::new((vec![0.0; n], vec![1.0; n]), particles)
+        .with_rng_generator(rand::rngs::StdRng::seed_from_u64(seed));
+    let mut ex =
+        Executor::new(Shared(problem.clone()), pso).configure(|s| s.max_iters(swarm_iterations));
+    if let Some(o) = observer("swarm") {
+        ex = ex.add_observer(o, ObserverMode::Always);
+    }
+    let res = ex.run().map_err(fit_err)?;
+    let swarm_best = res
+        .state()
+        .get_best_param()
+        .map(|p| p.position.clone())
+        .ok_or_else(|| Error::Fit("particle swarm returned no particle".into()))?;
+    let swarm_iters = res.state().get_iter();
+    let (u, polish_iters, cost) = polish(
+        problem,
+        &swarm_best,
+        0.05,
+        polish_iterations,
+        observer("polish"),
+    )?;
+    if let Some((_, Some(pb), c)) = log {
+        pb.set_message(format!("{} polish", c.name()));
+    }
+    Ok((u, swarm_iters, polish_iters, cost))
+}
+
+/// Nelder–Mead from `start` with an initial simplex of edge `step` (normalised units).
+fn polish(
+    problem: &Arc<SpectralProblem>,
+    start: &[f64],
+    step: f64,
+    iterations: u64,
+    observer: Option<HistoryObserver>,
+) -> Result<(Vec<f64>, u64, f64)> {
+    let fit_err = |e: argmin::core::Error| Error::Fit(e.to_string());
+    let n = start.len();
+    let mut simplex = vec![start.to_vec()];
+    for i in 0..n {
+        let mut v = start.to_vec();
+        v[i] = if v[i] + step <= 1.0 {
+            v[i] + step
+        } else {
+            v[i] - step
+        };
+        simplex.push(v);
+    }
+    let nm = NelderMead::new(simplex)
+        .with_sd_tolerance(1e-3)
+        .map_err(fit_err)?;
+    let mut ex = Executor::new(Shared(problem.clone()), nm).configure(|s| s.max_iters(iterations));
+    if let Some(o) = observer {
+        ex = ex.add_observer(o, ObserverMode::Always);
+    }
+    let res = ex.run().map_err(fit_err)?;
+    let u: Vec<f64> = res
+        .state()
+        .get_best_param()
+        .cloned()
+        .unwrap_or_else(|| start.to_vec())
+        .iter()
+        .map(|u| u.clamp(0.0, 1.0))
+        .collect();
+    Ok((u, res.state().get_iter(), res.state().get_best_cost()))
+}
+
 /// Akaike's information criterion with the cost read as −2 ln L (a χ² on the cost's scales):
 /// `AIC = cost + 2k` for `k` freed parameters (Akaike 1974, IEEE TAC 19:716).
 pub fn aic(cost: f64, k: usize) -> f64 {
     cost + 2.0 * k as f64
 }
 
-/// Runs the job: import, measured features, then for each candidate model a particle swarm,
-/// Nelder–Mead and the curvature; the candidate with the lowest [`aic`] is reported.
-///
-/// `progress`: show a progress bar on stderr (hidden automatically when stderr is not a terminal).
-pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
-    let started = std::time::Instant::now();
-    // Provenance: the recording's hash and the effective settings (job with defaults filled in).
-    let input_sha256 = result::sha256_file(&job.recording_path)?;
-    let settings = toml::to_string_pretty(&job.job)
-        .or_else(|_| job::read_text(&job.path))
-        .unwrap_or_default();
-    let spec = &job.job.recording.import;
+/// Reads the recording and its features.
+fn measure_recording(job: &LoadedJob, spec: &crate::import::ImportSpec) -> Result<Measurement> {
     let trace = crate::import::read_trace(&job.recording_path, spec)?;
     let fs_hz = sampling_rate(&trace, spec.fps_hz)?;
     let signal = job.job.spectrum.signal;
     let x = signal.extract(&trace)?;
-    let bands = job.job.spectrum.bands.clone();
-    let max_fill = job.job.spectrum.max_fill;
-    let measured = features(&x, fs_hz, &bands, max_fill)?;
+    let measured = features(
+        &x,
+        fs_hz,
+        &job.job.spectrum.bands,
+        job.job.spectrum.max_fill,
+    )?;
     for b in &measured.bands {
         if b.peak.is_none() {
             return Err(Error::input(
@@ -532,13 +587,106 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         }
     }
     let floors: Vec<f64> = measured.bands.iter().map(noise_floor).collect();
-    let meas = Measurement {
+    Ok(Measurement {
+        time_targets: instfreq::TimeTargets::for_job(
+            &job.job.fit.weights,
+            &trace,
+            &x,
+            fs_hz,
+            signal,
+        )?,
         trace,
         x,
         fs_hz,
         measured,
         floors,
+        targets: None,
+    })
+}
+
+/// A target job's "measurement": the model's default reversal window sampled at the target rate, no
+/// recorded points, and per band the target range.
+fn measure_targets(job: &LoadedJob, t: &job::TargetsSection) -> Result<Measurement> {
+    let (t0, t1) = crate::simulate::blade::default_window(&job.blade);
+    let n = ((t1 - t0) * t.fps_hz).floor() as usize + 1;
+    let times: Vec<f64> = (0..n).map(|k| t0 + k as f64 / t.fps_hz).collect();
+    let mut targets = Vec::new();
+    let mut bands = Vec::new();
+    for b in &job.job.spectrum.bands {
+        let tp = t.peaks.iter().find(|p| p.band == b.name).ok_or_else(|| {
+            Error::Config(format!("[targets] gives no target for band '{}'", b.name))
+        })?;
+        let r = tp.range();
+        targets.push(r);
+        bands.push(features::BandFeatures {
+            spec: b.clone(),
+            freq_hz: Vec::new(),
+            psd: Vec::new(),
+            peak: Some(crate::spectrum::Peak {
+                freq_hz: (r[0] * r[1]).sqrt(),
+                level: f64::NAN,
+                bin: 0,
+                prominence: f64::NAN,
+            }),
+            full_freq_hz: Vec::new(),
+            full_psd: Vec::new(),
+        });
+    }
+    Ok(Measurement {
+        x: vec![0.0; n],
+        trace: Trace {
+            t_s: times,
+            points: Vec::new(),
+        },
+        fs_hz: t.fps_hz,
+        measured: Features { bands, filled: 0 },
+        floors: vec![0.0; job.job.spectrum.bands.len()],
+        targets: Some(targets),
+        time_targets: None,
+    })
+}
+
+/// Cost of a target job: per band, `(ln f_m/f_edge / 0.01)²` when the model's peak `f_m` lies outside
+/// the target range (`f_edge` the nearest edge; 0 inside), 100 when the model has no peak in the band.
+pub fn target_cost(targets: &[[f64; 2]], model: &Features) -> f64 {
+    targets
+        .iter()
+        .zip(&model.bands)
+        .map(|(r, b)| match b.peak {
+            Some(p) => {
+                let f = p.freq_hz;
+                let edge = f.clamp(r[0], r[1]);
+                let d = (f / edge).ln() / 0.01;
+                d * d
+            }
+            None => 1e4,
+        })
+        .sum()
+}
+
+/// Runs the job: import, measured features, then for each candidate model a particle swarm,
+/// Nelder–Mead and the curvature; the candidate with the lowest [`aic`] is reported.
+///
+/// `progress`: show a progress bar on stderr (hidden automatically when stderr is not a terminal).
+pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
+    let started = std::time::Instant::now();
+    // Provenance: the recording's hash and the effective settings (job with defaults filled in).
+    let input_sha256 = result::sha256_file(&job.recording_path)?;
+    let settings = toml::to_string_pretty(&job.job)
+        .or_else(|_| job::read_text(&job.path))
+        .unwrap_or_default();
+    let signal = job.job.spectrum.signal;
+    let bands = job.job.spectrum.bands.clone();
+    let meas = match (&job.job.recording, &job.job.targets) {
+        (Some(rec), _) => measure_recording(job, &rec.import)?,
+        (None, Some(t)) => measure_targets(job, t)?,
+        (None, None) => {
+            return Err(Error::Config(
+                "the job gives neither [recording] nor [targets]".into(),
+            ));
+        }
     };
+    let fs_hz = meas.fs_hz;
 
     let fit = &job.job.fit;
     let candidates: Vec<Candidate> = if fit.models.is_empty() {
@@ -656,7 +804,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let best_params = problem.params_at(&cf.best_u);
     let best_sim = problem.simulate(&best_params)?;
     let model = problem.model_features(&best_sim)?;
-    let cost = problem.cost_of(&model);
+    let cost = problem.total_cost(&best_sim)?;
 
     let parameters: Vec<FittedParam> = cf
         .free
@@ -684,11 +832,19 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         .bands
         .iter()
         .zip(&model.bands)
-        .map(|(d, m)| {
+        .enumerate()
+        .map(|(i, (d, m))| {
             let (pd, pm) = (d.peak, m.peak);
-            let fd = pd.map(|p| p.freq_hz).unwrap_or(f64::NAN);
             let fm = pm.map(|p| p.freq_hz).unwrap_or(f64::NAN);
+            let range = problem.targets.as_ref().map(|t| t[i]);
+            // Against a target range: the nearest edge (the model's own peak when inside).
+            let fd = match range {
+                Some(r) if fm.is_finite() => fm.clamp(r[0], r[1]),
+                Some(r) => (r[0] * r[1]).sqrt(),
+                None => pd.map(|p| p.freq_hz).unwrap_or(f64::NAN),
+            };
             PeakComparison {
+                target_range_hz: range.filter(|r| r[0] < r[1]),
                 band: d.spec.name.clone(),
                 measured_hz: fd,
                 model_hz: fm,
@@ -699,11 +855,16 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         })
         .collect();
     let mut parameters = parameters;
-    if fit.uncertainty.bootstrap > 0 {
+    let mut warnings = Vec::new();
+    if fit.uncertainty.bootstrap > 0 && problem.targets.is_some() {
+        warnings.push(
+            "no bootstrap intervals for a target job: targets carry no measurement noise".into(),
+        );
+    } else if fit.uncertainty.bootstrap > 0 {
         if let Some(pb) = &pb {
             pb.set_message("bootstrap");
         }
-        let intervals = bootstrap_intervals(problem, &cf.best_u, &best_sim, &fit.uncertainty)?;
+        let intervals = bootstrap_intervals(problem, &cf.best_u, &best_sim, fit)?;
         for (p, iv) in parameters.iter_mut().zip(intervals) {
             p.interval = Some(iv);
         }
@@ -716,10 +877,9 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     if let Some(pb) = &pb {
         pb.finish_and_clear();
     }
-    let warnings = identifiability_warnings(&parameters, &cf.corr, &cf.best_u);
+    warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
     let evaluations = problem.evaluations.load(Ordering::Relaxed);
     let failures = problem.failures.load(Ordering::Relaxed);
-    let mut warnings = warnings;
     if failures * 10 > evaluations {
         warnings.push(format!(
             "{failures} of {evaluations} model evaluations failed (first: {}); the bounds reach parameter sets the model cannot simulate",
@@ -780,9 +940,12 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
 /// 2. the measurement's white noise is estimated from the noise floor `P` of the last band
 ///    ([`features::noise_floor`]; a one-sided density of white noise of variance σ² is `2σ²/fs`, so
 ///    `σ = √(P·fs/2)`);
-/// 3. each replicate adds fresh Gaussian noise of that σ, recomputes the measured features, and refits
-///    by Nelder–Mead from the optimum (replicates run in parallel with rayon);
-/// 4. the interval is the 15.87th to 84.13th percentile of the replicates' estimates.
+/// 3. each replicate adds fresh Gaussian noise of that σ, recomputes the measured features, and
+///    re-runs the estimator: the whole fit (swarm and polish, `full_refit = true`) or only a
+///    Nelder–Mead polish from the optimum (cheaper, but blind to the swarm's own scatter, so the
+///    intervals come out too narrow: README, "Uncertainty"); replicates run in parallel with rayon;
+/// 4. the interval is the basic bootstrap interval `[2θ̂ − q(84.13 %), 2θ̂ − q(15.87 %)]` of the
+///    replicates' estimates `θ*` (Davison & Hinkley 1997, eq. 5.6), which corrects the replicates' bias.
 ///
 /// What it covers: the spread from tracking noise and spectral estimation. What it does not: the
 /// optimiser ending in a different local minimum of the (rough) stick–slip cost surface, which can
@@ -795,8 +958,9 @@ pub fn bootstrap_intervals(
     problem: &SpectralProblem,
     best_u: &[f64],
     best_sim: &BladeSimulation,
-    settings: &job::UncertaintySection,
+    fit: &job::FitSection,
 ) -> Result<Vec<Interval>> {
+    let settings = &fit.uncertainty;
     use rand_distr::{Distribution, Normal};
     use rayon::prelude::*;
     let mut x_model = problem.signal.extract(&best_sim.to_trace())?;
@@ -826,6 +990,9 @@ pub fn bootstrap_intervals(
             let floors: Vec<f64> = measured.bands.iter().map(noise_floor).collect();
             let rep = SpectralProblem {
                 model: problem.model,
+                targets: problem.targets.clone(),
+                // The time-domain targets stay the recording's (they are not re-noised).
+                time_targets: problem.time_targets.clone(),
                 base: problem.base,
                 free: problem.free.clone(),
                 measured,
@@ -844,28 +1011,20 @@ pub fn bootstrap_intervals(
                 first_failure: Mutex::new(None),
                 progress: problem.progress.clone(),
             };
-            let mut simplex = vec![best_u.to_vec()];
-            for i in 0..n {
-                let mut v = best_u.to_vec();
-                v[i] = if v[i] + 0.02 <= 1.0 {
-                    v[i] + 0.02
-                } else {
-                    v[i] - 0.02
-                };
-                simplex.push(v);
-            }
-            let nm = NelderMead::new(simplex)
-                .with_sd_tolerance(1e-4)
-                .map_err(|e| Error::Fit(e.to_string()))?;
-            let res = Executor::new(Shared(Arc::new(rep)), nm)
-                .configure(|s| s.max_iters(settings.polish_iterations))
-                .run()
-                .map_err(|e| Error::Fit(e.to_string()))?;
-            let u = res
-                .state()
-                .get_best_param()
-                .cloned()
-                .unwrap_or_else(|| best_u.to_vec());
+            let rep = Arc::new(rep);
+            let u = if settings.full_refit {
+                optimise(
+                    &rep,
+                    fit.particles,
+                    fit.swarm_iterations,
+                    fit.polish_iterations,
+                    fit.seed.wrapping_add(1 + r as u64),
+                    None,
+                )?
+                .0
+            } else {
+                polish(&rep, best_u, 0.05, settings.polish_iterations, None)?.0
+            };
             Ok(problem
                 .free
                 .iter()
@@ -880,12 +1039,16 @@ pub fn bootstrap_intervals(
         .map(|i| {
             let mut v: Vec<f64> = estimates.iter().map(|e| e[i]).collect();
             v.sort_by(|a, b| a.total_cmp(b));
+            // Basic (reverse-percentile) interval: θ* − θ̂ stands in for θ̂ − θ, which corrects the
+            // bias the replicates show (Davison & Hinkley 1997, *Bootstrap Methods*, eq. 5.6).
+            let est = problem.free[i].value(best_u[i]);
             Interval {
-                lo: percentile(&v, 0.158_655),
-                hi: percentile(&v, 0.841_345),
+                lo: 2.0 * est - percentile(&v, 0.841_345),
+                hi: 2.0 * est - percentile(&v, 0.158_655),
                 level: 0.6827,
                 method: format!(
-                    "parametric bootstrap, {b} replicates (best-fit model + white noise σ = {sigma:.3e} from the measured floor; Nelder–Mead refit)"
+                    "basic parametric bootstrap, {b} replicates (best-fit model + white noise σ = {sigma:.3e} from the measured floor; {})",
+                    if settings.full_refit { "full refit" } else { "Nelder–Mead polish from the optimum" }
                 ),
             }
         })

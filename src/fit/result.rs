@@ -59,6 +59,10 @@ pub struct PeakComparison {
     pub rel_diff: f64,
     pub measured_level: f64,
     pub model_level: f64,
+    /// For a target job with a range target: the range, Hz (`measured_hz` is then the nearest edge,
+    /// or the model's peak when it lies inside).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target_range_hz: Option<[f64; 2]>,
 }
 
 /// One model of the hierarchy tried on the recording (speed against error at the level of the
@@ -217,6 +221,7 @@ mod tests {
                 rel_diff: 0.5 / 49.0,
                 measured_level: 1e-9,
                 model_level: 2e-9,
+                target_range_hz: None,
             }],
             undetermined: vec![],
             correlation: vec![vec![f64::NAN]],

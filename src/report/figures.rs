@@ -113,7 +113,13 @@ pub fn write_simulation(dir: &Path, sim: &BladeSimulation) -> Result<()> {
 
 /// The fit's figures: traces, PSDs per band with peaks, the friction law, the cost history.
 pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
-    let meas = o.signal.extract(&o.measured_trace)?;
+    // A target job has no recorded points: its figures show the model against the target lines.
+    let targets_only = o.measured_trace.points.is_empty();
+    let meas = if targets_only {
+        Vec::new()
+    } else {
+        o.signal.extract(&o.measured_trace)?
+    };
     let model = o.signal.extract(&o.best_sim.to_trace())?;
     let t = &o.measured_trace.t_s;
     // Remove each signal's mean so measured (camera frame) and model (model frame) share an axis.
@@ -127,10 +133,18 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
         "tip x − head x: measured and fitted model (means removed)",
         "t [s] (model clock)",
         "tip − head [mm]",
-        &[
-            Series::line("measured", t.clone(), demean(&meas)),
-            Series::line("model", o.best_sim.t_s.clone(), demean(&model)),
-        ],
+        &if targets_only {
+            vec![Series::line(
+                "model",
+                o.best_sim.t_s.clone(),
+                demean(&model),
+            )]
+        } else {
+            vec![
+                Series::line("measured", t.clone(), demean(&meas)),
+                Series::line("model", o.best_sim.t_s.clone(), demean(&model)),
+            ]
+        },
         &ChartOpts::default(),
     )?;
     let head_meas = o
@@ -144,10 +158,14 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
         "head y: measured and fitted model (means removed)",
         "t [s] (model clock)",
         "head y [mm]",
-        &[
-            Series::line("measured", t.clone(), head_meas),
-            Series::line("model", o.best_sim.t_s.clone(), head_model),
-        ],
+        &if targets_only {
+            vec![Series::line("model", o.best_sim.t_s.clone(), head_model)]
+        } else {
+            vec![
+                Series::line("measured", t.clone(), head_meas),
+                Series::line("model", o.best_sim.t_s.clone(), head_model),
+            ]
+        },
         &ChartOpts::default(),
     )?;
     for (d, m) in o.measured.bands.iter().zip(&o.model.bands) {
@@ -155,11 +173,25 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
         // without it the model's deep stick–slip troughs look like misfits they are not.
         let floor = noise_floor(d);
         let mut markers = Vec::new();
-        if let Some(p) = d.peak {
+        if let Some(p) = d.peak.filter(|_| !targets_only) {
             markers.push(Marker {
                 x: p.freq_hz,
                 y: p.level,
                 label: format!("measured {:.2} Hz", p.freq_hz),
+            });
+        }
+        if let (true, Some(pk), Some(pm)) = (
+            targets_only,
+            o.result.peaks.iter().find(|p| p.band == d.spec.name),
+            m.peak,
+        ) {
+            markers.push(Marker {
+                x: pk.measured_hz,
+                y: pm.level,
+                label: match pk.target_range_hz {
+                    Some(r) => format!("target {:.0}–{:.0} Hz", r[0], r[1]),
+                    None => format!("target {:.2} Hz", pk.measured_hz),
+                },
             });
         }
         if let Some(p) = m.peak {
@@ -172,22 +204,32 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
         line_chart(
             &dir.join(format!("psd_{}.svg", d.spec.name)),
             &format!(
-                "Welch PSD, {} band (nperseg {}): measured, model, model + noise floor",
-                d.spec.name, d.spec.nperseg
+                "Welch PSD, {} band (nperseg {}): {}",
+                d.spec.name,
+                d.spec.nperseg,
+                if targets_only {
+                    "model against the target"
+                } else {
+                    "measured, model, model + noise floor"
+                }
             ),
             "frequency [Hz]",
             "PSD [m²/Hz]",
-            &[
-                Series::line("measured", d.freq_hz.clone(), d.psd.clone()),
-                Series::line("model", m.freq_hz.clone(), m.psd.clone()),
-                Series::line(
-                    format!(
-                        "model + measured noise floor {floor:.2e} m²/Hz (as the cost compares)"
+            &if targets_only {
+                vec![Series::line("model", m.freq_hz.clone(), m.psd.clone())]
+            } else {
+                vec![
+                    Series::line("measured", d.freq_hz.clone(), d.psd.clone()),
+                    Series::line("model", m.freq_hz.clone(), m.psd.clone()),
+                    Series::line(
+                        format!(
+                            "model + measured noise floor {floor:.2e} m²/Hz (as the cost compares)"
+                        ),
+                        m.freq_hz.clone(),
+                        m.psd.iter().map(|p| p + floor).collect(),
                     ),
-                    m.freq_hz.clone(),
-                    m.psd.iter().map(|p| p + floor).collect(),
-                ),
-            ],
+                ]
+            },
             &ChartOpts {
                 log_y: true,
                 markers,
@@ -227,6 +269,7 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
         &series,
         &ChartOpts::default(),
     )?;
+    freq_vs_speed_figure(dir, o)?;
     let (it, c): (Vec<f64>, Vec<f64>) = o
         .result
         .history
@@ -244,6 +287,40 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
             ..ChartOpts::default()
         },
     )
+}
+
+/// `freq_vs_speed.svg`: instantaneous frequency against lip-tip speed, measurement and fitted model
+/// (see [`crate::fit::instfreq`]), with the default ridge and stick-detector settings. Not written
+/// when the recording has no `tip` point or neither estimator finds a point in the band.
+fn freq_vs_speed_figure(dir: &Path, o: &FitOutcome) -> Result<()> {
+    use crate::fit::instfreq::{freq_speed_figure, measured_freq_speed, model_freq_speed};
+    use crate::spectrum::instfreq::{RidgeConfig, StickDetector, band_floor};
+    if o.measured_trace.point("tip").is_none() {
+        return Ok(());
+    }
+    let cfg = RidgeConfig::default();
+    let meas = measured_freq_speed(
+        &o.measured_trace,
+        o.fs_hz,
+        o.signal,
+        &cfg,
+        &StickDetector::default(),
+    )?;
+    let x = o.signal.extract(&o.measured_trace)?;
+    let mask: Vec<bool> = x.iter().map(|v| !v.is_finite()).collect();
+    let floor = band_floor(&x, o.fs_hz, &cfg)?;
+    let model = model_freq_speed(&o.best_sim, o.fs_hz, o.signal, &cfg, floor, &mask)?;
+    let in_band = |p: &[crate::spectrum::instfreq::FreqSpeedPoint]| {
+        p.iter()
+            .any(|q| q.freq_hz >= cfg.band_hz.0 && q.freq_hz <= cfg.band_hz.1)
+    };
+    if [&meas.ridge, &meas.onsets, &model.ridge, &model.onsets]
+        .iter()
+        .all(|p| !in_band(p))
+    {
+        return Ok(());
+    }
+    freq_speed_figure(dir, &meas, &model, cfg.band_hz)
 }
 
 /// A human-readable summary of a fit result.

@@ -54,27 +54,41 @@ pub struct ReportSummary {
     pub warnings: Vec<String>,
 }
 
-/// The figures `wiperlab fit` writes for a result (file name, caption), in page order; the PSD
-/// figures follow the result's bands.
+/// True when the result comes from a target job (`[targets]`: frequencies to reach, no recording),
+/// read from the settings the result records.
+fn is_target_job(result: &FitResult) -> bool {
+    toml::from_str::<FitJob>(&result.settings).is_ok_and(|j| j.targets.is_some())
+}
+
+/// The figures `wiperlab fit` always writes for a result (file name, caption), in page order; the
+/// PSD figures follow the result's bands.
 pub fn fit_figure_list(result: &FitResult) -> Vec<(String, String)> {
+    let (compared, psd) = if is_target_job(result) {
+        (
+            "the fitted model (a target job has no recording)",
+            "the fitted model's PSD against the target frequency or range",
+        )
+    } else {
+        (
+            "measured and fitted model",
+            "measured, model, and model plus the measurement's noise floor (as the cost compares \
+             them), with both peaks marked",
+        )
+    };
     let mut v = vec![
         (
             "traces_tip.svg".to_string(),
-            "Tip x − head x against time: measured and fitted model (means removed).".to_string(),
+            format!("Tip x − head x against time: {compared} (means removed)."),
         ),
         (
             "traces_head.svg".into(),
-            "Head y against time: measured and fitted model (means removed).".into(),
+            format!("Head y against time: {compared} (means removed)."),
         ),
     ];
     for p in &result.peaks {
         v.push((
             format!("psd_{}.svg", p.band),
-            format!(
-                "Welch PSD in the {} band: measured, and model plus the measurement's noise floor \
-                 (as the cost compares them), with both peaks marked.",
-                p.band
-            ),
+            format!("Welch PSD in the {} band: {psd}.", p.band),
         ));
     }
     v.push((
@@ -89,6 +103,15 @@ pub fn fit_figure_list(result: &FitResult) -> Vec<(String, String)> {
     ));
     v
 }
+
+/// Figures `wiperlab fit` writes only when the data allow (file name, caption); shown after
+/// [`fit_figure_list`] when present, never reported missing.
+pub const OPTIONAL_FIGURES: &[(&str, &str)] = &[(
+    "freq_vs_speed.svg",
+    "Instantaneous frequency against the lip tip's mean speed: spectrogram ridge and \
+     1/stick-onset interval, measured and fitted model (written when the recording has a tip \
+     point and an estimate in the band).",
+)];
 
 /// Escapes text for HTML element content and double- or single-quoted attribute values.
 pub fn escape(s: &str) -> String {
@@ -327,16 +350,21 @@ pub fn render_html(
     // Peaks.
     h.push_str("<h2 id=\"peaks\">Measured against model peaks</h2>\n");
     h.push_str(
-        "<table id=\"peak-table\">\n<tr><th class=\"l\">band</th><th>measured [Hz]</th>\
+        "<table id=\"peak-table\">\n<tr><th class=\"l\">band</th><th>measured or target [Hz]</th>\
          <th>model [Hz]</th><th>(model − measured)/measured</th><th>measured PSD [m²/Hz]</th>\
          <th>model PSD [m²/Hz]</th></tr>\n",
     );
+    let target = is_target_job(r);
     for p in &r.peaks {
         let _ = writeln!(
             h,
             "<tr><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             e(&p.band),
-            num(p.measured_hz, 5),
+            match p.target_range_hz {
+                Some([lo, hi]) => format!("target {}–{}", num(lo, 4), num(hi, 4)),
+                None if target => format!("target {}", num(p.measured_hz, 5)),
+                None => num(p.measured_hz, 5),
+            },
             num(p.model_hz, 5),
             pct(p.rel_diff),
             num(p.measured_level, 3),
@@ -574,7 +602,8 @@ pub fn render_html(
 }
 
 /// Writes `paths.dir/index.html` for result `r`: links every SVG in `paths.dir` (the fit's own
-/// figures first, in [`fit_figure_list`] order, then any other SVG by name), and collects the
+/// figures first, in [`fit_figure_list`] order, then [`OPTIONAL_FIGURES`], then any other SVG by
+/// name), and collects the
 /// warnings: the result's own, undetermined parameters, failed model evaluations, fit figures
 /// missing from the directory, and a recording whose SHA-256 differs from the one fitted.
 ///
@@ -599,6 +628,15 @@ pub fn write_report(r: &FitResult, paths: &ReportPaths) -> Result<ReportSummary>
             figures.push(Figure { file, caption });
         } else {
             missing.push(file);
+        }
+    }
+    for (file, caption) in OPTIONAL_FIGURES {
+        if let Some(i) = present.iter().position(|p| p == file) {
+            present.remove(i);
+            figures.push(Figure {
+                file: file.to_string(),
+                caption: caption.to_string(),
+            });
         }
     }
     for file in present {
@@ -736,6 +774,7 @@ mod tests {
                 rel_diff: 0.5 / 49.0,
                 measured_level: 1e-9,
                 model_level: 2e-9,
+                target_range_hz: None,
             }],
             undetermined: vec!["B".into()],
             correlation: vec![vec![1.0, -0.9], vec![-0.9, 1.0]],
@@ -764,7 +803,7 @@ mod tests {
         let figs = dir.join("reports");
         std::fs::create_dir_all(&figs).unwrap();
         // Only two of the fit's figures, plus one extra SVG.
-        for f in ["cost.svg", "psd_low.svg", "extra.svg"] {
+        for f in ["cost.svg", "psd_low.svg", "extra.svg", "freq_vs_speed.svg"] {
             std::fs::write(figs.join(f), "<svg xmlns=\"http://www.w3.org/2000/svg\"/>").unwrap();
         }
         let rec = dir.join("rec.csv");
@@ -780,8 +819,11 @@ mod tests {
             },
         )
         .unwrap();
-        // Fit figures in fit_figure_list order, then the others by name.
-        assert_eq!(s.figures, ["psd_low.svg", "cost.svg", "extra.svg"]);
+        // Fit figures in fit_figure_list order, then the optional ones, then the others by name.
+        assert_eq!(
+            s.figures,
+            ["psd_low.svg", "cost.svg", "freq_vs_speed.svg", "extra.svg"]
+        );
         assert_eq!(
             s.missing_figures,
             ["traces_tip.svg", "traces_head.svg", "friction_law.svg"]

@@ -12,12 +12,15 @@
 //! * [`peaks`]: [`find_peak`], [`top_peaks`]: largest local maximum with parabolic interpolation of
 //!   the log PSD (J.O. Smith, SASP).
 //! * [`stft`]: [`spectrogram()`] and its [`Spectrogram::ridge`].
+//! * [`instfreq`]: instantaneous frequency (spectrogram ridge, stick-onset rate) against the lip
+//!   tip's speed; NaN-aware smoothed derivative, robust noise estimate, stick detection.
 //!
 //! Units: frequencies in Hz, times in s, PSD in (signal units)²/Hz, one-sided.
 //!
 //! References: P.D. Welch, IEEE Trans. Audio Electroacoust. 15(2):70–73, 1967; SciPy
 //! `scipy.signal.welch` (1.17); J.O. Smith, *Spectral Audio Signal Processing*, CCRMA.
 
+pub mod instfreq;
 pub mod peaks;
 pub mod resample;
 pub mod stft;

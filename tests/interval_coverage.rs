@@ -1,0 +1,172 @@
+//! Do the fit's intervals cover the truth at their stated rate?
+//!
+//! Synthetic recordings of the 1-DOF head model (cheap enough to fit many times) around the reversal,
+//! each with its own tracking noise (Gaussian, σ = 0.1 px per coordinate, as in the shipped sample:
+//! data/reversal/README.md), are fitted for k1 and C with parametric-bootstrap intervals at 68.27 %
+//! (`wiperlab::fit::bootstrap_intervals`). The recordings are simulated at the fit's own tolerance,
+//! so noise is the only source of error and the nominal rate applies. With R recordings the number
+//! covering the truth is Binomial(R, 0.6827); the test accepts the central ~98 % of that law.
+
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+use std::fmt::Write as _;
+use wiperlab::fit::job::LoadedJob;
+use wiperlab::fit::run_fit;
+use wiperlab::model::StickForm;
+use wiperlab::model::{BladeParams, FrictionLaw};
+use wiperlab::simulate::SolverOptions;
+use wiperlab::simulate::blade::{ModelKind, simulate_model};
+
+const RECORDINGS: usize = 12;
+
+fn binomial_cdf(k: usize, n: usize, p: f64) -> f64 {
+    let mut c = 1.0f64;
+    let mut total = 0.0;
+    for i in 0..=k {
+        if i > 0 {
+            c *= (n - i + 1) as f64 / i as f64;
+        }
+        total += c * p.powi(i as i32) * (1.0 - p).powi((n - i) as i32);
+    }
+    total
+}
+
+#[test]
+fn bootstrap_intervals_cover_the_truth_at_their_rate() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let base: BladeParams = toml::from_str(
+        &std::fs::read_to_string(root.join("data/reversal/blade_true.toml")).unwrap(),
+    )
+    .unwrap();
+    let (k1_true, c_true) = (0.015, 0.56);
+    let mut truth = base;
+    truth.k1_nm_per_rad = k1_true;
+    if let FrictionLaw::Exponential { c, .. } = &mut truth.friction {
+        *c = c_true;
+    }
+    // 0.6 s around the reversal at 1.8868 s (truth.json /params/t_reversal_s), 10 kfps.
+    let (t0, fps, n) = (1.60, 1e4, 6000usize);
+    let times: Vec<f64> = (0..n).map(|k| t0 + k as f64 / fps).collect();
+    let opts = SolverOptions {
+        rtol: 1e-8,
+        atol: 1e-10,
+        ..SolverOptions::default()
+    };
+    let sim = simulate_model(
+        ModelKind::Head1dof,
+        &truth,
+        (t0, *times.last().unwrap()),
+        &times,
+        &opts,
+        StickForm::Reduced,
+    )
+    .unwrap();
+    let dir = std::env::temp_dir().join(format!("wiperlab_coverage_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("blade.toml"), toml::to_string(&base).unwrap()).unwrap();
+    std::fs::write(
+        dir.join("truth.json"),
+        format!("{{\"k1\": {k1_true}, \"C\": {c_true}}}"),
+    )
+    .unwrap();
+    let (s, a) = (1.5e-5, 0.1);
+    let noise = Normal::new(0.0, 0.1).unwrap();
+    let mut covered = std::collections::BTreeMap::<String, usize>::new();
+    for r in 0..RECORDINGS {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(1000 + r as u64);
+        let mut e = || noise.sample(&mut rng);
+        let mut csv = String::from("pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y\n");
+        for i in 0..n {
+            let _ = writeln!(
+                csv,
+                "{:.6},{:.6},{:.6},{:.6}",
+                200.0 + (sim.v_m[i] - a) / s + e(),
+                300.0 + sim.u_m[i] / s + e(),
+                200.0 + (sim.v3_m[i] - a) / s + e(),
+                300.0 + (truth.l1_m + truth.l2_m) / s + e()
+            );
+        }
+        std::fs::write(dir.join(format!("rec{r}_xypts.csv")), csv).unwrap();
+        let job = format!(
+            r#"name = "coverage{r}"
+blade = "blade.toml"
+[recording]
+file = "rec{r}_xypts.csv"
+[recording.import]
+format = "dltdv"
+fps_hz = 10000.0
+m_per_px = 1.5e-5
+origin_px = [200.0, 300.0]
+t0_s = {t0:?}
+[recording.import.points]
+head = "pt1"
+tip = "pt2"
+[spectrum]
+signal = "tip_rel_x"
+[[spectrum.bands]]
+name = "low"
+range_hz = [30.0, 300.0]
+nperseg = 2048
+[solver]
+rtol = 1e-8
+atol = 1e-10
+[fit]
+particles = 8
+swarm_iterations = 5
+polish_iterations = 40
+seed = 3
+[fit.uncertainty]
+bootstrap = 12
+polish_iterations = 40
+seed = {seed}
+[fit.parameters]
+k1 = [0.008, 0.03]
+C = [0.4, 0.7]
+[truth]
+json = "truth.json"
+keys = {{ k1 = "/k1", C = "/C" }}
+"#,
+            seed = 50 * r
+        );
+        std::fs::write(dir.join(format!("job{r}.toml")), job).unwrap();
+        let loaded = LoadedJob::load(&dir.join(format!("job{r}.toml"))).unwrap();
+        let out = run_fit(&loaded, false).unwrap();
+        assert_eq!(
+            out.result.model, "head1dof",
+            "the smallest capable model for a low band"
+        );
+        for p in &out.result.parameters {
+            let iv = p
+                .interval
+                .as_ref()
+                .expect("an interval for every parameter");
+            let t = p.true_value.unwrap();
+            let inside = iv.lo <= t && t <= iv.hi;
+            eprintln!(
+                "recording {r}: {} = {:.6} (truth {t:.6}), interval [{:.6}, {:.6}] {}",
+                p.name,
+                p.value,
+                iv.lo,
+                iv.hi,
+                if inside { "covers" } else { "misses" }
+            );
+            *covered.entry(p.name.clone()).or_default() += usize::from(inside);
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    // Acceptance region [lo, hi] with P(X < lo) ≈ P(X > hi) ≈ 1 % under Binomial(R, 0.6827).
+    let p = 0.6827;
+    let lo = (0..=RECORDINGS)
+        .find(|&k| binomial_cdf(k, RECORDINGS, p) > 0.01)
+        .unwrap();
+    let hi = (0..=RECORDINGS)
+        .find(|&k| binomial_cdf(k, RECORDINGS, p) >= 0.99)
+        .unwrap();
+    for (name, c) in &covered {
+        eprintln!("{name}: {c} of {RECORDINGS} intervals cover the truth (accepted {lo}..={hi})");
+        assert!(
+            (lo..=hi).contains(c),
+            "{name}: {c} of {RECORDINGS} 68 % intervals cover the truth (accepted {lo}..={hi})"
+        );
+    }
+}
