@@ -24,8 +24,9 @@ pub struct ImportArgs {
     /// Sidecar TOML with the import settings (format, fps_hz, m_per_px, origin_px, points ...).
     #[arg(long)]
     pub spec: Option<PathBuf>,
-    /// File layout (default: detect).
-    #[arg(long, value_parser = ["dltdv", "tracker", "canonical"])]
+    /// File layout (default: detect from the content).
+    #[arg(long, value_parser = ["dltdv", "dltdv-sparse", "tracker", "kinovea-csv", "kinovea-txt",
+        "kinovea-kinematics", "deeplabcut", "sleap", "trackmate", "generic", "canonical"])]
     pub format: Option<String>,
     /// Frame rate, Hz (required for DLTdv).
     #[arg(long)]
@@ -38,6 +39,37 @@ pub struct ImportArgs {
     // the documented `--origin-px 200,300`; the count is checked in `import_spec`.
     #[arg(long, value_delimiter = ',')]
     pub origin_px: Option<Vec<f64>>,
+    /// Scale from two image points a known distance apart: X1,Y1,X2,Y2 in pixels (with
+    /// --scale-distance-m).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    pub scale_points_px: Option<Vec<f64>>,
+    /// Distance in metres between the --scale-points-px.
+    #[arg(long)]
+    pub scale_distance_m: Option<f64>,
+    /// Metres per calibrated unit of the file (cm: 0.01; Tracker, Kinovea, TrackMate, generic).
+    #[arg(long)]
+    pub units_to_m: Option<f64>,
+    /// Whether the file's y axis points down (default: the format's convention).
+    #[arg(long)]
+    pub y_down: Option<bool>,
+    /// Rotate so x runs along the sweep: sweep direction in degrees from +x (counter-clockwise).
+    #[arg(long, allow_negative_numbers = true)]
+    pub sweep_angle_deg: Option<f64>,
+    /// Rotate so x runs along the head's own principal axis of motion (angle reported).
+    #[arg(long)]
+    pub sweep_from_head: bool,
+    /// Seconds per unit of the file's time column where the file does not say (ms: 0.001).
+    #[arg(long)]
+    pub time_to_s: Option<f64>,
+    /// DeepLabCut/SLEAP: likelihood below which a point becomes a gap (default 0.6).
+    #[arg(long)]
+    pub min_likelihood: Option<f64>,
+    /// DLTdv: 1-based camera to read; DLTdv sparse: --n-cameras gives how many there are.
+    #[arg(long)]
+    pub camera: Option<usize>,
+    /// DLTdv sparse: number of cameras in the file (default 1).
+    #[arg(long)]
+    pub n_cameras: Option<usize>,
     /// Name of the tracked point that is the head.
     #[arg(long)]
     pub head: Option<String>,
@@ -74,6 +106,10 @@ pub enum Command {
         /// Directory for the SVG figures (default: reports/spectrum/<file stem>).
         #[arg(long)]
         out_dir: Option<PathBuf>,
+        /// Longest gap (samples) filled by linear interpolation; longer gaps split the record
+        /// into separate Welch runs.
+        #[arg(long, default_value_t = crate::import::FILL_MAX_SAMPLES)]
+        max_fill: usize,
     },
     /// Simulate the blade model over its reversal window.
     Simulate {
@@ -121,6 +157,24 @@ pub enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Work–precision of the simulation methods (event-driven, Moreau–Jean, smoothed friction) on
+    /// the belt benchmark and the blade; writes work_precision.csv and SVG figures.
+    Bench {
+        /// Fewer settings and shorter timing loops (about 10 s instead of 20 s).
+        #[arg(long)]
+        quick: bool,
+        /// Blade parameter TOMLs, comma-separated: the first is used for the work–precision problems,
+        /// all of them for the spectra-against-tolerance study.
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "data/reversal/blade_true.toml,data/reversal/blade.toml"
+        )]
+        blade: Vec<PathBuf>,
+        /// Output directory.
+        #[arg(long, default_value = "reports/bench")]
+        out_dir: PathBuf,
+    },
 }
 
 fn import_spec(a: &ImportArgs) -> Result<ImportSpec> {
@@ -129,11 +183,43 @@ fn import_spec(a: &ImportArgs) -> Result<ImportSpec> {
         None => ImportSpec::default(),
     };
     if let Some(f) = &a.format {
-        spec.format = match f.as_str() {
-            "dltdv" => Some(Format::Dltdv),
-            "tracker" => Some(Format::Tracker),
-            _ => None,
+        spec.format = Format::from_name(f);
+    }
+    if let Some(p) = &a.scale_points_px {
+        let &[x1, y1, x2, y2] = p.as_slice() else {
+            return Err(Error::Config(format!(
+                "--scale-points-px: expected X1,Y1,X2,Y2 in pixels (got {} values)",
+                p.len()
+            )));
         };
+        spec.scale_points_px = Some([[x1, y1], [x2, y2]]);
+    }
+    if a.scale_distance_m.is_some() {
+        spec.scale_distance_m = a.scale_distance_m;
+    }
+    if a.units_to_m.is_some() {
+        spec.units_to_m = a.units_to_m;
+    }
+    if a.y_down.is_some() {
+        spec.y_down = a.y_down;
+    }
+    if a.sweep_angle_deg.is_some() {
+        spec.sweep_angle_deg = a.sweep_angle_deg;
+    }
+    if a.sweep_from_head {
+        spec.sweep_from_head = true;
+    }
+    if a.time_to_s.is_some() {
+        spec.time_to_s = a.time_to_s;
+    }
+    if a.min_likelihood.is_some() {
+        spec.min_likelihood = a.min_likelihood;
+    }
+    if let Some(c) = a.camera {
+        spec.camera = c;
+    }
+    if let Some(n) = a.n_cameras {
+        spec.n_cameras = n;
     }
     if a.fps.is_some() {
         spec.fps_hz = a.fps;
@@ -232,11 +318,23 @@ pub fn run(cli: Cli) -> Result<()> {
             nperseg,
             band,
             out_dir,
+            max_fill,
         } => {
             let trace = read_any(&file, &import)?;
             let fs = crate::spectrum::median_rate_hz(&trace.t_s);
             let mut signals: Vec<(String, Vec<f64>)> = Vec::new();
+            // Frame-indexed files (t = frame/fps) are uniform already: resampling them would only
+            // smear each NaN over its neighbours through rounding of the grid.
+            let t0 = trace.t_s.first().copied().unwrap_or(0.0);
+            let already_uniform = trace
+                .t_s
+                .iter()
+                .enumerate()
+                .all(|(k, t)| (t - (t0 + k as f64 / fs)).abs() <= 1e-6 / fs);
             let uniform = |x: &[f64]| -> Result<Vec<f64>> {
+                if already_uniform {
+                    return Ok(x.to_vec());
+                }
                 Ok(crate::spectrum::resample_uniform(&trace.t_s, x, fs)?.1)
             };
             for p in &trace.points {
@@ -284,8 +382,31 @@ pub fn run(cli: Cli) -> Result<()> {
                 fs,
                 fs / nperseg as f64
             );
+            let summary = crate::import::describe(&trace);
+            if already_uniform {
+                println!(
+                    "  not resampled: the {} frame times are uniform (within 1e-6 of a step); \
+                     gaps ≤ {max_fill} samples filled, longer ones split the record",
+                    summary.n_frames
+                );
+            } else {
+                println!(
+                    "  resampled: {} frame times (step {} … {} s) → {n} uniform samples at \
+                     {fs:.6} Hz by linear interpolation; gaps ≤ {max_fill} samples filled, longer \
+                     ones split the record",
+                    summary.n_frames, summary.dt_min_s, summary.dt_max_s
+                );
+            }
             for (name, x) in &signals {
-                let f = features(x, fs, &bands, 5)?;
+                let f = match features(x, fs, &bands, max_fill) {
+                    Ok(f) => f,
+                    Err(e) => {
+                        println!("  {name:>12}: skipped: {e}");
+                        continue;
+                    }
+                };
+                let nan = x.iter().filter(|v| v.is_nan()).count();
+                println!("  {name:>12}: {nan} missing samples, {} filled", f.filled);
                 for b in &f.bands {
                     match b.peak {
                         Some(p) => println!(
@@ -363,6 +484,86 @@ pub fn run(cli: Cli) -> Result<()> {
                 sim.stats.rhs_evals,
                 dir.display()
             );
+            Ok(())
+        }
+        Command::Bench {
+            quick,
+            blade,
+            out_dir,
+        } => {
+            let mut blades = Vec::new();
+            for path in &blade {
+                let params: BladeParams = parse_toml(path, &read_text(path)?)?;
+                params.validate().map_err(Error::Config)?;
+                blades.push((path.display().to_string(), params));
+            }
+            let Some((_, params)) = blades.first() else {
+                return Err(Error::Config(
+                    "bench: --blade needs at least one file".into(),
+                ));
+            };
+            let rows = crate::bench::run_bench(&crate::bench::BenchOptions {
+                quick,
+                blade: *params,
+            })?;
+            crate::bench::write_reports(&out_dir, &rows)?;
+            println!(
+                "{:<13} {:<44} {:>8} {:>10} {:>10} {:>10} {:>6} {:>10} {:>10}",
+                "problem",
+                "method",
+                "setting",
+                "value",
+                "wall_s",
+                "rhs",
+                "trans",
+                "t_err_s",
+                "trace_err"
+            );
+            for r in &rows {
+                println!(
+                    "{:<13} {:<44} {:>8} {:>10.1e} {:>10.3e} {:>10} {:>6} {:>10.2e} {:>10.2e} {}",
+                    r.problem,
+                    r.method,
+                    r.setting_name,
+                    r.setting,
+                    r.wall_s,
+                    r.rhs_evals,
+                    r.transitions,
+                    r.transition_err_s,
+                    r.trace_err_m,
+                    r.note
+                );
+            }
+            println!("wrote {}", out_dir.join("work_precision.csv").display());
+            let rtols: Vec<f64> = if quick {
+                vec![1e-6, 1e-8, 1e-10, 1e-12]
+            } else {
+                (4..=13).map(|e| 10f64.powi(-e)).collect()
+            };
+            let mut spectra = Vec::new();
+            for (name, p) in &blades {
+                spectra.extend(crate::bench::spectra_vs_rtol(name, p, &rtols)?);
+            }
+            let loosest = crate::bench::write_spectra(&out_dir, &spectra, 0.002, 0.05)?;
+            println!(
+                "\n{:<32} {:>8} {:>9} {:>6} {:>12} {:>12}",
+                "blade", "rtol", "wall_s", "trans", "low_peak_hz", "high_peak_hz"
+            );
+            for r in &spectra {
+                println!(
+                    "{:<32} {:>8.0e} {:>9.3} {:>6} {:>12.3} {:>12.3}",
+                    r.blade, r.rtol, r.wall_s, r.transitions, r.low_peak_hz, r.high_peak_hz
+                );
+            }
+            match loosest {
+                Some(r) => println!(
+                    "loosest rtol with both peaks of every blade within 0.2 % of its tightest run (and the transition count within 5 %): {r:e}"
+                ),
+                None => println!(
+                    "no rtol has both peaks within 0.2 % (and the transition count within 5 %) of the tightest"
+                ),
+            }
+            println!("wrote {}", out_dir.join("spectra_vs_rtol.csv").display());
             Ok(())
         }
         Command::Fit { job, json, quiet } => {

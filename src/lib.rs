@@ -11,6 +11,7 @@
 //! around the reversal"; journal version J. Sound Vib. 393 (2017) 76), equations (1)–(5), written in SI
 //! units (see `model::blade`).
 
+pub mod bench;
 pub mod cli;
 pub mod error;
 pub mod fit;

@@ -89,13 +89,15 @@ fn detects_every_shared_file_by_content() {
         let Some(path) = shared(rel) else { return };
         assert_eq!(Format::detect(&path).unwrap(), format, "{rel}");
     }
-    // Another tool's CSV (Kinovea, FORMATS.md §2) is neither: a clear Input error naming the file.
-    let Some(path) = shared("realdata/kinovea/v1.csv") else {
+    // A servo log (Mitsubishi MR Configurator, SOURCES.md friction/) is no tracking export: a clear
+    // Input error naming the file and pointing to the generic reader.
+    let Some(path) = shared("realdata/friction/a3MR.csv") else {
         return;
     };
     let err = Format::detect(&path).unwrap_err();
     assert!(matches!(err, Error::Input { .. }), "{err}");
-    assert!(err.to_string().contains("v1.csv"), "{err}");
+    assert!(err.to_string().contains("a3MR.csv"), "{err}");
+    assert!(err.to_string().contains("generic"), "{err}");
 }
 
 #[test]

@@ -97,6 +97,11 @@ pub struct SpectralProblem {
     pub weights: Weights,
     /// Optional frequency-against-speed and trace-error terms (`None` when their weights are 0).
     pub time_targets: Option<instfreq::TimeTargets>,
+    /// Further recordings fitted jointly (`[[more_recordings]]`): each is a problem of its own
+    /// (its measurement, drive and base), sharing `free`; their costs add to this one's.
+    pub others: Vec<SpectralProblem>,
+    /// Name of this problem's recording in joint fits ("" for the main one).
+    pub label: String,
     pub evaluations: Arc<AtomicUsize>,
     pub failures: AtomicUsize,
     pub first_failure: Mutex<Option<String>>,
@@ -202,7 +207,8 @@ impl SpectralProblem {
                 FAILED_COST
             }
         };
-        c + 1e4 * outside
+        let joint: f64 = self.others.iter().map(|o| o.cost_at(u)).sum();
+        c + joint + 1e4 * outside
     }
 }
 
@@ -403,32 +409,48 @@ fn fit_candidate(
         pb.set_message(format!("{} swarm", candidate.name()));
     }
     let evaluations = Arc::new(AtomicUsize::new(0));
-    let trace = &meas.trace;
-    let problem = Arc::new(SpectralProblem {
+    let build = |m: &Measurement, base: BladeParams, label: String, progress| SpectralProblem {
         model: candidate.kind,
-        targets: meas.targets.clone(),
-        time_targets: meas.time_targets.clone(),
+        targets: m.targets.clone(),
+        time_targets: m.time_targets.clone(),
+        others: Vec::new(),
+        label,
         base,
         free: free.clone(),
         measured: Features {
-            bands: meas.measured.bands.clone(),
-            filled: meas.measured.filled,
+            bands: m.measured.bands.clone(),
+            filled: m.measured.filled,
         },
-        floors: meas.floors.clone(),
+        floors: m.floors.clone(),
         bands: job.job.spectrum.bands.clone(),
         signal: job.job.spectrum.signal,
-        nan_mask: meas.x.iter().map(|v| !v.is_finite()).collect(),
-        sample_times: trace.t_s.clone(),
-        fs_hz: meas.fs_hz,
+        nan_mask: m.x.iter().map(|v| !v.is_finite()).collect(),
+        sample_times: m.trace.t_s.clone(),
+        fs_hz: m.fs_hz,
         max_fill: job.job.spectrum.max_fill,
-        window: (trace.t_s[0], *trace.t_s.last().unwrap_or(&trace.t_s[0])),
+        window: (
+            m.trace.t_s[0],
+            *m.trace.t_s.last().unwrap_or(&m.trace.t_s[0]),
+        ),
         solver: job.job.solver,
         weights: fit.weights,
         evaluations: evaluations.clone(),
         failures: AtomicUsize::new(0),
         first_failure: Mutex::new(None),
-        progress: pb.clone(),
-    });
+        progress,
+    };
+    let mut main = build(meas, base, String::new(), pb.clone());
+    let dir = job.path.parent().unwrap_or(std::path::Path::new("."));
+    for more in &job.job.more_recordings {
+        let m = measure_recording(job, &dir.join(&more.file), &more.import)?;
+        let mut b = base;
+        b.drive_a_m = more.drive_a_m.unwrap_or(b.drive_a_m);
+        b.drive_omega_rad_per_s = more
+            .drive_omega_rad_per_s
+            .unwrap_or(b.drive_omega_rad_per_s);
+        main.others.push(build(&m, b, more.name.clone(), None));
+    }
+    let problem = Arc::new(main);
     let history = Arc::new(Mutex::new(Vec::new()));
     let (best_u, swarm_iters, polish_iters, cost) = optimise(
         &problem,
@@ -562,8 +584,12 @@ pub fn aic(cost: f64, k: usize) -> f64 {
 }
 
 /// Reads the recording and its features.
-fn measure_recording(job: &LoadedJob, spec: &crate::import::ImportSpec) -> Result<Measurement> {
-    let trace = crate::import::read_trace(&job.recording_path, spec)?;
+fn measure_recording(
+    job: &LoadedJob,
+    path: &std::path::Path,
+    spec: &crate::import::ImportSpec,
+) -> Result<Measurement> {
+    let trace = crate::import::read_trace(path, spec)?;
     let fs_hz = sampling_rate(&trace, spec.fps_hz)?;
     let signal = job.job.spectrum.signal;
     let x = signal.extract(&trace)?;
@@ -576,7 +602,7 @@ fn measure_recording(job: &LoadedJob, spec: &crate::import::ImportSpec) -> Resul
     for b in &measured.bands {
         if b.peak.is_none() {
             return Err(Error::input(
-                &job.recording_path,
+                path,
                 format!(
                     "the measured {} has no spectral peak in band '{}' {:?} Hz",
                     signal.label(),
@@ -678,7 +704,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let signal = job.job.spectrum.signal;
     let bands = job.job.spectrum.bands.clone();
     let meas = match (&job.job.recording, &job.job.targets) {
-        (Some(rec), _) => measure_recording(job, &rec.import)?,
+        (Some(rec), _) => measure_recording(job, &job.recording_path, &rec.import)?,
         (None, Some(t)) => measure_targets(job, t)?,
         (None, None) => {
             return Err(Error::Config(
@@ -854,11 +880,33 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
             }
         })
         .collect();
+    let mut peaks: Vec<PeakComparison> = peaks;
+    for o in &problem.others {
+        let p = o.params_at(&cf.best_u);
+        let f = o.simulate(&p).and_then(|sim| o.model_features(&sim))?;
+        for (d, m) in o.measured.bands.iter().zip(&f.bands) {
+            let fd = d.peak.map(|p| p.freq_hz).unwrap_or(f64::NAN);
+            let fm = m.peak.map(|p| p.freq_hz).unwrap_or(f64::NAN);
+            peaks.push(PeakComparison {
+                band: format!("{}:{}", o.label, d.spec.name),
+                measured_hz: fd,
+                model_hz: fm,
+                rel_diff: (fm - fd) / fd,
+                measured_level: d.peak.map(|p| p.level).unwrap_or(f64::NAN),
+                model_level: m.peak.map(|p| p.level).unwrap_or(f64::NAN),
+                target_range_hz: None,
+            });
+        }
+    }
     let mut parameters = parameters;
     let mut warnings = Vec::new();
     if fit.uncertainty.bootstrap > 0 && problem.targets.is_some() {
         warnings.push(
             "no bootstrap intervals for a target job: targets carry no measurement noise".into(),
+        );
+    } else if fit.uncertainty.bootstrap > 0 && !problem.others.is_empty() {
+        warnings.push(
+            "no bootstrap intervals for a joint fit of several recordings (not implemented): read the curvature's 1σ".into(),
         );
     } else if fit.uncertainty.bootstrap > 0 {
         if let Some(pb) = &pb {
@@ -879,7 +927,12 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     }
     warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
     let evaluations = problem.evaluations.load(Ordering::Relaxed);
-    let failures = problem.failures.load(Ordering::Relaxed);
+    let failures = problem.failures.load(Ordering::Relaxed)
+        + problem
+            .others
+            .iter()
+            .map(|o| o.failures.load(Ordering::Relaxed))
+            .sum::<usize>();
     if failures * 10 > evaluations {
         warnings.push(format!(
             "{failures} of {evaluations} model evaluations failed (first: {}); the bounds reach parameter sets the model cannot simulate",
@@ -993,6 +1046,8 @@ pub fn bootstrap_intervals(
                 targets: problem.targets.clone(),
                 // The time-domain targets stay the recording's (they are not re-noised).
                 time_targets: problem.time_targets.clone(),
+                others: Vec::new(),
+                label: String::new(),
                 base: problem.base,
                 free: problem.free.clone(),
                 measured,

@@ -231,7 +231,10 @@ pub fn read_trace_csv(path: &Path) -> Result<Trace> {
                 path,
                 line,
                 1,
-                format!("field t_s: time {t} s is not after the previous row's {prev} s"),
+                format!(
+                    "field t_s: time {t} s is not after the previous row's {prev} s (expected \
+                     strictly increasing times)"
+                ),
             ));
         }
         t_s.push(t);

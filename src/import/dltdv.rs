@@ -187,7 +187,10 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
                     path,
                     header_line,
                     0,
-                    format!("pt{}_cam{}_X is missing", p.point, spec.camera),
+                    format!(
+                        "pt{}_cam{}_X is missing (expected an X and a Y column per point)",
+                        p.point, spec.camera
+                    ),
                 ));
             }
             (_, None) => {
@@ -195,7 +198,10 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
                     path,
                     header_line,
                     0,
-                    format!("pt{}_cam{}_Y is missing", p.point, spec.camera),
+                    format!(
+                        "pt{}_cam{}_Y is missing (expected an X and a Y column per point)",
+                        p.point, spec.camera
+                    ),
                 ));
             }
         }
@@ -249,6 +255,60 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
         })
         .collect();
     Ok(Trace { t_s, points })
+}
+
+/// Write `trace` as a DLTdv `xypts.csv` for one camera: the inverse of [`read`] with the same
+/// `spec` (`m_per_px`, `origin_px`, `y_down`). Points become `pt1`, `pt2`, … in trace order; NaN is
+/// written as `NaN`; pixel values with Rust's shortest round-trip formatting (DLTdv itself writes
+/// `%.6f`, which [`read`] accepts too). The time axis is not written (DLTdv has none): it must be
+/// `t0_s + k/fps_hz` for [`read`] to give it back.
+///
+/// # Errors
+/// [`Error::Input`] if `m_per_px` is not set or the trace breaks its invariants; [`Error::Io`].
+pub fn write(path: &Path, trace: &Trace, spec: &ImportSpec) -> Result<()> {
+    let scale = spec.resolved_m_per_px()?.ok_or_else(|| {
+        Error::input(
+            path,
+            "writing DLTdv pixels needs m_per_px in the import spec",
+        )
+    })?;
+    trace
+        .check()
+        .map_err(|m| Error::input(path, format!("cannot write trace: {m}")))?;
+    let [ox, oy] = spec.origin_px;
+    let y_sign = if spec.y_down.unwrap_or(true) {
+        -1.0
+    } else {
+        1.0
+    };
+    let mut out = String::new();
+    let header: Vec<String> = (1..=trace.points.len())
+        .flat_map(|i| [format!("pt{i}_cam1_X"), format!("pt{i}_cam1_Y")])
+        .collect();
+    out.push_str(&header.join(","));
+    out.push('\n');
+    let cell = |v: f64| {
+        if v.is_nan() {
+            "NaN".to_owned()
+        } else {
+            format!("{v}")
+        }
+    };
+    for k in 0..trace.len() {
+        let row: Vec<String> = trace
+            .points
+            .iter()
+            .flat_map(|p| {
+                [
+                    cell(p.x_m[k] / scale + ox),
+                    cell(y_sign * p.y_m[k] / scale + oy),
+                ]
+            })
+            .collect();
+        out.push_str(&row.join(","));
+        out.push('\n');
+    }
+    std::fs::write(path, out).map_err(|e| Error::io(path, "write", e))
 }
 
 #[cfg(test)]

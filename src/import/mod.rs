@@ -6,8 +6,22 @@
 //! Supported inputs (layouts described in `shared/realdata/FORMATS.md`):
 //! * [`Format::Dltdv`] — DLTdv5–8 `*xypts.csv` (FORMATS.md §3): pixels, one row per frame, no time
 //!   column; needs [`ImportSpec::fps_hz`] and [`ImportSpec::m_per_px`]. Reader: [`dltdv`].
+//!   [`Format::DltdvSparse`] — the sparse `*xypts.tsv` save: [`dltdv_sparse`].
 //! * [`Format::Tracker`] — Open Source Physics Tracker "Export Data" / "Copy Data" text
 //!   (FORMATS.md §1): a `t` column in seconds and calibrated x, y per track. Reader: [`tracker`].
+//! * [`Format::KinoveaCsv`], [`Format::KinoveaTxt`], [`Format::KinoveaKinematics`] — Kinovea
+//!   trajectory CSV/TXT and kinematics CSV (§2): [`kinovea`].
+//! * [`Format::Deeplabcut`] (§4): [`deeplabcut`]; [`Format::Sleap`] (§5): [`sleap`];
+//!   [`Format::Trackmate`] (§6): [`trackmate`].
+//! * [`Format::Generic`] — any delimited table or JSON row array with user-mapped columns:
+//!   [`generic`].
+//!
+//! The readers other than DLTdv and Tracker return a [`common::RawTrace`] in file units;
+//! [`common::calibrate`] applies the time base (file times, or frame / `fps_hz`), the scale
+//! (`m_per_px`, two scale points, or `units_to_m`), origin and y flip in one place. Then every
+//! format gets roles ([`ImportSpec::points`]) and the optional rotation to the sweep
+//! (`sweep_angle_deg` / `sweep_from_head`). Text is UTF-8, or Windows-1252 when not UTF-8
+//! ([`common::decode`]).
 //!
 //! The canonical CSV that wiperlab itself writes and reads back is in [`canonical`].
 //!
@@ -40,8 +54,15 @@
 //! ```
 
 pub mod canonical;
+pub mod common;
+pub mod deeplabcut;
 pub mod dltdv;
+pub mod dltdv_sparse;
+pub mod generic;
+pub mod kinovea;
+pub mod sleap;
 pub mod tracker;
+pub mod trackmate;
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -53,23 +74,73 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Error, Result};
 use crate::trace::{PointTrack, Trace};
 
-/// The tracking-tool export layouts wiperlab reads. Serialised in lowercase (`"dltdv"`,
-/// `"tracker"`).
+/// The tracking-tool export layouts wiperlab reads. Serialised in kebab case (`"dltdv"`,
+/// `"tracker"`, `"kinovea-csv"`, ...), the same names `--format` takes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[serde(rename_all = "kebab-case")]
 pub enum Format {
     /// DLTdv `*xypts.csv` (FORMATS.md §3).
     Dltdv,
+    /// DLTdv sparse `*xypts.tsv` (FORMATS.md §3).
+    DltdvSparse,
     /// Tracker data export (FORMATS.md §1).
     Tracker,
+    /// Kinovea trajectory CSV, quoted cells (FORMATS.md §2a).
+    KinoveaCsv,
+    /// Kinovea trajectory TXT ("Gnuplot"), one section per object (FORMATS.md §2b).
+    KinoveaTxt,
+    /// Kinovea kinematics-dialog CSV, time in ms (FORMATS.md §2c).
+    KinoveaKinematics,
+    /// DeepLabCut single- or multi-animal prediction CSV (FORMATS.md §4).
+    Deeplabcut,
+    /// SLEAP analysis CSV, one row per instance (FORMATS.md §5).
+    Sleap,
+    /// TrackMate spot table, ≤ 6 (one header line) or ≥ 7 (up to four header lines) (FORMATS.md §6).
+    Trackmate,
+    /// Any delimited table with the columns mapped in [`ImportSpec::generic`].
+    Generic,
+}
+
+impl Format {
+    /// Every format, in the order `--format` lists them.
+    pub const ALL: [Format; 10] = [
+        Format::Dltdv,
+        Format::DltdvSparse,
+        Format::Tracker,
+        Format::KinoveaCsv,
+        Format::KinoveaTxt,
+        Format::KinoveaKinematics,
+        Format::Deeplabcut,
+        Format::Sleap,
+        Format::Trackmate,
+        Format::Generic,
+    ];
+
+    /// The kebab-case name (`"kinovea-csv"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Dltdv => "dltdv",
+            Format::DltdvSparse => "dltdv-sparse",
+            Format::Tracker => "tracker",
+            Format::KinoveaCsv => "kinovea-csv",
+            Format::KinoveaTxt => "kinovea-txt",
+            Format::KinoveaKinematics => "kinovea-kinematics",
+            Format::Deeplabcut => "deeplabcut",
+            Format::Sleap => "sleap",
+            Format::Trackmate => "trackmate",
+            Format::Generic => "generic",
+        }
+    }
+
+    /// The format called `name` ([`Format::name`]), if any.
+    pub fn from_name(name: &str) -> Option<Format> {
+        Format::ALL.into_iter().find(|f| f.name() == name)
+    }
 }
 
 impl fmt::Display for Format {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Format::Dltdv => "dltdv",
-            Format::Tracker => "tracker",
-        })
+        f.write_str(self.name())
     }
 }
 
@@ -79,10 +150,16 @@ const SNIFF_BYTES: u64 = 64 * 1024;
 impl Format {
     /// Guess the format of `path` from its first lines (content, not the file name).
     ///
-    /// * DLTdv: the first line's first comma-separated field is `pt{i}_cam{j}_X` or `_Y`.
+    /// * DLTdv: the first line's first comma-separated field is `pt{i}_cam{j}_X` or `_Y`; DLTdv
+    ///   sparse: the first line starts with `Sparse format`.
     /// * Tracker: the first line is `#multi:`, or one of the first four non-blank lines is a column
     ///   row whose first field is `t` (subscripts like `t_{1}` allowed; TAB, `;`, `,` or space
     ///   delimited) — see [`tracker`] for the full layout.
+    /// * Kinovea: TXT starts `#Kinovea Trajectory`; trajectory CSV starts with the quoted cell
+    ///   `"Time"`; kinematics CSV starts with `Time (ms)`.
+    /// * DeepLabCut: first line starts with `scorer`; SLEAP: the header has `frame_idx` and a
+    ///   `.x` column; TrackMate: first field `Label`/`LABEL` and a `POSITION_X` column.
+    /// * [`Format::Generic`] is never detected: it needs [`ImportSpec::generic`].
     ///
     /// # Errors
     /// [`Error::Io`] if the file cannot be opened or read; [`Error::Input`] naming the file and
@@ -104,10 +181,12 @@ impl Format {
             Error::input(
                 path,
                 format!(
-                    "unknown tracking-file format: expected a DLTdv xypts header \
-                     (pt1_cam1_X,pt1_cam1_Y,...) or a Tracker export (optional `#multi:` and \
-                     track-name row, then a column row `t x y ...`); first line is {first:?}; \
-                     set `format` in the import spec if the file is one of these"
+                    "unknown tracking-file format; first line is {first:?}: expected a DLTdv \
+                     xypts header (pt1_cam1_X,...), a DLTdv sparse file, a Tracker export (column \
+                     row `t x y ...`), a Kinovea export, a DeepLabCut CSV (`scorer,...`), a SLEAP \
+                     analysis CSV (`track,frame_idx,...`) or a TrackMate spot table \
+                     (`LABEL,...,POSITION_X,...`); for any other table set format = \"generic\" \
+                     and map its columns ([generic] in the import spec)"
                 ),
             )
         })
@@ -130,6 +209,28 @@ impl Format {
         if dltdv::parse_header_name(f0).is_some() {
             return Some(Format::Dltdv);
         }
+        if first.starts_with("Sparse format") {
+            return Some(Format::DltdvSparse);
+        }
+        if first.starts_with("#Kinovea Trajectory") {
+            return Some(Format::KinoveaTxt);
+        }
+        if first.starts_with("\"Time\"") {
+            return Some(Format::KinoveaCsv);
+        }
+        if first.starts_with("Time (ms)") {
+            return Some(Format::KinoveaKinematics);
+        }
+        if f0 == "scorer" {
+            return Some(Format::Deeplabcut);
+        }
+        let header: Vec<&str> = first.split(',').map(str::trim).collect();
+        if header.contains(&"frame_idx") && header.iter().any(|h| h.ends_with(".x")) {
+            return Some(Format::Sleap);
+        }
+        if (f0 == "Label" || f0 == "LABEL") && header.contains(&"POSITION_X") {
+            return Some(Format::Trackmate);
+        }
         if tracker::find_column_row(&lines).is_some() {
             return Some(Format::Tracker);
         }
@@ -142,16 +243,20 @@ impl Format {
 /// Meant to live in a TOML job or a sidecar next to the data (`deny_unknown_fields`, every field
 /// optional). Defaults: see [`ImportSpec::default`]. Which fields apply to which format:
 ///
-/// | field | DLTdv | Tracker |
-/// |---|---|---|
-/// | `fps_hz` | required: t = `t0_s` + (frame − 1)/`fps_hz` | optional check of the `t` column's median step (±1 %) |
-/// | `m_per_px` | required | must be absent (Tracker is calibrated) |
-/// | `origin_px` | subtracted from pixel coordinates | must be [0, 0] |
-/// | `y_down` | default true: y_m = −(y_px − origin_y)·`m_per_px` | default false; true flips y |
-/// | `units_to_m` | must be 1 | calibrated unit → m (cm: 0.01) |
-/// | `camera` | which `cam{j}` columns | must be 1 |
-/// | `decimal_comma` | must be false | `1,5` means 1.5 (not with a `,` delimiter) |
-/// | `t0_s` | time of frame 1 | added to the `t` column |
+/// | field | DLTdv (csv, sparse) | Tracker | other formats |
+/// |---|---|---|---|
+/// | `fps_hz` | required: t = `t0_s` + (frame − 1)/`fps_hz` | optional check of the `t` column's median step (±1 %) | required where the file has frame numbers only (DeepLabCut, SLEAP, TrackMate without a time unit, generic `frame`) |
+/// | `m_per_px` or `scale_points_px` + `scale_distance_m` | required | must be absent (Tracker is calibrated) | required for pixels; alternative to `units_to_m` when the file does not state its unit |
+/// | `origin_px` | subtracted from pixel coordinates | must be [0, 0] | subtracted in file units |
+/// | `y_down` | default true: y_m = −(y_px − origin_y)·`m_per_px` | default false; true flips y | default: true for DeepLabCut, SLEAP, TrackMate (image rows), false otherwise |
+/// | `units_to_m` | must be absent | calibrated unit → m (default 1; cm: 0.01) | required for Kinovea, TrackMate ≤ 6, generic unless `m_per_px`; overrides TrackMate's unit row |
+/// | `camera`, `n_cameras` | which `cam{j}` columns; sparse: cameras in the file | must be 1 | must be 1 |
+/// | `decimal_comma` | must be false | `1,5` means 1.5 (not with a `,` delimiter) | generic only (Kinovea detects it) |
+/// | `t0_s` | time of frame 1 | added to the `t` column | added to every time |
+/// | `time_to_s` | — | — | Kinovea CSV (required: unit not in the file), generic time column |
+/// | `min_likelihood` | — | — | DeepLabCut, SLEAP: below it → NaN (default 0.6) |
+/// | `sweep_angle_deg` / `sweep_from_head` | rotation so x runs along the sweep, every format | | |
+/// | `generic` | — | — | the column mapping of [`Format::Generic`] |
 ///
 /// ```toml
 /// format = "dltdv"            # optional, detected from content when absent
@@ -181,9 +286,43 @@ pub struct ImportSpec {
     /// (image rows, origin top-left), Tracker `false` (world coordinates, y up).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub y_down: Option<bool>,
-    /// Tracker only: metres per calibrated unit of the file (m: 1, cm: 0.01), finite and > 0;
-    /// default 1.
-    pub units_to_m: f64,
+    /// Metres per calibrated unit of the file (m: 1, cm: 0.01), finite and > 0. Tracker: default
+    /// 1 (the unit the user calibrated in). Kinovea, TrackMate ≤ 6 and generic tables do not state
+    /// whether they are in pixels or a calibrated unit: set this or `m_per_px`. Overrides a unit
+    /// the file states (TrackMate ≥ 7 unit row).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub units_to_m: Option<f64>,
+    /// Two image points `[[x1, y1], [x2, y2]]` (pixels) a known distance `scale_distance_m` apart:
+    /// m_per_px = distance / |p2 − p1|. Alternative to `m_per_px`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scale_points_px: Option<[[f64; 2]; 2]>,
+    /// Distance in metres between `scale_points_px`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scale_distance_m: Option<f64>,
+    /// Rotate the trace so that x runs along the sweep: the sweep direction's angle in degrees,
+    /// counter-clockwise from the physical +x axis (after the y flip). Every point is rotated by
+    /// −angle about the origin.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sweep_angle_deg: Option<f64>,
+    /// Estimate the sweep angle from the head's own motion (principal axis of its positions; the
+    /// point with role `head`, else the first point) and rotate by it; the angle is reported.
+    /// Not together with `sweep_angle_deg`. Default false.
+    pub sweep_from_head: bool,
+    /// Seconds per unit of the file's time column where the file does not say (Kinovea trajectory
+    /// CSV, generic tables; 0.001 for ms). Default: the unit in the header (`Time (ms)`), else an
+    /// error for Kinovea CSV and seconds for generic tables.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_to_s: Option<f64>,
+    /// DeepLabCut / SLEAP: points with a likelihood (score) below this become NaN gaps. Default
+    /// 0.6, DeepLabCut's default `pcutoff` (config.yaml); 0 keeps every point.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub min_likelihood: Option<f64>,
+    /// DLTdv sparse only: number of cameras the file's columns cover (the sparse file has no
+    /// header to tell); default 1.
+    pub n_cameras: usize,
+    /// Column mapping of a generic delimited table ([`Format::Generic`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub generic: Option<generic::GenericColumns>,
     /// DLTdv only: 1-based camera index `j` of the `pt{i}_cam{j}_*` columns to read; default 1.
     pub camera: usize,
     /// Time of the first frame in seconds (DLTdv), or offset added to Tracker's `t` column; default 0.
@@ -197,8 +336,8 @@ pub struct ImportSpec {
 }
 
 impl Default for ImportSpec {
-    /// No format (detect), no fps, no scale, origin `[0, 0]`, format's y convention, units 1 m,
-    /// camera 1, t0 0 s, decimal point, no roles.
+    /// No format (detect), no fps, no scale, origin `[0, 0]`, format's y convention, no unit
+    /// factor, no rotation, camera 1 of 1, t0 0 s, decimal point, likelihood cut-off 0.6, no roles.
     fn default() -> Self {
         ImportSpec {
             format: None,
@@ -206,7 +345,15 @@ impl Default for ImportSpec {
             m_per_px: None,
             origin_px: [0.0, 0.0],
             y_down: None,
-            units_to_m: 1.0,
+            units_to_m: None,
+            scale_points_px: None,
+            scale_distance_m: None,
+            sweep_angle_deg: None,
+            sweep_from_head: false,
+            time_to_s: None,
+            min_likelihood: None,
+            n_cameras: 1,
+            generic: None,
             camera: 1,
             t0_s: 0.0,
             decimal_comma: false,
@@ -237,7 +384,41 @@ impl ImportSpec {
         if let Some(s) = self.m_per_px {
             positive("m_per_px", s)?;
         }
-        positive("units_to_m", self.units_to_m)?;
+        if let Some(u) = self.units_to_m {
+            positive("units_to_m", u)?;
+        }
+        if let Some(t) = self.time_to_s {
+            positive("time_to_s", t)?;
+        }
+        if let Some(d) = self.scale_distance_m {
+            positive("scale_distance_m", d)?;
+        }
+        if let Some(a) = self.sweep_angle_deg {
+            if !a.is_finite() {
+                return Err(Error::Config(format!(
+                    "import: sweep_angle_deg must be finite, got {a}"
+                )));
+            }
+            if self.sweep_from_head {
+                return Err(Error::Config(
+                    "import: set sweep_angle_deg or sweep_from_head, not both".into(),
+                ));
+            }
+        }
+        if let Some(l) = self.min_likelihood
+            && !(0.0..=1.0).contains(&l)
+        {
+            return Err(Error::Config(format!(
+                "import: min_likelihood must be in [0, 1], got {l}"
+            )));
+        }
+        if self.n_cameras == 0 || (self.camera > self.n_cameras && format == Format::DltdvSparse) {
+            return Err(Error::Config(format!(
+                "import: n_cameras must be ≥ 1 and ≥ camera, got n_cameras = {} with camera = {}",
+                self.n_cameras, self.camera
+            )));
+        }
+        self.resolved_m_per_px()?;
         if !self.origin_px.iter().all(|v| v.is_finite()) {
             return Err(Error::Config(format!(
                 "import: origin_px must be finite, got {:?}",
@@ -269,13 +450,13 @@ impl ImportSpec {
             )))
         };
         match format {
-            Format::Dltdv => {
+            Format::Dltdv | Format::DltdvSparse => {
                 if self.camera == 0 {
                     return Err(Error::Config(
                         "import: camera is 1-based (cam1, cam2, ...), got 0".into(),
                     ));
                 }
-                if self.units_to_m != 1.0 {
+                if self.units_to_m.is_some() {
                     return not_for("units_to_m", "DLTdv is in pixels: set m_per_px");
                 }
                 if self.decimal_comma {
@@ -296,8 +477,55 @@ impl ImportSpec {
                     return not_for("camera", "a Tracker export holds one video");
                 }
             }
+            _ => {
+                if self.camera != 1 {
+                    return not_for("camera", "the file holds one video");
+                }
+                if self.decimal_comma && format != Format::Generic {
+                    return not_for(
+                        "decimal_comma",
+                        "the reader detects this format's decimal separator itself",
+                    );
+                }
+            }
+        }
+        if self.generic.is_some() && format != Format::Generic {
+            return not_for(
+                "generic",
+                "set format = \"generic\" to use a column mapping",
+            );
         }
         Ok(())
+    }
+
+    /// The image scale in m/px: `m_per_px`, or `scale_distance_m` / |p2 − p1| from
+    /// `scale_points_px`, or `None` if neither is set.
+    ///
+    /// # Errors
+    /// [`Error::Config`] if both ways are given, only one of `scale_points_px` and
+    /// `scale_distance_m` is, or the two points coincide or are not finite.
+    pub fn resolved_m_per_px(&self) -> Result<Option<f64>> {
+        match (self.m_per_px, self.scale_points_px, self.scale_distance_m) {
+            (m, None, None) => Ok(m),
+            (Some(_), _, _) => Err(Error::Config(
+                "import: set m_per_px or scale_points_px + scale_distance_m, not both".into(),
+            )),
+            (None, Some([[x1, y1], [x2, y2]]), Some(d)) => {
+                let len = (x2 - x1).hypot(y2 - y1);
+                if !(len.is_finite() && len > 0.0) {
+                    return Err(Error::Config(format!(
+                        "import: scale_points_px must be two distinct finite points, got \
+                         [[{x1}, {y1}], [{x2}, {y2}]]"
+                    )));
+                }
+                Ok(Some(d / len))
+            }
+            (None, _, _) => Err(Error::Config(
+                "import: scale_points_px and scale_distance_m go together (two image points a \
+                 known distance apart)"
+                    .into(),
+            )),
+        }
     }
 }
 
@@ -325,21 +553,152 @@ pub fn read_trace(path: &Path, spec: &ImportSpec) -> Result<Trace> {
 pub fn read_trace_with_summary(path: &Path, spec: &ImportSpec) -> Result<(Trace, ImportSummary)> {
     let format = match spec.format {
         Some(f) => f,
+        None if spec.generic.is_some() => Format::Generic,
         None => Format::detect(path)?,
     };
     spec.validate(format)?;
+    // The two-point scale becomes m_per_px for every reader.
+    let mut resolved = spec.clone();
+    if spec.scale_points_px.is_some() {
+        resolved.m_per_px = spec.resolved_m_per_px()?;
+        resolved.scale_points_px = None;
+        resolved.scale_distance_m = None;
+    }
+    let mut notes = Vec::new();
+    if let (Some(p), Some(m)) = (&spec.scale_points_px, resolved.m_per_px) {
+        notes.push(format!(
+            "scale from two points {p:?} {} m apart: {m:e} m/px",
+            spec.scale_distance_m.unwrap_or(f64::NAN)
+        ));
+    }
+    let spec = &resolved;
     let raw = match format {
-        Format::Dltdv => dltdv::read(path, spec)?,
-        Format::Tracker => tracker::read(path, spec)?,
+        Format::Dltdv => {
+            notes.push(format!(
+                "time base: (frame − 1) / {} fps; units: pixels × {:e} m/px, image y down flipped \
+                 unless y_down = false",
+                spec.fps_hz.unwrap_or(f64::NAN),
+                spec.m_per_px.unwrap_or(f64::NAN)
+            ));
+            dltdv::read(path, spec)?
+        }
+        Format::Tracker => {
+            notes.push(format!(
+                "time base: the file's t column (real frame times kept); units: calibrated × {} m",
+                spec.units_to_m.unwrap_or(1.0)
+            ));
+            tracker::read(path, spec)?
+        }
+        other => {
+            let raw = match other {
+                Format::DltdvSparse => dltdv_sparse::read(path, spec)?,
+                Format::KinoveaCsv => kinovea::read_csv(path, spec)?,
+                Format::KinoveaTxt => kinovea::read_txt(path, spec)?,
+                Format::KinoveaKinematics => kinovea::read_kinematics(path, spec)?,
+                Format::Deeplabcut => deeplabcut::read(path, spec)?,
+                Format::Sleap => sleap::read(path, spec)?,
+                Format::Trackmate => trackmate::read(path, spec)?,
+                Format::Generic => generic::read(path, spec)?,
+                Format::Dltdv | Format::Tracker => unreachable!("handled above"),
+            };
+            let (trace, n) = common::calibrate(path, raw, spec)?;
+            notes.extend(n);
+            trace
+        }
     };
-    let trace = assign_roles(path, raw, &spec.points)?;
+    let mut trace = assign_roles(path, raw, &spec.points)?;
+    if let Some(note) = rotate_to_sweep(path, &mut trace, spec)? {
+        notes.push(note);
+    }
     // The readers guarantee this; checked once more because t0_s is added to every time.
     trace
         .check()
         .map_err(|m| Error::input(path, format!("imported trace is inconsistent: {m}")))?;
     let mut summary = describe(&trace);
     summary.format = Some(format);
+    summary.notes = notes;
     Ok((trace, summary))
+}
+
+/// Principal-axis angle (radians, in (−π/2, π/2]) of the finite `(x, y)` samples: the direction of
+/// largest variance, 0.5·atan2(2·c_xy, c_xx − c_yy). `None` with fewer than 2 finite samples or no
+/// spread.
+pub fn principal_axis_rad(x: &[f64], y: &[f64]) -> Option<f64> {
+    let pts: Vec<(f64, f64)> = x
+        .iter()
+        .zip(y)
+        .filter(|(a, b)| a.is_finite() && b.is_finite())
+        .map(|(a, b)| (*a, *b))
+        .collect();
+    if pts.len() < 2 {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = pts.iter().map(|p| p.1).sum::<f64>() / n;
+    let (mut cxx, mut cyy, mut cxy) = (0.0, 0.0, 0.0);
+    for (a, b) in &pts {
+        cxx += (a - mx) * (a - mx);
+        cyy += (b - my) * (b - my);
+        cxy += (a - mx) * (b - my);
+    }
+    if cxx + cyy <= 0.0 {
+        return None;
+    }
+    let mut a = 0.5 * (2.0 * cxy).atan2(cxx - cyy);
+    if a <= -std::f64::consts::FRAC_PI_2 {
+        a += std::f64::consts::PI;
+    }
+    Some(a)
+}
+
+/// Rotate every point of `trace` by −θ about the origin, θ = `sweep_angle_deg` or the head's
+/// principal axis (`sweep_from_head`), so that x runs along the sweep. Returns the report note.
+fn rotate_to_sweep(path: &Path, trace: &mut Trace, spec: &ImportSpec) -> Result<Option<String>> {
+    let (theta, note) = if let Some(deg) = spec.sweep_angle_deg {
+        (
+            deg.to_radians(),
+            format!("rotation: by −{deg}° (sweep_angle_deg) so x runs along the sweep"),
+        )
+    } else if spec.sweep_from_head {
+        let Some(head) = trace.point("head").or_else(|| trace.points.first()) else {
+            return Err(Error::input(
+                path,
+                "sweep_from_head: the file has no points",
+            ));
+        };
+        let Some(theta) = principal_axis_rad(&head.x_m, &head.y_m) else {
+            return Err(Error::input(
+                path,
+                format!(
+                    "sweep_from_head: point {:?} has fewer than two distinct tracked positions; \
+                     give sweep_angle_deg instead",
+                    head.name
+                ),
+            ));
+        };
+        (
+            theta,
+            format!(
+                "rotation: sweep axis of point {:?} by principal axis = {:.4}° from +x; rotated by \
+                 −{:.4}° so x runs along the sweep",
+                head.name,
+                theta.to_degrees(),
+                theta.to_degrees()
+            ),
+        )
+    } else {
+        return Ok(None);
+    };
+    let (s, c) = theta.sin_cos();
+    for p in &mut trace.points {
+        for (x, y) in p.x_m.iter_mut().zip(p.y_m.iter_mut()) {
+            let (x0, y0) = (*x, *y);
+            *x = c * x0 + s * y0;
+            *y = -s * x0 + c * y0;
+        }
+    }
+    Ok(Some(note))
 }
 
 /// Conventional role order: these first, then other roles alphabetically.
@@ -409,8 +768,12 @@ pub struct ImportSummary {
     pub format: Option<Format>,
     /// Number of time samples (frames).
     pub n_frames: usize,
-    /// `(point name, NaN samples)` in trace order; a sample counts as NaN when x or y is NaN.
+    /// `(point name, NaN samples)` in trace order; a sample counts as NaN when x or y is NaN (for a
+    /// scalar point, when x is NaN).
     pub points: Vec<(String, usize)>,
+    /// Per point: a scalar signal (a generic or Kinovea-kinematics column stored in x; y is NaN
+    /// throughout).
+    pub scalar: Vec<bool>,
     /// First sample time in s (NaN for an empty trace).
     pub t_first_s: f64,
     /// Last sample time in s (NaN for an empty trace).
@@ -421,6 +784,15 @@ pub struct ImportSummary {
     pub dt_min_s: f64,
     /// Largest time step in s (NaN with fewer than 2 samples).
     pub dt_max_s: f64,
+    /// Per point (trace order): `(gap runs, longest gap)` in samples; a gap is a maximal run of
+    /// samples where x or y is NaN.
+    pub gaps: Vec<(usize, usize)>,
+    /// Per point: NaN samples in interior gaps of at most [`FILL_MAX_SAMPLES`] samples — the ones
+    /// `wiperlab spectrum` fills by linear interpolation with its default `--max-fill`.
+    pub fillable: Vec<usize>,
+    /// What the import did: time base, units and scale, y flip, rotation, encoding, thresholds,
+    /// skipped rows (empty from [`describe`]).
+    pub notes: Vec<String>,
 }
 
 impl ImportSummary {
@@ -447,14 +819,80 @@ pub fn describe(trace: &Trace) -> ImportSummary {
         points: trace
             .points
             .iter()
-            .map(|p| (p.name.clone(), p.nan_samples()))
+            .map(|p| {
+                let nan = if is_scalar(p) {
+                    p.x_m.iter().filter(|v| v.is_nan()).count()
+                } else {
+                    p.nan_samples()
+                };
+                (p.name.clone(), nan)
+            })
             .collect(),
+        scalar: trace.points.iter().map(is_scalar).collect(),
         t_first_s: t.first().copied().unwrap_or(f64::NAN),
         t_last_s: t.last().copied().unwrap_or(f64::NAN),
         dt_median_s,
         dt_min_s: dt.first().copied().unwrap_or(f64::NAN),
         dt_max_s: dt.last().copied().unwrap_or(f64::NAN),
+        gaps: trace.points.iter().map(gap_runs).collect(),
+        fillable: trace
+            .points
+            .iter()
+            .map(|p| fillable_samples(p, FILL_MAX_SAMPLES))
+            .collect(),
+        notes: Vec::new(),
     }
+}
+
+/// The longest interior gap (samples) that `wiperlab spectrum` fills by default (`--max-fill`).
+pub const FILL_MAX_SAMPLES: usize = 5;
+
+/// NaN samples of `p` in interior runs (finite samples on both sides) of at most `max_fill`.
+pub fn fillable_samples(p: &PointTrack, max_fill: usize) -> usize {
+    let scalar = is_scalar(p);
+    let missing: Vec<bool> = p
+        .x_m
+        .iter()
+        .zip(&p.y_m)
+        .map(|(x, y)| x.is_nan() || (!scalar && y.is_nan()))
+        .collect();
+    let (mut total, mut run, mut seen_finite) = (0, 0, false);
+    for m in missing {
+        if m {
+            run += 1;
+        } else {
+            if seen_finite && run <= max_fill {
+                total += run;
+            }
+            run = 0;
+            seen_finite = true;
+        }
+    }
+    total
+}
+
+/// A scalar point: y NaN throughout while x has a value somewhere.
+fn is_scalar(p: &PointTrack) -> bool {
+    p.y_m.iter().all(|v| v.is_nan()) && p.x_m.iter().any(|v| !v.is_nan())
+}
+
+/// `(number of NaN runs, longest run)` of a point (NaN where x or y is NaN; for a scalar point,
+/// where x is NaN).
+pub fn gap_runs(p: &PointTrack) -> (usize, usize) {
+    let scalar = is_scalar(p);
+    let (mut runs, mut longest, mut cur) = (0, 0, 0);
+    for (x, y) in p.x_m.iter().zip(&p.y_m) {
+        if x.is_nan() || (!scalar && y.is_nan()) {
+            if cur == 0 {
+                runs += 1;
+            }
+            cur += 1;
+            longest = longest.max(cur);
+        } else {
+            cur = 0;
+        }
+    }
+    (runs, longest)
 }
 
 impl fmt::Display for ImportSummary {
@@ -474,33 +912,45 @@ impl fmt::Display for ImportSummary {
             self.dt_min_s,
             self.dt_max_s
         )?;
-        for (name, nan) in &self.points {
+        for (i, (name, nan)) in self.points.iter().enumerate() {
             let pct = if self.n_frames > 0 {
                 100.0 * *nan as f64 / self.n_frames as f64
             } else {
                 0.0
             };
-            writeln!(
+            let kind = if self.scalar.get(i) == Some(&true) {
+                " (scalar, value in x)"
+            } else {
+                ""
+            };
+            write!(
                 f,
-                "  {name}: {} tracked, {nan} NaN ({pct:.2} %)",
+                "  {name}{kind}: {} tracked, {nan} NaN ({pct:.2} %)",
                 self.n_frames - nan
             )?;
+            match self.gaps.get(i) {
+                Some(&(runs, longest)) if runs > 0 => {
+                    write!(f, " in {runs} gaps, longest {longest} samples")?;
+                    let fill = self.fillable.get(i).copied().unwrap_or(0);
+                    writeln!(
+                        f,
+                        "; {fill} in interior gaps ≤ {FILL_MAX_SAMPLES} samples (filled by \
+                         spectrum), the rest split the record"
+                    )?
+                }
+                _ => writeln!(f)?,
+            }
+        }
+        for note in &self.notes {
+            writeln!(f, "  note: {note}")?;
         }
         Ok(())
     }
 }
 
-/// Read a whole file as text: BOM removed, invalid UTF-8 replaced (only names can be non-ASCII).
+/// Read a whole file as text, BOM removed: UTF-8, else Windows-1252 ([`common::decode`]).
 pub(crate) fn read_text(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, "read", e))?;
-    let text = match String::from_utf8(bytes) {
-        Ok(s) => s,
-        Err(e) => String::from_utf8_lossy(e.as_bytes()).into_owned(),
-    };
-    Ok(match text.strip_prefix('\u{feff}') {
-        Some(rest) => rest.to_owned(),
-        None => text,
-    })
+    common::read_decoded(path).map(|(s, _)| s)
 }
 
 /// Parse a finite decimal number (`1.5`, `-3.4E-6`, `.5`); `None` for anything else, including
@@ -538,9 +988,17 @@ pub(crate) fn csv_error(path: &Path, action: &'static str, e: csv::Error) -> Err
             path,
             line,
             err.field() + 1,
-            format!("invalid UTF-8 in field {}", err.field() + 1),
+            format!(
+                "invalid UTF-8 in field {}: expected UTF-8 text (re-save the file as UTF-8)",
+                err.field() + 1
+            ),
         ),
-        other => Error::parse(path, line, 0, format!("{other:?}")),
+        other => Error::parse(
+            path,
+            line.max(1),
+            0,
+            format!("expected a well-formed CSV record: {other:?}"),
+        ),
     }
 }
 
@@ -648,7 +1106,7 @@ mod tests {
     fn defaults_and_toml() {
         let spec: ImportSpec = toml::from_str("").unwrap();
         assert_eq!(spec, ImportSpec::default());
-        assert_eq!(spec.units_to_m, 1.0);
+        assert_eq!(spec.units_to_m, None);
         assert_eq!(spec.camera, 1);
         let spec: ImportSpec = toml::from_str(
             "format = \"tracker\"\nunits_to_m = 0.01\n[points]\nhead = \"mass A\"\n",
@@ -658,7 +1116,7 @@ mod tests {
         assert_eq!(spec.points["head"], "mass A");
         let err = toml::from_str::<ImportSpec>("fps = 10.0\n").unwrap_err();
         assert!(err.to_string().contains("unknown field"), "{err}");
-        let err = toml::from_str::<ImportSpec>("format = \"kinovea\"\n").unwrap_err();
+        let err = toml::from_str::<ImportSpec>("format = \"proanalyst\"\n").unwrap_err();
         assert!(err.to_string().contains("unknown variant"), "{err}");
         // Serialise → deserialise is the identity (resolved configs are written beside artefacts).
         let spec = ImportSpec {
@@ -695,7 +1153,7 @@ mod tests {
         );
         bad(
             ImportSpec {
-                units_to_m: -1.0,
+                units_to_m: Some(-1.0),
                 ..base.clone()
             },
             Format::Tracker,
@@ -795,7 +1253,28 @@ mod tests {
         assert!((s.dt_median_s - 0.1).abs() < 1e-12);
         let text = s.to_string();
         assert_eq!(text.lines().count(), 2, "{text}");
-        assert!(text.contains("head: 2 tracked, 2 NaN (50.00 %)"), "{text}");
+        assert!(text.contains("head: 2 tracked, 2 NaN (50.00 %) in 1 gaps, longest 2 samples; 2 in interior gaps ≤ 5"), "{text}");
+        let long = PointTrack {
+            name: "p".into(),
+            x_m: vec![
+                f64::NAN,
+                1.0,
+                f64::NAN,
+                1.0,
+                f64::NAN,
+                f64::NAN,
+                f64::NAN,
+                f64::NAN,
+                f64::NAN,
+                f64::NAN,
+                1.0,
+                f64::NAN,
+            ],
+            y_m: vec![0.0; 12],
+        };
+        // Leading and trailing NaN are never filled; the 6-sample gap is longer than 5.
+        assert_eq!(fillable_samples(&long, 5), 1);
+        assert_eq!(fillable_samples(&long, 6), 7);
         let empty = describe(&Trace::default());
         assert!(empty.t_first_s.is_nan() && empty.dt_median_s.is_nan());
     }

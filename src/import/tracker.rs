@@ -171,7 +171,7 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
                 path,
                 line,
                 0,
-                "unexpected line before the column row: a Tracker export has at most `#multi:` \
+                "unexpected line before the column row: expected at most `#multi:` \
                  and one track-name row there",
             ));
         }
@@ -253,7 +253,7 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
             column_line,
             0,
             format!(
-                "no track with both an x and a y column; columns: {}",
+                "expected a track with both an x and a y column; columns: {}",
                 header.join(", ")
             ),
         ));
@@ -264,7 +264,7 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
     } else {
         1.0
     };
-    let scale = spec.units_to_m;
+    let scale = spec.units_to_m.unwrap_or(1.0);
     let label = |j: usize| -> String {
         match columns.iter().find(|(_, x, y)| *x == j || *y == j) {
             Some((name, _, _)) => format!("{} (track {name})", header[j]),
@@ -309,7 +309,10 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
                 path,
                 line,
                 1,
-                format!("field t: time {t} s is not after the previous row's {p} s"),
+                format!(
+                    "field t: time {t} s is not after the previous row's {p} s (expected \
+                     strictly increasing times)"
+                ),
             ));
         }
         prev_t = Some(t);
@@ -354,6 +357,70 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
         .map(|((name, _, _), (x_m, y_m))| PointTrack { name, x_m, y_m })
         .collect();
     Ok(Trace { t_s, points })
+}
+
+/// Write `trace` as a Tracker "Export Data" text file (FORMATS.md §1 layout: `#multi:` when
+/// there is more than one point, a track-name row, a column row `t<TAB>x<TAB>y<TAB>...` with
+/// trailing delimiters, TAB delimited, LF line ends): the inverse of [`read`] with the default
+/// spec. Values in metres and seconds with Rust's shortest round-trip formatting; NaN as an
+/// empty cell, as Tracker writes a missing step. Read back with the default spec it gives the same
+/// trace bit for bit (point names included; a single point is called by its track name).
+///
+/// # Errors
+/// [`Error::Input`] if the trace breaks its invariants or a point name is empty, starts with `#`,
+/// has surrounding spaces or contains a TAB or a line break; [`Error::Io`].
+pub fn write(path: &Path, trace: &Trace) -> Result<()> {
+    trace
+        .check()
+        .map_err(|m| Error::input(path, format!("cannot write trace: {m}")))?;
+    if let Some(p) = trace.points.iter().find(|p| {
+        p.name.contains(['\t', '\n', '\r'])
+            || p.name.trim() != p.name
+            || p.name.is_empty()
+            || p.name.starts_with('#')
+    }) {
+        return Err(Error::input(
+            path,
+            format!(
+                "cannot write point name {:?} into a TAB-delimited Tracker file",
+                p.name
+            ),
+        ));
+    }
+    let mut out = String::new();
+    if trace.points.len() > 1 {
+        out.push_str("#multi:\n");
+    }
+    // Name over each track's x column: `\thead\t\ttip\t\t`.
+    out.push('\t');
+    for p in &trace.points {
+        out.push_str(&p.name);
+        out.push_str("\t\t");
+    }
+    out.push('\n');
+    out.push_str("t\t");
+    for _ in &trace.points {
+        out.push_str("x\ty\t");
+    }
+    out.push('\n');
+    let cell = |v: f64| {
+        if v.is_nan() {
+            String::new()
+        } else {
+            format!("{v}")
+        }
+    };
+    for k in 0..trace.len() {
+        out.push_str(&format!("{}\t", trace.t_s[k]));
+        for p in &trace.points {
+            out.push_str(&cell(p.x_m[k]));
+            out.push('\t');
+            out.push_str(&cell(p.y_m[k]));
+            out.push('\t');
+        }
+        out.push('\n');
+    }
+    std::fs::write(path, out).map_err(|e| Error::io(path, "write", e))
 }
 
 #[cfg(test)]
@@ -422,6 +489,31 @@ mod tests {
     }
 
     #[test]
+    fn space_and_comma_delimiters_with_trailing_delimiters() {
+        // FORMATS.md §1: SPACE and `,` are export-dialog delimiters; every name and value row
+        // ends with the delimiter.
+        let t = read_str(
+            "space",
+            "#multi:\n head  tip  \nt x y x y \n0.0 1.5E-3 2 3 4 \n0.1  2 3 4 \n",
+        )
+        .unwrap();
+        assert_eq!(names(&t), ["head", "tip"]);
+        assert_eq!(t.points[0].x_m[0], 1.5e-3);
+        assert!(
+            t.points[0].x_m[1].is_nan(),
+            "empty field between two spaces"
+        );
+        let t = read_str(
+            "comma",
+            "#multi:\r\n,head,,tip,,\r\nt,x,y,x,y,\r\n0.0,1,2,,,\r\n0.1,1,2,3,4,\r\n",
+        )
+        .unwrap();
+        assert_eq!(names(&t), ["head", "tip"]);
+        assert!(t.points[1].x_m[0].is_nan());
+        assert_eq!(t.points[1].y_m[1], 4.0);
+    }
+
+    #[test]
     fn bare_name_subscripts_and_func_column() {
         let t = read_str(
             "bare",
@@ -455,7 +547,7 @@ mod tests {
         let f = temp("comma", "t;x;y;\n0,0;1,5;\u{2212}2,25\n0,1;;\n");
         let spec = ImportSpec {
             decimal_comma: true,
-            units_to_m: 0.01,
+            units_to_m: Some(0.01),
             ..ImportSpec::default()
         };
         let t = read(&f.0, &spec).unwrap();
@@ -534,7 +626,7 @@ mod tests {
         assert!(msg.contains("no data rows"), "{msg}");
         let msg = read_str("noxy", "t\tvx\n0\t1\n").unwrap_err().to_string();
         assert!(
-            msg.contains("no track with both an x and a y column"),
+            msg.contains("expected a track with both an x and a y column"),
             "{msg}"
         );
         let msg = read_str("two", "a\nb\nt\tx\ty\n0\t1\t2\n")

@@ -297,7 +297,7 @@ impl Blade {
     /// Rows (1)–(3) of the equations of motion as `A·[θ̈, φ̈, N]ᵀ + a_f·f = b`; returns
     /// `(A, a_f, b)` with `a_f` the coefficients of the friction force.
     #[inline]
-    fn rows(
+    pub(crate) fn rows(
         &self,
         t: f64,
         y: &[f64; 4],

@@ -12,10 +12,15 @@
 //!
 //! `v_rel` is the slip velocity of the contact, `f` the friction force on it along +x, `N` the normal
 //! force. An event fires on a change from `g > 0` to `g ≤ 0`; besides both ends of a step, `g` is also
-//! sampled at interior points of the step (DifferentialEquations.jl's `interp_points`), so a function
-//! that dips across zero and back within one step is not missed. Right after a transition the new
+//! sampled at interior points of the step (DifferentialEquations.jl's `interp_points`); when the samples
+//! of a function have an interior minimum above zero, a golden-section search on the continuous
+//! extension looks for a dip below zero between them (across the boundary with the previous step when
+//! the minimum sample is there), so a function that dips across zero and back within one step is not
+//! missed. The search resolves the minimum's position to 1e-3 of two sample intervals, so a dip
+//! narrower than that can still escape. Right after a transition the new
 //! phase's event function may start at exactly 0 (a tangential stick→slip departure, physics.md §1.8);
-//! it is armed by the first strictly positive value.
+//! it is armed by the first strictly positive value, and if its first sample is already negative the
+//! sub-interval is searched for a positive maximum (a departure and a return within one sub-step).
 
 use super::rk;
 use crate::{Error, Result};
@@ -336,6 +341,40 @@ fn event_values<M: StickSlipModel<N>, const N: usize>(
     Ok((g, c))
 }
 
+/// Minimum of `g` on `[a, b]` by golden-section search (Kiefer 1953), stopping as soon as a value
+/// `<= 0` is seen (that is all the caller needs: a sign change) or the bracket has shrunk to 1e-3 of
+/// its start. Returns `(t_min, g_min, evaluations)`.
+fn golden_extremum<F: FnMut(f64) -> std::result::Result<f64, ModelFault>>(
+    mut g: F,
+    a: f64,
+    b: f64,
+) -> std::result::Result<(f64, f64, usize), ModelFault> {
+    const R: f64 = 0.618_033_988_749_894_8; // (√5 − 1)/2
+    let (mut lo, mut hi) = (a, b);
+    let mut x1 = hi - R * (hi - lo);
+    let mut x2 = lo + R * (hi - lo);
+    let mut f1 = g(x1)?;
+    let mut f2 = g(x2)?;
+    let mut n = 2;
+    while f1 > 0.0 && f2 > 0.0 && (hi - lo) > 1e-3 * (b - a) {
+        if f1 <= f2 {
+            hi = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = hi - R * (hi - lo);
+            f1 = g(x1)?;
+        } else {
+            lo = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = lo + R * (hi - lo);
+            f2 = g(x2)?;
+        }
+        n += 1;
+    }
+    Ok(if f1 <= f2 { (x1, f1, n) } else { (x2, f2, n) })
+}
+
 /// Locates a zero of `g` in `[a, b]` with `g(a) > 0 ≥ g(b)` by the Illinois variant of regula falsi
 /// (Dowell & Jarratt, BIT 11 (1971) 168; the method of SUNDIALS CVODE's root finder), with a bisection
 /// whenever the bracket fails to halve in three iterations. Returns the right end of the final bracket
@@ -470,6 +509,9 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                 format!("contact lost: normal force N = {:.6e} N <= 0", c0.normal),
             ));
         }
+        // The previous accepted step of this phase: its continuous extension and its last interior
+        // event sample, so that a minimum of the samples at a step boundary is searched too.
+        let mut prev: Option<(rk::Dense<N>, f64, [f64; N_EVENTS])> = None;
         loop {
             if t >= t_end {
                 break 'phases;
@@ -520,6 +562,21 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
             let m = opts.event_samples;
             let mut ta = t;
             let mut ga = g_prev;
+            // The sample before `ta` (for the minimum test): the previous step's last interior
+            // sample at the step start, if the previous step belongs to this phase.
+            let (mut tb, mut gb) =
+                prev.map_or((f64::NAN, [f64::NAN; N_EVENTS]), |(_, tp, gp)| (tp, gp));
+            let dense = a.dense;
+            let t_start = t;
+            // State on [previous step, this step] from the continuous extensions.
+            let y_at = |tt: f64| match prev {
+                Some((pd, _, _)) if tt < t_start => pd.eval(tt),
+                _ => dense.eval(tt),
+            };
+            let g_at = |k: usize, tt: f64| {
+                let yy = y_at(tt);
+                event_values(model, &mode, tt, &yy).map(|(g, _)| g[k])
+            };
             for j in 1..=m + 1 {
                 let tj = if j == m + 1 {
                     t_new
@@ -534,30 +591,47 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                 let (gj, _) = event_values(model, &mode, tj, &yj)
                     .map_err(|e| fail(tj, &yj, e.to_string()))?;
                 stats.event_evals += 1;
-                // Refine every function that crossed in [ta, tj]; keep the earliest. A function
-                // starting at exactly 0 (just after a transition) is armed by its first positive
-                // sample.
+                // Refine every function that crossed in [ta, tj]; keep the earliest.
                 for k in 0..N_EVENTS {
-                    // Phase events fire on g > 0 → g ≤ 0; a switching function also fires when it
-                    // leaves exactly 0 on the wrong side (a graze right after a switch).
-                    let crossed = if k < 3 {
-                        ga[k] > 0.0 && gj[k] <= 0.0
-                    } else {
-                        ga[k] >= 0.0 && gj[k] < 0.0
-                    };
-                    if crossed {
-                        let dense = a.dense;
-                        let tk = illinois_right(
-                            |tt| {
-                                let yy = dense.eval(tt);
-                                event_values(model, &mode, tt, &yy).map(|(g, _)| g[k])
-                            },
-                            ta,
-                            tj,
-                            ga[k],
-                            gj[k],
-                        )
-                        .map_err(|e| fail(tj, &yj, e.to_string()))?;
+                    let mut bracket = None;
+                    if k >= 3 {
+                        // A switching surface: fires on leaving the current region, also when the
+                        // function leaves exactly 0 on the wrong side (a graze right after a switch).
+                        if ga[k] >= 0.0 && gj[k] < 0.0 {
+                            bracket = Some((ta, tj, ga[k], gj[k]));
+                        }
+                    } else if ga[k] > 0.0 && gj[k] <= 0.0 {
+                        bracket = Some((ta, tj, ga[k], gj[k]));
+                    } else if ga[k] == 0.0 && j == 1 && gj[k] < 0.0 {
+                        // Just after a transition the function starts at 0; if it is already
+                        // negative at the first sample it may have risen and fallen back in between
+                        // (a slip that reverses again within the first sub-step): look for a
+                        // positive maximum.
+                        let (tm, gm, n) = golden_extremum(|tt| g_at(k, tt).map(|g| -g), ta, tj)
+                            .map_err(|e| fail(tj, &yj, e.to_string()))?;
+                        stats.event_evals += n;
+                        if -gm > 0.0 {
+                            bracket = Some((tm, tj, -gm, gj[k]));
+                        }
+                    } else if gb[k] > 0.0
+                        && ga[k] > 0.0
+                        && gj[k] > 0.0
+                        && ga[k].is_finite()
+                        && ga[k] <= gb[k]
+                        && ga[k] <= gj[k]
+                    {
+                        // The samples have an interior minimum above zero: the function may dip
+                        // across zero and back between samples. Find the minimum.
+                        let (tm, gm, n) = golden_extremum(|tt| g_at(k, tt), tb, tj)
+                            .map_err(|e| fail(tj, &yj, e.to_string()))?;
+                        stats.event_evals += n;
+                        if gm <= 0.0 {
+                            bracket = Some((tb, tm, gb[k], gm));
+                        }
+                    }
+                    if let Some((lo, hi, glo, ghi)) = bracket {
+                        let tk = illinois_right(|tt| g_at(k, tt), lo, hi, glo, ghi)
+                            .map_err(|e| fail(tj, &yj, e.to_string()))?;
                         if found.is_none_or(|(_, te)| tk < te) {
                             found = Some((k, tk));
                         }
@@ -566,6 +640,8 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                 if found.is_some() {
                     break;
                 }
+                tb = ta;
+                gb = ga;
                 ta = tj;
                 ga = gj;
             }
@@ -588,6 +664,7 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
             }
             match found {
                 None => {
+                    prev = Some((a.dense, tb, gb));
                     t = t_new;
                     y = a.y_new;
                     f = a.f_new;
@@ -595,11 +672,15 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                     h = rk::next_step(h, a.err);
                 }
                 Some((k, te)) => {
-                    let mut ye = if te >= t_new {
-                        a.y_new
-                    } else {
-                        a.dense.eval(te)
-                    };
+                    let mut ye = if te >= t_new { a.y_new } else { y_at(te) };
+                    // A dip found at the boundary with the previous step may lie before this step:
+                    // withdraw the outputs already recorded after it.
+                    while run.t_s.last().is_some_and(|&to| to > te) {
+                        run.t_s.pop();
+                        run.y.pop();
+                        run.phase.pop();
+                        next_out -= 1;
+                    }
                     model
                         .complete(&mode, te, &mut ye)
                         .map_err(|e| fail(te, &ye, e.to_string()))?;

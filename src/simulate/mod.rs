@@ -1,8 +1,10 @@
 //! Event-driven simulation: DOPRI5 with dense output ([`rk`]), the hybrid stick–slip driver
-//! ([`hybrid`]) and the blade-specific runner ([`blade`]).
+//! ([`hybrid`]) and the blade-specific runner ([`blade`]); the comparison methods of the
+//! work–precision study (Moreau–Jean time-stepping, smoothed friction) in [`timestep`].
 
 pub mod blade;
 pub mod hybrid;
 pub mod rk;
+pub mod timestep;
 
 pub use hybrid::{Phase, SolverOptions, Transition};

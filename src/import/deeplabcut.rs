@@ -1,0 +1,211 @@
+//! DeepLabCut prediction CSV reader (FORMATS.md §4).
+//!
+//! Single-animal: three header rows `scorer,...` / `bodyparts,...` / `coords,x,y,likelihood,...`;
+//! multi-animal (maDLC): four, with `individuals,...` second. Then one row per frame, the first
+//! column the 0-based frame index (no time: `fps_hz` is required), x, y in pixels (image y down),
+//! likelihood in [0, 1]. Missing values (maDLC) are empty fields.
+//!
+//! Points: `<bodypart>` (single animal) or `<individual>/<bodypart>` (multi-animal). A point whose
+//! likelihood is below [`ImportSpec::min_likelihood`] (default 0.6, DeepLabCut's `pcutoff`) becomes
+//! NaN in x and y — a gap, never a low-confidence position; the count is reported.
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::import::ImportSpec;
+use crate::import::common::{RawTime, RawTrace, RawUnits, Table, numbered_lines, read_decoded};
+
+/// DeepLabCut's default `pcutoff` (config.yaml), used when `min_likelihood` is not set.
+pub const DEFAULT_MIN_LIKELIHOOD: f64 = 0.6;
+
+/// Read a DeepLabCut CSV (module docs) into a [`RawTrace`] in pixels.
+///
+/// # Errors
+/// [`Error::Io`]; [`Error::Input`] for missing header rows or no data; [`Error::Parse`] (line,
+/// column, field) for a header row not named `scorer`/`individuals`/`bodyparts`/`coords`, a
+/// body part without x and y, a first column that is not an increasing frame index (labeled
+/// training data with image paths is refused), a non-numeric cell.
+pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
+    let (text, _) = read_decoded(path)?;
+    let lines = numbered_lines(&text);
+    let nonblank: Vec<&(usize, &str)> =
+        lines.iter().filter(|(_, l)| !l.trim().is_empty()).collect();
+    let multi = nonblank.get(1).is_some_and(|(_, l)| {
+        l.split(',')
+            .next()
+            .is_some_and(|c| c.trim() == "individuals")
+    });
+    let n_header = if multi { 4 } else { 3 };
+    let table = Table::parse(path, &lines, n_header, ',')?;
+    let expect: &[&str] = if multi {
+        &["scorer", "individuals", "bodyparts", "coords"]
+    } else {
+        &["scorer", "bodyparts", "coords"]
+    };
+    for ((line, cells), want) in table.headers.iter().zip(expect) {
+        if cells.first().map(String::as_str) != Some(*want) {
+            return Err(Error::parse(
+                path,
+                *line,
+                1,
+                format!(
+                    "expected a DeepLabCut header row starting with {want:?}, found {}",
+                    super::quote_cell(cells.first().map_or("", |s| s.as_str()))
+                ),
+            ));
+        }
+    }
+    let width = table.names().len();
+    let row = |name: &str| -> &Vec<String> {
+        let k = expect.iter().position(|w| *w == name).unwrap_or(0);
+        &table.headers[k].1
+    };
+    let (coords_line, coords) = (table.headers[n_header - 1].0, row("coords"));
+    let bodyparts = row("bodyparts");
+    let individuals = if multi {
+        Some(row("individuals"))
+    } else {
+        None
+    };
+    // Group columns by (individual, bodypart).
+    struct Cols {
+        name: String,
+        x: Option<usize>,
+        y: Option<usize>,
+        l: Option<usize>,
+    }
+    let mut groups: Vec<Cols> = Vec::new();
+    for j in 1..width {
+        let bp = bodyparts.get(j).map_or("", |s| s.as_str());
+        let name = match individuals {
+            Some(ind) => format!("{}/{bp}", ind.get(j).map_or("", |s| s.as_str())),
+            None => bp.to_owned(),
+        };
+        let g = match groups.iter().position(|g| g.name == name) {
+            Some(i) => i,
+            None => {
+                groups.push(Cols {
+                    name,
+                    x: None,
+                    y: None,
+                    l: None,
+                });
+                groups.len() - 1
+            }
+        };
+        let coord = coords.get(j).map_or("", |s| s.as_str());
+        let slot = match coord {
+            "x" => &mut groups[g].x,
+            "y" => &mut groups[g].y,
+            "likelihood" => &mut groups[g].l,
+            other => {
+                return Err(Error::parse(
+                    path,
+                    coords_line,
+                    j + 1,
+                    format!(
+                        "expected coords x, y or likelihood, found {}",
+                        super::quote_cell(other)
+                    ),
+                ));
+            }
+        };
+        if slot.is_some() {
+            return Err(Error::parse(
+                path,
+                coords_line,
+                j + 1,
+                format!("column {coord} of {:?} appears twice", groups[g].name),
+            ));
+        }
+        *slot = Some(j);
+    }
+    // The first column: 0-based frame index. Image paths mean labeled training data.
+    if table.rows[0].1[0].trim().parse::<f64>().is_err() {
+        return Err(table.bad_cell(
+            0,
+            0,
+            "a frame index (this looks like labeled training data with image paths, not a \
+             prediction time series)",
+        ));
+    }
+    let frames = table.axis(0, false, "a frame index")?;
+    let cutoff = spec.min_likelihood.unwrap_or(DEFAULT_MIN_LIKELIHOOD);
+    let mut points = Vec::new();
+    let mut below = 0usize;
+    for g in &groups {
+        let (Some(cx), Some(cy)) = (g.x, g.y) else {
+            return Err(Error::parse(
+                path,
+                coords_line,
+                0,
+                format!("body part {:?}: expected an x and a y column", g.name),
+            ));
+        };
+        let mut x = table.numbers(cx, false)?;
+        let mut y = table.numbers(cy, false)?;
+        if let Some(cl) = g.l {
+            let l = table.numbers(cl, false)?;
+            for i in 0..l.len() {
+                if l[i] < cutoff && !(x[i].is_nan() && y[i].is_nan()) {
+                    x[i] = f64::NAN;
+                    y[i] = f64::NAN;
+                    below += 1;
+                }
+            }
+        }
+        points.push((g.name.clone(), x, y));
+    }
+    let notes = vec![format!(
+        "DeepLabCut {}: {below} point samples with likelihood < {cutoff} set to NaN",
+        if multi {
+            "multi-animal"
+        } else {
+            "single-animal"
+        }
+    )];
+    Ok(RawTrace {
+        time: RawTime::Frames(frames),
+        points,
+        units: RawUnits::Pixels,
+        y_down_default: true,
+        notes,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::import::TempFile;
+
+    #[test]
+    fn multi_animal_with_gaps_and_cutoff() {
+        let f = TempFile::new(
+            "dlc_ma.csv",
+            "scorer,s,s,s,s,s,s\r\nindividuals,a1,a1,a1,single,single,single\r\n\
+             bodyparts,head,head,head,post,post,post\r\ncoords,x,y,likelihood,x,y,likelihood\r\n\
+             0,1.5,2.5,0.9,,,\r\n1,1.0,2.0,0.1,3,4,0.99\r\n",
+        );
+        let raw = read(&f.0, &ImportSpec::default()).unwrap();
+        assert_eq!(raw.time, RawTime::Frames(vec![0.0, 1.0]));
+        let names: Vec<&str> = raw.points.iter().map(|p| p.0.as_str()).collect();
+        assert_eq!(names, ["a1/head", "single/post"]);
+        assert_eq!(raw.points[0].1[0], 1.5);
+        assert!(raw.points[0].1[1].is_nan(), "likelihood 0.1 < 0.6 → gap");
+        assert!(raw.points[1].2[0].is_nan());
+        assert!(raw.notes[0].contains("1 point samples"), "{:?}", raw.notes);
+    }
+
+    #[test]
+    fn labeled_data_is_refused() {
+        let f = TempFile::new(
+            "dlc_lab.csv",
+            "scorer,s,s\nbodyparts,h,h\ncoords,x,y\nlabeled-data/v/img001.png,1,2\n",
+        );
+        let err = read(&f.0, &ImportSpec::default()).unwrap_err().to_string();
+        assert!(
+            err.contains(":4:1:") && err.contains("labeled training data"),
+            "{err}"
+        );
+    }
+}

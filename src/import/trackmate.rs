@@ -1,0 +1,336 @@
+//! Fiji TrackMate spot-table reader (FORMATS.md §6).
+//!
+//! * TrackMate ≤ 6 ("Spots in tracks statistics"): one header line `Label,ID,TRACK_ID,QUALITY,
+//!   POSITION_X,POSITION_Y,POSITION_Z,POSITION_T,FRAME,...`, no unit row.
+//! * TrackMate ≥ 7: up to four header lines — feature keys, names, short names (each omitted when
+//!   equal to the previous), units in parentheses (`(micron)`, `(sec)`, empty if none).
+//!
+//! `,` delimiter, no quoting, `.` decimal; missing values are empty fields (GUI) or `ø` (headless
+//! exporter). Files are written in Java's platform charset: a non-UTF-8 file is decoded as
+//! Windows-1252 (so `ø` is byte 0xF8) and this is reported.
+//!
+//! One point per track, named `track<TRACK_ID>`, over every frame from the first to the last
+//! `FRAME`; NaN where a track has no spot. Spots without a track id are skipped (counted).
+//! Time: `FRAME`/`fps_hz` when `fps_hz` is set, else from `POSITION_T` when the unit row gives
+//! it a time unit (frame interval = POSITION_T/FRAME), else an error. Coordinates: the unit row's
+//! length unit (micron → 1e-6 m); `pixel` → `m_per_px` required; no unit row → `units_to_m` or
+//! `m_per_px` required. Image y runs down (TrackMate's image coordinates).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::import::ImportSpec;
+use crate::import::common::{
+    RawTime, RawTrace, RawUnits, Table, TextEncoding, length_unit_m, numbered_lines, parse_cell,
+    read_decoded, time_unit_s,
+};
+use crate::import::sleap::MAX_SPAN_PER_ROW;
+
+/// Read a TrackMate spot table (module docs) into a [`RawTrace`] in file units.
+///
+/// # Errors
+/// [`Error::Io`]; [`Error::Parse`] for a missing `TRACK_ID`/`POSITION_X`/`POSITION_Y`/`FRAME`
+/// column, a non-integer frame, a non-numeric position, a track with two spots in one frame (a
+/// split/merge track: export the single-branch tracks); [`Error::Input`] for no spot with a track,
+/// or neither `fps_hz` nor a time unit.
+pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
+    let (text, enc) = read_decoded(path)?;
+    let lines = numbered_lines(&text);
+    // Header lines: the first, plus up to three more whose FRAME cell is not a number.
+    let nonblank: Vec<&str> = lines
+        .iter()
+        .map(|(_, l)| *l)
+        .filter(|l| !l.trim().is_empty())
+        .take(5)
+        .collect();
+    let Some(first) = nonblank.first() else {
+        return Err(Error::input(
+            path,
+            "empty file: expected a TrackMate header LABEL,...",
+        ));
+    };
+    let keys: Vec<String> = first
+        .split(',')
+        .map(|s| s.trim().to_ascii_uppercase())
+        .collect();
+    let Some(cx_key) = keys.iter().position(|k| k == "POSITION_X") else {
+        return Err(Error::parse(
+            path,
+            lines
+                .iter()
+                .find(|(_, l)| !l.trim().is_empty())
+                .map_or(1, |l| l.0),
+            0,
+            "expected a POSITION_X column in the TrackMate header",
+        ));
+    };
+    // A spot row always has a FRAME number; header rows (names, short names, units) never do.
+    let probe = keys.iter().position(|k| k == "FRAME").unwrap_or(cx_key);
+    let mut n_header = 1;
+    while n_header < nonblank.len().min(4) {
+        let cell = nonblank[n_header]
+            .split(',')
+            .nth(probe)
+            .unwrap_or("")
+            .trim();
+        if parse_cell(cell, false).is_ok_and(|v| v.is_some()) {
+            break;
+        }
+        n_header += 1;
+    }
+    let mut table = Table::parse(path, &lines, n_header, ',')?;
+    // The keys as the table split them (quotes honoured), so indices match the rows.
+    let keys: Vec<String> = table.headers[0]
+        .1
+        .iter()
+        .map(|s| s.trim().to_ascii_uppercase())
+        .collect();
+    table.names = keys.clone();
+    table.names.resize(table.rows[0].1.len(), String::new());
+    let hline = table.headers[0].0;
+    let col = |key: &str| -> Result<usize> {
+        keys.iter().position(|k| k == key).ok_or_else(|| {
+            Error::parse(
+                path,
+                hline,
+                0,
+                format!("expected a {key} column in the TrackMate header"),
+            )
+        })
+    };
+    let (ctrack, cx, cy, cframe) = (
+        col("TRACK_ID")?,
+        col("POSITION_X")?,
+        col("POSITION_Y")?,
+        col("FRAME")?,
+    );
+    let ct = keys.iter().position(|k| k == "POSITION_T");
+    // The units row is the last header line when it has a parenthesised cell.
+    let units: Option<&Vec<String>> = table
+        .headers
+        .iter()
+        .skip(1)
+        .map(|h| &h.1)
+        .find(|cells| cells.iter().any(|c| c.starts_with('(')));
+    let unit_of = |j: usize| units.and_then(|u| u.get(j)).map(|s| s.trim().to_owned());
+
+    let xs = table.numbers(cx, false)?;
+    let ys = table.numbers(cy, false)?;
+    let mut frames = Vec::with_capacity(table.rows.len());
+    let mut track_of = Vec::with_capacity(table.rows.len());
+    let mut untracked = 0usize;
+    for r in 0..table.rows.len() {
+        match parse_cell(&table.rows[r].1[cframe], false) {
+            Ok(Some(f)) if f >= 0.0 && f.fract() == 0.0 && f <= 1e8 => frames.push(f),
+            _ => return Err(table.bad_cell(r, cframe, "a non-negative integer frame")),
+        }
+        let cell = table.rows[r].1[ctrack].trim();
+        match parse_cell(cell, false) {
+            Ok(Some(t)) if t.fract() == 0.0 => track_of.push(Some(t as i64)),
+            Ok(None) => {
+                untracked += 1;
+                track_of.push(None)
+            }
+            _ if cell.eq_ignore_ascii_case("none") => {
+                untracked += 1;
+                track_of.push(None)
+            }
+            _ => return Err(table.bad_cell(r, ctrack, "an integer track id or an empty cell")),
+        }
+    }
+    let tracked: Vec<usize> = (0..table.rows.len())
+        .filter(|&r| track_of[r].is_some())
+        .collect();
+    if tracked.is_empty() {
+        return Err(Error::input(
+            path,
+            format!("no spot belongs to a track ({untracked} spots without TRACK_ID)"),
+        ));
+    }
+    let first = tracked
+        .iter()
+        .map(|&r| frames[r])
+        .fold(f64::INFINITY, f64::min);
+    let last = tracked
+        .iter()
+        .map(|&r| frames[r])
+        .fold(f64::NEG_INFINITY, f64::max);
+    let n = (last - first) as usize + 1;
+    if n > MAX_SPAN_PER_ROW * table.rows.len() + 1_000_000 {
+        return Err(Error::input(
+            path,
+            format!(
+                "FRAME runs from {first} to {last} with only {} rows: a corrupt frame?",
+                table.rows.len()
+            ),
+        ));
+    }
+    let n_tracks = tracked
+        .iter()
+        .filter_map(|&r| track_of[r])
+        .collect::<std::collections::BTreeSet<_>>()
+        .len();
+    crate::import::common::check_cells(path, n, n_tracks)?;
+    let mut index: BTreeMap<i64, usize> = BTreeMap::new();
+    let mut order: Vec<i64> = Vec::new();
+    let mut pts: Vec<(Vec<f64>, Vec<f64>, Vec<usize>)> = Vec::new();
+    for &r in &tracked {
+        let Some(id) = track_of[r] else { continue };
+        let i = *index.entry(id).or_insert_with(|| {
+            order.push(id);
+            pts.push((vec![f64::NAN; n], vec![f64::NAN; n], vec![0; n]));
+            pts.len() - 1
+        });
+        let k = (frames[r] - first) as usize;
+        if pts[i].2[k] != 0 {
+            return Err(table.bad_cell(
+                r,
+                cframe,
+                &format!(
+                    "one spot per track and frame (track {id} already has a spot in frame {} on \
+                     line {}; split/merge tracks are not a single trajectory)",
+                    frames[r], pts[i].2[k]
+                ),
+            ));
+        }
+        pts[i].2[k] = table.rows[r].0;
+        pts[i].0[k] = xs[r];
+        pts[i].1[k] = ys[r];
+    }
+    let mut notes = vec![format!(
+        "TrackMate ({} header line{}): {} spots in {} tracks, frames {first}–{last}, {untracked} \
+         spots without a track skipped",
+        n_header,
+        if n_header == 1 {
+            ", ≤ 6 layout"
+        } else {
+            "s, ≥ 7 layout"
+        },
+        tracked.len(),
+        order.len()
+    )];
+    if enc == TextEncoding::Windows1252 {
+        notes.push("encoding: not UTF-8, decoded as Windows-1252 (Java platform charset)".into());
+    }
+    // Time base.
+    let time = if spec.fps_hz.is_some() {
+        RawTime::Frames((0..n).map(|k| first + k as f64).collect())
+    } else {
+        let t_unit = ct.and_then(&unit_of).and_then(|u| time_unit_s(&u));
+        let (Some(ct), Some(tu)) = (ct, t_unit) else {
+            return Err(Error::input(
+                path,
+                "the spot table has frame numbers but no calibrated time (no POSITION_T unit): \
+                 set the frame rate (fps_hz in the import spec, --fps on the command line)",
+            ));
+        };
+        let ts = table.numbers(ct, false)?;
+        let mut dts: Vec<f64> = (0..table.rows.len())
+            .filter(|&r| frames[r] > 0.0 && ts[r].is_finite())
+            .map(|r| ts[r] * tu / frames[r])
+            .collect();
+        dts.sort_by(f64::total_cmp);
+        let Some(&dt) = dts
+            .get(dts.len() / 2)
+            .filter(|d| d.is_finite() && **d > 0.0)
+        else {
+            return Err(Error::input(
+                path,
+                "cannot derive the frame interval from POSITION_T/FRAME: set fps_hz",
+            ));
+        };
+        notes.push(format!(
+            "frame interval {dt} s from POSITION_T/FRAME (median over spots)"
+        ));
+        RawTime::Seconds((0..n).map(|k| (first + k as f64) * dt).collect())
+    };
+    let units = match unit_of(cx) {
+        Some(u) if u.to_ascii_lowercase().contains("pixel") => RawUnits::Pixels,
+        Some(u) => match length_unit_m(&u) {
+            Some(f) => RawUnits::Known(f, u),
+            None => RawUnits::Unknown,
+        },
+        None => RawUnits::Unknown,
+    };
+    let points = order
+        .iter()
+        .zip(pts)
+        .map(|(id, (x, y, _))| (format!("track{id}"), x, y))
+        .collect();
+    Ok(RawTrace {
+        time,
+        points,
+        units,
+        y_down_default: true,
+        notes,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::import::TempFile;
+
+    #[test]
+    fn trackmate7_four_line_header_latin1_missing() {
+        let mut bytes = b"LABEL,ID,TRACK_ID,POSITION_X,POSITION_Y,POSITION_T,FRAME\n\
+Label,Spot ID,Track ID,X,Y,T,Frame\n\
+Label,Spot ID,Track ID,X,Y,T,Frame\n\
+,,,(micron),(micron),(sec),\n"
+            .to_vec();
+        bytes.extend_from_slice(b"ID1,1,0,1.0,2.0,0.0,0\nID2,2,0,\xf8,3.0,0.5,1\nID3,3,\xf8,9,9,0.5,1\nID4,4,0,1.5,4.0,1.0,2\n");
+        let f = TempFile::at("tm7.csv");
+        std::fs::write(&f.0, &bytes).unwrap();
+        let raw = read(&f.0, &ImportSpec::default()).unwrap();
+        assert_eq!(raw.time, RawTime::Seconds(vec![0.0, 0.5, 1.0]));
+        assert_eq!(raw.units, RawUnits::Known(1e-6, "(micron)".into()));
+        assert_eq!(raw.points.len(), 1);
+        assert!(raw.points[0].1[1].is_nan(), "ø is missing");
+        assert_eq!(raw.points[0].2, [2.0, 3.0, 4.0]);
+        assert!(
+            raw.notes.iter().any(|n| n.contains("Windows-1252")),
+            "{:?}",
+            raw.notes
+        );
+        assert!(
+            raw.notes[0].contains("1 spots without a track"),
+            "{:?}",
+            raw.notes
+        );
+    }
+
+    #[test]
+    fn corrupt_frame_is_refused_not_allocated() {
+        let mut text = String::from("Label,ID,TRACK_ID,POSITION_X,POSITION_Y,FRAME\n");
+        for id in 0..30 {
+            text.push_str(&format!("ID{id},{id},{id},1,2,0\n"));
+        }
+        text.push_str("IDx,99,0,1,2,900000\n");
+        let f = TempFile::new("tm_corrupt.csv", &text);
+        let spec = ImportSpec {
+            fps_hz: Some(10.0),
+            ..ImportSpec::default()
+        };
+        let err = read(&f.0, &spec).unwrap_err().to_string();
+        assert!(err.contains("exceed") && err.contains("corrupt"), "{err}");
+    }
+
+    #[test]
+    fn trackmate6_needs_fps() {
+        let f = TempFile::new(
+            "tm6.csv",
+            "Label,ID,TRACK_ID,QUALITY,POSITION_X,POSITION_Y,POSITION_Z,POSITION_T,FRAME\n\
+             ID1,1,0,1,71.960,47.792,0,0,0\nID2,2,0,1,72.0,47.0,0,1,1\n",
+        );
+        let err = read(&f.0, &ImportSpec::default()).unwrap_err().to_string();
+        assert!(err.contains("fps_hz"), "{err}");
+        let spec = ImportSpec {
+            fps_hz: Some(10.0),
+            ..ImportSpec::default()
+        };
+        let raw = read(&f.0, &spec).unwrap();
+        assert_eq!(raw.units, RawUnits::Unknown);
+        assert_eq!(raw.points[0].1, [71.96, 72.0]);
+    }
+}

@@ -1,0 +1,193 @@
+//! `wiperlab import --describe` and `wiperlab spectrum` on the new formats: what they print, and
+//! the exit code and message for missing settings (through the built binary).
+
+mod common;
+
+use common::{TempFile, shared};
+use std::process::{Command, Output};
+
+fn wiperlab(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_wiperlab"))
+        .args(args)
+        .output()
+        .expect("cannot start the wiperlab binary")
+}
+
+fn text(o: &Output) -> (String, String) {
+    (
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// SLEAP, written here: frame 1 has no instance (padding row), so head has one NaN sample in one
+/// gap; the summary names format, frames, time base, units and the gap.
+#[test]
+fn describe_prints_format_points_time_units_gaps() {
+    let f = TempFile::with(
+        "describe_sleap.csv",
+        "track,frame_idx,head.x,head.y\nm,0,10,20\n,1,,\nm,2,12,22\n",
+    );
+    let o = wiperlab(&[
+        "import",
+        f.0.to_str().unwrap(),
+        "--describe",
+        "--fps",
+        "50",
+        "--m-per-px",
+        "0.001",
+    ]);
+    let (out, err) = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{out}{err}");
+    assert!(out.starts_with("sleap: 3 frames"), "{out}");
+    assert!(out.contains("(50.000000 fps)"), "{out}");
+    assert!(
+        out.contains("m/head: 2 tracked, 1 NaN (33.33 %) in 1 gaps, longest 1 samples"),
+        "{out}"
+    );
+    assert!(out.contains("time base: frame number / 50 fps"), "{out}");
+    assert!(out.contains("units: pixels × 1e-3 m/px"), "{out}");
+    assert!(out.contains("y: file y runs down"), "{out}");
+}
+
+/// Without a frame rate: exit code 2 and a message naming the file and the flag.
+#[test]
+fn missing_fps_is_exit_2_naming_the_setting() {
+    let f = TempFile::with("nofps_sleap.csv", "track,frame_idx,a.x,a.y\nm,0,1,2\n");
+    let o = wiperlab(&[
+        "import",
+        f.0.to_str().unwrap(),
+        "--describe",
+        "--m-per-px",
+        "1",
+    ]);
+    let (out, err) = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{out}{err}");
+    assert!(
+        err.contains("nofps_sleap.csv") && err.contains("--fps"),
+        "{err}"
+    );
+}
+
+/// `--format` overrides detection: a Tracker-looking file read as generic fails for want of a
+/// column mapping (a Config error), while detection reads it as Tracker.
+#[test]
+fn format_flag_overrides_detection() {
+    let f = TempFile::with("override.txt", "t\tx\ty\n0\t1\t2\n0.1\t1\t2\n");
+    let o = wiperlab(&["import", f.0.to_str().unwrap(), "--describe"]);
+    assert!(
+        text(&o).0.starts_with("tracker: 2 frames"),
+        "{:?}",
+        text(&o)
+    );
+    let o = wiperlab(&[
+        "import",
+        f.0.to_str().unwrap(),
+        "--describe",
+        "--format",
+        "generic",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).1.contains("[generic]"), "{:?}", text(&o));
+}
+
+/// The two-point scale and rotation flags reach the import: 3-4-5 px triangle, 0.5 m → 0.1 m/px.
+#[test]
+fn scale_points_and_rotation_flags() {
+    let f = TempFile::with(
+        "flags_xypts.csv",
+        "pt1_cam1_X,pt1_cam1_Y\n0,0\n10,0\n20,0\n",
+    );
+    let o = wiperlab(&[
+        "import",
+        f.0.to_str().unwrap(),
+        "--describe",
+        "--fps",
+        "10",
+        "--scale-points-px",
+        "0,0,3,4",
+        "--scale-distance-m",
+        "0.5",
+        "--sweep-from-head",
+    ]);
+    let (out, err) = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{out}{err}");
+    assert!(out.contains("1e-1 m/px"), "{out}");
+    assert!(out.contains("by principal axis = 0.0000°"), "{out}");
+}
+
+/// `wiperlab spectrum` on a DeepLabCut file states whether it resampled and the filled samples per
+/// signal (IL5, 800 fps; SOURCES.md). Resampling of jittered Tracker times is checked in
+/// `tracker_resampling_is_reported`.
+#[test]
+fn spectrum_reports_resampling_and_filled_points() {
+    let Some(path) = shared(
+        "realdata/deeplabcut/IL5-519-Cam2_2020-06-25_000124Track9DLC_resnet50_Austin2020_accuracy_testApr7shuffle3_1150000.csv",
+    ) else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("wiperlab_import_cli_{}", std::process::id()));
+    let o = wiperlab(&[
+        "spectrum",
+        path.to_str().unwrap(),
+        "--fps",
+        "800",
+        "--m-per-px",
+        "1e-4",
+        "--band",
+        "5:40",
+        "--out-dir",
+        dir.to_str().unwrap(),
+    ]);
+    let _ = std::fs::remove_dir_all(&dir);
+    let (out, err) = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{out}{err}");
+    // Frame-indexed times (frame/800) are uniform: no resampling, so the gaps stay as imported.
+    assert!(
+        out.contains("not resampled: the 431 frame times are uniform"),
+        "{out}"
+    );
+    assert!(out.contains("gaps ≤ 5 samples filled"), "{out}");
+    // t3L has 17 samples below the 0.6 cut-off (awk count as in tests/import_realdata.rs) in 7
+    // gaps of at most 6 samples (`--describe`); the gaps of ≤ 5 are filled.
+    let line = out
+        .lines()
+        .find(|l| l.trim_start().starts_with("t3L_x: 17 missing samples, "))
+        .unwrap_or_else(|| panic!("{out}"));
+    let filled: usize = line
+        .split(", ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(filled > 0 && filled < 17, "{line}");
+}
+
+/// Tracker 8047.txt keeps its jittered frame times (SOURCES.md: 0.0317–0.0350 s): spectrum says
+/// it resampled them.
+#[test]
+fn tracker_resampling_is_reported() {
+    let Some(path) = shared("realdata/tracker/8047.txt") else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("wiperlab_import_cli_t_{}", std::process::id()));
+    let o = wiperlab(&[
+        "spectrum",
+        path.to_str().unwrap(),
+        "--band",
+        "0.2:1.0",
+        "--out-dir",
+        dir.to_str().unwrap(),
+    ]);
+    let _ = std::fs::remove_dir_all(&dir);
+    let (out, err) = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{out}{err}");
+    assert!(out.contains("resampled: 4206 frame times"), "{out}");
+    assert!(
+        out.contains("point_x: 0 missing samples, 0 filled"),
+        "{out}"
+    );
+}
