@@ -76,6 +76,10 @@ name = "high"
 range_hz = [500.0, 5000.0]
 nperseg = 2048
 
+[solver]
+rtol = 1e-7
+atol = 1e-9
+
 [fit]
 particles = 4
 swarm_iterations = 1
@@ -304,7 +308,7 @@ fn report_page_after_a_quick_fit_loads_every_figure_in_chromium() {
         "<td class=\"l\">low</td>",
         "<td class=\"l\">high</td>",
         "Only one model (blade2dof) was fitted",
-        "rtol 1e-8, atol 1e-10", // the job's defaults (src/fit/job.rs fit_solver_default)
+        "rtol 1e-7, atol 1e-9", // the quick job's [solver]
         "low 30.00–300.0 Hz (Welch, Hann, nperseg 4096)",
         "particle swarm 4 particles × 1 iterations (seed 3)",
     ] {
