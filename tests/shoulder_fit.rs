@@ -82,6 +82,9 @@ t0_s = {t0:?}
 [recording.import.points]
 head = "pt1"
 tip = "pt2"
+[solver]                 # as the main job (fits/reversal.toml)
+rtol = 1e-8
+atol = 1e-10
 [fit]
 particles = 10
 swarm_iterations = 8
