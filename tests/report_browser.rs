@@ -76,6 +76,10 @@ name = "high"
 range_hz = [500.0, 5000.0]
 nperseg = 2048
 
+[solver]
+rtol = 1e-7
+atol = 1e-9
+
 [fit]
 particles = 4
 swarm_iterations = 1
@@ -232,7 +236,8 @@ fn figure_check(dom: &str) -> Check {
     }
 }
 
-/// The figures `wiperlab fit` writes for a two-band job (src/report/html.rs `fit_figure_list`).
+/// The figures `wiperlab fit` always writes for a two-band job (src/report/html.rs
+/// `fit_figure_list`).
 const FIT_FIGURES: [&str; 6] = [
     "cost.svg",
     "friction_law.svg",
@@ -241,6 +246,26 @@ const FIT_FIGURES: [&str; 6] = [
     "traces_head.svg",
     "traces_tip.svg",
 ];
+
+/// The figures `wiperlab fit` writes only when the data allow (src/report/html.rs
+/// `OPTIONAL_FIGURES`).
+const OPTIONAL_FIGURES: [&str; 1] = ["freq_vs_speed.svg"];
+
+/// The SVGs of a fit's report directory, checked to be every always-written figure plus only
+/// known optional ones.
+fn fit_svgs(dir: &Path) -> Vec<String> {
+    let figs = svgs(dir);
+    for f in FIT_FIGURES {
+        assert!(figs.iter().any(|g| g == f), "{f} missing from {figs:?}");
+    }
+    for g in &figs {
+        assert!(
+            FIT_FIGURES.contains(&g.as_str()) || OPTIONAL_FIGURES.contains(&g.as_str()),
+            "unexpected figure {g}"
+        );
+    }
+    figs
+}
 
 /// Quick fit with `wiperlab fit` (checks the report hint), then `wiperlab report` on the existing
 /// result; the page holds the tables, the SHA-256 of the recording, and every figure loads.
@@ -269,8 +294,11 @@ fn report_page_after_a_quick_fit_loads_every_figure_in_chromium() {
     );
     let dir = tmp.0.join("reports/quick");
     let page = dir.join("index.html");
-    assert!(out.contains("index.html (6 figures)"), "{out}");
-    assert_eq!(svgs(&dir), FIT_FIGURES);
+    let figs = fit_svgs(&dir);
+    assert!(
+        out.contains(&format!("index.html ({} figures)", figs.len())),
+        "{out}"
+    );
     let html = std::fs::read_to_string(&page).unwrap();
 
     // Tables: a row per freed parameter, per band; one model only.
@@ -280,14 +308,14 @@ fn report_page_after_a_quick_fit_loads_every_figure_in_chromium() {
         "<td class=\"l\">low</td>",
         "<td class=\"l\">high</td>",
         "Only one model (blade2dof) was fitted",
-        "rtol 1e-8, atol 1e-10", // the job's defaults (src/fit/job.rs fit_solver_default)
+        "rtol 1e-7, atol 1e-9", // the quick job's [solver]
         "low 30.00–300.0 Hz (Welch, Hann, nperseg 4096)",
         "particle swarm 4 particles × 1 iterations (seed 3)",
     ] {
         assert!(html.contains(needle), "page lacks {needle:?}");
     }
     // Every figure is linked once; nothing is fetched from elsewhere.
-    for f in FIT_FIGURES {
+    for f in &figs {
         assert_eq!(
             html.matches(&format!("src=\"{f}\"")).count(),
             1,
@@ -323,8 +351,8 @@ fn report_page_after_a_quick_fit_loads_every_figure_in_chromium() {
         check,
         Check {
             status: "ok".into(),
-            loaded: FIT_FIGURES.len(),
-            total: FIT_FIGURES.len(),
+            loaded: figs.len(),
+            total: figs.len(),
             broken: vec![],
         }
     );
@@ -346,6 +374,7 @@ fn browser_check_catches_a_broken_link_and_a_corrupt_svg() {
     let dir = tmp.0.join("reports/quick");
     let page = dir.join("index.html");
     let html = std::fs::read_to_string(&page).unwrap();
+    let n = fit_svgs(&dir).len();
 
     let Some(chromium) = chromium() else { return };
     // 1. A broken link, in a copy of the page beside the original.
@@ -359,7 +388,7 @@ fn browser_check_catches_a_broken_link_and_a_corrupt_svg() {
     let check = figure_check(&dump_dom(&chromium, &bad_link, &tmp.0.join("p1")));
     println!("broken link: {check:?}");
     assert_eq!(check.status, "broken");
-    assert_eq!((check.loaded, check.total), (5, 6));
+    assert_eq!((check.loaded, check.total), (n - 1, n));
     assert_eq!(check.broken, ["psd_missing.svg"]);
 
     // 2. A corrupt figure: the original page, with traces_tip.svg truncated (unclosed XML).
@@ -369,13 +398,13 @@ fn browser_check_catches_a_broken_link_and_a_corrupt_svg() {
     let check = figure_check(&dump_dom(&chromium, &page, &tmp.0.join("p2")));
     println!("corrupt SVG: {check:?}");
     assert_eq!(check.status, "broken");
-    assert_eq!((check.loaded, check.total), (5, 6));
+    assert_eq!((check.loaded, check.total), (n - 1, n));
     assert_eq!(check.broken, ["traces_tip.svg"]);
 }
 
 /// Text from results is escaped: a warning and a model-comparison row carrying markup appear as
-/// text, and the browser still sees only the six real figures (an unescaped `<img class="figure">`
-/// would be a seventh, broken one). Also renders the model-comparison table.
+/// text, and the browser still sees only the real figures (an unescaped `<img class="figure">`
+/// would be one more, broken). Also renders the model-comparison table.
 #[test]
 fn report_escapes_text_from_the_result() {
     let tmp = TempDir::new("escape");
@@ -408,6 +437,7 @@ fn report_escapes_text_from_the_result() {
 
     ok(&wiperlab(&tmp.0, &["report", job_s]), "report");
     let page = tmp.0.join("reports/quick/index.html");
+    let n = fit_svgs(&tmp.0.join("reports/quick")).len();
     let html = std::fs::read_to_string(&page).unwrap();
     assert!(!html.contains("injected.svg\">"), "unescaped markup");
     assert!(html.contains(
@@ -419,5 +449,30 @@ fn report_escapes_text_from_the_result() {
 
     let Some(chromium) = chromium() else { return };
     let check = figure_check(&dump_dom(&chromium, &page, &tmp.0.join("profile")));
-    assert_eq!((check.status.as_str(), check.total), ("ok", 6), "{check:?}");
+    assert_eq!((check.status.as_str(), check.total), ("ok", n), "{check:?}");
+}
+
+/// A result file that is not a fit result is a one-line input error naming the file, line and
+/// column (exit code 2), not a panic and not a silent refit.
+#[test]
+fn unreadable_result_is_a_clear_input_error() {
+    let tmp = TempDir::new("bad_result");
+    let job = write_quick_job(&tmp.0);
+    let result = tmp.0.join("quick.result.toml");
+    std::fs::write(&result, "job = \"quick\"\ncost = \"low\"\n").unwrap();
+    let o = wiperlab(&tmp.0, &["report", job.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "stderr:\n{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 1, "{err}");
+    assert!(
+        lines[0].starts_with(&format!("error: {}:2:", result.display())),
+        "{err}"
+    );
+    assert!(!tmp.0.join("reports/quick/index.html").exists());
+    assert_eq!(
+        std::fs::read_to_string(&result).unwrap(),
+        "job = \"quick\"\ncost = \"low\"\n",
+        "the result was overwritten"
+    );
 }

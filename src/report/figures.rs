@@ -2,7 +2,7 @@
 //! [`super::plot`]).
 
 use super::plot::{ChartOpts, Marker, Series, heatmap, line_chart};
-use crate::fit::features::Features;
+use crate::fit::features::{Features, noise_floor};
 use crate::fit::{FitOutcome, FitResult};
 use crate::model::FrictionLaw;
 use crate::simulate::blade::BladeSimulation;
@@ -169,6 +169,9 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
         &ChartOpts::default(),
     )?;
     for (d, m) in o.measured.bands.iter().zip(&o.model.bands) {
+        // The cost adds the measurement's noise floor to the model PSD (src/fit/mod.rs cost_of);
+        // without it the model's deep stick–slip troughs look like misfits they are not.
+        let floor = noise_floor(d);
         let mut markers = Vec::new();
         if let Some(p) = d.peak.filter(|_| !targets_only) {
             markers.push(Marker {
@@ -201,8 +204,14 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
         line_chart(
             &dir.join(format!("psd_{}.svg", d.spec.name)),
             &format!(
-                "Welch PSD, {} band (nperseg {}), measured and model",
-                d.spec.name, d.spec.nperseg
+                "Welch PSD, {} band (nperseg {}): {}",
+                d.spec.name,
+                d.spec.nperseg,
+                if targets_only {
+                    "model against the target"
+                } else {
+                    "measured, model, model + noise floor"
+                }
             ),
             "frequency [Hz]",
             "PSD [m²/Hz]",
@@ -212,6 +221,13 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
                 vec![
                     Series::line("measured", d.freq_hz.clone(), d.psd.clone()),
                     Series::line("model", m.freq_hz.clone(), m.psd.clone()),
+                    Series::line(
+                        format!(
+                            "model + measured noise floor {floor:.2e} m²/Hz (as the cost compares)"
+                        ),
+                        m.freq_hz.clone(),
+                        m.psd.iter().map(|p| p + floor).collect(),
+                    ),
                 ]
             },
             &ChartOpts {

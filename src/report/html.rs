@@ -4,9 +4,10 @@
 //! Contents, in order: the fit summary; the parameter table (value, 1σ from the cost's curvature,
 //! confidence interval when the fit computed one, search bounds, determined or not, truth and
 //! relative error when known); measured against model spectral peaks; the model comparison
-//! (`model_trials`, or a line saying that only one model was fitted); the correlation matrix;
-//! warnings; every SVG figure of `reports/<job>/`; provenance (recording path and SHA-256 at fit
-//! time and now, wiperlab version, solver tolerances, bands, fit settings, dates).
+//! (`model_trials`, or with one trial or none a line saying that only one model was fitted, and
+//! why); the correlation matrix; warnings; every SVG figure of `reports/<job>/`; provenance
+//! (recording path and SHA-256 at fit time and now, wiperlab version, solver tolerances, bands, fit
+//! settings, dates).
 //!
 //! Figures are `<img src="NAME.svg">` links relative to the page (the SVGs sit beside it), so the
 //! page stays small and each figure is also a file of its own. Nothing is fetched from the network:
@@ -53,27 +54,41 @@ pub struct ReportSummary {
     pub warnings: Vec<String>,
 }
 
-/// The figures `wiperlab fit` writes for a result (file name, caption), in page order; the PSD
-/// figures follow the result's bands.
+/// True when the result comes from a target job (`[targets]`: frequencies to reach, no recording),
+/// read from the settings the result records.
+fn is_target_job(result: &FitResult) -> bool {
+    toml::from_str::<FitJob>(&result.settings).is_ok_and(|j| j.targets.is_some())
+}
+
+/// The figures `wiperlab fit` always writes for a result (file name, caption), in page order; the
+/// PSD figures follow the result's bands.
 pub fn fit_figure_list(result: &FitResult) -> Vec<(String, String)> {
+    let (compared, psd) = if is_target_job(result) {
+        (
+            "the fitted model (a target job has no recording)",
+            "the fitted model's PSD against the target frequency or range",
+        )
+    } else {
+        (
+            "measured and fitted model",
+            "measured, model, and model plus the measurement's noise floor (as the cost compares \
+             them), with both peaks marked",
+        )
+    };
     let mut v = vec![
         (
             "traces_tip.svg".to_string(),
-            "Tip x − head x against time: measured and fitted model (means removed).".to_string(),
+            format!("Tip x − head x against time: {compared} (means removed)."),
         ),
         (
             "traces_head.svg".into(),
-            "Head y against time: measured and fitted model (means removed).".into(),
+            format!("Head y against time: {compared} (means removed)."),
         ),
     ];
     for p in &result.peaks {
         v.push((
             format!("psd_{}.svg", p.band),
-            format!(
-                "Welch PSD in the {} band: measured, and model plus the measurement's noise floor \
-                 (as the cost compares them), with both peaks marked.",
-                p.band
-            ),
+            format!("Welch PSD in the {} band: {psd}.", p.band),
         ));
     }
     v.push((
@@ -88,6 +103,15 @@ pub fn fit_figure_list(result: &FitResult) -> Vec<(String, String)> {
     ));
     v
 }
+
+/// Figures `wiperlab fit` writes only when the data allow (file name, caption); shown after
+/// [`fit_figure_list`] when present, never reported missing.
+pub const OPTIONAL_FIGURES: &[(&str, &str)] = &[(
+    "freq_vs_speed.svg",
+    "Instantaneous frequency against the lip tip's mean speed: spectrogram ridge and \
+     1/stick-onset interval, measured and fitted model (written when the recording has a tip \
+     point and an estimate in the band).",
+)];
 
 /// Escapes text for HTML element content and double- or single-quoted attribute values.
 pub fn escape(s: &str) -> String {
@@ -203,9 +227,9 @@ pub struct Provenance {
 const STYLE: &str = "body{font-family:sans-serif;max-width:1000px;margin:1.5em auto;padding:0 1em;\
 color:#222;line-height:1.4}h1{font-size:1.6em}h2{margin-top:1.6em;border-bottom:1px solid #ccc}\
 table{border-collapse:collapse;margin:.6em 0}th,td{border:1px solid #ccc;padding:.25em .6em;\
-text-align:right}th{background:#f2f2f2}td.l,th.l{text-align:left}tr.chosen td{font-weight:bold}\
+text-align:right;white-space:nowrap}th{background:#f2f2f2}td.l,th.l{text-align:left;white-space:normal}tr.chosen td{font-weight:bold}\
 .warn{color:#a33}.ok{color:#262}figure{margin:1.2em 0}figure img{max-width:100%;height:auto;\
-border:1px solid #ddd}figcaption{font-size:.9em;color:#444}pre{background:#f6f6f6;padding:.6em;\
+border:1px solid #ddd}figcaption,.note{font-size:.9em;color:#444}pre{background:#f6f6f6;padding:.6em;\
 overflow-x:auto;font-size:.85em}code{font-size:.9em}";
 
 /// The figure check run by the browser (see the module docs).
@@ -268,20 +292,27 @@ pub fn render_html(
          <th>fitted</th><th>± 1σ</th><th>interval</th><th>search bounds</th><th>determined</th>\
          <th>true</th><th>rel. error</th></tr>\n",
     );
+    let mut methods: Vec<String> = Vec::new();
     for p in &r.parameters {
         let meaning = PARAM_NAMES
             .iter()
             .find(|(n, _)| *n == p.name)
             .map(|(_, m)| *m)
             .unwrap_or("");
+        // The method is named once below the table (footnote number), not in every row.
         let interval = match &p.interval {
-            Some(i) => format!(
-                "[{}, {}] ({:.0} %, {})",
-                num(i.lo, 4),
-                num(i.hi, 4),
-                100.0 * i.level,
-                e(&i.method)
-            ),
+            Some(i) => {
+                if !methods.contains(&i.method) {
+                    methods.push(i.method.clone());
+                }
+                let k = methods.iter().position(|m| *m == i.method).unwrap_or(0) + 1;
+                format!(
+                    "[{}, {}] ({:.0} %)<sup>{k}</sup>",
+                    num(i.lo, 4),
+                    num(i.hi, 4),
+                    100.0 * i.level
+                )
+            }
             None => "—".into(),
         };
         let _ = writeln!(
@@ -307,20 +338,33 @@ pub fn render_html(
         );
     }
     h.push_str("</table>\n");
+    for (k, m) in methods.iter().enumerate() {
+        let _ = writeln!(
+            h,
+            "<p class=\"note\"><sup>{}</sup> Interval method: {}</p>",
+            k + 1,
+            e(m)
+        );
+    }
 
     // Peaks.
     h.push_str("<h2 id=\"peaks\">Measured against model peaks</h2>\n");
     h.push_str(
-        "<table id=\"peak-table\">\n<tr><th class=\"l\">band</th><th>measured [Hz]</th>\
+        "<table id=\"peak-table\">\n<tr><th class=\"l\">band</th><th>measured or target [Hz]</th>\
          <th>model [Hz]</th><th>(model − measured)/measured</th><th>measured PSD [m²/Hz]</th>\
          <th>model PSD [m²/Hz]</th></tr>\n",
     );
+    let target = is_target_job(r);
     for p in &r.peaks {
         let _ = writeln!(
             h,
             "<tr><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             e(&p.band),
-            num(p.measured_hz, 5),
+            match p.target_range_hz {
+                Some([lo, hi]) => format!("target {}–{}", num(lo, 4), num(hi, 4)),
+                None if target => format!("target {}", num(p.measured_hz, 5)),
+                None => num(p.measured_hz, 5),
+            },
             num(p.model_hz, 5),
             pct(p.rel_diff),
             num(p.measured_level, 3),
@@ -331,11 +375,21 @@ pub fn render_html(
 
     // Model comparison.
     h.push_str("<h2 id=\"models\">Model comparison</h2>\n");
-    if r.model_trials.is_empty() {
+    if r.model_trials.len() <= 1 {
         let _ = writeln!(
             h,
-            "<p id=\"model-comparison\">Only one model ({}) was fitted; no comparison.</p>",
-            e(&r.model)
+            "<p id=\"model-comparison\">Only one model ({}) was fitted; no comparison{}.</p>",
+            e(&r.model),
+            r.model_trials
+                .first()
+                .map(|t| format!(
+                    " (chosen as {}; cost {}, {} model evaluations, {} s)",
+                    e(&t.reason),
+                    num(t.cost, 5),
+                    t.model_evaluations,
+                    num(t.wall_time_s, 3)
+                ))
+                .unwrap_or_default()
         );
     } else {
         h.push_str(
@@ -548,7 +602,8 @@ pub fn render_html(
 }
 
 /// Writes `paths.dir/index.html` for result `r`: links every SVG in `paths.dir` (the fit's own
-/// figures first, in [`fit_figure_list`] order, then any other SVG by name), and collects the
+/// figures first, in [`fit_figure_list`] order, then [`OPTIONAL_FIGURES`], then any other SVG by
+/// name), and collects the
 /// warnings: the result's own, undetermined parameters, failed model evaluations, fit figures
 /// missing from the directory, and a recording whose SHA-256 differs from the one fitted.
 ///
@@ -573,6 +628,15 @@ pub fn write_report(r: &FitResult, paths: &ReportPaths) -> Result<ReportSummary>
             figures.push(Figure { file, caption });
         } else {
             missing.push(file);
+        }
+    }
+    for (file, caption) in OPTIONAL_FIGURES {
+        if let Some(i) = present.iter().position(|p| p == file) {
+            present.remove(i);
+            figures.push(Figure {
+                file: file.to_string(),
+                caption: caption.to_string(),
+            });
         }
     }
     for file in present {
@@ -648,6 +712,7 @@ pub fn write_report(r: &FitResult, paths: &ReportPaths) -> Result<ReportSummary>
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fit::result::sha256_hex;
 
     #[test]
     fn escape_covers_markup_and_quotes() {
@@ -668,6 +733,145 @@ mod tests {
         assert_eq!(num(f64::NAN, 3), "—");
         assert_eq!(num(0.0, 3), "0");
         assert_eq!(pct(-0.0245066), "-2.45 %");
+    }
+
+    fn result() -> FitResult {
+        use crate::fit::result::{FittedParam, Interval, PeakComparison};
+        let p = |name: &str, determined: bool, interval: Option<Interval>| FittedParam {
+            name: name.into(),
+            value: 0.03,
+            lower: 0.005,
+            upper: 0.15,
+            std_error: if determined { 0.001 } else { 0.2 },
+            determined,
+            true_value: Some(0.029),
+            rel_error: Some(0.03 / 0.029 - 1.0),
+            interval,
+        };
+        FitResult {
+            job: "unit".into(),
+            recording: "rec.csv".into(),
+            wiperlab_version: "0.1.0".into(),
+            model: "blade2dof".into(),
+            cost: 1.5,
+            parameters: vec![
+                p(
+                    "k1",
+                    true,
+                    Some(Interval {
+                        lo: 0.028,
+                        hi: 0.032,
+                        level: 0.68,
+                        method: "profile".into(),
+                    }),
+                ),
+                p("B", false, None),
+            ],
+            peaks: vec![PeakComparison {
+                band: "low".into(),
+                measured_hz: 49.0,
+                model_hz: 49.5,
+                rel_diff: 0.5 / 49.0,
+                measured_level: 1e-9,
+                model_level: 2e-9,
+                target_range_hz: None,
+            }],
+            undetermined: vec!["B".into()],
+            correlation: vec![vec![1.0, -0.9], vec![-0.9, 1.0]],
+            swarm_iterations: 1,
+            polish_iterations: 2,
+            model_evaluations: 30,
+            failed_evaluations: 2,
+            first_failure: Some("contact lost".into()),
+            wall_time_s: 0.5,
+            threads: 2,
+            solver_rtol: 1e-8,
+            solver_atol: 1e-10,
+            transitions_in_best_model: 10,
+            model_trials: vec![],
+            warnings: vec![],
+            input_sha256: sha256_hex(b"the recording at fit time"),
+            settings: String::new(),
+            history: vec![],
+        }
+    }
+
+    #[test]
+    fn page_tables_and_warnings_from_a_result() {
+        let dir = std::env::temp_dir().join(format!("wiperlab_html_unit_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let figs = dir.join("reports");
+        std::fs::create_dir_all(&figs).unwrap();
+        // Only two of the fit's figures, plus one extra SVG.
+        for f in ["cost.svg", "psd_low.svg", "extra.svg", "freq_vs_speed.svg"] {
+            std::fs::write(figs.join(f), "<svg xmlns=\"http://www.w3.org/2000/svg\"/>").unwrap();
+        }
+        let rec = dir.join("rec.csv");
+        std::fs::write(&rec, "the recording changed since").unwrap();
+        let r = result();
+        let s = write_report(
+            &r,
+            &ReportPaths {
+                job: dir.join("job.toml"),
+                result: dir.join("unit.result.toml"),
+                recording: rec.clone(),
+                dir: figs.clone(),
+            },
+        )
+        .unwrap();
+        // Fit figures in fit_figure_list order, then the optional ones, then the others by name.
+        assert_eq!(
+            s.figures,
+            ["psd_low.svg", "cost.svg", "freq_vs_speed.svg", "extra.svg"]
+        );
+        assert_eq!(
+            s.missing_figures,
+            ["traces_tip.svg", "traces_head.svg", "friction_law.svg"]
+        );
+        let has = |needle: &str| s.warnings.iter().any(|w| w.contains(needle));
+        assert!(has("leave B undetermined"), "{:?}", s.warnings);
+        assert!(has("2 of 30 model evaluations failed"), "{:?}", s.warnings);
+        assert!(has("figures missing"), "{:?}", s.warnings);
+        assert!(has("has changed since the fit"), "{:?}", s.warnings);
+        assert_eq!(s.warnings.len(), 4, "{:?}", s.warnings);
+        let html = std::fs::read_to_string(&s.path).unwrap();
+        assert!(html.contains("<td>[0.02800, 0.03200] (68 %)<sup>1</sup></td>"));
+        assert!(html.contains("<sup>1</sup> Interval method: profile</p>"));
+        assert!(html.contains("<td>+3.45 %</td>")); // 0.03/0.029 − 1
+        assert!(html.contains("<span class=\"warn\">NO</span>"));
+        assert!(html.contains("<td>-0.900</td>"));
+        assert!(html.contains(&format!(
+            "<code id=\"sha256-now\">{}</code>",
+            sha256_hex(b"the recording changed since")
+        )));
+        assert!(html.contains("Only one model (blade2dof) was fitted"));
+        assert!(html.contains("The result does not record the job's settings."));
+
+        // Unchanged recording, all figures present, nothing failed: no warnings at all.
+        std::fs::write(&rec, "the recording at fit time").unwrap();
+        for (f, _) in fit_figure_list(&r) {
+            std::fs::write(figs.join(f), "<svg xmlns=\"http://www.w3.org/2000/svg\"/>").unwrap();
+        }
+        let mut r = r;
+        r.parameters[1].determined = true;
+        r.failed_evaluations = 0;
+        let s = write_report(
+            &r,
+            &ReportPaths {
+                job: dir.join("job.toml"),
+                result: dir.join("unit.result.toml"),
+                recording: rec,
+                dir: figs,
+            },
+        )
+        .unwrap();
+        assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+        assert!(
+            std::fs::read_to_string(&s.path)
+                .unwrap()
+                .contains("<p id=\"warning-list\">None.</p>")
+        );
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]

@@ -461,14 +461,17 @@ fn draw_xy(
                 ),
         ))?;
     }
-    for m in &opts.markers {
+    for (i, m) in opts.markers.iter().enumerate() {
         let Some(p) = plane.point(m.x, m.y) else {
             continue;
         };
+        // Every other label goes below its marker, so two close peaks (measured and model) keep
+        // readable labels.
+        let dy = if i % 2 == 0 { -16 } else { 4 };
         chart.draw_series(std::iter::once(
             EmptyElement::at(p)
                 + Circle::new((0, 0), 5, BLACK.stroke_width(2))
-                + Text::new(m.label.clone(), (7, -16), ("sans-serif", 13).into_font()),
+                + Text::new(m.label.clone(), (7, dy), ("sans-serif", 13).into_font()),
         ))?;
     }
 
@@ -784,8 +787,8 @@ fn heatmap_image(
     let png = png::encode_rgb(w, h, &rgb)?;
     Some(format!(
         "<image x=\"{x0}\" y=\"{y0}\" width=\"{w}\" height=\"{h}\" preserveAspectRatio=\"none\" \
-         href=\"data:image/png;base64,{}\"/>",
-        png::base64(&png)
+         href=\"{}\"/>",
+        png::data_uri(&png)
     ))
 }
 
