@@ -2,7 +2,8 @@
 //! than the fit uses, so the data are not bit-identical to any model evaluation), written as a
 //! DLTdv file through the same camera model as the shipped sample (15 µm/px, origin (200, 300)).
 
-use std::fmt::Write as _;
+mod common;
+
 use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
 use wiperlab::model::{BladeParams, FrictionLaw, StickForm};
@@ -41,19 +42,7 @@ fn fit_recovers_friction_c_and_neck_stiffness() {
     .unwrap();
     let dir = std::env::temp_dir().join(format!("wiperlab_fit_recovery_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let (s, a) = (1.5e-5, 0.1);
-    let mut csv = String::from("pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y\n");
-    for i in 0..n {
-        let _ = writeln!(
-            csv,
-            "{:.6},{:.6},{:.6},{:.6}",
-            200.0 + (sim.v_m[i] - a) / s,
-            300.0 + sim.u_m[i] / s,
-            200.0 + (sim.v3_m[i] - a) / s,
-            300.0 + (truth.l1_m + truth.l2_m) / s
-        );
-    }
-    std::fs::write(dir.join("rec_xypts.csv"), csv).unwrap();
+    common::write_dltdv(&dir.join("rec_xypts.csv"), &sim, &mut || 0.0);
     std::fs::write(dir.join("blade.toml"), toml::to_string(&base).unwrap()).unwrap();
     std::fs::write(
         dir.join("truth.json"),

@@ -7,9 +7,10 @@
 //! so noise is the only source of error and the nominal rate applies. With R recordings the number
 //! covering the truth is Binomial(R, 0.6827); the test accepts the central ~98 % of that law.
 
+mod common;
+
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use std::fmt::Write as _;
 use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
 use wiperlab::model::StickForm;
@@ -69,24 +70,13 @@ fn bootstrap_intervals_cover_the_truth_at_their_rate() {
         format!("{{\"k1\": {k1_true}, \"C\": {c_true}}}"),
     )
     .unwrap();
-    let (s, a) = (1.5e-5, 0.1);
     let noise = Normal::new(0.0, 0.1).unwrap();
     let mut covered = std::collections::BTreeMap::<String, usize>::new();
     for r in 0..RECORDINGS {
         let mut rng = rand::rngs::StdRng::seed_from_u64(1000 + r as u64);
-        let mut e = || noise.sample(&mut rng);
-        let mut csv = String::from("pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y\n");
-        for i in 0..n {
-            let _ = writeln!(
-                csv,
-                "{:.6},{:.6},{:.6},{:.6}",
-                200.0 + (sim.v_m[i] - a) / s + e(),
-                300.0 + sim.u_m[i] / s + e(),
-                200.0 + (sim.v3_m[i] - a) / s + e(),
-                300.0 + (truth.l1_m + truth.l2_m) / s + e()
-            );
-        }
-        std::fs::write(dir.join(format!("rec{r}_xypts.csv")), csv).unwrap();
+        common::write_dltdv(&dir.join(format!("rec{r}_xypts.csv")), &sim, &mut || {
+            noise.sample(&mut rng)
+        });
         let job = format!(
             r#"name = "coverage{r}"
 blade = "blade.toml"

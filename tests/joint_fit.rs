@@ -4,7 +4,8 @@
 //! recording keeps its own drive) and must recover both within 5 %, as the single-recording fit does
 //! (tests/fit_recovery.rs), and report the peaks of both recordings.
 
-use std::fmt::Write as _;
+mod common;
+
 use std::path::Path;
 use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
@@ -30,19 +31,7 @@ fn write_recording(p: &BladeParams, path: &Path) -> f64 {
         StickForm::Reduced,
     )
     .unwrap();
-    let (s, a) = (1.5e-5, 0.1);
-    let mut csv = String::from("pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y\n");
-    for i in 0..n {
-        let _ = writeln!(
-            csv,
-            "{:.6},{:.6},{:.6},{:.6}",
-            200.0 + (sim.v_m[i] - a) / s,
-            300.0 + sim.u_m[i] / s,
-            200.0 + (sim.v3_m[i] - a) / s,
-            300.0 + (p.l1_m + p.l2_m) / s
-        );
-    }
-    std::fs::write(path, csv).unwrap();
+    common::write_dltdv(path, &sim, &mut || 0.0);
     t0
 }
 
@@ -71,11 +60,7 @@ fn joint_fit_of_two_sweep_speeds_recovers_shared_parameters() {
         format!("{{\"C\": {c_true}, \"k1\": {k1_true}}}"),
     )
     .unwrap();
-    let import = |t0: f64| {
-        format!(
-            "format = \"dltdv\"\nfps_hz = 10000.0\nm_per_px = 1.5e-5\norigin_px = [200.0, 300.0]\nt0_s = {t0:?}\n"
-        )
-    };
+    let import = common::dltdv_import;
     let job = format!(
         r#"name = "joint"
 blade = "blade.toml"

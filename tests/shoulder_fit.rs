@@ -4,7 +4,8 @@
 //! candidate must win on AIC and recover k1_contact within 5 % (issue 6, "Done when"). The opposite
 //! case, a recording made without a shoulder, is the main job (tests/cli.rs asserts `blade2dof` wins).
 
-use std::fmt::Write as _;
+mod common;
+
 use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
 use wiperlab::model::{BladeParams, Shoulder, StickForm};
@@ -49,19 +50,7 @@ fn fit_prefers_and_recovers_the_shoulder() {
     );
     let dir = std::env::temp_dir().join(format!("wiperlab_shoulder_fit_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let (s, a) = (1.5e-5, 0.1);
-    let mut csv = String::from("pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y\n");
-    for i in 0..n {
-        let _ = writeln!(
-            csv,
-            "{:.6},{:.6},{:.6},{:.6}",
-            200.0 + (sim.v_m[i] - a) / s,
-            300.0 + sim.u_m[i] / s,
-            200.0 + (sim.v3_m[i] - a) / s,
-            300.0 + (truth.l1_m + truth.l2_m) / s
-        );
-    }
-    std::fs::write(dir.join("rec_xypts.csv"), csv).unwrap();
+    common::write_dltdv(&dir.join("rec_xypts.csv"), &sim, &mut || 0.0);
     std::fs::write(dir.join("blade.toml"), toml::to_string(&base).unwrap()).unwrap();
     std::fs::write(
         dir.join("truth.json"),

@@ -52,3 +52,49 @@ impl Drop for TempFile {
         let _ = std::fs::remove_file(&self.0);
     }
 }
+
+/// The shipped sample's true blade parameters (`data/reversal/blade_true.toml`).
+pub fn true_blade() -> wiperlab::model::BladeParams {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/reversal/blade_true.toml");
+    toml::from_str(&std::fs::read_to_string(p).expect("read blade_true.toml")).expect("parse")
+}
+
+/// Frame times `t0 + k/fps` covering `[t0, t1)`.
+pub fn frame_times(t0: f64, t1: f64, fps: f64) -> Vec<f64> {
+    let n = ((t1 - t0) * fps) as usize;
+    (0..n).map(|k| t0 + k as f64 / fps).collect()
+}
+
+/// Writes a simulation as a DLTdv8 `xypts.csv` (point 1 the head, point 2 the lip tip) through the
+/// shipped sample's camera model (data/reversal/README.md, "Camera and coordinates": 15 µm per
+/// pixel, `x_px = 200 + (X − a)/S`, `y_px = 300 − Z/S` with a = 0.1 m, y down, `%.6f`), written
+/// here by hand so the data do not depend on the reader under test. `noise_px` draws the tracking
+/// noise added to each coordinate (pixels).
+pub fn write_dltdv(
+    path: &Path,
+    sim: &wiperlab::simulate::blade::BladeSimulation,
+    noise_px: &mut dyn FnMut() -> f64,
+) {
+    use std::fmt::Write as _;
+    let (s, a) = (1.5e-5, 0.1);
+    let mut csv = String::from("pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y\n");
+    for i in 0..sim.t_s.len() {
+        let _ = writeln!(
+            csv,
+            "{:.6},{:.6},{:.6},{:.6}",
+            200.0 + (sim.v_m[i] - a) / s + noise_px(),
+            300.0 + sim.u_m[i] / s + noise_px(),
+            200.0 + (sim.v3_m[i] - a) / s + noise_px(),
+            300.0 + sim.reach_m / s + noise_px()
+        );
+    }
+    std::fs::write(path, csv).expect("write the recording");
+}
+
+/// The `[recording.import]` lines of a job reading a file written by [`write_dltdv`] whose frame 1
+/// is at `t0` on the model clock.
+pub fn dltdv_import(t0: f64) -> String {
+    format!(
+        "format = \"dltdv\"\nfps_hz = 10000.0\nm_per_px = 1.5e-5\norigin_px = [200.0, 300.0]\nt0_s = {t0:?}\n"
+    )
+}
