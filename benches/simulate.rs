@@ -95,6 +95,7 @@ fn cost(c: &mut Criterion) {
     let measured = features(&x, fs, &bands, 5).expect("features");
     let problem = SpectralProblem {
         model: wiperlab::simulate::blade::ModelKind::Blade2dof,
+        head: None,
         targets: None,
         time_targets: None,
         others: Vec::new(),

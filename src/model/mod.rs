@@ -3,6 +3,7 @@
 pub mod belt;
 pub mod blade;
 pub mod friction;
+pub mod necklip;
 
 pub use blade::{Blade, BladeParams, Shoulder, StickForm};
 pub use friction::FrictionLaw;

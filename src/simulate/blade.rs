@@ -68,6 +68,10 @@ pub enum ModelKind {
     /// The 1-DOF head model: neck and lip locked into one link (no neck–lip mode), the head on its
     /// spring ([`LockedBlade`]). Explains a low band only.
     Head1dof,
+    /// The neck/lip model on a prescribed head ([`crate::model::necklip::NeckLip`]): the head's
+    /// vertical motion is taken from the recording, so the low component is imposed, not modelled.
+    /// Explains a high band only.
+    Necklip,
     /// The full 2-DOF head/neck/lip link model of the seed, eqs. (1)–(5) ([`Blade`]).
     #[default]
     Blade2dof,
@@ -75,12 +79,17 @@ pub enum ModelKind {
 
 impl ModelKind {
     /// Every kind, smallest first.
-    pub const ALL: [ModelKind; 2] = [ModelKind::Head1dof, ModelKind::Blade2dof];
+    pub const ALL: [ModelKind; 3] = [
+        ModelKind::Head1dof,
+        ModelKind::Necklip,
+        ModelKind::Blade2dof,
+    ];
 
     /// Name used in job files and reports.
     pub fn name(self) -> &'static str {
         match self {
             ModelKind::Head1dof => "head1dof",
+            ModelKind::Necklip => "necklip",
             ModelKind::Blade2dof => "blade2dof",
         }
     }
@@ -89,13 +98,18 @@ impl ModelKind {
     pub fn dof(self) -> usize {
         match self {
             ModelKind::Head1dof => 1,
-            ModelKind::Blade2dof => 2,
+            ModelKind::Necklip | ModelKind::Blade2dof => 2,
         }
     }
 
     /// Whether the model has a neck–lip mode, i.e. can produce a high (hundreds of Hz) band.
     pub fn has_neck_mode(self) -> bool {
-        self == ModelKind::Blade2dof
+        self != ModelKind::Head1dof
+    }
+
+    /// Whether the model explains the low (head) component; the neck/lip model imposes it.
+    pub fn has_head_mode(self) -> bool {
+        self != ModelKind::Necklip
     }
 }
 
@@ -113,6 +127,9 @@ pub fn simulate_model(
     stick_form: StickForm,
 ) -> Result<BladeSimulation> {
     match kind {
+        ModelKind::Necklip => Err(Error::Config(
+            "the neck/lip model needs a prescribed head motion: use simulate_necklip".into(),
+        )),
         ModelKind::Blade2dof => simulate_blade(params, window, sample_times, opts, stick_form),
         ModelKind::Head1dof => {
             params.validate().map_err(Error::Config)?;
@@ -127,6 +144,31 @@ pub fn simulate_model(
             run_to_simulation(&model, &model.blade, y0, params, window, sample_times, opts)
         }
     }
+}
+
+/// Simulates the neck/lip model on the prescribed head `head` from the full model's quasi-static
+/// slip equilibrium at `window.0` (the constraint's Baumgarte term pulls the head height onto `head`).
+///
+/// # Errors
+/// As [`simulate_blade`].
+pub fn simulate_necklip(
+    params: &BladeParams,
+    head: &crate::model::necklip::PrescribedHead,
+    window: (f64, f64),
+    sample_times: &[f64],
+    opts: &SolverOptions,
+) -> Result<BladeSimulation> {
+    params.validate().map_err(Error::Config)?;
+    let model = crate::model::necklip::NeckLip::new(*params, head.clone());
+    let y0 = model
+        .blade
+        .slip_equilibrium(window.0)
+        .map_err(|e| Error::Simulation {
+            t_s: window.0,
+            message: e.to_string(),
+            state: "initial equilibrium".into(),
+        })?;
+    run_to_simulation(&model, &model.blade, y0, params, window, sample_times, opts)
 }
 
 /// Simulates the blade from the quasi-static slip equilibrium at `window.0` to `window.1`, recording

@@ -549,6 +549,13 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                     continue;
                 }
             };
+            if !a.err.is_finite() || !a.y_new.iter().all(|v| v.is_finite()) {
+                // A non-finite error estimate or state (e.g. near a singular constraint): shrink
+                // like a failed right-hand side, so the step-size collapse check ends the run.
+                stats.rejected += 1;
+                h *= 0.25;
+                continue;
+            }
             if a.err > 1.0 {
                 stats.rejected += 1;
                 h = rk::next_step(h, a.err).min(h * 0.9);
