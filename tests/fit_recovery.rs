@@ -12,11 +12,7 @@ use wiperlab::simulate::blade::{default_window, simulate_blade};
 
 #[test]
 fn fit_recovers_friction_c_and_neck_stiffness() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let base: BladeParams = toml::from_str(
-        &std::fs::read_to_string(root.join("data/reversal/blade_true.toml")).unwrap(),
-    )
-    .unwrap();
+    let base: BladeParams = common::true_blade();
     // Known parameters: the sample's, with C and k1 moved off the sample's values.
     let (c_true, k1_true) = (0.5, 0.026);
     let mut truth = base;

@@ -34,11 +34,7 @@ fn binomial_cdf(k: usize, n: usize, p: f64) -> f64 {
 
 #[test]
 fn bootstrap_intervals_cover_the_truth_at_their_rate() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let base: BladeParams = toml::from_str(
-        &std::fs::read_to_string(root.join("data/reversal/blade_true.toml")).unwrap(),
-    )
-    .unwrap();
+    let base: BladeParams = common::true_blade();
     let (k1_true, c_true) = (0.015, 0.56);
     let mut truth = base;
     truth.k1_nm_per_rad = k1_true;

@@ -37,11 +37,7 @@ fn write_recording(p: &BladeParams, path: &Path) -> f64 {
 
 #[test]
 fn joint_fit_of_two_sweep_speeds_recovers_shared_parameters() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let base: BladeParams = toml::from_str(
-        &std::fs::read_to_string(root.join("data/reversal/blade_true.toml")).unwrap(),
-    )
-    .unwrap();
+    let base: BladeParams = common::true_blade();
     let (c_true, k1_true) = (0.5, 0.026);
     let mut truth = base;
     truth.k1_nm_per_rad = k1_true;

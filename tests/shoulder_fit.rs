@@ -14,11 +14,7 @@ use wiperlab::simulate::blade::{default_window, simulate_blade};
 
 #[test]
 fn fit_prefers_and_recovers_the_shoulder() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let base: BladeParams = toml::from_str(
-        &std::fs::read_to_string(root.join("data/reversal/blade_true.toml")).unwrap(),
-    )
-    .unwrap();
+    let base: BladeParams = common::true_blade();
     // Known parameters: a free neck 4x softer than the sample's, touching the shoulder at 0.06 rad
     // (|θ| reaches ~0.12-0.15 rad in slip, data/reversal/clean_10kfps.csv.gz) with k1_contact = 0.03.
     let (k1_free, theta_c, k1c) = (0.0075, 0.06, 0.03);
