@@ -16,10 +16,13 @@
 //! response to the tip: the low component is imposed from the data, not explained, so the fit
 //! compares it on the high band.
 //!
-//! **Limit.** The constraint's gradient `(l1 sin θ, l2 sin φ)` vanishes at upright, where `N` is
-//! undetermined; the model is meant for windows before or after the blade's flip at the reversal,
-//! not across it. Across it a run (1.80–2.20 s on the sample) was seen not to finish, so the fit does
-//! not offer this model yet (open work).
+//! **The flip.** The constraint's gradient `(l1 sin θ, l2 sin φ)` vanishes at upright, where `N` is
+//! undetermined, so the model cannot pass the blade's flip at the reversal. With the recorded lean
+//! `d = v3 − v` ([`PrescribedHead::with_lean`]) the window is cut at the flip
+//! ([`PrescribedHead::segments`], a guard of [`FLIP_GUARD_OF_REACH`] of the reach around the sign
+//! change of `d`) and the run after it starts from the state the tracks give
+//! ([`NeckLip::state_from_tracks`]). On the sample's blade the guard is 20 ms, and the neck angle
+//! after the flip stays within 4.8e-4 rad of the full model's (`tests/necklip.rs`).
 
 use super::blade::{Blade, BladeParams, Dynamics, StickForm};
 use crate::simulate::hybrid::{Contact, Mode, ModelFault, StickSlipModel};
@@ -28,14 +31,14 @@ use nalgebra::{Matrix3, Matrix4, Vector3, Vector4};
 /// Baumgarte gain of the head-height constraint, s⁻¹ (physics.md §0.3).
 const OMEGA_B: f64 = 1e4;
 
-/// A prescribed head drop `u_p(t)` with its first two derivatives, from samples.
+/// A smoothed, uniformly sampled track `x(t)` with its first two derivatives, from samples.
 ///
 /// Built from a (possibly noisy) uniformly sampled track by a local quadratic least-squares fit over
 /// `2·half_width + 1` samples at each sample (Savitzky & Golay 1964, Anal. Chem. 36:1627), which
 /// gives `u`, `u̇`, `ü` there; between samples `u` is a cubic Hermite in `(u, u̇)` and `u̇`, `ü` are
 /// linear. Missing (NaN) samples are skipped by the local fits.
 #[derive(Debug, Clone)]
-pub struct PrescribedHead {
+pub struct SmoothedTrack {
     t0_s: f64,
     dt_s: f64,
     u: Vec<f64>,
@@ -43,8 +46,8 @@ pub struct PrescribedHead {
     udd: Vec<f64>,
 }
 
-impl PrescribedHead {
-    /// From samples `u_m[k]` at `t0_s + k·dt_s`.
+impl SmoothedTrack {
+    /// From samples `u_m[k]` at `t0_s + k·dt_s` (any unit; the derivatives are per second).
     ///
     /// # Errors
     /// A message when fewer than 3 finite samples fall in some local window (a gap longer than the
@@ -57,7 +60,7 @@ impl PrescribedHead {
     ) -> Result<Self, String> {
         if !(dt_s > 0.0 && dt_s.is_finite()) || u_m.len() < 2 * half_width + 1 || half_width == 0 {
             return Err(format!(
-                "prescribed head: need dt > 0 and at least {} samples (got dt = {dt_s}, {} samples)",
+                "smoothed track: need dt > 0 and at least {} samples (got dt = {dt_s}, {} samples)",
                 2 * half_width + 1,
                 u_m.len()
             ));
@@ -86,7 +89,7 @@ impl PrescribedHead {
                 .flatten()
                 .ok_or_else(|| {
                     format!(
-                        "prescribed head: too few head samples around t = {:.6} s for a local fit",
+                        "smoothed track: too few samples around t = {:.6} s for a local fit",
                         t0_s + k as f64 * dt_s
                     )
                 })?;
@@ -94,7 +97,7 @@ impl PrescribedHead {
             ud[k] = c[1];
             udd[k] = 2.0 * c[2];
         }
-        Ok(PrescribedHead {
+        Ok(SmoothedTrack {
             t0_s,
             dt_s,
             u,
@@ -103,7 +106,7 @@ impl PrescribedHead {
         })
     }
 
-    /// `(u_p, u̇_p, ü_p)` at `t` (held constant beyond the samples).
+    /// `(x, ẋ, ẍ)` at `t` (held constant beyond the samples).
     pub fn at(&self, t: f64) -> (f64, f64, f64) {
         let n = self.u.len();
         let x = ((t - self.t0_s) / self.dt_s).clamp(0.0, (n - 1) as f64);
@@ -122,6 +125,111 @@ impl PrescribedHead {
         (u, ud, udd)
     }
 }
+
+/// The recorded head that drives the neck/lip model: its drop `u_p(t)` (m, positive down) and,
+/// optionally, the blade's lean `d(t) = v3 − v` (tip x relative to head x, m), both smoothed by
+/// [`SmoothedTrack`]. The lean locates the flip at the reversal (where `d` changes sign), which the
+/// model cannot pass ([`PrescribedHead::segments`]), and gives the state after it
+/// ([`NeckLip::state_from_tracks`]).
+#[derive(Debug, Clone)]
+pub struct PrescribedHead {
+    pub drop: SmoothedTrack,
+    pub lean: Option<SmoothedTrack>,
+}
+
+impl PrescribedHead {
+    /// The head drop from samples `u_m[k]` at `t0_s + k·dt_s`, without a lean track (the model then
+    /// runs one segment, which must not cross the flip). See [`SmoothedTrack::from_samples`].
+    ///
+    /// # Errors
+    /// As [`SmoothedTrack::from_samples`].
+    pub fn from_samples(
+        t0_s: f64,
+        dt_s: f64,
+        u_m: &[f64],
+        half_width: usize,
+    ) -> Result<Self, String> {
+        Ok(PrescribedHead {
+            drop: SmoothedTrack::from_samples(t0_s, dt_s, u_m, half_width)?,
+            lean: None,
+        })
+    }
+
+    /// Adds the lean track `d_m[k] = v3 − v` at the same times as the drop.
+    ///
+    /// # Errors
+    /// As [`SmoothedTrack::from_samples`].
+    pub fn with_lean(mut self, d_m: &[f64], half_width: usize) -> Result<Self, String> {
+        self.lean = Some(SmoothedTrack::from_samples(
+            self.drop.t0_s,
+            self.drop.dt_s,
+            d_m,
+            half_width,
+        )?);
+        Ok(self)
+    }
+
+    /// `(u_p, u̇_p, ü_p)` at `t` (held constant beyond the samples).
+    pub fn at(&self, t: f64) -> (f64, f64, f64) {
+        self.drop.at(t)
+    }
+
+    /// The parts of `window` the model can run on: maximal intervals on the track's sample grid
+    /// where the smoothed lean keeps `|d| ≥ guard_m`. The flip at the reversal (a sign change of `d`)
+    /// and a guard around it are left out. Without a lean track: the whole window.
+    pub fn segments(&self, window: (f64, f64), guard_m: f64) -> Vec<(f64, f64)> {
+        let Some(lean) = &self.lean else {
+            return vec![window];
+        };
+        let (t0, dt) = (lean.t0_s, lean.dt_s);
+        let k0 = ((window.0 - t0) / dt).ceil().max(0.0) as usize;
+        let k1 = (((window.1 - t0) / dt).floor() as usize).min(lean.u.len() - 1);
+        let mut out = Vec::new();
+        let mut cur: Option<(f64, f64, f64)> = None; // (start, last sample inside, sign of d)
+        for k in k0..=k1 {
+            let t = t0 + k as f64 * dt;
+            let d = lean.u[k];
+            let inside = d.abs() >= guard_m;
+            if let Some((a, b, sign)) = cur
+                && !(inside && d.signum() == sign)
+            {
+                if b > a {
+                    out.push((a, b));
+                }
+                cur = None;
+            }
+            if inside {
+                cur = Some(match cur {
+                    Some((a, _, sign)) => (a, t, sign),
+                    None => (t, t, d.signum()),
+                });
+            }
+        }
+        if let Some((a, b, _)) = cur
+            && b > a
+        {
+            out.push((a, b));
+        }
+        // The grid may start or end within a sample of the window's ends.
+        if let Some(f) = out.first_mut()
+            && f.0 - window.0 < dt
+        {
+            f.0 = window.0;
+        }
+        if let Some(l) = out.last_mut()
+            && window.1 - l.1 < dt
+        {
+            l.1 = window.1;
+        }
+        out
+    }
+}
+
+/// Fraction of the reach `l1 + l2` below which the lean `|d|` counts as the flip: the head-height
+/// constraint's gradient `(l1 sin θ, l2 sin φ)` has at least the length `|d|/√2` (Cauchy–Schwarz on
+/// `d = l1 sin θ + l2 sin φ`), so outside the guard it stays above 0.035 (l1 + l2), clear of the 0.02
+/// (l1 + l2) at which [`NeckLip`] refuses to evaluate.
+pub const FLIP_GUARD_OF_REACH: f64 = 0.05;
 
 /// The neck/lip model on a prescribed head; state `[θ, φ, θ̇, φ̇]` as the full model's.
 #[derive(Debug, Clone)]
@@ -142,6 +250,75 @@ impl NeckLip {
             ),
             head,
         }
+    }
+
+    /// The state `[θ, φ, θ̇, φ̇]` at `t` from the recorded tracks, and the slip direction there (the
+    /// sign of the tip's velocity `v̇ + ḋ`), to start a segment after the flip.
+    ///
+    /// `θ, φ` solve `l1 sin θ + l2 sin φ = d` and `l1(1 − cos θ) + l2(1 − cos φ) = u_p` (Newton). The
+    /// two equations have two solution branches (to second order `θ, φ = d/L ± (l2, −l1)·e` with
+    /// `L = l1 + l2`); the one whose ratio `φ/θ` is nearer the blade's quasi-static slip equilibrium
+    /// at `t` is taken. If the drop is below the least one the lean allows (tracking noise near the
+    /// flip), `θ = φ = asin(d/L)`, and the Baumgarte term pulls the height onto `u_p`. The rates
+    /// solve the same equations differentiated, with `ḋ, u̇_p` from the smoothed tracks.
+    ///
+    /// # Errors
+    /// [`ModelFault::Geometry`] without a lean track, with a lean beyond the reach, or where the
+    /// rates are undetermined (`sin(φ − θ) ≈ 0`).
+    pub fn state_from_tracks(&self, t: f64) -> Result<([f64; 4], f64), ModelFault> {
+        let lean = self.head.lean.as_ref().ok_or_else(|| {
+            ModelFault::Geometry("neck/lip model: no lean track to start a segment from".into())
+        })?;
+        let p = &self.blade.params;
+        let (l1, l2) = (p.l1_m, p.l2_m);
+        let reach = l1 + l2;
+        let (d, dd, _) = lean.at(t);
+        let (u, ud, _) = self.head.at(t);
+        if d.is_nan() || d.abs() >= reach {
+            return Err(ModelFault::Geometry(format!(
+                "neck/lip model: lean d = {d:.6e} m at t = {t:.6} s is beyond the reach {reach:.6e} m"
+            )));
+        }
+        let solve = |mut th: f64, mut ph: f64| {
+            for _ in 0..30 {
+                let (st, ct) = th.sin_cos();
+                let (sp, cp) = ph.sin_cos();
+                let f = [l1 * st + l2 * sp - d, l1 * (1.0 - ct) + l2 * (1.0 - cp) - u];
+                let det = l1 * l2 * (ct * sp - st * cp);
+                if det.abs() < 1e-300 || f[0].abs().max(f[1].abs()) < 1e-16 * reach {
+                    break;
+                }
+                th -= (l2 * sp * f[0] - l2 * cp * f[1]) / det;
+                ph -= (-l1 * st * f[0] + l1 * ct * f[1]) / det;
+            }
+            (th, ph)
+        };
+        let mid = (d / reach).asin();
+        let e2 = (2.0 * u - d * d / reach) / (l1 * l2 * reach);
+        let (th, ph) = if e2 > 0.0 {
+            let e = e2.sqrt();
+            let a = solve(mid + l2 * e, mid - l1 * e);
+            let b = solve(mid - l2 * e, mid + l1 * e);
+            let eq = self.blade.slip_equilibrium(t)?;
+            // Distance from the equilibrium's direction in (θ, φ): |θ φ_eq − φ θ_eq| / |·|.
+            let miss = |(th, ph): (f64, f64)| (th * eq[1] - ph * eq[0]).abs() / th.hypot(ph);
+            if miss(a) <= miss(b) { a } else { b }
+        } else {
+            (mid, mid)
+        };
+        let (st, ct) = th.sin_cos();
+        let (sp, cp) = ph.sin_cos();
+        let det = l1 * l2 * (ct * sp - st * cp);
+        if det.abs() < 1e-6 * l1 * l2 {
+            return Err(ModelFault::Geometry(format!(
+                "neck/lip model: at t = {t:.6} s neck and lip are aligned (θ = {th:.3e}, φ = {ph:.3e} rad), so the rates cannot be taken from the tracks"
+            )));
+        }
+        let thd = (l2 * sp * dd - l2 * cp * ud) / det;
+        let phd = (-l1 * st * dd + l1 * ct * ud) / det;
+        let tip_speed = self.blade.drive(t).1 + dd;
+        let dir = if tip_speed >= 0.0 { 1.0 } else { -1.0 };
+        Ok(([th, ph, thd, phd], dir))
     }
 
     /// Row 3 replaced: the head-height constraint at acceleration level, `(coefficients, rhs)`.

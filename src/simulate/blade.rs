@@ -146,11 +146,21 @@ pub fn simulate_model(
     }
 }
 
-/// Simulates the neck/lip model on the prescribed head `head` from the full model's quasi-static
-/// slip equilibrium at `window.0` (the constraint's Baumgarte term pulls the head height onto `head`).
+/// Simulates the neck/lip model on the prescribed head `head`.
+///
+/// The model cannot pass the blade's flip at the reversal (its head-height constraint degenerates
+/// at upright, [`crate::model::necklip`]), so with a lean track the window is cut into the segments
+/// of [`PrescribedHead::segments`](crate::model::necklip::PrescribedHead::segments) (guard
+/// [`FLIP_GUARD_OF_REACH`](crate::model::necklip::FLIP_GUARD_OF_REACH) of the reach). A segment that
+/// starts at `window.0` starts from the full model's quasi-static slip equilibrium there (the
+/// constraint's Baumgarte term pulls the head height onto `head`); a later one from the state the
+/// tracks give ([`NeckLip::state_from_tracks`](crate::model::necklip::NeckLip::state_from_tracks)).
+/// Samples in the guard hold NaN positions and angles (the drive `v` is known) and the phase of the
+/// segment before, so the spectra skip them.
 ///
 /// # Errors
-/// As [`simulate_blade`].
+/// As [`simulate_blade`]; [`Error::Simulation`] too when the lean stays inside the guard over the
+/// whole window.
 pub fn simulate_necklip(
     params: &BladeParams,
     head: &crate::model::necklip::PrescribedHead,
@@ -158,17 +168,84 @@ pub fn simulate_necklip(
     sample_times: &[f64],
     opts: &SolverOptions,
 ) -> Result<BladeSimulation> {
+    use crate::model::necklip::{FLIP_GUARD_OF_REACH, NeckLip};
     params.validate().map_err(Error::Config)?;
-    let model = crate::model::necklip::NeckLip::new(*params, head.clone());
-    let y0 = model
-        .blade
-        .slip_equilibrium(window.0)
-        .map_err(|e| Error::Simulation {
+    let model = NeckLip::new(*params, head.clone());
+    let reach = params.l1_m + params.l2_m;
+    let segments = head.segments(window, FLIP_GUARD_OF_REACH * reach);
+    if segments.is_empty() {
+        return Err(Error::Simulation {
             t_s: window.0,
+            message: format!(
+                "the recorded lean stays within {:.3e} m of upright over the whole window: nothing for the neck/lip model to run on",
+                FLIP_GUARD_OF_REACH * reach
+            ),
+            state: "no segment".into(),
+        });
+    }
+    let n = sample_times.len();
+    let drive_dir = |t: f64| {
+        if model.blade.drive(t).1 >= 0.0 {
+            Phase::SlipPos
+        } else {
+            Phase::SlipNeg
+        }
+    };
+    let mut sim = BladeSimulation {
+        t_s: sample_times.to_vec(),
+        v_m: sample_times
+            .iter()
+            .map(|&t| model.blade.drive(t).0)
+            .collect(),
+        u_m: vec![f64::NAN; n],
+        v3_m: vec![f64::NAN; n],
+        theta_rad: vec![f64::NAN; n],
+        phi_rad: vec![f64::NAN; n],
+        phase: vec![drive_dir(window.0); n],
+        transitions: Vec::new(),
+        switches: Vec::new(),
+        stats: Stats::default(),
+        reach_m: reach,
+    };
+    for (i, &(a, b)) in segments.iter().enumerate() {
+        let fail = |e: crate::simulate::hybrid::ModelFault| Error::Simulation {
+            t_s: a,
             message: e.to_string(),
-            state: "initial equilibrium".into(),
-        })?;
-    run_to_simulation(&model, &model.blade, y0, params, window, sample_times, opts)
+            state: format!("start of neck/lip segment {} ({a:.6}–{b:.6} s)", i + 1),
+        };
+        let (y0, mode0) = if i == 0 && a == window.0 {
+            (
+                model.blade.slip_equilibrium(a).map_err(fail)?,
+                Mode::new(drive_dir(a), 0.0),
+            )
+        } else {
+            let (y, dir) = model.state_from_tracks(a).map_err(fail)?;
+            (y, Mode::new(Phase::slip(dir), 0.0))
+        };
+        let lo = sample_times.partition_point(|&t| t < a);
+        let hi = sample_times.partition_point(|&t| t <= b);
+        let run = integrate(&model, a, y0, mode0, b, &sample_times[lo..hi], opts)?;
+        for (j, y) in (lo..hi).zip(&run.y) {
+            let t = sample_times[j];
+            sim.u_m[j] = model.blade.head_drop(y);
+            sim.v3_m[j] = model.blade.tip_position(t, y);
+            sim.theta_rad[j] = y[0];
+            sim.phi_rad[j] = y[1];
+        }
+        sim.phase[lo..hi].copy_from_slice(&run.phase);
+        let last = run.phase.last().copied().unwrap_or(mode0.phase);
+        let next = segments
+            .get(i + 1)
+            .map_or(n, |s| sample_times.partition_point(|&t| t < s.0));
+        sim.phase[hi..next].fill(last);
+        sim.transitions.extend(run.transitions);
+        sim.switches.extend(run.switches);
+        sim.stats.steps += run.stats.steps;
+        sim.stats.rejected += run.stats.rejected;
+        sim.stats.rhs_evals += run.stats.rhs_evals;
+        sim.stats.event_evals += run.stats.event_evals;
+    }
+    Ok(sim)
 }
 
 /// Simulates the blade from the quasi-static slip equilibrium at `window.0` to `window.1`, recording
