@@ -189,13 +189,13 @@ pub struct FitSection {
     pub seed: u64,
     #[serde(default)]
     pub weights: Weights,
-    /// Models of the hierarchy to fit and compare, e.g. `["head1dof", "blade2dof",
-    /// "blade2dof+shoulder"]`. Empty (the default): only the smallest model that can produce every
+    /// Models of the hierarchy to fit and compare, from [`MODEL_NAMES`], e.g. `["head1dof",
+    /// "blade2dof", "blade2dof+shoulder"]`. Empty (the default): only the smallest model that can produce every
     /// band the job asks for (see [`crate::fit::smallest_capable_model`]). With several, each is
     /// fitted and the one with the lowest Akaike criterion (cost + 2k) is reported.
     #[serde(default)]
     pub models: Vec<String>,
-    /// Bounds of the shoulder-contact parameters freed by the `blade2dof+shoulder` candidate.
+    /// Bounds of the shoulder-contact parameters freed by the `+shoulder` candidates.
     #[serde(default)]
     pub shoulder: Option<ShoulderBounds>,
     /// Confidence intervals by parametric bootstrap (see [`crate::fit::bootstrap_intervals`]).
@@ -240,7 +240,13 @@ pub struct ShoulderBounds {
 }
 
 /// Names of the candidate models a job may list in `[fit] models`.
-pub const MODEL_NAMES: &[&str] = &["head1dof", "blade2dof", "blade2dof+shoulder"];
+pub const MODEL_NAMES: &[&str] = &[
+    "head1dof",
+    "necklip",
+    "necklip+shoulder",
+    "blade2dof",
+    "blade2dof+shoulder",
+];
 
 fn d_particles() -> usize {
     12
@@ -489,12 +495,14 @@ impl LoadedJob {
                     ),
                 ));
             }
-            if m == "blade2dof+shoulder" && job.fit.shoulder.is_none() {
+            if m.ends_with("+shoulder") && job.fit.shoulder.is_none() {
                 return Err(Error::parse(
                     path,
                     line_of(&text, "models"),
                     1,
-                    "[fit] models lists \"blade2dof+shoulder\": give its bounds in [fit.shoulder] (k1c = [lo, hi], theta_c = [lo, hi])",
+                    format!(
+                        "[fit] models lists \"{m}\": give its bounds in [fit.shoulder] (k1c = [lo, hi], theta_c = [lo, hi])"
+                    ),
                 ));
             }
         }

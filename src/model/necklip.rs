@@ -22,7 +22,7 @@
 //! ([`PrescribedHead::segments`], a guard of [`FLIP_GUARD_OF_REACH`] of the reach around the sign
 //! change of `d`) and the run after it starts from the state the tracks give
 //! ([`NeckLip::state_from_tracks`]). On the sample's blade the guard is 20 ms, and the neck angle
-//! after the flip stays within 4.8e-4 rad of the full model's (`tests/necklip.rs`).
+//! after the flip stays within 3.2e-4 rad of the full model's (`tests/necklip.rs`).
 
 use super::blade::{Blade, BladeParams, Dynamics, StickForm};
 use crate::simulate::hybrid::{Contact, Mode, ModelFault, StickSlipModel};
@@ -35,12 +35,13 @@ const OMEGA_B: f64 = 1e4;
 ///
 /// Built from a (possibly noisy) uniformly sampled track by a local quadratic least-squares fit over
 /// `2·half_width + 1` samples at each sample (Savitzky & Golay 1964, Anal. Chem. 36:1627), which
-/// gives `u`, `u̇`, `ü` there; between samples `u` is a cubic Hermite in `(u, u̇)` and `u̇`, `ü` are
-/// linear. Missing (NaN) samples are skipped by the local fits.
+/// gives `u`, `u̇`, `ü` there; between samples see [`SmoothedTrack::at`]. Missing (NaN) samples are
+/// skipped by the local fits.
 #[derive(Debug, Clone)]
 pub struct SmoothedTrack {
     t0_s: f64,
     dt_s: f64,
+    half_width: usize,
     u: Vec<f64>,
     ud: Vec<f64>,
     udd: Vec<f64>,
@@ -100,6 +101,7 @@ impl SmoothedTrack {
         Ok(SmoothedTrack {
             t0_s,
             dt_s,
+            half_width,
             u,
             ud,
             udd,
@@ -107,21 +109,81 @@ impl SmoothedTrack {
     }
 
     /// `(x, ẋ, ẍ)` at `t` (held constant beyond the samples).
+    ///
+    /// Between samples: the quintic Hermite interpolant of the local fits' `(x, ẋ, ẍ)` at both ends,
+    /// so the three are one C² function and its derivatives (consistent for the constraint's
+    /// Baumgarte terms; an inconsistent set made the integrator take ten times the steps).
     pub fn at(&self, t: f64) -> (f64, f64, f64) {
         let n = self.u.len();
         let x = ((t - self.t0_s) / self.dt_s).clamp(0.0, (n - 1) as f64);
         let k = (x.floor() as usize).min(n - 2);
         let s = x - k as f64;
         let h = self.dt_s;
-        let (u0, u1, d0, d1) = (self.u[k], self.u[k + 1], self.ud[k], self.ud[k + 1]);
-        // Cubic Hermite basis.
-        let (s2, s3) = (s * s, s * s * s);
-        let u = (2.0 * s3 - 3.0 * s2 + 1.0) * u0
-            + (s3 - 2.0 * s2 + s) * h * d0
-            + (-2.0 * s3 + 3.0 * s2) * u1
-            + (s3 - s2) * h * d1;
-        let ud = d0 + s * (d1 - d0);
-        let udd = self.udd[k] + s * (self.udd[k + 1] - self.udd[k]);
+        let (p0, p1) = (self.u[k], self.u[k + 1]);
+        let (m0, m1) = (h * self.ud[k], h * self.ud[k + 1]);
+        let (a0, a1) = (h * h * self.udd[k], h * h * self.udd[k + 1]);
+        // p(s) = Σ c_i s^i with p, p', p'' matching (p0, m0, a0) at s = 0 and (p1, m1, a1) at s = 1.
+        let c2 = 0.5 * a0;
+        let c3 = 10.0 * (p1 - p0) - 6.0 * m0 - 4.0 * m1 - 1.5 * a0 + 0.5 * a1;
+        let c4 = -15.0 * (p1 - p0) + 8.0 * m0 + 7.0 * m1 + 1.5 * a0 - a1;
+        let c5 = 6.0 * (p1 - p0) - 3.0 * m0 - 3.0 * m1 - 0.5 * a0 + 0.5 * a1;
+        let u = p0 + s * (m0 + s * (c2 + s * (c3 + s * (c4 + s * c5))));
+        let ud = (m0 + s * (2.0 * c2 + s * (3.0 * c3 + s * (4.0 * c4 + s * 5.0 * c5)))) / h;
+        let udd = (2.0 * c2 + s * (6.0 * c3 + s * (12.0 * c4 + s * 20.0 * c5))) / (h * h);
+        (u, ud, udd)
+    }
+}
+
+/// A track smoothed by a Gaussian kernel of standard deviation `σ`: the Nadaraya–Watson estimate
+/// `x(t) = Σ g(t − t_k) x_k / Σ g(t − t_k)` over the finite samples within 7σ (Nadaraya 1964,
+/// Watson 1964), with its first two derivatives in closed form. Infinitely differentiable in `t`
+/// (the kernel's tail beyond 7σ is 2e-11 of its peak). In the interior it is a convolution with
+/// gain `exp(−(2πfσ)²/2)` at frequency `f`; near the ends and gaps it is one-sided. NaN where no
+/// finite sample lies within 7σ.
+#[derive(Debug, Clone)]
+pub struct KernelTrack {
+    t0_s: f64,
+    dt_s: f64,
+    x: Vec<f64>,
+    sigma_s: f64,
+}
+
+impl KernelTrack {
+    /// Kernel smooth of samples `x[k]` at `t0_s + k·dt_s` with standard deviation `sigma_s`.
+    pub fn new(t0_s: f64, dt_s: f64, x: &[f64], sigma_s: f64) -> Self {
+        KernelTrack {
+            t0_s,
+            dt_s,
+            x: x.to_vec(),
+            sigma_s,
+        }
+    }
+
+    /// `(x, ẋ, ẍ)` at `t`.
+    pub fn at(&self, t: f64) -> (f64, f64, f64) {
+        let s2 = self.sigma_s * self.sigma_s;
+        let reach = (7.0 * self.sigma_s / self.dt_s).ceil() as isize;
+        let c = ((t - self.t0_s) / self.dt_s).round() as isize;
+        let (mut s0, mut s1, mut s2w, mut n0, mut n1, mut n2) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        for k in (c - reach).max(0)..=(c + reach).min(self.x.len() as isize - 1) {
+            let xk = self.x[k as usize];
+            if !xk.is_finite() {
+                continue;
+            }
+            let tau = t - (self.t0_s + k as f64 * self.dt_s);
+            let g = (-0.5 * tau * tau / s2).exp();
+            let g1 = -tau / s2 * g;
+            let g2 = (tau * tau / (s2 * s2) - 1.0 / s2) * g;
+            s0 += g;
+            s1 += g1;
+            s2w += g2;
+            n0 += xk * g;
+            n1 += xk * g1;
+            n2 += xk * g2;
+        }
+        let u = n0 / s0;
+        let ud = (n1 - u * s1) / s0;
+        let udd = (n2 - 2.0 * ud * s1 - u * s2w) / s0;
         (u, ud, udd)
     }
 }
@@ -133,8 +195,17 @@ impl SmoothedTrack {
 /// ([`NeckLip::state_from_tracks`]).
 #[derive(Debug, Clone)]
 pub struct PrescribedHead {
-    pub drop: SmoothedTrack,
+    pub drop: DropTrack,
     pub lean: Option<SmoothedTrack>,
+}
+
+/// How the head drop is smoothed.
+#[derive(Debug, Clone)]
+pub enum DropTrack {
+    /// Local quadratic fits with a C² quintic between samples: follows a clean track closely.
+    Local(SmoothedTrack),
+    /// A Gaussian kernel smooth: infinitely differentiable, for noisy (tracked) recordings.
+    Kernel(KernelTrack),
 }
 
 impl PrescribedHead {
@@ -150,7 +221,7 @@ impl PrescribedHead {
         half_width: usize,
     ) -> Result<Self, String> {
         Ok(PrescribedHead {
-            drop: SmoothedTrack::from_samples(t0_s, dt_s, u_m, half_width)?,
+            drop: DropTrack::Local(SmoothedTrack::from_samples(t0_s, dt_s, u_m, half_width)?),
             lean: None,
         })
     }
@@ -160,23 +231,50 @@ impl PrescribedHead {
     /// # Errors
     /// As [`SmoothedTrack::from_samples`].
     pub fn with_lean(mut self, d_m: &[f64], half_width: usize) -> Result<Self, String> {
-        self.lean = Some(SmoothedTrack::from_samples(
-            self.drop.t0_s,
-            self.drop.dt_s,
-            d_m,
-            half_width,
-        )?);
+        let (t0_s, dt_s) = match &self.drop {
+            DropTrack::Local(s) => (s.t0_s, s.dt_s),
+            DropTrack::Kernel(k) => (k.t0_s, k.dt_s),
+        };
+        self.lean = Some(SmoothedTrack::from_samples(t0_s, dt_s, d_m, half_width)?);
         Ok(self)
+    }
+
+    /// The head drop from tracked (noisy) samples, smoothed by a Gaussian kernel of standard
+    /// deviation `sigma_s` ([`KernelTrack`]), without a lean track.
+    ///
+    /// # Errors
+    /// A message when `dt_s` or `sigma_s` is not positive, or fewer than 3 samples are finite.
+    pub fn from_tracked_samples(
+        t0_s: f64,
+        dt_s: f64,
+        u_m: &[f64],
+        sigma_s: f64,
+    ) -> Result<Self, String> {
+        if !(dt_s > 0.0 && sigma_s > 0.0 && sigma_s.is_finite())
+            || u_m.iter().filter(|v| v.is_finite()).count() < 3
+        {
+            return Err(format!(
+                "prescribed head: need dt > 0, σ > 0 and at least 3 finite samples (got dt = {dt_s}, σ = {sigma_s})"
+            ));
+        }
+        Ok(PrescribedHead {
+            drop: DropTrack::Kernel(KernelTrack::new(t0_s, dt_s, u_m, sigma_s)),
+            lean: None,
+        })
     }
 
     /// `(u_p, u̇_p, ü_p)` at `t` (held constant beyond the samples).
     pub fn at(&self, t: f64) -> (f64, f64, f64) {
-        self.drop.at(t)
+        match &self.drop {
+            DropTrack::Local(s) => s.at(t),
+            DropTrack::Kernel(k) => k.at(t),
+        }
     }
 
     /// The parts of `window` the model can run on: maximal intervals on the track's sample grid
     /// where the smoothed lean keeps `|d| ≥ guard_m`. The flip at the reversal (a sign change of `d`)
-    /// and a guard around it are left out. Without a lean track: the whole window.
+    /// and a guard around it are left out, and so are the tracks' first and last smoothing
+    /// half-widths (3σ for a kernel smooth). Without a lean track: the whole window.
     pub fn segments(&self, window: (f64, f64), guard_m: f64) -> Vec<(f64, f64)> {
         let Some(lean) = &self.lean else {
             return vec![window];
@@ -221,6 +319,18 @@ impl PrescribedHead {
         {
             l.1 = window.1;
         }
+        // Within `edge` of the tracks' ends the smooths are one-sided and their rates unreliable
+        // (a start state taken there made the normal force negative): keep out of it.
+        let edge = (lean.half_width as f64 * dt).max(match &self.drop {
+            DropTrack::Local(s) => s.half_width as f64 * s.dt_s,
+            DropTrack::Kernel(k) => 3.0 * k.sigma_s,
+        });
+        let (lo, hi) = (t0 + edge, t0 + (lean.u.len() - 1) as f64 * dt - edge);
+        for sgm in &mut out {
+            sgm.0 = sgm.0.max(lo);
+            sgm.1 = sgm.1.min(hi);
+        }
+        out.retain(|sgm| sgm.1 > sgm.0);
         out
     }
 }
@@ -484,5 +594,73 @@ impl StickSlipModel<4> for NeckLip {
             "neck/lip on prescribed head (u_p = {up:.6e} m): {}",
             self.blade.describe(t, y)
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Local quadratic fits reproduce a quadratic exactly, and so does the quintic between samples.
+    #[test]
+    fn smoothed_track_is_exact_on_a_quadratic() {
+        let (t0, dt) = (0.5, 1e-3);
+        let f = |t: f64| 3.0 + 2.0 * t - 7.0 * t * t;
+        let x: Vec<f64> = (0..50).map(|k| f(t0 + k as f64 * dt)).collect();
+        let tr = SmoothedTrack::from_samples(t0, dt, &x, 4).unwrap();
+        for t in [0.5, 0.50037, 0.5213, 0.549] {
+            let (u, ud, udd) = tr.at(t);
+            assert!((u - f(t)).abs() < 1e-12, "u at {t}");
+            assert!((ud - (2.0 - 14.0 * t)).abs() < 1e-9, "u̇ at {t}");
+            assert!((udd + 14.0).abs() < 1e-6, "ü at {t}");
+        }
+    }
+
+    /// In the interior the kernel smooth of a sinusoid is the sinusoid times the Gaussian's Fourier
+    /// transform exp(−(2πfσ)²/2); its derivatives are those of the attenuated sinusoid.
+    #[test]
+    fn kernel_track_has_the_gaussian_gain() {
+        let (dt, sigma) = (1e-4, 5e-4);
+        for f_hz in [49.0, 300.0] {
+            let w = 2.0 * std::f64::consts::PI * f_hz;
+            let x: Vec<f64> = (0..4000).map(|k| (w * k as f64 * dt).sin()).collect();
+            let tr = KernelTrack::new(0.0, dt, &x, sigma);
+            let gain = (-0.5 * (w * sigma).powi(2)).exp();
+            for t in [0.17, 0.20013, 0.23] {
+                let (u, ud, udd) = tr.at(t);
+                assert!(
+                    (u - gain * (w * t).sin()).abs() < 1e-6,
+                    "{f_hz} Hz: u at {t}"
+                );
+                assert!((ud - gain * w * (w * t).cos()).abs() < 1e-6 * w, "u̇");
+                assert!(
+                    (udd + gain * w * w * (w * t).sin()).abs() < 1e-6 * w * w,
+                    "ü"
+                );
+            }
+        }
+    }
+
+    /// A lean that crosses zero once gives two segments, cut where |d| < guard.
+    #[test]
+    fn segments_leave_out_the_flip() {
+        let dt = 1e-3;
+        // d = 1e-3 (t − 1) m on [0, 2] s: crosses zero at 1 s; guard 1e-4 m leaves out 0.9–1.1 s.
+        let d: Vec<f64> = (0..=2000).map(|k| 1e-3 * (k as f64 * dt - 1.0)).collect();
+        let u = vec![0.0; d.len()];
+        let head = PrescribedHead::from_samples(0.0, dt, &u, 3)
+            .unwrap()
+            .with_lean(&d, 3)
+            .unwrap();
+        let seg = head.segments((0.0, 2.0), 1e-4);
+        assert_eq!(seg.len(), 2, "{seg:?}");
+        // The tracks' first and last 3 samples (the smoothing half-width) are left out too.
+        assert!((seg[0].0 - 3.0 * dt).abs() < 1e-12, "{seg:?}");
+        assert!((seg[0].1 - 0.9).abs() < 1.5 * dt, "{seg:?}");
+        assert!((seg[1].0 - 1.1).abs() < 1.5 * dt, "{seg:?}");
+        assert!((seg[1].1 - (2.0 - 3.0 * dt)).abs() < 1e-12, "{seg:?}");
+        // Without a lean track: the whole window.
+        let plain = PrescribedHead::from_samples(0.0, dt, &u, 3).unwrap();
+        assert_eq!(plain.segments((0.2, 1.7), 1e-4), vec![(0.2, 1.7)]);
     }
 }

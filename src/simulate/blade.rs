@@ -151,12 +151,16 @@ pub fn simulate_model(
 /// The model cannot pass the blade's flip at the reversal (its head-height constraint degenerates
 /// at upright, [`crate::model::necklip`]), so with a lean track the window is cut into the segments
 /// of [`PrescribedHead::segments`](crate::model::necklip::PrescribedHead::segments) (guard
-/// [`FLIP_GUARD_OF_REACH`](crate::model::necklip::FLIP_GUARD_OF_REACH) of the reach). A segment that
-/// starts at `window.0` starts from the full model's quasi-static slip equilibrium there (the
-/// constraint's Baumgarte term pulls the head height onto `head`); a later one from the state the
-/// tracks give ([`NeckLip::state_from_tracks`](crate::model::necklip::NeckLip::state_from_tracks)).
-/// Samples in the guard hold NaN positions and angles (the drive `v` is known) and the phase of the
-/// segment before, so the spectra skip them.
+/// [`FLIP_GUARD_OF_REACH`](crate::model::necklip::FLIP_GUARD_OF_REACH) of the reach). The first
+/// segment starts from the full model's quasi-static slip equilibrium (the constraint's Baumgarte
+/// term pulls the head height onto `head`): the window is meant to start in steady slip, and the
+/// recorded angles there need not balance the model's stiffnesses (starting from them gave a
+/// negative normal force away from the true blade). A segment after the flip starts from the
+/// state the tracks give
+/// ([`NeckLip::state_from_tracks`](crate::model::necklip::NeckLip::state_from_tracks)), in stick or
+/// slip as the tip's speed and the friction limit say. Samples outside the segments hold NaN
+/// positions and angles (the drive `v` is known) and the phase of the segment before, so the
+/// spectra skip them.
 ///
 /// # Errors
 /// As [`simulate_blade`]; [`Error::Simulation`] too when the lean stays inside the guard over the
@@ -207,20 +211,44 @@ pub fn simulate_necklip(
         stats: Stats::default(),
         reach_m: reach,
     };
-    for (i, &(a, b)) in segments.iter().enumerate() {
+    for (i, &(a0, b)) in segments.iter().enumerate() {
+        let mut a = a0;
         let fail = |e: crate::simulate::hybrid::ModelFault| Error::Simulation {
-            t_s: a,
+            t_s: a0,
             message: e.to_string(),
-            state: format!("start of neck/lip segment {} ({a:.6}–{b:.6} s)", i + 1),
+            state: format!("start of neck/lip segment {} ({a0:.6}–{b:.6} s)", i + 1),
         };
-        let (y0, mode0) = if i == 0 && a == window.0 {
+        let (y0, mode0) = if i == 0 {
             (
                 model.blade.slip_equilibrium(a).map_err(fail)?,
                 Mode::new(drive_dir(a), 0.0),
             )
         } else {
-            let (y, dir) = model.state_from_tracks(a).map_err(fail)?;
-            (y, Mode::new(Phase::slip(dir), 0.0))
+            // The first sample (up to 10 ms into the segment) where the tracks give a state the
+            // model can start from: right after the flip slip can be Painlevé-singular with the
+            // head height prescribed, and static friction may not yet hold the tip.
+            let dt = sample_times.get(1).map_or(1e-4, |t1| t1 - sample_times[0]);
+            let mut start = None;
+            let mut why = String::new();
+            let mut ts = a;
+            while start.is_none() && ts <= (a + 0.01).min(b) {
+                match model.state_from_tracks(ts) {
+                    Ok((y, dir)) => match start_from_tracks(&model, ts, y, dir) {
+                        Ok(s) => start = Some(s),
+                        Err(e) => why = e.to_string(),
+                    },
+                    Err(e) => why = e.to_string(),
+                }
+                if start.is_none() {
+                    ts += dt;
+                }
+            }
+            a = ts;
+            start.ok_or_else(|| {
+                fail(crate::simulate::hybrid::ModelFault::Geometry(format!(
+                    "no consistent start within 10 ms of the segment's start: {why}"
+                )))
+            })?
         };
         let lo = sample_times.partition_point(|&t| t < a);
         let hi = sample_times.partition_point(|&t| t <= b);
@@ -246,6 +274,44 @@ pub fn simulate_necklip(
         sim.stats.event_evals += run.stats.event_evals;
     }
     Ok(sim)
+}
+
+/// The mode a neck/lip segment starts in from the tracks, and its state: stick when the tip's speed
+/// from the tracks is below what they resolve (1 mm/s, or 5 % of the drive's speed) and static
+/// friction can hold the tip there (seed eq. 5; the velocity is then made consistent with stick),
+/// else slip along the tip's velocity. Right after the flip the tip is usually held while the head
+/// passes over it, and slip there can be Painlevé-singular with the head height prescribed.
+fn start_from_tracks(
+    model: &crate::model::necklip::NeckLip,
+    t: f64,
+    y: [f64; 4],
+    dir: f64,
+) -> std::result::Result<([f64; 4], Mode), crate::simulate::hybrid::ModelFault> {
+    use crate::simulate::hybrid::{ModelFault, StickSlipModel};
+    let mut dy = [0.0; 4];
+    let tip_speed = model.slip_velocity(t, &y).abs();
+    if tip_speed < 1e-3_f64.max(0.05 * model.blade.drive(t).1.abs()) {
+        let anchor = model.contact_position(t, &y);
+        let mut ys = y;
+        model.enter_stick(t, &mut ys, anchor);
+        let stick = Mode::new(Phase::Stick, anchor);
+        if let Ok(c) = model.rhs(&stick, t, &ys, &mut dy)
+            && c.normal > 0.0
+            && c.friction.abs() <= c.limit
+        {
+            return Ok((ys, stick));
+        }
+    }
+    let slip = Mode::new(Phase::slip(dir), 0.0);
+    let c = model.rhs(&slip, t, &y, &mut dy)?;
+    if c.normal > 0.0 {
+        Ok((y, slip))
+    } else {
+        Err(ModelFault::Geometry(format!(
+            "normal force {:.3e} N <= 0 in slip",
+            c.normal
+        )))
+    }
 }
 
 /// Simulates the blade from the quasi-static slip equilibrium at `window.0` to `window.1`, recording
