@@ -396,6 +396,63 @@ impl Blade {
         })
     }
 
+    /// Right-hand side of the tip constraint at acceleration level,
+    /// `−v̈ + l1 sin θ θ̇² + l2 sin φ φ̇² − 2ω_B Φ̇ − ω_B² Φ` with `Φ = v3 − anchor` (Baumgarte; no
+    /// Baumgarte terms for `ω_B = 0`).
+    pub(crate) fn tip_constraint_rhs(
+        &self,
+        t: f64,
+        y: &[f64; 4],
+        anchor: f64,
+        omega_b: f64,
+    ) -> f64 {
+        let (l1, l2) = (self.params.l1_m, self.params.l2_m);
+        let (_, _, vdd) = self.drive(t);
+        let mut rhs = -vdd + l1 * y[0].sin() * y[2] * y[2] + l2 * y[1].sin() * y[3] * y[3];
+        if omega_b > 0.0 {
+            let phi_c = self.tip_position(t, y) - anchor;
+            let phi_cd = self.tip_velocity(t, y);
+            rhs -= 2.0 * omega_b * phi_cd + omega_b * omega_b * phi_c;
+        }
+        rhs
+    }
+
+    /// Solves three rows `A·[θ̈, φ̈, N]ᵀ + a_f·f = b` (those of [`Blade::rows`], or with a row
+    /// replaced) together with the tip constraint `l1 cos θ θ̈ + l2 cos φ φ̈ = tip_rhs` for
+    /// `[θ̈, φ̈, N, f]`; the constraint row is scaled to the size of the first two. `None` if the
+    /// 4×4 system is singular.
+    pub(crate) fn solve_with_tip_constraint(
+        &self,
+        y: &[f64; 4],
+        a3: &Matrix3<f64>,
+        af: &Vector3<f64>,
+        b3: &Vector3<f64>,
+        tip_rhs: f64,
+    ) -> Option<Vector4<f64>> {
+        let (l1, l2) = (self.params.l1_m, self.params.l2_m);
+        let w = a3[(0, 0)].abs().max(a3[(1, 1)].abs()) / l1.max(l2);
+        let a = Matrix4::new(
+            a3[(0, 0)],
+            a3[(0, 1)],
+            a3[(0, 2)],
+            af[0],
+            a3[(1, 0)],
+            a3[(1, 1)],
+            a3[(1, 2)],
+            af[1],
+            a3[(2, 0)],
+            a3[(2, 1)],
+            a3[(2, 2)],
+            af[2],
+            w * l1 * y[0].cos(),
+            w * l2 * y[1].cos(),
+            0.0,
+            0.0,
+        );
+        a.lu()
+            .solve(&Vector4::new(b3[0], b3[1], b3[2], w * tip_rhs))
+    }
+
     /// Stick dynamics: eqs. (1)–(3) plus the constraint acceleration
     /// `l1 cos θ θ̈ + l2 cos φ φ̈ = −v̈ + l1 sin θ θ̇² + l2 sin φ φ̇² − 2ω_B Φ̇ − ω_B² Φ`
     /// with `Φ = v3 − anchor` (Baumgarte; `ω_B = 0` for the drift-free form, where Φ = Φ̇ = 0 exactly).
@@ -419,40 +476,9 @@ impl Blade {
         touching: bool,
     ) -> Result<Dynamics, ModelFault> {
         let (a3, af, b3) = self.rows(t, y, touching);
-        let (l1, l2) = (self.params.l1_m, self.params.l2_m);
-        let (sth, cth) = y[0].sin_cos();
-        let (sph, cph) = y[1].sin_cos();
-        let (_, _, vdd) = self.drive(t);
-        let mut rhs4 = -vdd + l1 * sth * y[2] * y[2] + l2 * sph * y[3] * y[3];
-        if omega_b > 0.0 {
-            let phi_c = self.tip_position(t, y) - anchor;
-            let phi_cd = self.tip_velocity(t, y);
-            rhs4 -= 2.0 * omega_b * phi_cd + omega_b * omega_b * phi_c;
-        }
-        // Unknowns [θ̈, φ̈, N, f]; scale the constraint row to the size of the others.
-        let w = a3[(0, 0)].abs().max(a3[(1, 1)].abs()) / l1.max(l2);
-        let a = Matrix4::new(
-            a3[(0, 0)],
-            a3[(0, 1)],
-            a3[(0, 2)],
-            af[0],
-            a3[(1, 0)],
-            a3[(1, 1)],
-            a3[(1, 2)],
-            af[1],
-            a3[(2, 0)],
-            a3[(2, 1)],
-            a3[(2, 2)],
-            af[2],
-            w * l1 * cth,
-            w * l2 * cph,
-            0.0,
-            0.0,
-        );
-        let b = Vector4::new(b3[0], b3[1], b3[2], w * rhs4);
-        let z = a
-            .lu()
-            .solve(&b)
+        let rhs4 = self.tip_constraint_rhs(t, y, anchor, omega_b);
+        let z = self
+            .solve_with_tip_constraint(y, &a3, &af, &b3, rhs4)
             .ok_or_else(|| ModelFault::Singular("stick constraint system is singular".into()))?;
         Ok(Dynamics {
             theta_dd: z[0],

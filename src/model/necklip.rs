@@ -26,7 +26,7 @@
 
 use super::blade::{Blade, BladeParams, Dynamics, StickForm};
 use crate::simulate::hybrid::{Contact, Mode, ModelFault, StickSlipModel};
-use nalgebra::{Matrix3, Matrix4, Vector3, Vector4};
+use nalgebra::{Matrix3, Vector3};
 
 /// Baumgarte gain of the head-height constraint, s⁻¹ (physics.md §0.3).
 const OMEGA_B: f64 = 1e4;
@@ -506,37 +506,17 @@ impl NeckLip {
                 })
             }
             None => {
-                let p = &self.blade.params;
-                let (l1, l2) = (p.l1_m, p.l2_m);
-                let (sth, cth) = y[0].sin_cos();
-                let (sph, cph) = y[1].sin_cos();
-                let (_, _, vdd) = self.blade.drive(t);
-                let phi_c = self.blade.tip_position(t, y) - mode.anchor;
-                let phi_cd = self.blade.tip_velocity(t, y);
-                let tip_rhs = -vdd + l1 * sth * y[2] * y[2] + l2 * sph * y[3] * y[3]
-                    - 2.0 * OMEGA_B * phi_cd
-                    - OMEGA_B * OMEGA_B * phi_c;
-                let a = Matrix4::new(
-                    a3[(0, 0)],
-                    a3[(0, 1)],
-                    a3[(0, 2)],
-                    af[0],
-                    a3[(1, 0)],
-                    a3[(1, 1)],
-                    a3[(1, 2)],
-                    af[1],
-                    w * hrow[0],
-                    w * hrow[1],
-                    0.0,
-                    0.0,
-                    w * l1 * cth,
-                    w * l2 * cph,
-                    0.0,
-                    0.0,
-                );
-                let z = a
-                    .lu()
-                    .solve(&Vector4::new(b3[0], b3[1], w * hrhs, w * tip_rhs))
+                // Row 3 replaced by the height constraint, then the tip constraint (Baumgarte).
+                let mut a = a3;
+                a[(2, 0)] = w * hrow[0];
+                a[(2, 1)] = w * hrow[1];
+                a[(2, 2)] = 0.0;
+                let f = Vector3::new(af[0], af[1], 0.0);
+                let b = Vector3::new(b3[0], b3[1], w * hrhs);
+                let tip_rhs = self.blade.tip_constraint_rhs(t, y, mode.anchor, OMEGA_B);
+                let z = self
+                    .blade
+                    .solve_with_tip_constraint(y, &a, &f, &b, tip_rhs)
                     .ok_or_else(|| {
                         ModelFault::Singular("neck/lip stick system is singular".into())
                     })?;

@@ -22,7 +22,6 @@ use super::rk;
 use crate::model::belt::Belt;
 use crate::model::blade::Blade;
 use crate::{Error, Result};
-use nalgebra::{Matrix4, Vector4};
 
 /// A model that both comparison methods can integrate. State as in its [`super::hybrid::StickSlipModel`]
 /// implementation, with every component integrated (the blade's full `[θ, φ, θ̇, φ̇]`).
@@ -274,29 +273,8 @@ impl NonsmoothModel<4> for Blade {
         // Stick: tip velocity zero at t + h, i.e. l1 cθ θ̈ + l2 cφ φ̈ = −γ*/h with γ* the tip
         // velocity at t + h without this step's accelerations.
         let gamma_free = vd_next + l1 * cth * y[2] + l2 * cph * y[3];
-        let w = a3[(0, 0)].abs().max(a3[(1, 1)].abs()) / l1.max(l2);
-        let a4 = Matrix4::new(
-            a3[(0, 0)],
-            a3[(0, 1)],
-            a3[(0, 2)],
-            af[0],
-            a3[(1, 0)],
-            a3[(1, 1)],
-            a3[(1, 2)],
-            af[1],
-            a3[(2, 0)],
-            a3[(2, 1)],
-            a3[(2, 2)],
-            af[2],
-            w * l1 * cth,
-            w * l2 * cph,
-            0.0,
-            0.0,
-        );
-        let b4 = Vector4::new(b3[0], b3[1], b3[2], -w * gamma_free / h);
-        let z = a4
-            .lu()
-            .solve(&b4)
+        let z = self
+            .solve_with_tip_constraint(y, &a3, &af, &b3, -gamma_free / h)
             .ok_or_else(|| ModelFault::Singular("stick system singular".into()))?;
         let mu_s = self.params.friction.mu_static();
         let (acc, normal, phase) = if z[2] > 0.0 && z[3].abs() <= mu_s * z[2] {
