@@ -1,4 +1,8 @@
 //! Command-line interface: argument parsing and glue only; the library does the work.
+//!
+//! The doc comments on the argument types are clap's `--help` text, which names placeholders the
+//! way command-line help does (`<file stem>`, `reports/<job>/`); rustdoc would read them as HTML.
+#![allow(rustdoc::invalid_html_tags)]
 
 use crate::fit::features::{BandSpec, SignalKind, features};
 use crate::fit::job::{LoadedJob, parse_toml, read_text};

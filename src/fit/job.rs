@@ -139,7 +139,7 @@ impl Default for SpectrumSection {
     }
 }
 
-/// Cost weights (see [`super::cost_of`]).
+/// Cost weights (see [`super::SpectralProblem::cost_of`]).
 #[derive(Debug, Clone, Copy, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Weights {
