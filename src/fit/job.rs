@@ -187,6 +187,10 @@ pub struct FitSection {
     /// Seed of the swarm's random generator (the fit is reproducible for a given seed).
     #[serde(default = "d_seed")]
     pub seed: u64,
+    /// Independent swarm-and-polish runs; the lowest cost is kept (see `optimise` in
+    /// [`crate::fit`]). Each run costs a full swarm and polish.
+    #[serde(default = "d_restarts")]
+    pub restarts: usize,
     #[serde(default)]
     pub weights: Weights,
     /// Models of the hierarchy to fit and compare, from [`MODEL_NAMES`], e.g. `["head1dof",
@@ -258,6 +262,9 @@ fn d_polish() -> u64 {
     40
 }
 fn d_seed() -> u64 {
+    1
+}
+fn d_restarts() -> usize {
     1
 }
 
