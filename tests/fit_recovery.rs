@@ -48,18 +48,7 @@ fn fit_recovers_friction_c_and_neck_stiffness() {
     let job = format!(
         r#"name = "recovery"
 blade = "blade.toml"
-[recording]
-file = "rec_xypts.csv"
-[recording.import]
-format = "dltdv"
-fps_hz = 10000.0
-m_per_px = 1.5e-5
-origin_px = [200.0, 300.0]
-t0_s = {t0:?}
-[recording.import.points]
-head = "pt1"
-tip = "pt2"
-[fit]
+{recording}[fit]
 particles = 8
 swarm_iterations = 6
 polish_iterations = 25
@@ -70,7 +59,8 @@ k1 = [0.01, 0.05]
 [truth]
 json = "truth.json"
 keys = {{ C = "/C", k1 = "/k1" }}
-"#
+"#,
+        recording = common::dltdv_recording("rec_xypts.csv", t0),
     );
     std::fs::write(dir.join("job.toml"), job).unwrap();
     let loaded = LoadedJob::load(&dir.join("job.toml")).unwrap();

@@ -76,24 +76,7 @@ fn bootstrap_intervals_cover_the_truth_at_their_rate() {
         let job = format!(
             r#"name = "coverage{r}"
 blade = "blade.toml"
-[recording]
-file = "rec{r}_xypts.csv"
-[recording.import]
-format = "dltdv"
-fps_hz = 10000.0
-m_per_px = 1.5e-5
-origin_px = [200.0, 300.0]
-t0_s = {t0:?}
-[recording.import.points]
-head = "pt1"
-tip = "pt2"
-[spectrum]
-signal = "tip_rel_x"
-[[spectrum.bands]]
-name = "low"
-range_hz = [30.0, 300.0]
-nperseg = 2048
-[solver]
+{recording}{spectrum}[solver]
 rtol = 1e-8
 atol = 1e-10
 [fit]
@@ -112,7 +95,9 @@ C = [0.4, 0.7]
 json = "truth.json"
 keys = {{ k1 = "/k1", C = "/C" }}
 "#,
-            seed = 50 * r
+            seed = 50 * r,
+            recording = common::dltdv_recording(&format!("rec{r}_xypts.csv"), t0),
+            spectrum = common::spectrum_bands(&[("low", [30.0, 300.0], 2048)]),
         );
         std::fs::write(dir.join(format!("job{r}.toml")), job).unwrap();
         let loaded = LoadedJob::load(&dir.join(format!("job{r}.toml"))).unwrap();

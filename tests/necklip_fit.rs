@@ -2,9 +2,15 @@
 //! the blade's flip, leaves the flip's guard out of the measured spectra, and is never chosen for a
 //! job with a low band, which it imposes from the head track instead of explaining.
 
+mod common;
+
 use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
 use wiperlab::simulate::blade::ModelKind;
+
+/// The main job's bands (fits/reversal.toml).
+const MAIN_JOB_BANDS: &[(&str, [f64; 2], usize)] =
+    &[("low", [30.0, 300.0], 4096), ("high", [500.0, 5000.0], 512)];
 
 #[test]
 fn necklip_is_fitted_but_not_chosen_for_a_low_band() {
@@ -18,34 +24,8 @@ fn necklip_is_fitted_but_not_chosen_for_a_low_band() {
         r#"name = "necklip_fit"
 blade = "{root}/data/reversal/blade_true.toml"
 
-[recording]
-file = "{root}/data/reversal/wiper_reversal_sample_xypts.csv"
-
-[recording.import]
-format = "dltdv"
-fps_hz = 10000.0
-m_per_px = 1.5e-5
-origin_px = [200.0, 300.0]
-t0_s = 0.9434198694385137
-
-[recording.import.points]
-head = "pt1"
-tip = "pt2"
-
-[spectrum]
-signal = "tip_rel_x"
-max_fill = 5
-
-[[spectrum.bands]]
-name = "low"
-range_hz = [30.0, 300.0]
-nperseg = 4096
-
-[[spectrum.bands]]
-name = "high"
-range_hz = [500.0, 5000.0]
-nperseg = 2048
-
+{recording}
+{spectrum}
 [solver]
 rtol = 1e-8
 atol = 1e-10
@@ -60,7 +40,9 @@ models = ["necklip", "blade2dof"]
 [fit.parameters]
 k1 = [0.005, 0.15]
 "#,
-        root = root.display()
+        root = root.display(),
+        recording = common::sample_recording(),
+        spectrum = common::spectrum_bands(MAIN_JOB_BANDS),
     );
     let path = dir.join("job.toml");
     std::fs::write(&path, job).unwrap();

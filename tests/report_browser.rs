@@ -10,6 +10,8 @@
 //! Without Chromium the browser part of each test prints why it is skipped and the rest still runs;
 //! with `WIPERLAB_REQUIRE_BROWSER=1` (set by `.ci/run`) a missing Chromium fails instead.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -49,33 +51,8 @@ fn write_quick_job(dir: &Path) -> PathBuf {
         r#"name = "quick"
 blade = "{data}/blade_true.toml"
 
-[recording]
-file = "{data}/wiper_reversal_sample_xypts.csv"
-
-[recording.import]
-format = "dltdv"
-fps_hz = 10000.0
-m_per_px = 1.5e-5
-origin_px = [200.0, 300.0]
-t0_s = 0.9434198694385137
-
-[recording.import.points]
-head = "pt1"
-tip = "pt2"
-
-[spectrum]
-signal = "tip_rel_x"
-
-[[spectrum.bands]]
-name = "low"
-range_hz = [30.0, 300.0]
-nperseg = 4096
-
-[[spectrum.bands]]
-name = "high"
-range_hz = [500.0, 5000.0]
-nperseg = 2048
-
+{recording}
+{spectrum}
 [solver]
 rtol = 1e-7
 atol = 1e-9
@@ -94,7 +71,12 @@ k1 = [0.02, 0.04]
 json = "{data}/truth.json"
 keys = {{ C = "/params/C", k1 = "/params/k1" }}
 "#,
-        data = data.display()
+        data = data.display(),
+        recording = common::sample_recording(),
+        spectrum = common::spectrum_bands(&[
+            ("low", [30.0, 300.0], 4096),
+            ("high", [500.0, 5000.0], 2048)
+        ]),
     );
     let p = dir.join("quick.toml");
     std::fs::write(&p, text).expect("write the quick job");

@@ -56,18 +56,7 @@ fn fit_prefers_and_recovers_the_shoulder() {
     let job = format!(
         r#"name = "shoulder"
 blade = "blade.toml"
-[recording]
-file = "rec_xypts.csv"
-[recording.import]
-format = "dltdv"
-fps_hz = 10000.0
-m_per_px = 1.5e-5
-origin_px = [200.0, 300.0]
-t0_s = {t0:?}
-[recording.import.points]
-head = "pt1"
-tip = "pt2"
-[solver]                 # as the main job (fits/reversal.toml)
+{recording}[solver]                 # as the main job (fits/reversal.toml)
 rtol = 1e-8
 atol = 1e-10
 [fit]
@@ -84,7 +73,8 @@ k1 = [0.002, 0.05]
 [truth]
 json = "truth.json"
 keys = {{ k1 = "/k1", k1c = "/k1c", theta_c = "/theta_c" }}
-"#
+"#,
+        recording = common::dltdv_recording("rec_xypts.csv", t0),
     );
     std::fs::write(dir.join("job.toml"), job).unwrap();
     let loaded = LoadedJob::load(&dir.join("job.toml")).unwrap();

@@ -98,3 +98,36 @@ pub fn dltdv_import(t0: f64) -> String {
         "format = \"dltdv\"\nfps_hz = 10000.0\nm_per_px = 1.5e-5\norigin_px = [200.0, 300.0]\nt0_s = {t0:?}\n"
     )
 }
+
+/// Frame 1 of the shipped sample (`data/reversal/`) on the model clock, s: data/reversal/truth.json
+/// `camera.t0_s` (drive phase ωt = π/2), as in the main job `fits/reversal.toml`.
+pub const SAMPLE_T0_S: f64 = 0.9434198694385137;
+
+/// The `[recording]` section of a job, with its `[recording.import]` ([`dltdv_import`]) and points
+/// (`pt1` the head, `pt2` the lip tip), for a DLTdv export laid out like the shipped sample or
+/// written by [`write_dltdv`]. `file` is written as given (relative paths resolve from the job).
+pub fn dltdv_recording(file: &str, t0: f64) -> String {
+    format!(
+        "[recording]\nfile = {file:?}\n[recording.import]\n{}[recording.import.points]\nhead = \"pt1\"\ntip = \"pt2\"\n",
+        dltdv_import(t0)
+    )
+}
+
+/// [`dltdv_recording`] of the shipped sample recording, by absolute path.
+pub fn sample_recording() -> String {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data/reversal/wiper_reversal_sample_xypts.csv");
+    dltdv_recording(&file.display().to_string(), SAMPLE_T0_S)
+}
+
+/// The `[spectrum]` section of a job: signal tip x − head x and the given bands
+/// `(name, [lo, hi] Hz, nperseg)`.
+pub fn spectrum_bands(bands: &[(&str, [f64; 2], usize)]) -> String {
+    let mut s = String::from("[spectrum]\nsignal = \"tip_rel_x\"\nmax_fill = 5\n");
+    for (name, [lo, hi], nperseg) in bands {
+        s.push_str(&format!(
+            "[[spectrum.bands]]\nname = {name:?}\nrange_hz = [{lo:?}, {hi:?}]\nnperseg = {nperseg}\n"
+        ));
+    }
+    s
+}
