@@ -176,7 +176,7 @@ fn assert_fresh(path: &Path, since: SystemTime) {
 // The main job
 // ---------------------------------------------------------------------------------------------
 
-/// `wiperlab fit fits/reversal.toml --json` (about 20 s in release on 2 cores). Writes
+/// `wiperlab fit fits/reversal.toml --json` (about 10 min in release on 2 cores). Writes
 /// `fits/reversal.result.toml` and `reports/reversal/*.svg` in the repo, as the job documents.
 #[test]
 fn main_job_end_to_end() {
@@ -267,6 +267,15 @@ fn main_job_end_to_end() {
             "{name}: true_value {true_value} but truth.json has {want}"
         );
         println!("{name}: fitted {value:.6e}, true {true_value:.6e}, rel error {rel:+.4}");
+        // The fit must find the truth's basin: the sample was made by an independent
+        // implementation with these parameters (truth.json), so what is left is tracking noise and
+        // the two implementations' differences. Measured: A +1.3 %, B +2.6 %, C −0.1 %, k1 −0.9 %;
+        // a single swarm (restarts = 1) ended at B +29.5 %, C −12.4 %, k1 −11 % (README, "Restarts").
+        assert!(
+            rel.abs() <= 0.05,
+            "{name}: fitted {value} against the true {true_value} ({:+.2} %)",
+            rel * 100.0
+        );
     }
 
     // The result file beside the job: rewritten by this run, valid TOML, the same result.

@@ -26,6 +26,12 @@ pub struct BandSpec {
 /// bins) the low peak is resolved; with 2048 the high band's stick–slip comb (lines ~7 Hz apart
 /// whose largest member changes with the integration tolerance) merges into its envelope, whose peak
 /// then moves by < 0.05 Hz between rtol 1e-7 and 1e-12 (measured; see README).
+///
+/// For fitting, 2048 still resolves bumps ~18 Hz apart on that envelope, and its largest one
+/// changes as the parameters move: the peak jumps by ~2 % (883 → 866 Hz) between neighbouring
+/// parameter sets and the cost surface gets steps of 3–4. The main job (`fits/reversal.toml`)
+/// therefore uses 512 samples (19.5 Hz bins) in the high band, where the envelope is one hump
+/// (README, "Restarts"); this default is kept for jobs that want the finer estimate.
 pub fn default_bands() -> Vec<BandSpec> {
     vec![
         BandSpec {
