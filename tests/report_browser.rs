@@ -292,7 +292,7 @@ fn report_page_after_a_quick_fit_loads_every_figure_in_chromium() {
         "Only one model (blade2dof) was fitted",
         "rtol 1e-7, atol 1e-9", // the quick job's [solver]
         "low 30.00–300.0 Hz (Welch, Hann, nperseg 4096)",
-        "particle swarm 4 particles × 1 iterations (seed 3)",
+        "1 × (particle swarm 4 particles × 1 iterations, Nelder–Mead ≤ 3 iterations), best kept (seed 3)",
     ] {
         assert!(html.contains(needle), "page lacks {needle:?}");
     }

@@ -554,8 +554,8 @@ fn build_problem(
 /// # Errors
 /// An unknown model name, and every error of reading and measuring the recording.
 pub fn problem_for(job: &LoadedJob, model: &str) -> Result<SpectralProblem> {
-    let candidate = Candidate::parse(model)
-        .ok_or_else(|| Error::Config(format!("unknown model '{model}'")))?;
+    let candidate =
+        Candidate::parse(model).ok_or_else(|| Error::Config(format!("unknown model '{model}'")))?;
     let meas = measure(job)?;
     Ok(build_problem(job, &meas, candidate, &None)?.0)
 }

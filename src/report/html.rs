@@ -569,12 +569,13 @@ pub fn render_html(
             &mut h,
             "fit settings",
             format!(
-                "particle swarm {} particles × {} iterations (seed {}), Nelder–Mead ≤ {} iterations; \
-                 weights peak {}, level {}, shape {}",
+                "{} × (particle swarm {} particles × {} iterations, Nelder–Mead ≤ {} iterations), \
+                 best kept (seed {}); weights peak {}, level {}, shape {}",
+                f.restarts.max(1),
                 f.particles,
                 f.swarm_iterations,
-                f.seed,
                 f.polish_iterations,
+                f.seed,
                 f.weights.peak,
                 f.weights.level,
                 f.weights.shape

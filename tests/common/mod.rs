@@ -115,8 +115,8 @@ pub fn dltdv_recording(file: &str, t0: f64) -> String {
 
 /// [`dltdv_recording`] of the shipped sample recording, by absolute path.
 pub fn sample_recording() -> String {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("data/reversal/wiper_reversal_sample_xypts.csv");
+    let file =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("data/reversal/wiper_reversal_sample_xypts.csv");
     dltdv_recording(&file.display().to_string(), SAMPLE_T0_S)
 }
 
