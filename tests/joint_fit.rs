@@ -84,6 +84,8 @@ particles = 8
 swarm_iterations = 6
 polish_iterations = 25
 seed = 3
+[fit.uncertainty]        # two replicates: checks that a joint fit gets intervals, not their coverage
+bootstrap = 2
 [fit.parameters]
 C = [0.3, 0.8]
 k1 = [0.01, 0.05]
@@ -125,6 +127,23 @@ keys = {{ C = "/C", k1 = "/k1" }}
             100.0 * p.rel_error.unwrap()
         );
         assert!(p.rel_error.unwrap().abs() < 0.05, "{} off", p.name);
+        // Every parameter of a joint fit has a bootstrap interval, whose replicates re-noise both
+        // recordings, each at its own measured noise level.
+        let iv = p.interval.as_ref().unwrap_or_else(|| {
+            panic!(
+                "{}: no interval; warnings {:?}",
+                p.name, out.result.warnings
+            )
+        });
+        eprintln!(
+            "{}: interval [{:.6}, {:.6}] ({})",
+            p.name, iv.lo, iv.hi, iv.method
+        );
+        assert!(
+            iv.lo.is_finite() && iv.hi.is_finite() && iv.lo < iv.hi,
+            "{iv:?}"
+        );
+        assert!(iv.method.contains("of the recordings"), "{}", iv.method);
     }
     std::fs::remove_dir_all(&dir).ok();
 }

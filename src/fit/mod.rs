@@ -1095,10 +1095,6 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         warnings.push(
             "no bootstrap intervals for a target job: targets carry no measurement noise".into(),
         );
-    } else if fit.uncertainty.bootstrap > 0 && !problem.others.is_empty() {
-        warnings.push(
-            "no bootstrap intervals for a joint fit of several recordings (not implemented): read the curvature's 1σ".into(),
-        );
     } else if fit.uncertainty.bootstrap > 0 {
         if let Some(pb) = &pb {
             pb.set_message("bootstrap");
@@ -1181,11 +1177,14 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
 /// bootstrap (Efron & Tibshirani 1993, *An Introduction to the Bootstrap*, ch. 6 and 13):
 ///
 /// 1. the best-fit model's signal, with the measurement's NaN mask, is the noiseless reference;
-/// 2. the measurement's white noise is estimated from the noise floor `P` of the last band
+///    in a joint fit each recording has its own (the model at the fitted parameters with that
+///    recording's drive);
+/// 2. each recording's white noise is estimated from the noise floor `P` of its last band
 ///    ([`features::noise_floor`]; a one-sided density of white noise of variance σ² is `2σ²/fs`, so
 ///    `σ = √(P·fs/2)`);
-/// 3. each replicate adds fresh Gaussian noise of that σ, recomputes the measured features, and
-///    re-runs the estimator: the whole fit (swarm and polish, `full_refit = true`) or only a
+/// 3. each replicate adds fresh Gaussian noise of that σ to every recording, recomputes the measured
+///    features, and re-runs the estimator: the whole fit (its restarts of swarm and polish,
+///    `full_refit = true`) or only a
 ///    Nelder–Mead polish from the optimum (cheaper, but blind to the swarm's own scatter, so the
 ///    intervals come out too narrow: README, "Uncertainty"); replicates run in parallel with rayon;
 /// 4. the interval is the basic bootstrap interval `[2θ̂ − q(84.13 %), 2θ̂ − q(15.87 %)]` of the
@@ -1205,59 +1204,23 @@ pub fn bootstrap_intervals(
     fit: &job::FitSection,
 ) -> Result<Vec<Interval>> {
     let settings = &fit.uncertainty;
-    use rand_distr::{Distribution, Normal};
     use rayon::prelude::*;
-    let mut x_model = problem.signal.extract(&best_sim.to_trace())?;
-    for (xi, m) in x_model.iter_mut().zip(&problem.nan_mask) {
-        if *m {
-            *xi = f64::NAN;
-        }
+    // The noiseless reference and noise level of every recording: the main one, then those of a
+    // joint fit, each simulated at the fit's parameters with its own drive.
+    let mut references = vec![ReplicateSource::new(problem, best_sim)?];
+    for o in &problem.others {
+        let sim = o.simulate(&o.params_at(best_u))?;
+        references.push(ReplicateSource::new(o, &sim)?);
     }
-    let floor = problem.floors.last().copied().unwrap_or(0.0);
-    let sigma = (floor * problem.fs_hz / 2.0).sqrt();
-    if !(sigma.is_finite() && sigma > 0.0) {
-        return Err(Error::Fit(format!(
-            "bootstrap: cannot estimate the measurement noise (floor {floor:e}); no intervals"
-        )));
-    }
-    let normal = Normal::new(0.0, sigma).map_err(|e| Error::Fit(e.to_string()))?;
     let n = best_u.len();
     let estimates: Vec<Result<Vec<f64>>> = (0..settings.bootstrap)
         .into_par_iter()
         .map(|r| {
             let mut rng = rand::rngs::StdRng::seed_from_u64(settings.seed.wrapping_add(r as u64));
-            let x: Vec<f64> = x_model
-                .iter()
-                .map(|v| v + normal.sample(&mut rng))
-                .collect();
-            let measured = features(&x, problem.fs_hz, &problem.bands, problem.max_fill)?;
-            let floors: Vec<f64> = measured.bands.iter().map(noise_floor).collect();
-            let rep = SpectralProblem {
-                model: problem.model,
-                head: problem.head.clone(),
-                targets: problem.targets.clone(),
-                // The time-domain targets stay the recording's (they are not re-noised).
-                time_targets: problem.time_targets.clone(),
-                others: Vec::new(),
-                label: String::new(),
-                base: problem.base,
-                free: problem.free.clone(),
-                measured,
-                floors,
-                bands: problem.bands.clone(),
-                signal: problem.signal,
-                sample_times: problem.sample_times.clone(),
-                nan_mask: problem.nan_mask.clone(),
-                fs_hz: problem.fs_hz,
-                max_fill: problem.max_fill,
-                window: problem.window,
-                solver: problem.solver,
-                weights: problem.weights,
-                evaluations: problem.evaluations.clone(),
-                failures: AtomicUsize::new(0),
-                first_failure: Mutex::new(None),
-                progress: problem.progress.clone(),
-            };
+            let mut rep = references[0].replicate(problem, &mut rng)?;
+            for (o, src) in problem.others.iter().zip(&references[1..]) {
+                rep.others.push(src.replicate(o, &mut rng)?);
+            }
             let rep = Arc::new(rep);
             let u = if settings.full_refit {
                 optimise(&rep, fit, fit.seed.wrapping_add(1 + r as u64), None)?.0
@@ -1286,12 +1249,98 @@ pub fn bootstrap_intervals(
                 hi: 2.0 * est - percentile(&v, 0.158_655),
                 level: 0.6827,
                 method: format!(
-                    "basic parametric bootstrap, {b} replicates (best-fit model + white noise σ = {sigma:.3e} from the measured floor; {})",
+                    "basic parametric bootstrap, {b} replicates (best-fit model + white noise σ = {} from the measured floor{}; {})",
+                    references
+                        .iter()
+                        .map(|r| format!("{:.3e}", r.sigma))
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    if references.len() > 1 { "s of the recordings" } else { "" },
                     if settings.full_refit { "full refit" } else { "Nelder–Mead polish from the optimum" }
                 ),
             }
         })
         .collect())
+}
+
+/// One recording's side of a bootstrap replicate: the best-fit model's signal (NaN where the
+/// measurement is) and the white-noise level estimated from the measurement's floor.
+struct ReplicateSource {
+    x_model: Vec<f64>,
+    sigma: f64,
+    normal: rand_distr::Normal<f64>,
+}
+
+impl ReplicateSource {
+    fn new(problem: &SpectralProblem, best_sim: &BladeSimulation) -> Result<Self> {
+        let mut x_model = problem.signal.extract(&best_sim.to_trace())?;
+        for (xi, m) in x_model.iter_mut().zip(&problem.nan_mask) {
+            if *m {
+                *xi = f64::NAN;
+            }
+        }
+        let floor = problem.floors.last().copied().unwrap_or(0.0);
+        let sigma = (floor * problem.fs_hz / 2.0).sqrt();
+        if !(sigma.is_finite() && sigma > 0.0) {
+            return Err(Error::Fit(format!(
+                "bootstrap: cannot estimate the measurement noise{} (floor {floor:e}); no intervals",
+                if problem.label.is_empty() {
+                    String::new()
+                } else {
+                    format!(" of recording '{}'", problem.label)
+                }
+            )));
+        }
+        let normal = rand_distr::Normal::new(0.0, sigma).map_err(|e| Error::Fit(e.to_string()))?;
+        Ok(ReplicateSource {
+            x_model,
+            sigma,
+            normal,
+        })
+    }
+
+    /// `problem` with its measurement replaced by the model signal plus fresh noise (no joint
+    /// recordings attached; the caller adds their replicates).
+    fn replicate(
+        &self,
+        problem: &SpectralProblem,
+        rng: &mut rand::rngs::StdRng,
+    ) -> Result<SpectralProblem> {
+        use rand_distr::Distribution;
+        let x: Vec<f64> = self
+            .x_model
+            .iter()
+            .map(|v| v + self.normal.sample(rng))
+            .collect();
+        let measured = features(&x, problem.fs_hz, &problem.bands, problem.max_fill)?;
+        let floors: Vec<f64> = measured.bands.iter().map(noise_floor).collect();
+        Ok(SpectralProblem {
+            model: problem.model,
+            head: problem.head.clone(),
+            targets: problem.targets.clone(),
+            // The time-domain targets stay the recording's (they are not re-noised).
+            time_targets: problem.time_targets.clone(),
+            others: Vec::new(),
+            label: problem.label.clone(),
+            base: problem.base,
+            free: problem.free.clone(),
+            measured,
+            floors,
+            bands: problem.bands.clone(),
+            signal: problem.signal,
+            sample_times: problem.sample_times.clone(),
+            nan_mask: problem.nan_mask.clone(),
+            fs_hz: problem.fs_hz,
+            max_fill: problem.max_fill,
+            window: problem.window,
+            solver: problem.solver,
+            weights: problem.weights,
+            evaluations: problem.evaluations.clone(),
+            failures: AtomicUsize::new(0),
+            first_failure: Mutex::new(None),
+            progress: problem.progress.clone(),
+        })
+    }
 }
 
 /// Linear-interpolation percentile (NumPy's default, "linear") of sorted `v` at fraction `q`.
