@@ -84,6 +84,7 @@ particles = 8
 swarm_iterations = 5
 polish_iterations = 40
 seed = 3
+restarts = 2
 [fit.uncertainty]
 bootstrap = 12
 polish_iterations = 40
