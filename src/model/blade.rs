@@ -303,6 +303,19 @@ impl Blade {
         y: &[f64; 4],
         touching: bool,
     ) -> (Matrix3<f64>, Vector3<f64>, Vector3<f64>) {
+        let (a, af, b, _) = self.rows_and_tip_velocity(t, y, touching);
+        (a, af, b)
+    }
+
+    /// [`Blade::rows`] and the tip velocity [`Blade::tip_velocity`] from the same sines and
+    /// cosines (the slip phase needs both; bitwise the same values as the two calls).
+    #[inline]
+    fn rows_and_tip_velocity(
+        &self,
+        t: f64,
+        y: &[f64; 4],
+        touching: bool,
+    ) -> (Matrix3<f64>, Vector3<f64>, Vector3<f64>, f64) {
         let p = &self.params;
         let m = &self.mc;
         let (l1, l2) = (p.l1_m, p.l2_m);
@@ -310,7 +323,9 @@ impl Blade {
         let (sth, cth) = th.sin_cos();
         let (sph, cph) = ph.sin_cos();
         let (sd, cd) = (th - ph).sin_cos();
-        let (_, _, vdd) = self.drive(t);
+        let (_, vd, vdd) = self.drive(t);
+        // As in `tip_velocity`, term by term (sin_cos gives the same cosines as cos).
+        let v3d = vd + l1 * cth * thd + l2 * cph * phd;
         let u = l1 * (1.0 - cth) + l2 * (1.0 - cph);
         let ud = l1 * sth * thd + l2 * sph * phd;
         let ka = m.ma - m.mt * l1;
@@ -348,7 +363,7 @@ impl Blade {
         );
         let af = Vector3::new(-l1 * cth, -l2 * cph, 0.0);
         let b = Vector3::new(-r1, -r2, b3);
-        (a, af, b)
+        (a, af, b, v3d)
     }
 
     /// Slip dynamics in direction `s = ±1` (eq. 4 substituted into eqs. 1–3).
@@ -369,8 +384,8 @@ impl Blade {
         y: &[f64; 4],
         touching: bool,
     ) -> Result<Dynamics, ModelFault> {
-        let (a0, af, b) = self.rows(t, y, touching);
-        let mu = self.params.friction.mu_slip(self.tip_velocity(t, y));
+        let (a0, af, b, v3d) = self.rows_and_tip_velocity(t, y, touching);
+        let mu = self.params.friction.mu_slip(v3d);
         // f = −s μ N: fold into the N column.
         let mut a = a0;
         for i in 0..3 {
