@@ -278,7 +278,7 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
         .unzip();
     line_chart(
         &dir.join("cost.svg"),
-        "best cost against model evaluations (swarm, then Nelder–Mead)",
+        "best cost against model evaluations (swarm, then Nelder–Mead; each restart anew)",
         "model evaluations",
         "best cost",
         &[Series::line("best cost", it, c)],

@@ -99,7 +99,7 @@ pub fn fit_figure_list(result: &FitResult) -> Vec<(String, String)> {
     ));
     v.push((
         "cost.svg".into(),
-        "Best cost against model evaluations (particle swarm, then Nelder–Mead).".into(),
+        "Best cost against model evaluations (particle swarm, then Nelder–Mead; with [fit] restarts, each restart starts anew, so the curve jumps up where one begins).".into(),
     ));
     v
 }
