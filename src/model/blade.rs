@@ -260,6 +260,41 @@ pub struct Dynamics {
     pub friction_n: f64,
 }
 
+/// Rows (1)–(3) of the equations of motion at one instant ([`Blade::rows`]) and the tip kinematics
+/// computed from the same sines and cosines.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Rows {
+    /// `A` of `A·[θ̈, φ̈, N]ᵀ + a_f·f = b`.
+    pub a: Matrix3<f64>,
+    /// `a_f`, the coefficients of the friction force.
+    pub af: Vector3<f64>,
+    pub b: Vector3<f64>,
+    /// Tip position v3 = v + l1 sin θ + l2 sin φ, m.
+    pub tip_position: f64,
+    /// Tip velocity v̇3, m/s.
+    pub tip_velocity: f64,
+    /// `−v̈ + l1 sin θ θ̇² + l2 sin φ φ̇²`, m/s²: the tip constraint's right-hand side at
+    /// acceleration level without Baumgarte terms.
+    pub tip_rhs_free: f64,
+    /// `[cos θ, cos φ]`.
+    pub cos: [f64; 2],
+}
+
+impl Rows {
+    /// Right-hand side of the tip constraint at acceleration level,
+    /// `−v̈ + l1 sin θ θ̇² + l2 sin φ φ̇² − 2ω_B Φ̇ − ω_B² Φ` with `Φ = v3 − anchor` (Baumgarte; no
+    /// Baumgarte terms for `ω_B = 0`).
+    pub fn tip_constraint_rhs(&self, anchor: f64, omega_b: f64) -> f64 {
+        let mut rhs = self.tip_rhs_free;
+        if omega_b > 0.0 {
+            let phi_c = self.tip_position - anchor;
+            let phi_cd = self.tip_velocity;
+            rhs -= 2.0 * omega_b * phi_cd + omega_b * omega_b * phi_c;
+        }
+        rhs
+    }
+}
+
 impl Blade {
     /// A blade with the given parameters and stick form.
     pub fn new(params: BladeParams, stick_form: StickForm) -> Self {
@@ -303,19 +338,15 @@ impl Blade {
         y: &[f64; 4],
         touching: bool,
     ) -> (Matrix3<f64>, Vector3<f64>, Vector3<f64>) {
-        let (a, af, b, _) = self.rows_and_tip_velocity(t, y, touching);
-        (a, af, b)
+        let r = self.rows_with_kinematics(t, y, touching);
+        (r.a, r.af, r.b)
     }
 
-    /// [`Blade::rows`] and the tip velocity [`Blade::tip_velocity`] from the same sines and
-    /// cosines (the slip phase needs both; bitwise the same values as the two calls).
+    /// [`Blade::rows`] with the tip kinematics the slip and stick phases also need, from the same
+    /// sines and cosines (bitwise the values [`Blade::tip_position`], [`Blade::tip_velocity`] and
+    /// `cos` give; `sin_cos` and `cos` agree).
     #[inline]
-    fn rows_and_tip_velocity(
-        &self,
-        t: f64,
-        y: &[f64; 4],
-        touching: bool,
-    ) -> (Matrix3<f64>, Vector3<f64>, Vector3<f64>, f64) {
+    pub(crate) fn rows_with_kinematics(&self, t: f64, y: &[f64; 4], touching: bool) -> Rows {
         let p = &self.params;
         let m = &self.mc;
         let (l1, l2) = (p.l1_m, p.l2_m);
@@ -323,9 +354,11 @@ impl Blade {
         let (sth, cth) = th.sin_cos();
         let (sph, cph) = ph.sin_cos();
         let (sd, cd) = (th - ph).sin_cos();
-        let (_, vd, vdd) = self.drive(t);
-        // As in `tip_velocity`, term by term (sin_cos gives the same cosines as cos).
-        let v3d = vd + l1 * cth * thd + l2 * cph * phd;
+        let (v, vd, vdd) = self.drive(t);
+        // As in `tip_position`, `tip_velocity` and `tip_constraint_rhs`, term by term.
+        let tip_position = v + l1 * sth + l2 * sph;
+        let tip_velocity = vd + l1 * cth * thd + l2 * cph * phd;
+        let tip_rhs_free = -vdd + l1 * sth * thd * thd + l2 * sph * phd * phd;
         let u = l1 * (1.0 - cth) + l2 * (1.0 - cph);
         let ud = l1 * sth * thd + l2 * sph * phd;
         let ka = m.ma - m.mt * l1;
@@ -363,7 +396,15 @@ impl Blade {
         );
         let af = Vector3::new(-l1 * cth, -l2 * cph, 0.0);
         let b = Vector3::new(-r1, -r2, b3);
-        (a, af, b, v3d)
+        Rows {
+            a,
+            af,
+            b,
+            tip_position,
+            tip_velocity,
+            tip_rhs_free,
+            cos: [cth, cph],
+        }
     }
 
     /// Slip dynamics in direction `s = ±1` (eq. 4 substituted into eqs. 1–3).
@@ -384,8 +425,14 @@ impl Blade {
         y: &[f64; 4],
         touching: bool,
     ) -> Result<Dynamics, ModelFault> {
-        let (a0, af, b, v3d) = self.rows_and_tip_velocity(t, y, touching);
-        let mu = self.params.friction.mu_slip(v3d);
+        let Rows {
+            a: a0,
+            af,
+            b,
+            tip_velocity,
+            ..
+        } = self.rows_with_kinematics(t, y, touching);
+        let mu = self.params.friction.mu_slip(tip_velocity);
         // f = −s μ N: fold into the N column.
         let mut a = a0;
         for i in 0..3 {
@@ -411,34 +458,13 @@ impl Blade {
         })
     }
 
-    /// Right-hand side of the tip constraint at acceleration level,
-    /// `−v̈ + l1 sin θ θ̇² + l2 sin φ φ̇² − 2ω_B Φ̇ − ω_B² Φ` with `Φ = v3 − anchor` (Baumgarte; no
-    /// Baumgarte terms for `ω_B = 0`).
-    pub(crate) fn tip_constraint_rhs(
-        &self,
-        t: f64,
-        y: &[f64; 4],
-        anchor: f64,
-        omega_b: f64,
-    ) -> f64 {
-        let (l1, l2) = (self.params.l1_m, self.params.l2_m);
-        let (_, _, vdd) = self.drive(t);
-        let mut rhs = -vdd + l1 * y[0].sin() * y[2] * y[2] + l2 * y[1].sin() * y[3] * y[3];
-        if omega_b > 0.0 {
-            let phi_c = self.tip_position(t, y) - anchor;
-            let phi_cd = self.tip_velocity(t, y);
-            rhs -= 2.0 * omega_b * phi_cd + omega_b * omega_b * phi_c;
-        }
-        rhs
-    }
-
     /// Solves three rows `A·[θ̈, φ̈, N]ᵀ + a_f·f = b` (those of [`Blade::rows`], or with a row
     /// replaced) together with the tip constraint `l1 cos θ θ̈ + l2 cos φ φ̈ = tip_rhs` for
-    /// `[θ̈, φ̈, N, f]`; the constraint row is scaled to the size of the first two. `None` if the
-    /// 4×4 system is singular.
+    /// `[θ̈, φ̈, N, f]`, `cos = [cos θ, cos φ]`; the constraint row is scaled to the size of the first
+    /// two. `None` if the 4×4 system is singular.
     pub(crate) fn solve_with_tip_constraint(
         &self,
-        y: &[f64; 4],
+        cos: [f64; 2],
         a3: &Matrix3<f64>,
         af: &Vector3<f64>,
         b3: &Vector3<f64>,
@@ -459,8 +485,8 @@ impl Blade {
             a3[(2, 1)],
             a3[(2, 2)],
             af[2],
-            w * l1 * y[0].cos(),
-            w * l2 * y[1].cos(),
+            w * l1 * cos[0],
+            w * l2 * cos[1],
             0.0,
             0.0,
         );
@@ -490,10 +516,10 @@ impl Blade {
         omega_b: f64,
         touching: bool,
     ) -> Result<Dynamics, ModelFault> {
-        let (a3, af, b3) = self.rows(t, y, touching);
-        let rhs4 = self.tip_constraint_rhs(t, y, anchor, omega_b);
+        let r = self.rows_with_kinematics(t, y, touching);
+        let rhs4 = r.tip_constraint_rhs(anchor, omega_b);
         let z = self
-            .solve_with_tip_constraint(y, &a3, &af, &b3, rhs4)
+            .solve_with_tip_constraint(r.cos, &r.a, &r.af, &r.b, rhs4)
             .ok_or_else(|| ModelFault::Singular("stick constraint system is singular".into()))?;
         Ok(Dynamics {
             theta_dd: z[0],

@@ -450,7 +450,8 @@ impl NeckLip {
 
     fn dynamics(&self, t: f64, y: &[f64; 4], mode: &Mode) -> Result<Dynamics, ModelFault> {
         let touching = mode.region & 1 != 0;
-        let (a3, af, b3) = self.blade.rows(t, y, touching);
+        let rows = self.blade.rows_with_kinematics(t, y, touching);
+        let (a3, af, b3) = (rows.a, rows.af, rows.b);
         let (hrow, hrhs) = self.height_row(t, y);
         // N is the multiplier of the height constraint, whose gradient (l1 sin θ, l2 sin φ) vanishes
         // at upright: there N is undetermined and the model cannot pass the blade's flip.
@@ -466,11 +467,7 @@ impl NeckLip {
             / self.blade.params.l1_m.max(self.blade.params.l2_m);
         match mode.phase.slip_dir() {
             Some(s) => {
-                let mu = self
-                    .blade
-                    .params
-                    .friction
-                    .mu_slip(self.blade.tip_velocity(t, y));
+                let mu = self.blade.params.friction.mu_slip(rows.tip_velocity);
                 let build = |mu_s: f64| {
                     Matrix3::new(
                         a3[(0, 0)],
@@ -513,10 +510,10 @@ impl NeckLip {
                 a[(2, 2)] = 0.0;
                 let f = Vector3::new(af[0], af[1], 0.0);
                 let b = Vector3::new(b3[0], b3[1], w * hrhs);
-                let tip_rhs = self.blade.tip_constraint_rhs(t, y, mode.anchor, OMEGA_B);
+                let tip_rhs = rows.tip_constraint_rhs(mode.anchor, OMEGA_B);
                 let z = self
                     .blade
-                    .solve_with_tip_constraint(y, &a, &f, &b, tip_rhs)
+                    .solve_with_tip_constraint(rows.cos, &a, &f, &b, tip_rhs)
                     .ok_or_else(|| {
                         ModelFault::Singular("neck/lip stick system is singular".into())
                     })?;

@@ -266,15 +266,16 @@ impl NonsmoothModel<4> for Blade {
         h: f64,
         y: &mut [f64; 4],
     ) -> std::result::Result<Phase, ModelFault> {
-        let (a3, af, b3) = self.rows(t, y, self.params.touches_shoulder(y[0]));
+        let rows = self.rows_with_kinematics(t, y, self.params.touches_shoulder(y[0]));
+        let (a3, af, b3) = (rows.a, rows.af, rows.b);
         let (l1, l2) = (self.params.l1_m, self.params.l2_m);
-        let (cth, cph) = (y[0].cos(), y[1].cos());
+        let [cth, cph] = rows.cos;
         let vd_next = self.drive(t + h).1;
         // Stick: tip velocity zero at t + h, i.e. l1 cθ θ̈ + l2 cφ φ̈ = −γ*/h with γ* the tip
         // velocity at t + h without this step's accelerations.
         let gamma_free = vd_next + l1 * cth * y[2] + l2 * cph * y[3];
         let z = self
-            .solve_with_tip_constraint(y, &a3, &af, &b3, -gamma_free / h)
+            .solve_with_tip_constraint([cth, cph], &a3, &af, &b3, -gamma_free / h)
             .ok_or_else(|| ModelFault::Singular("stick system singular".into()))?;
         let mu_s = self.params.friction.mu_static();
         let (acc, normal, phase) = if z[2] > 0.0 && z[3].abs() <= mu_s * z[2] {
