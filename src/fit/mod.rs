@@ -505,10 +505,7 @@ fn build_problem(
             necklip_view(job, m, &base)?
         } else {
             (
-                Features {
-                    bands: m.measured.bands.clone(),
-                    filled: m.measured.filled,
-                },
+                m.measured.clone(),
                 m.floors.clone(),
                 m.x.iter().map(|v| !v.is_finite()).collect(),
             )

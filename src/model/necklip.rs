@@ -208,6 +208,33 @@ pub enum DropTrack {
     Kernel(KernelTrack),
 }
 
+impl DropTrack {
+    /// `(u_p, u̇_p, ü_p)` at `t`.
+    fn at(&self, t: f64) -> (f64, f64, f64) {
+        match self {
+            DropTrack::Local(s) => s.at(t),
+            DropTrack::Kernel(k) => k.at(t),
+        }
+    }
+
+    /// The sample grid `(t0_s, dt_s)` the track was built on.
+    fn grid(&self) -> (f64, f64) {
+        match self {
+            DropTrack::Local(s) => (s.t0_s, s.dt_s),
+            DropTrack::Kernel(k) => (k.t0_s, k.dt_s),
+        }
+    }
+
+    /// How far from the track's ends the smooth is one-sided, s: the local fits' half-width, or
+    /// 3σ of the kernel.
+    fn edge_s(&self) -> f64 {
+        match self {
+            DropTrack::Local(s) => s.half_width as f64 * s.dt_s,
+            DropTrack::Kernel(k) => 3.0 * k.sigma_s,
+        }
+    }
+}
+
 impl PrescribedHead {
     /// The head drop from samples `u_m[k]` at `t0_s + k·dt_s`, without a lean track (the model then
     /// runs one segment, which must not cross the flip). See [`SmoothedTrack::from_samples`].
@@ -231,10 +258,7 @@ impl PrescribedHead {
     /// # Errors
     /// As [`SmoothedTrack::from_samples`].
     pub fn with_lean(mut self, d_m: &[f64], half_width: usize) -> Result<Self, String> {
-        let (t0_s, dt_s) = match &self.drop {
-            DropTrack::Local(s) => (s.t0_s, s.dt_s),
-            DropTrack::Kernel(k) => (k.t0_s, k.dt_s),
-        };
+        let (t0_s, dt_s) = self.drop.grid();
         self.lean = Some(SmoothedTrack::from_samples(t0_s, dt_s, d_m, half_width)?);
         Ok(self)
     }
@@ -265,10 +289,7 @@ impl PrescribedHead {
 
     /// `(u_p, u̇_p, ü_p)` at `t` (held constant beyond the samples).
     pub fn at(&self, t: f64) -> (f64, f64, f64) {
-        match &self.drop {
-            DropTrack::Local(s) => s.at(t),
-            DropTrack::Kernel(k) => k.at(t),
-        }
+        self.drop.at(t)
     }
 
     /// The parts of `window` the model can run on: maximal intervals on the track's sample grid
@@ -321,10 +342,7 @@ impl PrescribedHead {
         }
         // Within `edge` of the tracks' ends the smooths are one-sided and their rates unreliable
         // (a start state taken there made the normal force negative): keep out of it.
-        let edge = (lean.half_width as f64 * dt).max(match &self.drop {
-            DropTrack::Local(s) => s.half_width as f64 * s.dt_s,
-            DropTrack::Kernel(k) => 3.0 * k.sigma_s,
-        });
+        let edge = (lean.half_width as f64 * dt).max(self.drop.edge_s());
         let (lo, hi) = (t0 + edge, t0 + (lean.u.len() - 1) as f64 * dt - edge);
         for sgm in &mut out {
             sgm.0 = sgm.0.max(lo);
