@@ -116,6 +116,7 @@ impl StickSlipModel<1> for Dip {
                 0.0
             },
             limit: 1.0,
+            slip_velocity: None,
         })
     }
     fn slip_velocity(&self, _t: f64, y: &[f64; 1]) -> f64 {

@@ -48,7 +48,7 @@ fn necklip_on_the_full_models_head_reproduces_its_neck_and_lip() {
     );
     // θ ≈ −0.10 rad here. What limits the agreement is the prescribed head: a local quadratic fit
     // through the full model's 10 kHz samples (7 points), a quintic between them; measured:
-    // 4.2e-12 rad and 2.4e-16 m.
+    // 3.4e-12 rad and 2.4e-16 m.
     assert!(worst_theta < 1e-9, "θ differs by {worst_theta} rad");
     assert!(worst_u < 1e-11, "u differs by {worst_u} m");
     assert!(
@@ -126,7 +126,7 @@ fn necklip_runs_across_the_flip_in_two_segments() {
         );
     }
     // After the flip, started from the tracks: θ (≈ 0.05–0.14 rad there) stays within 2e-3 rad of
-    // the full model's (measured 3.2e-4 rad; what limits it is the 7-point smoothing of the head
+    // the full model's (measured 2.8e-4 rad; what limits it is the 7-point smoothing of the head
     // drop, whose acceleration jumps at each transition).
     let worst_after = times
         .iter()
@@ -167,8 +167,10 @@ fn necklip_runs_across_the_flip_in_two_segments() {
     // The high peak is the envelope of a stick–slip comb (lines ~7 Hz apart) and hops between comb
     // lines with small changes: the independent reference gives 884.0 Hz at rtol 1e-10 and 862.8 Hz
     // at 1e-8 on the same blade (data/reversal/README.md), 2.4 % apart. Measured here: necklip
-    // 860.0 Hz, full model 883.3 Hz (2.6 %; 2.3–2.5 % at rtol 1e-7 to 1e-10 and with the tracks at
-    // 100 kHz, so not the smoothing). The bar is that spread plus a little: 3 %.
+    // 884.8 Hz, full model 883.3 Hz (0.17 %). With nalgebra's LU instead of the closed-form 3×3 and
+    // 4×4 inverses, i.e. only the rounding changed, it was 860.0 Hz (2.6 %; 2.3–2.5 % at rtol 1e-7
+    // to 1e-10 and with the tracks at 100 kHz, so not the smoothing). The bar is that spread plus a
+    // little: 3 %.
     assert!(
         (f_nl / f_full - 1.0).abs() < 0.03,
         "necklip {f_nl} Hz against {f_full} Hz"

@@ -40,6 +40,7 @@ impl StickSlipModel<2> for Bilinear {
             normal: 1.0,
             friction: 0.0,
             limit: 0.0,
+            slip_velocity: None,
         })
     }
     fn slip_velocity(&self, _t: f64, y: &[f64; 2]) -> f64 {

@@ -35,12 +35,14 @@ impl StickSlipModel<2> for Belt {
         dy[0] = y[1];
         match mode.phase.slip_dir() {
             Some(s) => {
-                let f = -s * self.law.mu_slip(y[1] - self.v_belt_m_per_s) * self.normal_n;
+                let v_slip = y[1] - self.v_belt_m_per_s;
+                let f = -s * self.law.mu_slip(v_slip) * self.normal_n;
                 dy[1] = (spring + f) / self.mass_kg;
                 Ok(Contact {
                     normal: self.normal_n,
                     friction: f,
                     limit,
+                    slip_velocity: Some(v_slip),
                 })
             }
             None => {
@@ -50,6 +52,7 @@ impl StickSlipModel<2> for Belt {
                     normal: self.normal_n,
                     friction: -spring,
                     limit,
+                    slip_velocity: None,
                 })
             }
         }

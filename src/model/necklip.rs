@@ -22,7 +22,7 @@
 //! ([`PrescribedHead::segments`], a guard of [`FLIP_GUARD_OF_REACH`] of the reach around the sign
 //! change of `d`) and the run after it starts from the state the tracks give
 //! ([`NeckLip::state_from_tracks`]). On the sample's blade the guard is 20 ms, and the neck angle
-//! after the flip stays within 3.2e-4 rad of the full model's (`tests/necklip.rs`).
+//! after the flip stays within 2.8e-4 rad of the full model's (`tests/necklip.rs`).
 
 use super::blade::{Blade, BladeParams, Dynamics, StickForm};
 use crate::simulate::hybrid::{Contact, Mode, ModelFault, StickSlipModel};
@@ -560,6 +560,7 @@ impl StickSlipModel<4> for NeckLip {
             normal: d.normal_n,
             friction: d.friction_n,
             limit: self.blade.params.friction.mu_static() * d.normal_n,
+            slip_velocity: None,
         })
     }
 

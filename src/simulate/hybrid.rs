@@ -117,6 +117,10 @@ pub struct Contact {
     pub friction: f64,
     /// Static limit μ_s·N, N.
     pub limit: f64,
+    /// The contact's slip velocity at the same instant (m/s), when the right-hand side computed it
+    /// on the way (the friction law needs it in slip); `None` makes the event functions ask
+    /// [`StickSlipModel::slip_velocity`] instead.
+    pub slip_velocity: Option<f64>,
 }
 
 /// Why a model could not evaluate its right-hand side.
@@ -325,7 +329,9 @@ fn event_values<M: StickSlipModel<N>, const N: usize>(
     let mut g = [NO_EVENT; N_EVENTS];
     match mode.phase.slip_dir() {
         Some(s) => {
-            g[0] = s * model.slip_velocity(t, &yc);
+            g[0] = s * c
+                .slip_velocity
+                .unwrap_or_else(|| model.slip_velocity(t, &yc));
             g[2] = c.normal;
         }
         None => {
