@@ -606,7 +606,8 @@ pub fn spectra_vs_rtol(
 /// are within `rel` of the tightest run's and the number of transitions within
 /// `max_count_change` (relative) of it, with every tighter rtol also passing. (The count guard
 /// exists because at loose tolerances the peaks can still sit within 0.2 % while the stick–slip
-/// motion itself has changed: 216 transitions at rtol 1e-4 against 146.)
+/// motion itself has changed: 216 transitions at rtol 1e-4 against 146.) A band with no peak at
+/// some tolerance (NaN) passes only if the tightest run has none either.
 pub fn write_spectra(
     dir: &Path,
     rows: &[SpectrumRow],
@@ -639,10 +640,17 @@ pub fn write_spectra(
         let Some(conv) = sel.iter().min_by(|a, b| a.rtol.total_cmp(&b.rtol)) else {
             continue;
         };
+        // A band without a peak (NaN: e.g. a mode at the band's edge) agrees with a run that has
+        // none either, and disagrees completely with one that has.
+        let rel_dev = |f: f64, f_conv: f64| match (f.is_nan(), f_conv.is_nan()) {
+            (true, true) => 0.0,
+            (false, false) => ((f - f_conv) / f_conv).abs(),
+            _ => f64::INFINITY,
+        };
         let dev = |r: &SpectrumRow| {
             [
-                ((r.low_peak_hz - conv.low_peak_hz) / conv.low_peak_hz).abs(),
-                ((r.high_peak_hz - conv.high_peak_hz) / conv.high_peak_hz).abs(),
+                rel_dev(r.low_peak_hz, conv.low_peak_hz),
+                rel_dev(r.high_peak_hz, conv.high_peak_hz),
             ]
         };
         let n_conv = conv.transitions as f64;
@@ -655,10 +663,21 @@ pub fn write_spectra(
         }
         let others: Vec<&&SpectrumRow> = sel.iter().filter(|r| r.rtol > conv.rtol).collect();
         for (i, band) in ["low band peak", "high band peak"].iter().enumerate() {
+            // Only runs with a peak to compare: none at the tightest tolerance means no series.
+            let pts: Vec<(f64, f64)> = others
+                .iter()
+                .map(|r| (r.rtol, dev(r)[i]))
+                .filter(|(_, d)| {
+                    d.is_finite() && [conv.low_peak_hz, conv.high_peak_hz][i].is_finite()
+                })
+                .collect();
+            if pts.is_empty() {
+                continue;
+            }
             let mut s = Series::line(
                 format!("{name}: {band}"),
-                others.iter().map(|r| r.rtol).collect(),
-                others.iter().map(|r| dev(r)[i].max(1e-9)).collect(),
+                pts.iter().map(|p| p.0).collect(),
+                pts.iter().map(|p| p.1.max(1e-9)).collect(),
             );
             s.style = crate::report::plot::SeriesStyle::LinePoints;
             series.push(s);
