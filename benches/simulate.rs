@@ -112,6 +112,7 @@ fn cost(c: &mut Criterion) {
         max_fill: 5,
         window,
         solver,
+        swarm_solver: solver,
         weights: Weights::default(),
         evaluations: Arc::new(AtomicUsize::new(0)),
         failures: AtomicUsize::new(0),

@@ -33,10 +33,11 @@ pub struct FitJob {
     pub blade: PathBuf,
     #[serde(default)]
     pub spectrum: SpectrumSection,
-    /// Integrator settings for every model evaluation; default rtol 1e-7, atol 1e-9. The fit's
-    /// spectral peaks stay within 0.2 % of converged down to rtol 1e-6 (`wiperlab bench`,
-    /// reports/bench/spectra_vs_rtol.csv), but at 1e-6 the recovery in tests/fit_recovery.rs misses C
-    /// by 8 %; at 1e-7 it recovers C and k1 to 0.2 % (0.02 % at 1e-8).
+    /// Integrator settings for every model evaluation; default rtol 1e-7, atol 1e-9. With the
+    /// default bands the fit's spectral peaks stay within 0.05 % of converged down to rtol 1e-5
+    /// (`wiperlab bench`, reports/bench/spectra_vs_rtol.csv), and tests/fit_recovery.rs recovers C
+    /// and k1 to 0.23 % and 0.32 % at 1e-6, 0.11 % and 0.22 % at 1e-7 (README, "Spectra against
+    /// tolerance"). `[fit] swarm_rtol` may loosen it for the swarm stage only.
     #[serde(default = "fit_solver_default")]
     pub solver: SolverOptions,
     pub fit: FitSection,
@@ -191,6 +192,12 @@ pub struct FitSection {
     /// [`crate::fit`]). Each run costs a full swarm and polish.
     #[serde(default = "d_restarts")]
     pub restarts: usize,
+    /// Relative tolerance of the simulations in the particle-swarm stage (its absolute tolerance
+    /// scaled by the same factor against `[solver]`): a cheaper coarse search. The polish, the
+    /// reported cost, the curvature and everything after use `[solver]`. Default (`None`): the
+    /// `[solver]` tolerance throughout.
+    #[serde(default)]
+    pub swarm_rtol: Option<f64>,
     #[serde(default)]
     pub weights: Weights,
     /// Models of the hierarchy to fit and compare, from [`MODEL_NAMES`], e.g. `["head1dof",
@@ -601,6 +608,16 @@ impl LoadedJob {
             }
         }
         job.solver.validate()?;
+        if let Some(r) = job.fit.swarm_rtol
+            && !(r.is_finite() && r > 0.0 && r < 1.0)
+        {
+            return Err(Error::parse(
+                path,
+                line_of(&text, "swarm_rtol"),
+                1,
+                format!("[fit] swarm_rtol must be in (0, 1) (got {r})"),
+            ));
+        }
         for b in &job.spectrum.bands {
             if !(b.range_hz[0] >= 0.0 && b.range_hz[0] < b.range_hz[1]) || b.nperseg < 8 {
                 return Err(Error::parse(

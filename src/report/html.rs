@@ -99,7 +99,7 @@ pub fn fit_figure_list(result: &FitResult) -> Vec<(String, String)> {
     ));
     v.push((
         "cost.svg".into(),
-        "Best cost against model evaluations (particle swarm, then Nelder–Mead; with [fit] restarts, each restart starts anew, so the curve jumps up where one begins).".into(),
+        "Best cost against model evaluations (particle swarm, then Nelder–Mead; with [fit] restarts, each restart starts anew, so the curve jumps up where one begins; with [fit] swarm_rtol, the swarm's costs are those of its looser tolerance).".into(),
     ));
     v
 }
@@ -569,11 +569,15 @@ pub fn render_html(
             &mut h,
             "fit settings",
             format!(
-                "{} × (particle swarm {} particles × {} iterations, Nelder–Mead ≤ {} iterations), \
+                "{} × (particle swarm {} particles × {} iterations{}, Nelder–Mead ≤ {} iterations), \
                  best kept (seed {}); weights peak {}, level {}, shape {}",
                 f.restarts.max(1),
                 f.particles,
                 f.swarm_iterations,
+                match f.swarm_rtol {
+                    Some(r) => format!(" at rtol {r:e}"),
+                    None => String::new(),
+                },
                 f.polish_iterations,
                 f.seed,
                 f.weights.peak,
