@@ -663,13 +663,15 @@ pub fn write_spectra(
         }
         let others: Vec<&&SpectrumRow> = sel.iter().filter(|r| r.rtol > conv.rtol).collect();
         for (i, band) in ["low band peak", "high band peak"].iter().enumerate() {
-            // Only runs with a peak to compare: none at the tightest tolerance means no series.
+            // No peak at the tightest tolerance: nothing to draw a deviation from.
+            if [conv.low_peak_hz, conv.high_peak_hz][i].is_nan() {
+                continue;
+            }
+            // Runs that lost the peak (infinite deviation) are left out of the plot.
             let pts: Vec<(f64, f64)> = others
                 .iter()
                 .map(|r| (r.rtol, dev(r)[i]))
-                .filter(|(_, d)| {
-                    d.is_finite() && [conv.low_peak_hz, conv.high_peak_hz][i].is_finite()
-                })
+                .filter(|(_, d)| d.is_finite())
                 .collect();
             if pts.is_empty() {
                 continue;

@@ -466,7 +466,9 @@ impl NeckLip {
         (Vector3::new(l1 * sth, l2 * sph, 0.0), rhs)
     }
 
-    fn dynamics(&self, t: f64, y: &[f64; 4], mode: &Mode) -> Result<Dynamics, ModelFault> {
+    /// Accelerations and contact forces in `mode`, and the tip velocity v̇3 (m/s) from the same
+    /// sines and cosines (bitwise [`Blade::tip_velocity`]).
+    fn dynamics(&self, t: f64, y: &[f64; 4], mode: &Mode) -> Result<(Dynamics, f64), ModelFault> {
         let touching = mode.region & 1 != 0;
         let rows = self.blade.rows_with_kinematics(t, y, touching);
         let (a3, af, b3) = (rows.a, rows.af, rows.b);
@@ -513,12 +515,15 @@ impl NeckLip {
                     .ok_or_else(|| {
                         ModelFault::Singular("neck/lip slip system not solvable".into())
                     })?;
-                Ok(Dynamics {
-                    theta_dd: z[0],
-                    phi_dd: z[1],
-                    normal_n: z[2],
-                    friction_n: -s * mu * z[2],
-                })
+                Ok((
+                    Dynamics {
+                        theta_dd: z[0],
+                        phi_dd: z[1],
+                        normal_n: z[2],
+                        friction_n: -s * mu * z[2],
+                    },
+                    rows.tip_velocity,
+                ))
             }
             None => {
                 // Row 3 replaced by the height constraint, then the tip constraint (Baumgarte).
@@ -535,12 +540,15 @@ impl NeckLip {
                     .ok_or_else(|| {
                         ModelFault::Singular("neck/lip stick system is singular".into())
                     })?;
-                Ok(Dynamics {
-                    theta_dd: z[0],
-                    phi_dd: z[1],
-                    normal_n: z[2],
-                    friction_n: z[3],
-                })
+                Ok((
+                    Dynamics {
+                        theta_dd: z[0],
+                        phi_dd: z[1],
+                        normal_n: z[2],
+                        friction_n: z[3],
+                    },
+                    rows.tip_velocity,
+                ))
             }
         }
     }
@@ -554,13 +562,14 @@ impl StickSlipModel<4> for NeckLip {
         y: &[f64; 4],
         dy: &mut [f64; 4],
     ) -> Result<Contact, ModelFault> {
-        let d = self.dynamics(t, y, mode)?;
+        let (d, tip_velocity) = self.dynamics(t, y, mode)?;
         *dy = [y[2], y[3], d.theta_dd, d.phi_dd];
         Ok(Contact {
             normal: d.normal_n,
             friction: d.friction_n,
             limit: self.blade.params.friction.mu_static() * d.normal_n,
-            slip_velocity: None,
+            // The slip event reuses it instead of recomputing it (only slip phases read it).
+            slip_velocity: mode.phase.slip_dir().map(|_| tip_velocity),
         })
     }
 
