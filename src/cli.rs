@@ -291,7 +291,8 @@ fn fit_and_write(
         .map_err(|e| Error::io(&result_path, "cannot write", e))?;
     let report_dir = report_dir(job);
     create_dir(&report_dir)?;
-    crate::report::figures::fit_figures(&report_dir, &outcome)?;
+    let freq_speed = crate::fit::instfreq::compare_freq_speed(&outcome)?;
+    crate::report::figures::fit_figures(&report_dir, &outcome, freq_speed.as_ref())?;
     Ok((outcome.result, result_path, report_dir))
 }
 
@@ -423,7 +424,8 @@ pub fn run(cli: Cli) -> Result<()> {
                         None => println!("  {name:>12} band {:>10}: no peak", b.spec.name),
                     }
                 }
-                crate::report::figures::spectrum_figures(&dir, name, x, fs, &f)?;
+                let sg = crate::spectrum::stft::overview_spectrogram(x, fs)?;
+                crate::report::figures::spectrum_figures(&dir, name, &f, sg.as_ref())?;
             }
             println!("figures in {}", dir.display());
             Ok(())

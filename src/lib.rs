@@ -2,10 +2,25 @@
 //!
 //! A windshield-wiper blade's measured motion beside a physical model of it.
 //!
-//! Data flow: [`import`] (tracking-tool exports → [`trace::Trace`]) → [`spectrum`] (Welch PSD, peaks,
-//! spectrogram) → [`model`] + [`simulate`] (the 2-DOF head/neck/lip link model with stick–slip
-//! friction, event-driven) → [`fit`] (friction law A, B, C and neck stiffness with `argmin`) →
-//! [`report`] (SVG figures).
+//! The module tree is the pipeline; a stage uses only the stages before it (checked by
+//! `tests/architecture.rs`):
+//!
+//! Pipeline order: `error` → `trace` → `import` → `spectrum` → `model` → `simulate` → `fit` → `report` → `bench` → `cli`.
+//!
+//! * [`error`]: the crate's error type, shared by every stage.
+//! * [`trace`]: the canonical [`trace::Trace`] (SI, y up, NaN = missing), the type every stage
+//!   downstream reads.
+//! * [`import`]: tracking-tool exports → [`trace::Trace`] (pixels and frames end here).
+//! * [`spectrum`]: Welch PSD, peaks, spectrogram, instantaneous frequency.
+//! * [`model`]: the friction law, the 2-DOF head/neck/lip link model, the belt benchmarks, and the
+//!   contract between a stick–slip model and the integrator ([`model::stick_slip`]).
+//! * [`simulate`]: the event-driven integrator and the blade runner (a simulation becomes a
+//!   [`trace::Trace`] like a measurement).
+//! * [`fit`]: the friction law A, B, C and the neck stiffness fitted with `argmin`; model choice,
+//!   intervals, results.
+//! * [`report`]: SVG figures and the HTML report page, drawn from values computed upstream.
+//! * [`bench`]: the work–precision study behind `wiperlab bench`.
+//! * [`cli`]: argument parsing and dispatch for the `wiperlab` binary.
 //!
 //! The model is that of the seed paper (Unno et al., "Investigation of the dynamics of the wiper blade
 //! around the reversal"; journal version J. Sound Vib. 393 (2017) 76), equations (1)–(5), written in SI

@@ -5,6 +5,7 @@
 use wiperlab::Error;
 use wiperlab::model::belt::Belt;
 use wiperlab::model::{Blade, BladeParams, FrictionLaw, StickForm};
+use wiperlab::simulate::belt::limit_cycle;
 use wiperlab::simulate::blade::{BladeSimulation, default_window, simulate_blade};
 use wiperlab::simulate::hybrid::{Mode, Phase, SolverOptions, integrate};
 
@@ -135,7 +136,7 @@ fn accumulation_of_transitions_keeps_period_and_budget() {
     };
     let period = coulomb_period(m, k, 10.0, 1.0, 0.6);
     let t_end = 1000.0 * period;
-    let cyc = belt.limit_cycle(0.0, t_end, &tight()).unwrap().unwrap();
+    let cyc = limit_cycle(&belt, 0.0, t_end, &tight()).unwrap().unwrap();
     let per_ms = cyc.transitions as f64 / (t_end * 1e3);
     eprintln!(
         "T = {period:.6e} s, {} transitions ({per_ms:.0} per ms), rel err {:.2e}",
@@ -148,7 +149,7 @@ fn accumulation_of_transitions_keeps_period_and_budget() {
         max_transitions: 100,
         ..tight()
     };
-    match belt.limit_cycle(0.0, t_end, &small) {
+    match limit_cycle(&belt, 0.0, t_end, &small) {
         Err(Error::Simulation { t_s, message, .. }) => {
             assert!(message.contains("more than 100 transitions"), "{message}");
             assert!(t_s > 0.0 && t_s < t_end);
@@ -204,7 +205,7 @@ fn near_zero_damping() {
         },
     };
     let period = coulomb_period(1.0, k, 0.1, 1.0, 0.6);
-    let cyc = belt.limit_cycle(0.0, 5.0, &tight()).unwrap().unwrap();
+    let cyc = limit_cycle(&belt, 0.0, 5.0, &tight()).unwrap().unwrap();
     assert!((cyc.period_s - period).abs() < 1e-9 * period);
 
     let mut p = sample_params();
@@ -250,8 +251,7 @@ fn seed_law_converges_to_coulomb_as_b_grows() {
                 c: 0.5,
             },
         };
-        let cyc = belt
-            .limit_cycle(0.0, 3.5 * t_coulomb, &tight())
+        let cyc = limit_cycle(&belt, 0.0, 3.5 * t_coulomb, &tight())
             .unwrap()
             .unwrap();
         let err = (cyc.period_s - t_coulomb).abs() / t_coulomb;

@@ -404,7 +404,12 @@ fn measured_and_true_model_agree_on_frequency_against_speed() {
     // The figure the fit writes, here with the true model: all four series are drawn.
     let dir = std::env::temp_dir().join(format!("wiperlab_instfreq_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    wiperlab::fit::instfreq::freq_speed_figure(&dir, &meas, &model, cfg.band_hz).unwrap();
+    let comparison = wiperlab::fit::instfreq::FreqSpeedComparison {
+        measured: meas.clone(),
+        model: model.clone(),
+        band_hz: cfg.band_hz,
+    };
+    wiperlab::report::figures::freq_vs_speed_figure(&dir, &comparison).unwrap();
     let svg = std::fs::read_to_string(dir.join("freq_vs_speed.svg")).unwrap();
     let _ = std::fs::remove_dir_all(&dir);
     for label in [

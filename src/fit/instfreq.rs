@@ -1,6 +1,6 @@
 //! Frequency against tip speed in the fit: the estimators of [`crate::spectrum::instfreq`] applied
 //! to a measured trace and to a simulation alike, the optional cost terms built on them, and the
-//! `freq_vs_speed.svg` figure.
+//! comparison the `freq_vs_speed.svg` figure draws ([`compare_freq_speed`]).
 //!
 //! * [`measured_freq_speed`] / [`model_freq_speed`]: spectrogram ridge of the job's signal and
 //!   stick-onset rate, each against the lip tip's mean speed (see the estimator module for the
@@ -21,7 +21,6 @@
 
 use super::features::SignalKind;
 use super::job::Weights;
-use crate::report::plot::{ChartOpts, Series, line_chart};
 use crate::simulate::blade::BladeSimulation;
 use crate::simulate::hybrid::Phase;
 use crate::spectrum::instfreq::{
@@ -30,7 +29,6 @@ use crate::spectrum::instfreq::{
 };
 use crate::trace::Trace;
 use crate::{Error, Result};
-use std::path::Path;
 
 /// Number of equal speed bins of the `freq_speed` cost term.
 pub const SPEED_BINS: usize = 8;
@@ -255,44 +253,52 @@ pub fn trace_error(measured: &[f64], model: &[f64]) -> f64 {
     if den > 0.0 { num / den } else { f64::NAN }
 }
 
-/// Writes `freq_vs_speed.svg` into `dir`: ridge and stick-onset rate against the tip's mean speed
-/// (mm/s), measurement and model on one chart, frequency axis limited to `band_hz`.
+/// Measured and model frequency-against-speed estimates of a fit, for `freq_vs_speed.svg`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FreqSpeedComparison {
+    pub measured: FreqSpeed,
+    pub model: FreqSpeed,
+    /// The ridge's search band, Hz: points outside it are not drawn.
+    pub band_hz: (f64, f64),
+}
+
+/// The measured and fitted-model instantaneous frequency against lip-tip speed of a fit outcome,
+/// with the default ridge and stick-detector settings. `None` when the recording has no `tip`
+/// point or neither estimator finds a point in the band.
 ///
 /// # Errors
-/// [`Error::Io`]/[`Error::Numerics`] from drawing.
-pub fn freq_speed_figure(
-    dir: &Path,
-    measured: &FreqSpeed,
-    model: &FreqSpeed,
-    band_hz: (f64, f64),
-) -> Result<()> {
-    let xy = |p: &[FreqSpeedPoint]| -> (Vec<f64>, Vec<f64>) {
-        p.iter()
-            .filter(|q| q.freq_hz >= band_hz.0 && q.freq_hz <= band_hz.1)
-            .map(|q| (q.speed_m_per_s * 1e3, q.freq_hz))
-            .unzip()
-    };
-    let mut series = Vec::new();
-    for (label, pts) in [
-        ("measured: spectrogram ridge", &measured.ridge),
-        ("model: spectrogram ridge", &model.ridge),
-        ("measured: 1/stick-onset interval", &measured.onsets),
-        ("model: 1/stick-onset interval", &model.onsets),
-    ] {
-        let (x, y) = xy(pts);
-        series.push(Series::points(label, x, y));
+/// Those of [`measured_freq_speed`] and [`model_freq_speed`].
+pub fn compare_freq_speed(o: &super::FitOutcome) -> Result<Option<FreqSpeedComparison>> {
+    if o.measured_trace.point("tip").is_none() {
+        return Ok(None);
     }
-    line_chart(
-        &dir.join("freq_vs_speed.svg"),
-        &format!(
-            "instantaneous frequency against lip-tip speed ({:.0}–{:.0} Hz)",
-            band_hz.0, band_hz.1
-        ),
-        "mean lip-tip speed |Δv3|/Δt [mm/s]",
-        "frequency [Hz]",
-        &series,
-        &ChartOpts::default(),
-    )
+    let cfg = RidgeConfig::default();
+    let stick = StickDetector::default();
+    let measured = measured_freq_speed(&o.measured_trace, o.fs_hz, o.signal, &cfg, &stick)?;
+    let x = o.signal.extract(&o.measured_trace)?;
+    let mask: Vec<bool> = x.iter().map(|v| !v.is_finite()).collect();
+    let floor = band_floor(&x, o.fs_hz, &cfg)?;
+    let model = model_freq_speed(&o.best_sim, o.fs_hz, o.signal, &cfg, floor, &mask)?;
+    let in_band = |p: &[FreqSpeedPoint]| {
+        p.iter()
+            .any(|q| q.freq_hz >= cfg.band_hz.0 && q.freq_hz <= cfg.band_hz.1)
+    };
+    if [
+        &measured.ridge,
+        &measured.onsets,
+        &model.ridge,
+        &model.onsets,
+    ]
+    .iter()
+    .all(|p| !in_band(p))
+    {
+        return Ok(None);
+    }
+    Ok(Some(FreqSpeedComparison {
+        measured,
+        model,
+        band_hz: cfg.band_hz,
+    }))
 }
 
 #[cfg(test)]

@@ -32,7 +32,7 @@
 //! stick are solved together as one linear system (physics.md §1.8).
 
 use super::friction::FrictionLaw;
-use crate::simulate::hybrid::{Contact, Mode, ModelFault, Phase, StickSlipModel};
+use super::stick_slip::{Contact, Mode, ModelFault, Phase, StickSlipModel};
 use nalgebra::{Matrix3, Matrix4, Vector3, Vector4};
 use serde::{Deserialize, Serialize};
 
@@ -91,7 +91,7 @@ pub struct BladeParams {
 ///
 /// The neck moment is `k1·θ` for `|θ| ≤ θ_c` and `sign θ·[k1·θ_c + k1_contact·(|θ| − θ_c)]` beyond:
 /// continuous in θ, with a kink in stiffness at `|θ| = θ_c`, located exactly as a switching event by
-/// the integrator ([`crate::simulate::hybrid::StickSlipModel::switching_surfaces`]). The shoulder is
+/// the integrator ([`super::stick_slip::StickSlipModel::switching_surfaces`]). The shoulder is
 /// symmetric (one on each side of the neck), since the blade leans either way around a reversal.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -4,6 +4,7 @@ pub mod belt;
 pub mod blade;
 pub mod friction;
 pub mod necklip;
+pub mod stick_slip;
 
 pub use blade::{Blade, BladeParams, Shoulder, StickForm};
 pub use friction::FrictionLaw;

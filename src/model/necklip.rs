@@ -25,7 +25,7 @@
 //! after the flip stays within 2.8e-4 rad of the full model's (`tests/necklip.rs`).
 
 use super::blade::{Blade, BladeParams, Dynamics, StickForm};
-use crate::simulate::hybrid::{Contact, Mode, ModelFault, StickSlipModel};
+use super::stick_slip::{Contact, Mode, ModelFault, StickSlipModel};
 use nalgebra::{Matrix3, Vector3};
 
 /// Baumgarte gain of the head-height constraint, s⁻¹ (physics.md §0.3).

@@ -3,9 +3,12 @@
 
 use super::plot::{ChartOpts, Marker, Series, heatmap, line_chart};
 use crate::fit::features::{Features, noise_floor};
+use crate::fit::instfreq::FreqSpeedComparison;
 use crate::fit::{FitOutcome, FitResult};
 use crate::model::FrictionLaw;
 use crate::simulate::blade::BladeSimulation;
+use crate::spectrum::Spectrogram;
+use crate::spectrum::instfreq::FreqSpeedPoint;
 use crate::{Error, Result};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -22,8 +25,13 @@ fn peak_markers(f: &Features) -> Vec<Marker> {
         .collect()
 }
 
-/// PSD with the peaks of every band marked, and a spectrogram, for one signal.
-pub fn spectrum_figures(dir: &Path, name: &str, x: &[f64], fs_hz: f64, f: &Features) -> Result<()> {
+/// PSD with the peaks of every band marked, and the spectrogram when one is given, for one signal.
+pub fn spectrum_figures(
+    dir: &Path,
+    name: &str,
+    f: &Features,
+    spectrogram: Option<&Spectrogram>,
+) -> Result<()> {
     let b0 = &f.bands[0];
     let (fr, ps): (Vec<f64>, Vec<f64>) = b0
         .full_freq_hz
@@ -44,16 +52,13 @@ pub fn spectrum_figures(dir: &Path, name: &str, x: &[f64], fs_hz: f64, f: &Featu
             ..ChartOpts::default()
         },
     )?;
-    let finite: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();
-    let nper = (finite.len() / 16)
-        .clamp(16, 1024)
-        .next_power_of_two()
-        .min(finite.len());
-    if finite.len() >= 32 {
-        let sg = crate::spectrum::spectrogram(&finite, fs_hz, nper, nper * 3 / 4, nper)?;
+    if let Some(sg) = spectrogram {
         heatmap(
             &dir.join(format!("spectrogram_{name}.svg")),
-            &format!("spectrogram of {name} (Hann, nperseg {nper}, 75 % overlap)"),
+            &format!(
+                "spectrogram of {name} (Hann, nperseg {}, 75 % overlap)",
+                sg.nperseg
+            ),
             "time from first sample [s]",
             "frequency [Hz]",
             &sg.t_s,
@@ -111,8 +116,13 @@ pub fn write_simulation(dir: &Path, sim: &BladeSimulation) -> Result<()> {
     )
 }
 
-/// The fit's figures: traces, PSDs per band with peaks, the friction law, the cost history.
-pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
+/// The fit's figures: traces, PSDs per band with peaks, the friction law, the cost history, and
+/// frequency against tip speed when `freq_speed` is given.
+pub fn fit_figures(
+    dir: &Path,
+    o: &FitOutcome,
+    freq_speed: Option<&FreqSpeedComparison>,
+) -> Result<()> {
     // A target job has no recorded points: its figures show the model against the target lines.
     let targets_only = o.measured_trace.points.is_empty();
     let meas = if targets_only {
@@ -269,7 +279,9 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
         &series,
         &ChartOpts::default(),
     )?;
-    freq_vs_speed_figure(dir, o)?;
+    if let Some(c) = freq_speed {
+        freq_vs_speed_figure(dir, c)?;
+    }
     let (it, c): (Vec<f64>, Vec<f64>) = o
         .result
         .history
@@ -289,38 +301,41 @@ pub fn fit_figures(dir: &Path, o: &FitOutcome) -> Result<()> {
     )
 }
 
-/// `freq_vs_speed.svg`: instantaneous frequency against lip-tip speed, measurement and fitted model
-/// (see [`crate::fit::instfreq`]), with the default ridge and stick-detector settings. Not written
-/// when the recording has no `tip` point or neither estimator finds a point in the band.
-fn freq_vs_speed_figure(dir: &Path, o: &FitOutcome) -> Result<()> {
-    use crate::fit::instfreq::{freq_speed_figure, measured_freq_speed, model_freq_speed};
-    use crate::spectrum::instfreq::{RidgeConfig, StickDetector, band_floor};
-    if o.measured_trace.point("tip").is_none() {
-        return Ok(());
-    }
-    let cfg = RidgeConfig::default();
-    let meas = measured_freq_speed(
-        &o.measured_trace,
-        o.fs_hz,
-        o.signal,
-        &cfg,
-        &StickDetector::default(),
-    )?;
-    let x = o.signal.extract(&o.measured_trace)?;
-    let mask: Vec<bool> = x.iter().map(|v| !v.is_finite()).collect();
-    let floor = band_floor(&x, o.fs_hz, &cfg)?;
-    let model = model_freq_speed(&o.best_sim, o.fs_hz, o.signal, &cfg, floor, &mask)?;
-    let in_band = |p: &[crate::spectrum::instfreq::FreqSpeedPoint]| {
+/// Writes `freq_vs_speed.svg` into `dir`: ridge and stick-onset rate against the tip's mean speed
+/// (mm/s), measurement and model on one chart, frequency axis limited to the comparison's band
+/// (computed upstream by [`crate::fit::instfreq::compare_freq_speed`]).
+///
+/// # Errors
+/// [`Error::Io`]/[`Error::Numerics`] from drawing.
+pub fn freq_vs_speed_figure(dir: &Path, c: &FreqSpeedComparison) -> Result<()> {
+    let band_hz = c.band_hz;
+    let xy = |p: &[FreqSpeedPoint]| -> (Vec<f64>, Vec<f64>) {
         p.iter()
-            .any(|q| q.freq_hz >= cfg.band_hz.0 && q.freq_hz <= cfg.band_hz.1)
+            .filter(|q| q.freq_hz >= band_hz.0 && q.freq_hz <= band_hz.1)
+            .map(|q| (q.speed_m_per_s * 1e3, q.freq_hz))
+            .unzip()
     };
-    if [&meas.ridge, &meas.onsets, &model.ridge, &model.onsets]
-        .iter()
-        .all(|p| !in_band(p))
-    {
-        return Ok(());
+    let mut series = Vec::new();
+    for (label, pts) in [
+        ("measured: spectrogram ridge", &c.measured.ridge),
+        ("model: spectrogram ridge", &c.model.ridge),
+        ("measured: 1/stick-onset interval", &c.measured.onsets),
+        ("model: 1/stick-onset interval", &c.model.onsets),
+    ] {
+        let (x, y) = xy(pts);
+        series.push(Series::points(label, x, y));
     }
-    freq_speed_figure(dir, &meas, &model, cfg.band_hz)
+    line_chart(
+        &dir.join("freq_vs_speed.svg"),
+        &format!(
+            "instantaneous frequency against lip-tip speed ({:.0}–{:.0} Hz)",
+            band_hz.0, band_hz.1
+        ),
+        "mean lip-tip speed |Δv3|/Δt [mm/s]",
+        "frequency [Hz]",
+        &series,
+        &ChartOpts::default(),
+    )
 }
 
 /// A human-readable summary of a fit result.

@@ -2,6 +2,7 @@
 //! ([`hybrid`]) and the blade-specific runner ([`blade`]); the comparison methods of the
 //! work–precision study (Moreau–Jean time-stepping, smoothed friction) in [`timestep`].
 
+pub mod belt;
 pub mod blade;
 pub mod hybrid;
 pub mod rk;

@@ -33,6 +33,8 @@ pub struct Spectrogram {
     pub freq_hz: Vec<f64>,
     /// `[time][freq]`: `t_s.len()` rows of `freq_hz.len()` values, units²/Hz.
     pub density: Vec<Vec<f64>>,
+    /// Segment length in samples.
+    pub nperseg: usize,
 }
 
 impl Spectrogram {
@@ -101,6 +103,7 @@ pub fn spectrogram(
         t_s: Vec::with_capacity(n_seg),
         freq_hz: Vec::new(),
         density: Vec::with_capacity(n_seg),
+        nperseg,
     };
     fill_freqs(&mut out.freq_hz, nfft, fs_hz);
     for s in 0..n_seg {
@@ -111,6 +114,24 @@ pub fn spectrogram(
         out.t_s.push((start as f64 + nperseg as f64 / 2.0) / fs_hz);
     }
     Ok(out)
+}
+
+/// The overview spectrogram `wiperlab spectrum` draws for one signal: the finite samples of `x`
+/// (gaps dropped), segments of about a sixteenth of the record rounded up to a power of two in
+/// [16, 1024] samples, 75 % overlap, no zero padding. `None` for fewer than 32 finite samples.
+///
+/// # Errors
+/// Those of [`spectrogram`] (e.g. a non-positive `fs_hz`).
+pub fn overview_spectrogram(x: &[f64], fs_hz: f64) -> Result<Option<Spectrogram>> {
+    let finite: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();
+    if finite.len() < 32 {
+        return Ok(None);
+    }
+    let nper = (finite.len() / 16)
+        .clamp(16, 1024)
+        .next_power_of_two()
+        .min(finite.len());
+    spectrogram(&finite, fs_hz, nper, nper * 3 / 4, nper).map(Some)
 }
 
 #[cfg(test)]
