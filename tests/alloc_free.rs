@@ -4,7 +4,8 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use wiperlab::model::belt::Belt;
-use wiperlab::model::{Blade, BladeParams, FrictionLaw, StickForm};
+use wiperlab::model::benchmarks::leine_belt;
+use wiperlab::model::{Blade, BladeParams, StickForm};
 use wiperlab::simulate::blade::default_window;
 use wiperlab::simulate::hybrid::{Mode, Phase, SolverOptions, StickSlipModel, integrate};
 use wiperlab::simulate::rk;
@@ -59,15 +60,8 @@ fn right_hand_sides_allocate_nothing() {
     let y = reduced.slip_equilibrium(t0).unwrap();
     let anchor = reduced.tip_position(t0, &y);
     let belt = Belt {
-        mass_kg: 1.0,
-        k_n_per_m: 1.0,
         c_ns_per_m: 0.1,
-        v_belt_m_per_s: 0.2,
-        normal_n: 1.0,
-        law: FrictionLaw::Leine {
-            mu_s: 1.0,
-            delta_s_per_m: 3.0,
-        },
+        ..leine_belt()
     };
     let modes = [
         Mode {

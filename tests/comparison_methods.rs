@@ -4,24 +4,9 @@
 //! t = 3 s (slip) and 6 s (stick) with the exact solution (here: the event-driven integrator at
 //! rtol 1e-12, itself checked to ~1e-12 against RK4 + Hénon in tests/stick_slip_benchmarks.rs).
 
-use wiperlab::model::FrictionLaw;
-use wiperlab::model::belt::Belt;
+use wiperlab::model::benchmarks::leine_belt as leine;
 use wiperlab::simulate::hybrid::{Mode, Phase, SolverOptions, integrate};
 use wiperlab::simulate::timestep::{moreau_jean, smoothed};
-
-fn leine() -> Belt {
-    Belt {
-        mass_kg: 1.0,
-        k_n_per_m: 1.0,
-        c_ns_per_m: 0.0,
-        v_belt_m_per_s: 0.2,
-        normal_n: 1.0,
-        law: FrictionLaw::Leine {
-            mu_s: 1.0,
-            delta_s_per_m: 3.0,
-        },
-    }
-}
 
 fn exact_at(times: &[f64]) -> Vec<f64> {
     let opts = SolverOptions {

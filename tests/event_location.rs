@@ -1,8 +1,8 @@
 //! Event location of the hybrid integrator: convergence order of transition times, dips across zero
 //! within one step, and the slip direction after tangential stick→slip departures (physics.md §1.8).
 
-use wiperlab::model::belt::Belt;
-use wiperlab::model::{Blade, BladeParams, FrictionLaw, StickForm};
+use wiperlab::model::benchmarks::{CoulombBelt, seed_law_belt};
+use wiperlab::model::{Blade, BladeParams, StickForm};
 use wiperlab::simulate::blade::default_window;
 use wiperlab::simulate::hybrid::{
     Contact, Mode, ModelFault, Phase, SolverOptions, StickSlipModel, integrate,
@@ -22,19 +22,9 @@ fn fixed_step(h: f64) -> SolverOptions {
 /// in stick at x = 0: the first departure is at t_d = x_s/v_b = 10 s·F_s/k (stick is exact), the first
 /// stick onset at t_d + t_slip with the closed-form t_slip. Returns the error of that onset time.
 fn onset_error(opts: &SolverOptions) -> f64 {
-    let k = 4.0 * std::f64::consts::PI.powi(2);
-    let (vb, fs, fk) = (0.1, 1.0, 0.6);
-    let belt = Belt {
-        mass_kg: 1.0,
-        k_n_per_m: k,
-        c_ns_per_m: 0.0,
-        v_belt_m_per_s: vb,
-        normal_n: 1.0,
-        law: FrictionLaw::Coulomb { mu_s: fs, mu_k: fk },
-    };
-    let w = k.sqrt();
-    let t_slip = 2.0 / w * (std::f64::consts::PI - (w * (fs - fk) / k / vb).atan());
-    let t_onset = fs / k / vb + t_slip;
+    let case = CoulombBelt::ONE_HZ;
+    let (belt, vb) = (case.belt(), case.v_belt_m_per_s);
+    let t_onset = case.first_stick_onset_s();
     let mode = Mode {
         phase: Phase::Stick,
         anchor: 0.0,
@@ -172,18 +162,7 @@ fn dip_across_zero_within_one_step_is_not_missed() {
 fn tangential_departures_take_the_consistent_direction() {
     // Belt with the seed law (physics.md §3.4): every departure is slip− (γ < 0), and γ < 0 at
     // output samples inside every slip phase.
-    let belt = Belt {
-        mass_kg: 1.0,
-        k_n_per_m: 1.0,
-        c_ns_per_m: 0.0,
-        v_belt_m_per_s: 0.2,
-        normal_n: 1.0,
-        law: FrictionLaw::Exponential {
-            a: 0.5,
-            b_s_per_m: 3.0,
-            c: 0.5,
-        },
-    };
+    let belt = seed_law_belt(3.0);
     let times: Vec<f64> = (0..30_000).map(|i| i as f64 * 1e-3).collect();
     let mode = Mode {
         phase: Phase::Stick,

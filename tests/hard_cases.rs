@@ -4,6 +4,7 @@
 
 use wiperlab::Error;
 use wiperlab::model::belt::Belt;
+use wiperlab::model::benchmarks::{CoulombBelt, seed_law_belt};
 use wiperlab::model::{Blade, BladeParams, FrictionLaw, StickForm};
 use wiperlab::simulate::belt::limit_cycle;
 use wiperlab::simulate::blade::{BladeSimulation, default_window, simulate_blade};
@@ -64,10 +65,21 @@ fn transition_gap(a: &BladeSimulation, b: &BladeSimulation) -> f64 {
         .fold(0.0, f64::max)
 }
 
-fn coulomb_period(m: f64, k: f64, vb: f64, fs: f64, fk: f64) -> f64 {
-    // physics.md §3.1 closed form.
-    let w = (k / m).sqrt();
-    2.0 / w * (std::f64::consts::PI - (w * (fs - fk) / k / vb).atan()) + 2.0 * (fs - fk) / (k * vb)
+/// Closed-form Coulomb belt period (physics.md §3.1) with N = 1.
+fn coulomb_period(mass_kg: f64, k_n_per_m: f64, v_belt_m_per_s: f64, mu_s: f64, mu_k: f64) -> f64 {
+    coulomb(mass_kg, k_n_per_m, v_belt_m_per_s, mu_s, mu_k)
+        .closed_form()
+        .period_s()
+}
+
+fn coulomb(mass_kg: f64, k_n_per_m: f64, v_belt_m_per_s: f64, mu_s: f64, mu_k: f64) -> CoulombBelt {
+    CoulombBelt {
+        mass_kg,
+        k_n_per_m,
+        v_belt_m_per_s,
+        mu_s,
+        mu_k,
+    }
 }
 
 fn expect_simulation_error(
@@ -123,17 +135,7 @@ fn near_painleve_stops_with_diagnostic() {
 fn accumulation_of_transitions_keeps_period_and_budget() {
     let m = 1e-6;
     let k = m * (2.0 * std::f64::consts::PI * 5e4).powi(2);
-    let belt = Belt {
-        mass_kg: m,
-        k_n_per_m: k,
-        c_ns_per_m: 0.0,
-        v_belt_m_per_s: 10.0,
-        normal_n: 1.0,
-        law: FrictionLaw::Coulomb {
-            mu_s: 1.0,
-            mu_k: 0.6,
-        },
-    };
+    let belt = coulomb(m, k, 10.0, 1.0, 0.6).belt();
     let period = coulomb_period(m, k, 10.0, 1.0, 0.6);
     let t_end = 1000.0 * period;
     let cyc = limit_cycle(&belt, 0.0, t_end, &tight()).unwrap().unwrap();
@@ -194,15 +196,8 @@ fn stiff_neck_simulates_and_stick_forms_agree() {
 fn near_zero_damping() {
     let k = 4.0 * std::f64::consts::PI.powi(2);
     let belt = Belt {
-        mass_kg: 1.0,
-        k_n_per_m: k,
         c_ns_per_m: 1e-12,
-        v_belt_m_per_s: 0.1,
-        normal_n: 1.0,
-        law: FrictionLaw::Coulomb {
-            mu_s: 1.0,
-            mu_k: 0.6,
-        },
+        ..coulomb(1.0, k, 0.1, 1.0, 0.6).belt()
     };
     let period = coulomb_period(1.0, k, 0.1, 1.0, 0.6);
     let cyc = limit_cycle(&belt, 0.0, 5.0, &tight()).unwrap().unwrap();
@@ -239,18 +234,7 @@ fn seed_law_converges_to_coulomb_as_b_grows() {
     let t_coulomb = coulomb_period(1.0, 1.0, 0.2, 1.0, 0.5);
     let mut last = f64::INFINITY;
     for b in [1e2, 1e3, 1e4, 1e5, 1e6] {
-        let belt = Belt {
-            mass_kg: 1.0,
-            k_n_per_m: 1.0,
-            c_ns_per_m: 0.0,
-            v_belt_m_per_s: 0.2,
-            normal_n: 1.0,
-            law: FrictionLaw::Exponential {
-                a: 0.5,
-                b_s_per_m: b,
-                c: 0.5,
-            },
-        };
+        let belt = seed_law_belt(b);
         let cyc = limit_cycle(&belt, 0.0, 3.5 * t_coulomb, &tight())
             .unwrap()
             .unwrap();

@@ -2,7 +2,8 @@
 //! the same `StickSlipModel` / `integrate` machinery as the blade.
 //!
 //! Reference values are computed in this file by methods that share nothing with the integrator:
-//! - undamped Coulomb: closed form (physics.md §3.1, derived again below);
+//! - undamped Coulomb: closed form (physics.md §3.1, `model::benchmarks::CoulombBelt::closed_form`,
+//!   checked here against the §0.4 table);
 //! - damped Coulomb: the analytic slip solution of physics.md §3.2 with bisection on ẏ(t) = v_b;
 //! - Leine block and seed law: the stick phase is analytic (x = x_s − v_b·t back to x_e), the slip
 //!   phase is integrated with fixed-step classical RK4 and the event located by Hénon's trick
@@ -12,8 +13,11 @@
 //! Each reference is also compared with the 7–8 digit numbers of physics.md §0.4 (computed there
 //! with SciPy DOP853/Radau/LSODA), so a mistake in the reference itself would show.
 
-use wiperlab::model::FrictionLaw;
 use wiperlab::model::belt::Belt;
+use wiperlab::model::benchmarks::{
+    CoulombBelt, DAMPED_COULOMB_REFERENCE, LEINE_REFERENCE, SEED_LAW_REFERENCE,
+    damped_coulomb_belt, leine_belt, seed_law_belt,
+};
 use wiperlab::simulate::SolverOptions;
 use wiperlab::simulate::belt::limit_cycle;
 
@@ -27,16 +31,6 @@ fn tight() -> SolverOptions {
 
 /// Required relative accuracy of t_slip, t_stick and T at tight tolerance (issue 5).
 const REL: f64 = 1e-9;
-
-/// Closed form of physics.md §3.1 for m ẍ + k x = F_f, Coulomb friction F_s > F_k, belt speed v_b:
-/// t_slip = (2/ω)(π − atan(ωΔ/v_b)), t_stick = 2(F_s − F_k)/(k v_b), x_e = (2F_k − F_s)/k.
-fn coulomb_closed_form(m: f64, k: f64, vb: f64, fs: f64, fk: f64) -> (f64, f64, f64) {
-    let w = (k / m).sqrt();
-    let delta = (fs - fk) / k;
-    let t_slip = 2.0 / w * (std::f64::consts::PI - (w * delta / vb).atan());
-    let t_stick = 2.0 * (fs - fk) / (k * vb);
-    (t_slip, t_stick, (2.0 * fk - fs) / k)
-}
 
 fn rel(a: f64, b: f64) -> f64 {
     ((a - b) / b).abs()
@@ -211,16 +205,16 @@ fn undamped_coulomb_belt_matches_closed_form_to_1e9() {
         (1.0, 4.0 * std::f64::consts::PI.powi(2), 0.1),
         (1.0, 1.0, 0.2),
     ] {
-        let (fs, fk) = (1.0, 0.6);
-        let belt = Belt {
+        let case = CoulombBelt {
             mass_kg: m,
             k_n_per_m: k,
-            c_ns_per_m: 0.0,
             v_belt_m_per_s: vb,
-            normal_n: 1.0,
-            law: FrictionLaw::Coulomb { mu_s: fs, mu_k: fk },
+            mu_s: 1.0,
+            mu_k: 0.6,
         };
-        let (t_slip, t_stick, x_e) = coulomb_closed_form(m, k, vb, fs, fk);
+        let belt = case.belt();
+        let closed = case.closed_form();
+        let (t_slip, t_stick, x_e) = (closed.t_slip_s, closed.t_stick_s, closed.x_stick_onset_m);
         let reference = Reference {
             t_slip,
             t_stick,
@@ -240,35 +234,26 @@ fn undamped_coulomb_belt_matches_closed_form_to_1e9() {
     }
     // The closed form itself against the physics.md §0.4 table (7 digits): T = 1.0221888 s and
     // 8.0688879 s.
-    let (a, b, _) = coulomb_closed_form(1.0, 4.0 * std::f64::consts::PI.powi(2), 0.1, 1.0, 0.6);
-    assert!((a + b - 1.0221888).abs() < 1e-7);
-    let (a, b, _) = coulomb_closed_form(1.0, 1.0, 0.2, 1.0, 0.6);
-    assert!((a + b - 8.0688879).abs() < 1e-7);
-}
-
-fn damped_belt(vb: f64) -> Belt {
-    let k = 4.0 * std::f64::consts::PI.powi(2);
-    Belt {
-        mass_kg: 1.0,
-        k_n_per_m: k,
-        c_ns_per_m: 2.0 * 0.05 * k.sqrt(),
-        v_belt_m_per_s: vb,
-        normal_n: 1.0,
-        law: FrictionLaw::Coulomb {
-            mu_s: 1.0,
-            mu_k: 0.6,
-        },
+    let one_hz = CoulombBelt::ONE_HZ.closed_form();
+    assert!((one_hz.period_s() - 1.0221888).abs() < 1e-7);
+    let slow = CoulombBelt {
+        k_n_per_m: 1.0,
+        v_belt_m_per_s: 0.2,
+        ..CoulombBelt::ONE_HZ
     }
+    .closed_form();
+    assert!((slow.period_s() - 8.0688879).abs() < 1e-7);
 }
 
 #[test]
 fn damped_coulomb_belt_matches_semi_analytic_to_1e9() {
-    let belt = damped_belt(0.05);
+    let belt = damped_coulomb_belt(0.05);
     let r = damped_coulomb_reference(1.0, belt.k_n_per_m, belt.c_ns_per_m, 0.05, 1.0, 0.6)
         .expect("stick-slip");
     // physics.md §0.4 row 3 (7 digits): t_slip 0.7581836, t_stick 0.3128486, T 1.0710322.
-    assert!((r.t_slip - 0.7581836).abs() < 1e-7, "{}", r.t_slip);
-    assert!((r.t_stick - 0.3128486).abs() < 1e-7, "{}", r.t_stick);
+    let table = DAMPED_COULOMB_REFERENCE;
+    assert!((r.t_slip - table.t_slip_s).abs() < 1e-7, "{}", r.t_slip);
+    assert!((r.t_stick - table.t_stick_s).abs() < 1e-7, "{}", r.t_stick);
     check_cycle("damped Coulomb", &belt, r, 5.0);
 }
 
@@ -276,14 +261,14 @@ fn damped_coulomb_belt_matches_semi_analytic_to_1e9() {
 fn no_stick_slip_negative_case() {
     // physics.md §0.4 row 4 / §3.2: ζ = 0.05, v_b = 0.1: the mass never regains belt speed.
     // Independently: the analytic slip velocity never reaches v_b within 50 periods.
-    let belt = damped_belt(0.1);
+    let belt = damped_coulomb_belt(0.1);
     assert!(
         damped_coulomb_reference(1.0, belt.k_n_per_m, belt.c_ns_per_m, 0.1, 1.0, 0.6).is_none()
     );
     assert!(limit_cycle(&belt, 0.0, 20.0, &tight()).unwrap().is_none());
     // The same belt at v_b = 0.05 does stick–slip (the check can fail both ways).
     assert!(
-        limit_cycle(&damped_belt(0.05), 0.0, 20.0, &tight())
+        limit_cycle(&damped_coulomb_belt(0.05), 0.0, 20.0, &tight())
             .unwrap()
             .is_some()
     );
@@ -292,44 +277,25 @@ fn no_stick_slip_negative_case() {
 #[test]
 fn leine_block_on_belt_matches_reference_to_1e9() {
     // physics.md §3.3: m = k = F_s = 1, δ = 3 s/m, v_dr = 0.2, F = −F_s sgn(γ)/(1 + δ|γ|).
-    let belt = Belt {
-        mass_kg: 1.0,
-        k_n_per_m: 1.0,
-        c_ns_per_m: 0.0,
-        v_belt_m_per_s: 0.2,
-        normal_n: 1.0,
-        law: FrictionLaw::Leine {
-            mu_s: 1.0,
-            delta_s_per_m: 3.0,
-        },
-    };
+    let belt = leine_belt();
     let r = rk4_reference(&belt);
     // physics.md §0.4 (SciPy, 7–8 digits): t_slip 4.2959995, t_stick 7.7050318, x_e −0.5410064.
-    assert!((r.t_slip - 4.2959995).abs() < 1e-7, "{r:?}");
-    assert!((r.t_stick - 7.7050318).abs() < 1e-7, "{r:?}");
-    assert!((r.x_e - -0.5410064).abs() < 1e-7, "{r:?}");
+    let table = LEINE_REFERENCE;
+    assert!((r.t_slip - table.t_slip_s).abs() < 1e-7, "{r:?}");
+    assert!((r.t_stick - table.t_stick_s).abs() < 1e-7, "{r:?}");
+    assert!((r.x_e - table.x_stick_onset_m).abs() < 1e-7, "{r:?}");
     check_cycle("Leine", &belt, r, 40.0);
 }
 
 #[test]
 fn seed_friction_law_in_belt_oscillator_to_1e9() {
     // physics.md §3.4: m = k = N = 1, A = C = 0.5, B = 3 s/m, v_dr = 0.2.
-    let belt = Belt {
-        mass_kg: 1.0,
-        k_n_per_m: 1.0,
-        c_ns_per_m: 0.0,
-        v_belt_m_per_s: 0.2,
-        normal_n: 1.0,
-        law: FrictionLaw::Exponential {
-            a: 0.5,
-            b_s_per_m: 3.0,
-            c: 0.5,
-        },
-    };
+    let belt = seed_law_belt(3.0);
     let r = rk4_reference(&belt);
     // physics.md §0.4 (SciPy): t_slip 4.5590598, t_stick 4.9039561, x_e 0.0192088.
-    assert!((r.t_slip - 4.5590598).abs() < 1e-7, "{r:?}");
-    assert!((r.t_stick - 4.9039561).abs() < 1e-7, "{r:?}");
-    assert!((r.x_e - 0.0192088).abs() < 1e-7, "{r:?}");
+    let table = SEED_LAW_REFERENCE;
+    assert!((r.t_slip - table.t_slip_s).abs() < 1e-7, "{r:?}");
+    assert!((r.t_stick - table.t_stick_s).abs() < 1e-7, "{r:?}");
+    assert!((r.x_e - table.x_stick_onset_m).abs() < 1e-7, "{r:?}");
     check_cycle("seed law", &belt, r, 30.0);
 }

@@ -17,8 +17,8 @@
 //! sample times. Cost: wall time (mean over repeats of at least 0.2 s, `--quick`: 0.05 s) and
 //! right-hand-side evaluations (for Moreau–Jean: one linear contact solve per step).
 
-use crate::model::belt::Belt;
-use crate::model::{Blade, BladeParams, FrictionLaw, StickForm};
+use crate::model::benchmarks::{CoulombBelt, leine_belt};
+use crate::model::{Blade, BladeParams, StickForm};
 use crate::report::plot::{ChartOpts, Series, line_chart};
 use crate::simulate::blade::default_window;
 use crate::simulate::hybrid::{Mode, Phase, SolverOptions, StickSlipModel, integrate};
@@ -239,21 +239,6 @@ where
     Ok(())
 }
 
-/// The belt problem: Leine's block on a belt (physics.md §3.3).
-pub fn leine_belt() -> Belt {
-    Belt {
-        mass_kg: 1.0,
-        k_n_per_m: 1.0,
-        c_ns_per_m: 0.0,
-        v_belt_m_per_s: 0.2,
-        normal_n: 1.0,
-        law: FrictionLaw::Leine {
-            mu_s: 1.0,
-            delta_s_per_m: 3.0,
-        },
-    }
-}
-
 /// The blade's state at its first stick onset in the reference run of the default window (rtol
 /// 1e-13), with the time and anchor: the start of the `blade-burst` problem.
 pub fn blade_burst_start(params: &BladeParams) -> Result<(f64, [f64; 4], f64)> {
@@ -405,19 +390,9 @@ pub fn run_bench(opts: &BenchOptions) -> Result<Vec<BenchRow>> {
 /// Transition-time error of the undamped Coulomb belt's first stick onset against the closed form
 /// (physics.md §3.1) with fixed DOPRI5 steps `h` (tolerances loose enough to accept every step).
 pub fn event_order_rows() -> Result<Vec<BenchRow>> {
-    let k = 4.0 * std::f64::consts::PI.powi(2);
-    let (vb, fs, fk) = (0.1, 1.0, 0.6);
-    let belt = Belt {
-        mass_kg: 1.0,
-        k_n_per_m: k,
-        c_ns_per_m: 0.0,
-        v_belt_m_per_s: vb,
-        normal_n: 1.0,
-        law: FrictionLaw::Coulomb { mu_s: fs, mu_k: fk },
-    };
-    let w = k.sqrt();
-    let t_slip = 2.0 / w * (std::f64::consts::PI - (w * (fs - fk) / k / vb).atan());
-    let t_onset = fs / k / vb + t_slip;
+    let case = CoulombBelt::ONE_HZ;
+    let (belt, vb) = (case.belt(), case.v_belt_m_per_s);
+    let t_onset = case.first_stick_onset_s();
     let mut rows = Vec::new();
     for h in [0.08, 0.04, 0.02, 0.01, 0.005, 0.0025] {
         let opts = SolverOptions {

@@ -1,6 +1,7 @@
 //! Physical models: the friction law, the blade link model, the belt-oscillator benchmarks.
 
 pub mod belt;
+pub mod benchmarks;
 pub mod blade;
 pub mod friction;
 pub mod necklip;
