@@ -32,7 +32,9 @@
 //! stick are solved together as one linear system (physics.md §1.8).
 
 use super::friction::FrictionLaw;
-use super::stick_slip::{Contact, Mode, ModelFault, Phase, StickSlipModel};
+use super::stick_slip::{
+    ConstraintAngle, Contact, LinearSystem, LinkModel, Mode, ModelFault, Phase, StickSlipModel,
+};
 use nalgebra::{Matrix3, Matrix4, Vector3, Vector4};
 use serde::{Deserialize, Serialize};
 
@@ -456,16 +458,21 @@ impl Blade {
         let det = a.determinant();
         let same_sign = det * det0 > 0.0;
         if !same_sign || det.abs() < 1e-9 * det0.abs() {
-            return Err(ModelFault::Singular(format!(
-                "slip equations singular (Painlevé-type): det with friction {det:.3e}, frictionless {det0:.3e}, μ = {mu:.4}"
-            )));
+            return Err(ModelFault::Painleve {
+                model: LinkModel::Blade,
+                det_with_friction: det,
+                det_frictionless: det0,
+                mu,
+            });
         }
         // nalgebra's closed-form 3×3 inverse (cofactors) instead of LU with pivoting: it halved the
         // slip right-hand side (criterion `blade rhs, slip`, 194 → 95 ns on this machine).
         let z = a
             .try_inverse()
             .map(|inv| inv * b)
-            .ok_or_else(|| ModelFault::Singular("slip system not solvable".into()))?;
+            .ok_or(ModelFault::Singular {
+                system: LinearSystem::BladeSlip,
+            })?;
         Ok((
             Dynamics {
                 theta_dd: z[0],
@@ -539,7 +546,9 @@ impl Blade {
         let rhs4 = r.tip_constraint_rhs(anchor, omega_b);
         let z = self
             .solve_with_tip_constraint(r.cos, &r.a, &r.af, &r.b, rhs4)
-            .ok_or_else(|| ModelFault::Singular("stick constraint system is singular".into()))?;
+            .ok_or(ModelFault::Singular {
+                system: LinearSystem::BladeStick,
+            })?;
         Ok(Dynamics {
             theta_dd: z[0],
             phi_dd: z[1],
@@ -562,9 +571,10 @@ impl Blade {
         let arg = (anchor - v - l1 * sth) / l2;
         let reachable = arg.abs() < 1.0;
         if !reachable {
-            return Err(ModelFault::Geometry(format!(
-                "stick constraint has no lip angle: sin φ = {arg:.6} (the head moved beyond the lip's reach)"
-            )));
+            return Err(ModelFault::NoStickAngle {
+                angle: ConstraintAngle::Lip,
+                sine: arg,
+            });
         }
         let phi = arg.asin();
         let phi_d = -(vd + l1 * cth * theta_d) / (l2 * phi.cos());
@@ -596,7 +606,9 @@ impl Blade {
             let dx = j
                 .lu()
                 .solve(&nalgebra::Vector2::new(-f0[0], -f0[1]))
-                .ok_or_else(|| ModelFault::Singular("equilibrium Jacobian singular".into()))?;
+                .ok_or(ModelFault::Singular {
+                    system: LinearSystem::EquilibriumJacobian,
+                })?;
             // Damp large steps (angles stay within ±0.5 rad per iteration).
             let scale = (0.5 / dx.amax()).min(1.0);
             th += scale * dx[0];
@@ -608,10 +620,11 @@ impl Blade {
         let f = acc(th, ph)?;
         let scale = self.params.k1_nm_per_rad / self.mc.mth;
         if !(f[0].abs() < 1e-8 * scale && f[1].abs() < 1e-8 * scale) {
-            return Err(ModelFault::Geometry(format!(
-                "no quasi-static slip equilibrium found at t = {t} s (residual accelerations {:.3e}, {:.3e} rad/s²)",
-                f[0], f[1]
-            )));
+            return Err(ModelFault::NoEquilibrium {
+                model: LinkModel::Blade,
+                t_s: t,
+                residual_rad_per_s2: f[0].abs().max(f[1].abs()),
+            });
         }
         Ok([th, ph, 0.0, 0.0])
     }
@@ -778,9 +791,12 @@ impl LockedBlade {
                 let det0 = s_th - s_n * n_th;
                 let det = s_th - c * n_th;
                 if det * det0 <= 0.0 || det.abs() < 1e-9 * det0.abs() {
-                    return Err(ModelFault::Singular(format!(
-                        "locked-link slip equations singular (Painlevé-type): det with friction {det:.3e}, frictionless {det0:.3e}, μ = {mu:.4}"
-                    )));
+                    return Err(ModelFault::Painleve {
+                        model: LinkModel::LockedLink,
+                        det_with_friction: det,
+                        det_frictionless: det0,
+                        mu,
+                    });
                 }
                 let thdd = (s_b - c * n_b) / det;
                 let n = n_b - n_th * thdd;
@@ -818,9 +834,10 @@ impl LockedBlade {
         let (v, vd, _) = self.blade.drive(t);
         let arg = (anchor - v) / l;
         if arg.abs() >= 1.0 {
-            return Err(ModelFault::Geometry(format!(
-                "stick constraint has no link angle: sin θ = {arg:.6} (the head moved beyond the link's reach)"
-            )));
+            return Err(ModelFault::NoStickAngle {
+                angle: ConstraintAngle::Link,
+                sine: arg,
+            });
         }
         let th = arg.asin();
         Ok((th, -vd / (l * th.cos())))
@@ -851,9 +868,11 @@ impl LockedBlade {
         let f = acc(th)?;
         let scale = self.blade.params.k1_nm_per_rad / self.blade.mc.mth;
         if f.abs().is_nan() || f.abs() >= 1e-8 * scale {
-            return Err(ModelFault::Geometry(format!(
-                "no quasi-static slip equilibrium of the locked link at t = {t} s (residual {f:.3e} rad/s²)"
-            )));
+            return Err(ModelFault::NoEquilibrium {
+                model: LinkModel::LockedLink,
+                t_s: t,
+                residual_rad_per_s2: f.abs(),
+            });
         }
         Ok([th, th, 0.0, 0.0])
     }

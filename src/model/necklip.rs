@@ -25,7 +25,7 @@
 //! after the flip stays within 2.8e-4 rad of the full model's (`tests/necklip.rs`).
 
 use super::blade::{Blade, BladeParams, Dynamics, StickForm};
-use super::stick_slip::{Contact, Mode, ModelFault, StickSlipModel};
+use super::stick_slip::{Contact, LinearSystem, LinkModel, Mode, ModelFault, StickSlipModel};
 use nalgebra::{Matrix3, Vector3};
 
 /// Baumgarte gain of the head-height constraint, s⁻¹ (physics.md §0.3).
@@ -391,21 +391,22 @@ impl NeckLip {
     /// solve the same equations differentiated, with `ḋ, u̇_p` from the smoothed tracks.
     ///
     /// # Errors
-    /// [`ModelFault::Geometry`] without a lean track, with a lean beyond the reach, or where the
-    /// rates are undetermined (`sin(φ − θ) ≈ 0`).
+    /// [`ModelFault::NoLeanTrack`] without a lean track, [`ModelFault::LeanBeyondReach`] with a lean
+    /// beyond the reach, [`ModelFault::AlignedLinks`] where the rates are undetermined
+    /// (`sin(φ − θ) ≈ 0`).
     pub fn state_from_tracks(&self, t: f64) -> Result<([f64; 4], f64), ModelFault> {
-        let lean = self.head.lean.as_ref().ok_or_else(|| {
-            ModelFault::Geometry("neck/lip model: no lean track to start a segment from".into())
-        })?;
+        let lean = self.head.lean.as_ref().ok_or(ModelFault::NoLeanTrack)?;
         let p = &self.blade.params;
         let (l1, l2) = (p.l1_m, p.l2_m);
         let reach = l1 + l2;
         let (d, dd, _) = lean.at(t);
         let (u, ud, _) = self.head.at(t);
         if d.is_nan() || d.abs() >= reach {
-            return Err(ModelFault::Geometry(format!(
-                "neck/lip model: lean d = {d:.6e} m at t = {t:.6} s is beyond the reach {reach:.6e} m"
-            )));
+            return Err(ModelFault::LeanBeyondReach {
+                t_s: t,
+                lean_m: d,
+                reach_m: reach,
+            });
         }
         let solve = |mut th: f64, mut ph: f64| {
             for _ in 0..30 {
@@ -438,9 +439,11 @@ impl NeckLip {
         let (sp, cp) = ph.sin_cos();
         let det = l1 * l2 * (ct * sp - st * cp);
         if det.abs() < 1e-6 * l1 * l2 {
-            return Err(ModelFault::Geometry(format!(
-                "neck/lip model: at t = {t:.6} s neck and lip are aligned (θ = {th:.3e}, φ = {ph:.3e} rad), so the rates cannot be taken from the tracks"
-            )));
+            return Err(ModelFault::AlignedLinks {
+                t_s: t,
+                theta_rad: th,
+                phi_rad: ph,
+            });
         }
         let thd = (l2 * sp * dd - l2 * cp * ud) / det;
         let phd = (-l1 * st * dd + l1 * ct * ud) / det;
@@ -477,10 +480,10 @@ impl NeckLip {
         // at upright: there N is undetermined and the model cannot pass the blade's flip.
         let (l1, l2) = (self.blade.params.l1_m, self.blade.params.l2_m);
         if hrow[0].hypot(hrow[1]) < 0.02 * (l1 + l2) {
-            return Err(ModelFault::Geometry(format!(
-                "neck/lip model: the head-height constraint degenerates near upright (θ = {:.3e}, φ = {:.3e} rad), where the normal force is undetermined; this model cannot pass the blade's flip at the reversal: use a window before or after it, or blade2dof",
-                y[0], y[1]
-            )));
+            return Err(ModelFault::UprightDegenerate {
+                theta_rad: y[0],
+                phi_rad: y[1],
+            });
         }
         // Scale the constraint rows to the size of the others.
         let w = a3[(0, 0)].abs().max(a3[(1, 1)].abs())
@@ -505,16 +508,18 @@ impl NeckLip {
                 let a = build(-s * mu);
                 let (det0, det) = (a0.determinant(), a.determinant());
                 if det * det0 <= 0.0 || det.abs() < 1e-9 * det0.abs() {
-                    return Err(ModelFault::Singular(format!(
-                        "neck/lip slip equations singular (Painlevé-type): det with friction {det:.3e}, frictionless {det0:.3e}, μ = {mu:.4}"
-                    )));
+                    return Err(ModelFault::Painleve {
+                        model: LinkModel::NeckLip,
+                        det_with_friction: det,
+                        det_frictionless: det0,
+                        mu,
+                    });
                 }
-                let z = a
-                    .lu()
-                    .solve(&Vector3::new(b3[0], b3[1], w * hrhs))
-                    .ok_or_else(|| {
-                        ModelFault::Singular("neck/lip slip system not solvable".into())
-                    })?;
+                let z = a.lu().solve(&Vector3::new(b3[0], b3[1], w * hrhs)).ok_or(
+                    ModelFault::Singular {
+                        system: LinearSystem::NeckLipSlip,
+                    },
+                )?;
                 Ok((
                     Dynamics {
                         theta_dd: z[0],
@@ -537,8 +542,8 @@ impl NeckLip {
                 let z = self
                     .blade
                     .solve_with_tip_constraint(rows.cos, &a, &f, &b, tip_rhs)
-                    .ok_or_else(|| {
-                        ModelFault::Singular("neck/lip stick system is singular".into())
+                    .ok_or(ModelFault::Singular {
+                        system: LinearSystem::NeckLipStick,
                     })?;
                 Ok((
                     Dynamics {

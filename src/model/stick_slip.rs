@@ -104,22 +104,140 @@ pub struct Contact {
     pub slip_velocity: Option<f64>,
 }
 
-/// Why a model could not evaluate its right-hand side.
-#[derive(Debug, Clone)]
-pub enum ModelFault {
-    /// The slip equations have no unique solution (Painlevé-type inconsistency) or the constraint
-    /// system is singular.
-    Singular(String),
-    /// The geometry left the model's domain (e.g. the stick constraint has no solution).
-    Geometry(String),
+/// Which link model's equations a [`ModelFault`] concerns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LinkModel {
+    /// The 2-DOF head/neck/lip blade (seed eqs. 1–5).
+    Blade,
+    /// The blade with neck and lip locked together (the 1-DOF head model's link).
+    LockedLink,
+    /// The neck/lip model driven by the tracked head.
+    NeckLip,
 }
 
-impl std::fmt::Display for ModelFault {
+impl std::fmt::Display for LinkModel {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            ModelFault::Singular(s) | ModelFault::Geometry(s) => f.write_str(s),
-        }
+        f.write_str(match self {
+            LinkModel::Blade => "blade",
+            LinkModel::LockedLink => "locked-link",
+            LinkModel::NeckLip => "neck/lip",
+        })
     }
+}
+
+/// A linear system a model solves for its accelerations and contact forces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LinearSystem {
+    /// The blade's 3×3 slip system (accelerations and normal force).
+    BladeSlip,
+    /// The blade's 4×4 stick system with the tip constraint.
+    BladeStick,
+    /// The Newton iteration's Jacobian for the quasi-static slip equilibrium.
+    EquilibriumJacobian,
+    /// The neck/lip model's slip system.
+    NeckLipSlip,
+    /// The neck/lip model's stick system.
+    NeckLipStick,
+    /// The smoothed-friction comparison model's system.
+    Smoothed,
+}
+
+impl std::fmt::Display for LinearSystem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            LinearSystem::BladeSlip => "slip system",
+            LinearSystem::BladeStick => "stick constraint system",
+            LinearSystem::EquilibriumJacobian => "equilibrium Jacobian",
+            LinearSystem::NeckLipSlip => "neck/lip slip system",
+            LinearSystem::NeckLipStick => "neck/lip stick system",
+            LinearSystem::Smoothed => "smoothed-friction system",
+        })
+    }
+}
+
+/// The angle a stick constraint solves for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ConstraintAngle {
+    /// The lip angle φ (the blade's stick constraint).
+    Lip,
+    /// The link angle θ (the locked link's stick constraint).
+    Link,
+}
+
+impl std::fmt::Display for ConstraintAngle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ConstraintAngle::Lip => "lip",
+            ConstraintAngle::Link => "link",
+        })
+    }
+}
+
+/// Why a model could not evaluate its right-hand side or build a consistent state. Each variant
+/// carries the numbers that show why (angles in rad, forces in N, lengths in m, times in s).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ModelFault {
+    /// The slip equations have no unique solution: the determinant with friction has the opposite
+    /// sign to the frictionless one (a Painlevé-type inconsistency; physics.md §1.4).
+    #[error(
+        "{model} slip equations singular (Painlevé-type): det with friction {det_with_friction:.3e}, frictionless {det_frictionless:.3e}, μ = {mu:.4}"
+    )]
+    Painleve {
+        model: LinkModel,
+        det_with_friction: f64,
+        det_frictionless: f64,
+        mu: f64,
+    },
+    /// A linear system of the model is singular.
+    #[error("{system} is singular")]
+    Singular { system: LinearSystem },
+    /// The stick constraint has no solution: the head moved beyond the reach of the link.
+    #[error(
+        "stick constraint has no {angle} angle: sine = {sine:.6} (the head moved beyond the link's reach)"
+    )]
+    NoStickAngle { angle: ConstraintAngle, sine: f64 },
+    /// Newton's iteration found no quasi-static slip equilibrium to start from.
+    #[error(
+        "no quasi-static slip equilibrium of the {model} found at t = {t_s} s (largest residual acceleration {residual_rad_per_s2:.3e} rad/s²)"
+    )]
+    NoEquilibrium {
+        model: LinkModel,
+        t_s: f64,
+        residual_rad_per_s2: f64,
+    },
+    /// The neck/lip model needs the recording's lean track to start a segment.
+    #[error("neck/lip model: no lean track to start a segment from")]
+    NoLeanTrack,
+    /// The tracked lean is longer than neck and lip together.
+    #[error(
+        "neck/lip model: lean d = {lean_m:.6e} m at t = {t_s:.6} s is beyond the reach {reach_m:.6e} m"
+    )]
+    LeanBeyondReach { t_s: f64, lean_m: f64, reach_m: f64 },
+    /// Neck and lip are aligned, so the tracks do not determine the angular rates.
+    #[error(
+        "neck/lip model: at t = {t_s:.6} s neck and lip are aligned (θ = {theta_rad:.3e}, φ = {phi_rad:.3e} rad), so the rates cannot be taken from the tracks"
+    )]
+    AlignedLinks {
+        t_s: f64,
+        theta_rad: f64,
+        phi_rad: f64,
+    },
+    /// The head-height constraint degenerates near upright, where the normal force is undetermined.
+    #[error(
+        "neck/lip model: the head-height constraint degenerates near upright (θ = {theta_rad:.3e}, φ = {phi_rad:.3e} rad), where the normal force is undetermined; this model cannot pass the blade's flip at the reversal: use a window before or after it, or blade2dof"
+    )]
+    UprightDegenerate { theta_rad: f64, phi_rad: f64 },
+    /// The normal force is not positive: the lip tip left the glass.
+    #[error("contact lost: normal force {normal_n:.3e} N <= 0")]
+    ContactLost { normal_n: f64 },
+    /// No consistent starting state was found near a segment's start.
+    #[error("no consistent start within {search_s} s of the segment's start: {last}")]
+    NoConsistentStart {
+        search_s: f64,
+        /// The last attempt's fault.
+        last: Box<ModelFault>,
+    },
 }
 
 /// A mechanical system with one frictional contact, integrated as a hybrid system.
@@ -187,4 +305,38 @@ pub fn region_of<M: StickSlipModel<N>, const N: usize>(model: &M, t: f64, y: &[f
         }
     }
     r
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fault's message names what failed and carries its numbers, and a nested fault keeps them.
+    #[test]
+    fn faults_carry_their_numbers() {
+        let p = ModelFault::Painleve {
+            model: LinkModel::Blade,
+            det_with_friction: -2.5e-3,
+            det_frictionless: 1.0e-2,
+            mu: 1.25,
+        };
+        let m = p.to_string();
+        assert!(
+            m.contains("blade slip equations") && m.contains("Painlevé"),
+            "{m}"
+        );
+        assert!(
+            m.contains("-2.500e-3") && m.contains("1.000e-2") && m.contains("1.2500"),
+            "{m}"
+        );
+        let nested = ModelFault::NoConsistentStart {
+            search_s: 0.01,
+            last: Box::new(ModelFault::ContactLost { normal_n: -0.5 }),
+        };
+        assert!(
+            nested
+                .to_string()
+                .ends_with("contact lost: normal force -5.000e-1 N <= 0")
+        );
+    }
 }

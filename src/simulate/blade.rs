@@ -1,10 +1,14 @@
 //! Simulating the blade over a drive window, sampled at given (camera) times.
 
-use super::hybrid::{Mode, Phase, SolverOptions, Stats, Switch, Transition, integrate};
+use super::hybrid::{Mode, ModelFault, Phase, SolverOptions, Stats, Switch, Transition, integrate};
 use crate::model::blade::{Blade, BladeParams, LockedBlade, StickForm};
 use crate::trace::{PointTrack, Trace};
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
+
+/// How far into a neck/lip segment (s) the runner looks for a state the tracks and the contact
+/// allow the model to start from.
+const START_SEARCH_S: f64 = 0.01;
 
 /// A simulated reversal: the observables at each sample time, the transitions and the counters.
 /// All vectors have the length of `t_s`.
@@ -213,7 +217,7 @@ pub fn simulate_necklip(
     };
     for (i, &(a0, b)) in segments.iter().enumerate() {
         let mut a = a0;
-        let fail = |e: crate::simulate::hybrid::ModelFault| Error::Simulation {
+        let fail = |e: ModelFault| Error::Simulation {
             t_s: a0,
             message: e.to_string(),
             state: format!("start of neck/lip segment {} ({a0:.6}–{b:.6} s)", i + 1),
@@ -228,27 +232,26 @@ pub fn simulate_necklip(
             // model can start from: right after the flip slip can be Painlevé-singular with the
             // head height prescribed, and static friction may not yet hold the tip.
             let dt = sample_times.get(1).map_or(1e-4, |t1| t1 - sample_times[0]);
-            let mut start = None;
-            let mut why = String::new();
+            let limit = (a + START_SEARCH_S).min(b);
             let mut ts = a;
-            while start.is_none() && ts <= (a + 0.01).min(b) {
-                match model.state_from_tracks(ts) {
-                    Ok((y, dir)) => match start_from_tracks(&model, ts, y, dir) {
-                        Ok(s) => start = Some(s),
-                        Err(e) => why = e.to_string(),
-                    },
-                    Err(e) => why = e.to_string(),
-                }
-                if start.is_none() {
-                    ts += dt;
+            loop {
+                let attempt = model
+                    .state_from_tracks(ts)
+                    .and_then(|(y, dir)| start_from_tracks(&model, ts, y, dir));
+                match attempt {
+                    Ok(s) => {
+                        a = ts;
+                        break s;
+                    }
+                    Err(e) if ts + dt > limit => {
+                        return Err(fail(ModelFault::NoConsistentStart {
+                            search_s: START_SEARCH_S,
+                            last: Box::new(e),
+                        }));
+                    }
+                    Err(_) => ts += dt,
                 }
             }
-            a = ts;
-            start.ok_or_else(|| {
-                fail(crate::simulate::hybrid::ModelFault::Geometry(format!(
-                    "no consistent start within 10 ms of the segment's start: {why}"
-                )))
-            })?
         };
         let lo = sample_times.partition_point(|&t| t < a);
         let hi = sample_times.partition_point(|&t| t <= b);
@@ -286,8 +289,8 @@ fn start_from_tracks(
     t: f64,
     y: [f64; 4],
     dir: f64,
-) -> std::result::Result<([f64; 4], Mode), crate::simulate::hybrid::ModelFault> {
-    use crate::simulate::hybrid::{ModelFault, StickSlipModel};
+) -> std::result::Result<([f64; 4], Mode), ModelFault> {
+    use crate::simulate::hybrid::StickSlipModel;
     let mut dy = [0.0; 4];
     let tip_speed = model.slip_velocity(t, &y).abs();
     if tip_speed < 1e-3_f64.max(0.05 * model.blade.drive(t).1.abs()) {
@@ -307,10 +310,7 @@ fn start_from_tracks(
     if c.normal > 0.0 {
         Ok((y, slip))
     } else {
-        Err(ModelFault::Geometry(format!(
-            "normal force {:.3e} N <= 0 in slip",
-            c.normal
-        )))
+        Err(ModelFault::ContactLost { normal_n: c.normal })
     }
 }
 

@@ -21,6 +21,7 @@ use super::hybrid::{ModelFault, Phase, Stats};
 use super::rk;
 use crate::model::belt::Belt;
 use crate::model::blade::Blade;
+use crate::model::stick_slip::LinearSystem;
 use crate::{Error, Result};
 
 /// A model that both comparison methods can integrate. State as in its [`super::hybrid::StickSlipModel`]
@@ -276,7 +277,9 @@ impl NonsmoothModel<4> for Blade {
         let gamma_free = vd_next + l1 * cth * y[2] + l2 * cph * y[3];
         let z = self
             .solve_with_tip_constraint([cth, cph], &a3, &af, &b3, -gamma_free / h)
-            .ok_or_else(|| ModelFault::Singular("stick system singular".into()))?;
+            .ok_or(ModelFault::Singular {
+                system: LinearSystem::BladeStick,
+            })?;
         let mu_s = self.params.friction.mu_static();
         let (acc, normal, phase) = if z[2] > 0.0 && z[3].abs() <= mu_s * z[2] {
             ([z[0], z[1]], z[2], Phase::Stick)
@@ -287,16 +290,13 @@ impl NonsmoothModel<4> for Blade {
             for i in 0..3 {
                 a[(i, 2)] += af[i] * (-s * mu);
             }
-            let zs = a
-                .lu()
-                .solve(&b3)
-                .ok_or_else(|| ModelFault::Singular("slip system singular".into()))?;
+            let zs = a.lu().solve(&b3).ok_or(ModelFault::Singular {
+                system: LinearSystem::BladeSlip,
+            })?;
             ([zs[0], zs[1]], zs[2], Phase::slip(s))
         };
         if normal <= 0.0 {
-            return Err(ModelFault::Geometry(format!(
-                "contact lost: normal force {normal:.3e} N"
-            )));
+            return Err(ModelFault::ContactLost { normal_n: normal });
         }
         y[2] += h * acc[0];
         y[3] += h * acc[1];
@@ -319,12 +319,11 @@ impl NonsmoothModel<4> for Blade {
         for i in 0..3 {
             a[(i, 2)] += af[i] * coef;
         }
-        let z = a
-            .lu()
-            .solve(&b3)
-            .ok_or_else(|| ModelFault::Singular("smoothed system singular".into()))?;
+        let z = a.lu().solve(&b3).ok_or(ModelFault::Singular {
+            system: LinearSystem::Smoothed,
+        })?;
         if z[2] <= 0.0 {
-            return Err(ModelFault::Geometry("contact lost".into()));
+            return Err(ModelFault::ContactLost { normal_n: z[2] });
         }
         dy[0] = y[2];
         dy[1] = y[3];
