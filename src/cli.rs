@@ -14,6 +14,8 @@ use crate::{Error, Result};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 
+mod campaign;
+
 /// wiperlab: a wiper blade's tracked motion beside a stick–slip model of it.
 #[derive(Parser, Debug)]
 #[command(name = "wiperlab", version, about)]
@@ -160,6 +162,11 @@ pub enum Command {
         /// No progress bar when fitting.
         #[arg(long)]
         quiet: bool,
+    },
+    /// Campaigns: one fit job over many recordings, locally or as a Slurm job array.
+    Campaign {
+        #[command(subcommand)]
+        action: campaign::CampaignCommand,
     },
     /// Work–precision of the simulation methods (event-driven, Moreau–Jean, smoothed friction) on
     /// the belt benchmark and the blade; writes work_precision.csv and SVG figures.
@@ -572,6 +579,7 @@ pub fn run(cli: Cli) -> Result<()> {
             println!("wrote {}", out_dir.join("spectra_vs_rtol.csv").display());
             Ok(())
         }
+        Command::Campaign { action } => campaign::run(action),
         Command::Fit { job, json, quiet } => {
             let loaded = LoadedJob::load(&job)?;
             let (result, result_path, report_dir) = fit_and_write(&loaded, !quiet && !json)?;

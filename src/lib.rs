@@ -5,7 +5,7 @@
 //! The module tree is the pipeline; a stage uses only the stages before it (checked by
 //! `tests/architecture.rs`):
 //!
-//! Pipeline order: `error` → `trace` → `import` → `spectrum` → `model` → `simulate` → `fit` → `report` → `bench` → `cli`.
+//! Pipeline order: `error` → `trace` → `import` → `spectrum` → `model` → `simulate` → `fit` → `campaign` → `report` → `bench` → `cli`.
 //!
 //! * [`error`]: the crate's error type, shared by every stage.
 //! * [`trace`]: the canonical [`trace::Trace`] (SI, y up, NaN = missing), the type every stage
@@ -18,6 +18,8 @@
 //!   [`trace::Trace`] like a measurement).
 //! * [`fit`]: the friction law A, B, C and the neck stiffness fitted with `argmin`; model choice,
 //!   intervals, results.
+//! * [`campaign`]: one fit job over many recordings, locally in parallel or as a Slurm job array,
+//!   collected into one table.
 //! * [`report`]: SVG figures and the HTML report page, drawn from values computed upstream.
 //! * [`bench`]: the work–precision study behind `wiperlab bench`.
 //! * [`cli`]: argument parsing and dispatch for the `wiperlab` binary.
@@ -27,6 +29,7 @@
 //! units (see `model::blade`).
 
 pub mod bench;
+pub mod campaign;
 pub mod cli;
 pub mod error;
 pub mod fit;

@@ -1,0 +1,208 @@
+//! `wiperlab campaign …`: parses the subcommand, calls `crate::campaign`, prints.
+
+use crate::campaign::Campaign;
+use crate::campaign::run::{Status, describe_overrides, fit_entry, run_local};
+use crate::campaign::slurm::{SlurmSettings, status, submit, write_script};
+use crate::{Error, Result};
+use clap::{Args, Subcommand};
+use std::path::PathBuf;
+
+/// What to do with a campaign.
+#[derive(Debug, Subcommand)]
+pub enum CampaignCommand {
+    /// List the campaign's recordings, their overrides and condition labels.
+    List { campaign: PathBuf },
+    /// Fit every recording on this machine, in parallel; skips recordings whose result is complete
+    /// for unchanged inputs (rerun to continue after an interruption); a failed recording does not
+    /// stop the others (the exit code is then 1).
+    Run {
+        campaign: PathBuf,
+        /// Recordings fitted at once (each fit also uses the thread pool). Default: 1.
+        #[arg(long, default_value_t = 1)]
+        jobs: usize,
+        /// No per-recording lines on stderr.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Fit one recording (what each Slurm array task runs).
+    Task {
+        campaign: PathBuf,
+        /// Position of the recording in `campaign list` (0-based; Slurm's SLURM_ARRAY_TASK_ID).
+        #[arg(long)]
+        index: usize,
+    },
+    /// Write the Slurm job-array script (one task per recording) and, with --submit, submit it.
+    Slurm {
+        campaign: PathBuf,
+        #[command(flatten)]
+        settings: SlurmArgs,
+        /// Submit with sbatch after writing the script.
+        #[arg(long)]
+        submit: bool,
+    },
+    /// State of each recording: done, failed, or the array task's queue state.
+    Status { campaign: PathBuf },
+    /// Merge every result into <campaign dir>/<name>/campaign.csv.
+    Collect { campaign: PathBuf },
+}
+
+/// Slurm settings from the command line (each overrides the campaign file's `[slurm]`).
+#[derive(Debug, Args)]
+pub struct SlurmArgs {
+    /// Partition (`sbatch --partition`).
+    #[arg(long)]
+    partition: Option<String>,
+    /// Time limit per task (`sbatch --time`), e.g. 00:30:00.
+    #[arg(long)]
+    time: Option<String>,
+    /// CPUs per task, also the fit's thread count. Default 2.
+    #[arg(long)]
+    cpus_per_task: Option<u32>,
+    /// Largest number of tasks running at once (`--array=0-N%K`).
+    #[arg(long)]
+    max_parallel: Option<u32>,
+}
+
+/// Runs a campaign subcommand.
+///
+/// # Errors
+/// Those of the campaign functions; a `task` whose fit failed returns the fit's error (after the
+/// failure is recorded in the recording's status file).
+pub fn run(cmd: CampaignCommand) -> Result<()> {
+    match cmd {
+        CampaignCommand::List { campaign } => list(&Campaign::load(&campaign)?),
+        CampaignCommand::Run {
+            campaign,
+            jobs,
+            quiet,
+        } => run_all(&Campaign::load(&campaign)?, jobs, quiet),
+        CampaignCommand::Task { campaign, index } => {
+            let c = Campaign::load(&campaign)?;
+            let entry = c.entries.get(index).ok_or_else(|| {
+                Error::Config(format!(
+                    "campaign task: --index {index} is beyond the campaign's {} recordings",
+                    c.entries.len()
+                ))
+            })?;
+            let s = fit_entry(&c, entry)?;
+            println!("{}: done in {:.1} s", s.id, s.wall_time_s);
+            Ok(())
+        }
+        CampaignCommand::Slurm {
+            campaign,
+            settings,
+            submit: go,
+        } => slurm(&Campaign::load(&campaign)?, &settings, go),
+        CampaignCommand::Status { campaign } => {
+            let st = status(&Campaign::load(&campaign)?);
+            if let Some(id) = &st.job_id {
+                println!("Slurm job {id}");
+            }
+            for (id, s) in &st.tasks {
+                println!("  {id:<24} {s}");
+            }
+            let counts: Vec<String> = st
+                .counts()
+                .iter()
+                .map(|(s, n)| format!("{n} {s}"))
+                .collect();
+            println!("{}", counts.join(", "));
+            Ok(())
+        }
+        CampaignCommand::Collect { campaign } => {
+            let c = Campaign::load(&campaign)?;
+            let (table, path) = crate::campaign::collect::collect(&c)?;
+            let done = table.rows.iter().filter(|r| r.state == "done").count();
+            println!(
+                "{done} of {} recordings collected into {}",
+                table.rows.len(),
+                path.display()
+            );
+            for r in table.rows.iter().filter(|r| r.state != "done") {
+                println!("  {}: {} {}", r.id, r.state, r.reason);
+            }
+            Ok(())
+        }
+    }
+}
+
+fn list(c: &Campaign) -> Result<()> {
+    println!(
+        "campaign '{}': {} recordings, template {}, outputs in {}",
+        c.name,
+        c.entries.len(),
+        c.template_path.display(),
+        c.out_dir().display()
+    );
+    for (i, e) in c.entries.iter().enumerate() {
+        let labels: Vec<String> = e.labels.iter().map(|(k, v)| format!("{k}={v}")).collect();
+        println!(
+            "  {i:>4} {:<24} {} [{}] {}",
+            e.id,
+            labels.join(" "),
+            describe_overrides(e),
+            e.recording.display()
+        );
+    }
+    Ok(())
+}
+
+fn run_all(c: &Campaign, jobs: usize, quiet: bool) -> Result<()> {
+    let report = move |id: &str, r: &Result<Status>, n: usize, total: usize| {
+        if quiet {
+            return;
+        }
+        match r {
+            Ok(s) => eprintln!("[{n}/{total}] {id}: done in {:.1} s", s.wall_time_s),
+            Err(e) => eprintln!("[{n}/{total}] {id}: FAILED: {e}"),
+        }
+    };
+    let s = run_local(c, jobs, &report)?;
+    println!(
+        "campaign '{}': {} fitted, {} skipped (complete, inputs unchanged), {} failed",
+        c.name,
+        s.fitted.len(),
+        s.skipped.len(),
+        s.failed.len()
+    );
+    for (id, why) in &s.failed {
+        println!("  failed {id}: {why}");
+    }
+    if s.failed.is_empty() {
+        Ok(())
+    } else {
+        Err(Error::Fit(format!(
+            "{} of {} recordings failed (the others' results are written; reasons above and in `campaign collect`)",
+            s.failed.len(),
+            c.entries.len()
+        )))
+    }
+}
+
+fn slurm(c: &Campaign, a: &SlurmArgs, go: bool) -> Result<()> {
+    let cli = SlurmSettings {
+        partition: a.partition.clone(),
+        time: a.time.clone(),
+        cpus_per_task: a.cpus_per_task,
+        max_parallel: a.max_parallel,
+    };
+    let settings = c.file.slurm.overridden_by(&cli);
+    let exe = std::env::current_exe()
+        .map_err(|e| Error::Config(format!("campaign slurm: cannot find this executable: {e}")))?;
+    let script = write_script(c, &settings, &exe)?;
+    println!("wrote {}", script.display());
+    if go {
+        let id = submit(c, &script)?;
+        println!(
+            "submitted Slurm job {id} ({} array tasks); follow it with `wiperlab campaign status {}`",
+            c.entries.len(),
+            c.path.display()
+        );
+    } else {
+        println!(
+            "submit it with `sbatch {}` or rerun with --submit",
+            script.display()
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,347 @@
+//! `wiperlab campaign` as a lab runs it, on the shipped example campaign (`campaigns/example.toml`:
+//! six model-made recordings in `data/campaign/`, written by `examples/make_campaign.rs`, truth in
+//! `data/campaign/truth.csv`):
+//! * a local run fits every recording, collects them into `campaign.csv`, skips finished
+//!   recordings on a rerun, refits the one whose recording changed, and records a failure without
+//!   stopping the others;
+//! * the same campaign through a real one-node Slurm (`tests/slurm/start.sh`: munged, slurmctld
+//!   and slurmd on localhost; needs root and Debian's `slurm-wlm` and `munge`) gives the same
+//!   collected values as the local run. Without Slurm the test says it skipped, unless
+//!   WIPERLAB_REQUIRE_SLURM=1 (CI), where that is a failure.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn wiperlab(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_wiperlab"))
+        .args(args)
+        .output()
+        .expect("cannot start the wiperlab binary")
+}
+
+fn ok(o: &Output, what: &str) -> String {
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{what} failed\nstdout:\n{}\nstderr:\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// A fresh directory under the system temp dir, removed on drop.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(name: &str) -> TempDir {
+        let p =
+            std::env::temp_dir().join(format!("wiperlab_campaign_{}_{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&p);
+        std::fs::create_dir_all(&p).expect("create temp dir");
+        TempDir(p)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Copies `recordings` (file names in data/campaign/) and their conditions rows into `dir`, and
+/// writes `dir/c.toml`: the example campaign's template on those copies.
+fn campaign_copy(dir: &Path, recordings: &[&str]) -> PathBuf {
+    let data = root().join("data/campaign");
+    let table = std::fs::read_to_string(data.join("conditions.csv")).expect("conditions.csv");
+    let mut lines = table.lines();
+    let mut rows = vec![lines.next().expect("header").to_string()];
+    for r in recordings {
+        std::fs::copy(data.join(r), dir.join(r)).expect("copy recording");
+        rows.push(
+            lines
+                .clone()
+                .find(|l| l.starts_with(&format!("{r},")))
+                .unwrap_or_else(|| panic!("no conditions row for {r}"))
+                .to_string(),
+        );
+    }
+    std::fs::write(dir.join("conditions.csv"), rows.join("\n") + "\n").expect("write table");
+    let campaign = format!(
+        "template = {:?}\nrecordings = [\"*_xypts.csv\"]\nconditions = \"conditions.csv\"\n",
+        root().join("campaigns/example_template.toml")
+    );
+    let path = dir.join("c.toml");
+    std::fs::write(&path, campaign).expect("write campaign");
+    path
+}
+
+/// `campaign.csv` as rows of column → value.
+fn read_table(path: &Path) -> Vec<BTreeMap<String, String>> {
+    let mut r = csv::Reader::from_path(path).expect("campaign.csv");
+    let headers = r.headers().expect("header").clone();
+    r.records()
+        .map(|rec| {
+            let rec = rec.expect("row");
+            headers
+                .iter()
+                .zip(rec.iter())
+                .map(|(h, v)| (h.to_string(), v.to_string()))
+                .collect()
+        })
+        .collect()
+}
+
+/// data/campaign/truth.csv: recording file name → (C, k1).
+fn truth() -> BTreeMap<String, (f64, f64)> {
+    let mut r = csv::Reader::from_path(root().join("data/campaign/truth.csv")).expect("truth.csv");
+    r.records()
+        .map(|rec| {
+            let rec = rec.expect("row");
+            (
+                rec[0].to_string(),
+                (rec[1].parse().expect("C"), rec[2].parse().expect("k1")),
+            )
+        })
+        .collect()
+}
+
+fn num(row: &BTreeMap<String, String>, col: &str) -> f64 {
+    row.get(col)
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no number in column {col}: {row:?}"))
+}
+
+#[test]
+fn local_campaign_fits_collects_skips_and_survives_a_failure() {
+    let dir = TempDir::new("local");
+    let all = [
+        "hard_fast_xypts.csv",
+        "hard_normal_xypts.csv",
+        "hard_slow_xypts.csv",
+        "soft_fast_xypts.csv",
+        "soft_normal_xypts.csv",
+        "soft_slow_xypts.csv",
+    ];
+    let c = campaign_copy(&dir.0, &all);
+    let cs = c.to_str().expect("UTF-8 path");
+    let out = ok(
+        &wiperlab(&["campaign", "run", cs, "--jobs", "2"]),
+        "campaign run",
+    );
+    assert!(out.contains("6 fitted, 0 skipped"), "{out}");
+    ok(&wiperlab(&["campaign", "collect", cs]), "campaign collect");
+    let rows = read_table(&dir.0.join("c/campaign.csv"));
+    assert_eq!(rows.len(), 6);
+    let truth = truth();
+    for row in &rows {
+        assert_eq!(row["state"], "done", "{row:?}");
+        let (c_true, k1_true) = truth[&format!("{}.csv", row["id"])];
+        let (c, k1) = (num(row, "C"), num(row, "k1"));
+        println!(
+            "{}: C {:+.2} %, k1 {:+.2} % ({} / {} sweep)",
+            row["id"],
+            100.0 * (c / c_true - 1.0),
+            100.0 * (k1 / k1_true - 1.0),
+            row["compound"],
+            row["sweep"]
+        );
+        // The friction offset within the single-recording tests' 5 % (tests/fit_recovery.rs).
+        assert!((c / c_true - 1.0).abs() < 0.05, "{row:?}");
+        // The conditions table's labels and overrides reach the row.
+        assert!(["soft", "hard"].contains(&row["compound"].as_str()));
+        assert!(num(row, "drive_omega_rad_per_s") > 0.0 && num(row, "t0_s") > 0.0);
+    }
+    // A rerun skips every recording (same content hashes); a changed recording is refitted.
+    let out = ok(&wiperlab(&["campaign", "run", cs]), "campaign rerun");
+    assert!(out.contains("0 fitted, 6 skipped"), "{out}");
+    let changed = dir.0.join("soft_slow_xypts.csv");
+    let mut text = std::fs::read_to_string(&changed).expect("read copy");
+    let last = text.lines().last().expect("a row").to_string();
+    text.push_str(&last);
+    text.push('\n');
+    std::fs::write(&changed, text).expect("append a frame");
+    let out = ok(
+        &wiperlab(&["campaign", "run", cs]),
+        "campaign after a change",
+    );
+    assert!(out.contains("1 fitted, 5 skipped"), "{out}");
+    // A recording that cannot be read fails alone, with its reason in the table.
+    std::fs::write(
+        dir.0.join("hard_slow_xypts.csv"),
+        "pt1_cam1_X,pt1_cam1_Y\n1,x\n",
+    )
+    .expect("break a recording");
+    let o = wiperlab(&["campaign", "run", cs]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "a failed recording is a failed computation"
+    );
+    assert!(
+        out.contains("0 fitted, 5 skipped") && out.contains("1 failed"),
+        "{out}"
+    );
+    ok(
+        &wiperlab(&["campaign", "collect", cs]),
+        "collect after a failure",
+    );
+    let rows = read_table(&dir.0.join("c/campaign.csv"));
+    let bad = rows
+        .iter()
+        .find(|r| r["id"] == "hard_slow_xypts")
+        .expect("row of the broken recording");
+    assert_eq!(bad["state"], "failed");
+    assert!(bad["reason"].contains("hard_slow_xypts.csv"), "{bad:?}");
+    assert_eq!(rows.iter().filter(|r| r["state"] == "done").count(), 5);
+}
+
+#[test]
+fn campaign_errors_name_the_file_and_line() {
+    let dir = TempDir::new("errors");
+    let c = campaign_copy(&dir.0, &["soft_fast_xypts.csv"]);
+    let cs = c.to_str().expect("UTF-8 path");
+    // A conditions row naming a recording the campaign does not have: file, line, the name.
+    let table = dir.0.join("conditions.csv");
+    let mut text = std::fs::read_to_string(&table).expect("table");
+    text.push_str("nope_xypts.csv,1.0,1.6,soft,normal,1\n");
+    std::fs::write(&table, &text).expect("write table");
+    let o = wiperlab(&["campaign", "list", cs]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("conditions.csv:3:") && err.contains("nope_xypts.csv"),
+        "{err}"
+    );
+    // A non-number in an override column: its line and column.
+    let header = text.lines().next().expect("header");
+    std::fs::write(
+        &table,
+        format!("{header}\nsoft_fast_xypts.csv,fast,1.6,soft,fast,1\n"),
+    )
+    .expect("write table");
+    let o = wiperlab(&["campaign", "list", cs]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("conditions.csv:2:2") && err.contains("t0_s"),
+        "{err}"
+    );
+}
+
+/// Slurm is usable here: root, the daemons' binaries and the start script.
+fn slurm_available() -> Result<(), String> {
+    let root_user = Command::new("id")
+        .arg("-u")
+        .output()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
+        .unwrap_or(false);
+    if !root_user {
+        return Err("not root (the test starts slurmctld and slurmd)".into());
+    }
+    for bin in [
+        "/usr/sbin/slurmctld",
+        "/usr/sbin/slurmd",
+        "/usr/sbin/munged",
+    ] {
+        if !Path::new(bin).exists() {
+            return Err(format!("{bin} is not installed (Debian: slurm-wlm, munge)"));
+        }
+    }
+    Ok(())
+}
+
+#[test]
+fn slurm_array_gives_the_local_results() {
+    if let Err(why) = slurm_available() {
+        if std::env::var("WIPERLAB_REQUIRE_SLURM").as_deref() == Ok("1") {
+            panic!("WIPERLAB_REQUIRE_SLURM=1 but Slurm cannot run here: {why}");
+        }
+        println!("skipped: {why}");
+        return;
+    }
+    let state = std::env::temp_dir().join("wiperlab-slurm");
+    let start = Command::new("bash")
+        .arg(root().join("tests/slurm/start.sh"))
+        .arg(&state)
+        .output()
+        .expect("run tests/slurm/start.sh");
+    ok(&start, "starting Slurm");
+    let four = [
+        "hard_normal_xypts.csv",
+        "hard_slow_xypts.csv",
+        "soft_normal_xypts.csv",
+        "soft_slow_xypts.csv",
+    ];
+    let via_slurm = TempDir::new("slurm");
+    let local = TempDir::new("slurm_local");
+    let cs = campaign_copy(&via_slurm.0, &four);
+    let cl = campaign_copy(&local.0, &four);
+    let (cs, cl) = (cs.to_str().expect("path"), cl.to_str().expect("path"));
+    let out = ok(
+        &wiperlab(&[
+            "campaign",
+            "slurm",
+            cs,
+            "--cpus-per-task",
+            "1",
+            "--max-parallel",
+            "2",
+            "--submit",
+        ]),
+        "campaign slurm --submit",
+    );
+    assert!(out.contains("submitted Slurm job"), "{out}");
+    ok(
+        &wiperlab(&["campaign", "run", cl, "--jobs", "2"]),
+        "local run",
+    );
+    // Poll the array through `campaign status` (squeue and the tasks' status files).
+    let t0 = Instant::now();
+    loop {
+        let st = ok(&wiperlab(&["campaign", "status", cs]), "campaign status");
+        if st.lines().last().is_some_and(|l| l.trim() == "4 done") {
+            break;
+        }
+        assert!(
+            !st.contains("failed") && t0.elapsed() < Duration::from_secs(600),
+            "array not done after {:?}:\n{st}",
+            t0.elapsed()
+        );
+        std::thread::sleep(Duration::from_secs(2));
+    }
+    ok(&wiperlab(&["campaign", "collect", cs]), "collect (Slurm)");
+    ok(&wiperlab(&["campaign", "collect", cl]), "collect (local)");
+    let a = read_table(&via_slurm.0.join("c/campaign.csv"));
+    let b = read_table(&local.0.join("c/campaign.csv"));
+    assert_eq!(a.len(), 4);
+    for (ra, rb) in a.iter().zip(&b) {
+        assert_eq!(ra["id"], rb["id"]);
+        assert_eq!(ra["state"], "done");
+        // Same binary, same generated job, same seed: the same fit, bit for bit.
+        for col in [
+            "C",
+            "k1",
+            "cost",
+            "model",
+            "peak_low_model_hz",
+            "peak_high_model_hz",
+        ] {
+            assert_eq!(ra[col], rb[col], "{col} of {}", ra["id"]);
+        }
+    }
+    let logs = via_slurm.0.join("c/slurm/logs");
+    let n_logs = std::fs::read_dir(&logs).map_or(0, |d| d.count());
+    assert_eq!(n_logs, 4, "one log per array task in {}", logs.display());
+    let _ = Command::new("bash")
+        .arg(root().join("tests/slurm/stop.sh"))
+        .arg(&state)
+        .output();
+}
