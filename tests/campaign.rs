@@ -139,6 +139,32 @@ fn local_campaign_fits_collects_skips_and_survives_a_failure() {
     ok(&wiperlab(&["campaign", "collect", cs]), "campaign collect");
     let rows = read_table(&dir.0.join("c/campaign.csv"));
     assert_eq!(rows.len(), 6);
+    // The report page lists every recording and draws each parameter against each varying
+    // condition (compound, sweep, t0_s, drive speed) and the friction laws.
+    let page = std::fs::read_to_string(dir.0.join("c/report/index.html")).expect("report page");
+    for id in ["hard_fast_xypts", "soft_slow_xypts"] {
+        assert!(page.contains(id), "{id} missing from the report page");
+    }
+    for fig in [
+        "friction_laws",
+        "C_vs_compound",
+        "k1_vs_sweep",
+        "C_vs_drive_omega_rad_per_s",
+    ] {
+        let svg = dir.0.join(format!("c/report/{fig}.svg"));
+        assert!(
+            page.contains(&format!("{fig}.svg")),
+            "{fig} not on the page"
+        );
+        assert!(
+            std::fs::read_to_string(&svg).is_ok_and(|t| t.contains("<svg")),
+            "{fig}"
+        );
+    }
+    assert!(
+        !dir.0.join("c/report/C_vs_repeat.svg").exists(),
+        "repeat is 1 everywhere"
+    );
     let truth = truth();
     for row in &rows {
         assert_eq!(row["state"], "done", "{row:?}");

@@ -4,6 +4,7 @@
 use super::run::{EntryPaths, State, read_status, write_atomic};
 use super::{Campaign, Override};
 use crate::fit::result::FitResult;
+use crate::model::{BladeParams, FrictionLaw};
 use crate::{Error, Result};
 use std::path::PathBuf;
 
@@ -39,6 +40,9 @@ pub struct Row {
     pub model_evaluations: usize,
     pub failed_evaluations: usize,
     pub wall_time_s: f64,
+    /// The fitted friction law: the recording's blade file with the fitted A, B, C in place
+    /// (`None` until the recording is done).
+    pub friction: Option<FrictionLaw>,
 }
 
 /// The collected campaign.
@@ -94,6 +98,7 @@ pub fn gather(campaign: &Campaign) -> Result<Table> {
             model_evaluations: 0,
             failed_evaluations: 0,
             wall_time_s: f64::NAN,
+            friction: None,
         };
         if let Some(s) = status {
             row.wall_time_s = s.wall_time_s;
@@ -104,6 +109,7 @@ pub fn gather(campaign: &Campaign) -> Result<Table> {
             };
             if s.state == State::Done {
                 fill_from_result(&mut row, &FitResult::read(&paths.result)?, &mut table);
+                row.friction = fitted_law(&paths.blade, &row.params)?;
             }
         }
         table.rows.push(row);
@@ -142,6 +148,25 @@ fn fill_from_result(row: &mut Row, r: &FitResult, table: &mut Table) {
         }
         row.peaks.push((band, pk.measured_hz, pk.model_hz));
     }
+}
+
+/// The blade file's friction law with the fitted `A`, `B`, `C` in place of its own values.
+fn fitted_law(
+    blade: &std::path::Path,
+    params: &[(String, ParamValue)],
+) -> Result<Option<FrictionLaw>> {
+    let text = std::fs::read_to_string(blade).map_err(|e| Error::io(blade, "cannot read", e))?;
+    let p: BladeParams =
+        toml::from_str(&text).map_err(|e| Error::input(blade, format!("blade file: {e}")))?;
+    let get = |n: &str| params.iter().find(|(k, _)| k == n).map(|(_, v)| v.value);
+    Ok(Some(match p.friction {
+        FrictionLaw::Exponential { a, b_s_per_m, c } => FrictionLaw::Exponential {
+            a: get("A").unwrap_or(a),
+            b_s_per_m: get("B").unwrap_or(b_s_per_m),
+            c: get("C").unwrap_or(c),
+        },
+        other => other,
+    }))
 }
 
 fn num(x: f64) -> String {
@@ -222,4 +247,146 @@ pub fn collect(campaign: &Campaign) -> Result<(Table, PathBuf)> {
     let path = campaign.out_dir().join("campaign.csv");
     write_atomic(&path, to_csv(&table)?.as_bytes())?;
     Ok((table, path))
+}
+
+/// A fitted value far from the campaign's others: robust z-score `|x − median| / (1.4826·MAD)`
+/// above [`OUTLIER_Z`] (Iglewicz & Hoaglin 1993, *How to Detect and Handle Outliers*, §3.3, with
+/// the MAD scaled to σ for normal data).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Outlier {
+    pub id: String,
+    pub param: String,
+    pub value: f64,
+    pub robust_z: f64,
+}
+
+/// Robust z-score above which a fitted value is listed as an outlier.
+pub const OUTLIER_Z: f64 = 3.5;
+
+/// The outliers of each parameter among the done recordings (at least 4 values needed).
+pub fn outliers(t: &Table) -> Vec<Outlier> {
+    let mut out = Vec::new();
+    for p in &t.param_names {
+        let vals: Vec<(&str, f64)> = t
+            .rows
+            .iter()
+            .filter_map(|r| {
+                r.params
+                    .iter()
+                    .find(|(n, _)| n == p)
+                    .map(|(_, v)| (r.id.as_str(), v.value))
+            })
+            .filter(|(_, v)| v.is_finite())
+            .collect();
+        if vals.len() < 4 {
+            continue;
+        }
+        let med = median(vals.iter().map(|(_, v)| *v).collect());
+        let mad = median(vals.iter().map(|(_, v)| (v - med).abs()).collect());
+        if mad <= 0.0 {
+            continue;
+        }
+        for (id, v) in vals {
+            let z = (v - med).abs() / (1.4826 * mad);
+            if z > OUTLIER_Z {
+                out.push(Outlier {
+                    id: id.to_string(),
+                    param: p.clone(),
+                    value: v,
+                    robust_z: z,
+                });
+            }
+        }
+    }
+    out
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(id: &str, c: f64) -> Row {
+        Row {
+            id: id.into(),
+            recording: PathBuf::from(id),
+            labels: Vec::new(),
+            overrides: Vec::new(),
+            state: "done".into(),
+            reason: String::new(),
+            model: "blade2dof".into(),
+            cost: 0.1,
+            params: vec![(
+                "C".into(),
+                ParamValue {
+                    value: c,
+                    lo: f64::NAN,
+                    hi: f64::NAN,
+                    std_error: f64::NAN,
+                },
+            )],
+            peaks: Vec::new(),
+            model_evaluations: 1,
+            failed_evaluations: 0,
+            wall_time_s: 1.0,
+            friction: None,
+        }
+    }
+
+    /// Five values near 0.56 and one at 0.9: only the last is listed (its robust z is about 200).
+    #[test]
+    fn one_far_value_is_an_outlier() {
+        let t = Table {
+            label_columns: Vec::new(),
+            param_names: vec!["C".into()],
+            band_names: Vec::new(),
+            rows: [0.558, 0.56, 0.561, 0.559, 0.562, 0.9]
+                .iter()
+                .enumerate()
+                .map(|(i, c)| row(&format!("r{i}"), *c))
+                .collect(),
+        };
+        let o = outliers(&t);
+        assert_eq!(o.len(), 1, "{o:?}");
+        assert_eq!(o[0].id, "r5");
+        assert!(o[0].robust_z > 100.0);
+    }
+
+    /// The CSV has one row per recording and a column per parameter value and interval end.
+    #[test]
+    fn csv_columns() {
+        let t = Table {
+            label_columns: vec!["compound".into()],
+            param_names: vec!["C".into()],
+            band_names: Vec::new(),
+            rows: vec![Row {
+                labels: vec!["soft".into()],
+                overrides: vec![f64::NAN; 5],
+                ..row("a", 0.5)
+            }],
+        };
+        let text = to_csv(&t).unwrap();
+        let mut lines = text.lines();
+        let header = lines.next().unwrap();
+        assert!(
+            header.starts_with("id,recording,compound,t0_s,"),
+            "{header}"
+        );
+        assert!(header.contains(",C,C_lo,C_hi,C_std,"), "{header}");
+        assert!(
+            lines
+                .next()
+                .unwrap()
+                .starts_with("a,a,soft,,,,,,done,,blade2dof,1e-1,5e-1,")
+        );
+    }
 }

@@ -42,7 +42,8 @@ pub enum CampaignCommand {
     },
     /// State of each recording: done, failed, or the array task's queue state.
     Status { campaign: PathBuf },
-    /// Merge every result into <campaign dir>/<name>/campaign.csv.
+    /// Merge every result into <campaign dir>/<name>/campaign.csv and draw the campaign report
+    /// page <campaign dir>/<name>/report/index.html.
     Collect { campaign: PathBuf },
 }
 
@@ -112,12 +113,26 @@ pub fn run(cmd: CampaignCommand) -> Result<()> {
         CampaignCommand::Collect { campaign } => {
             let c = Campaign::load(&campaign)?;
             let (table, path) = crate::campaign::collect::collect(&c)?;
+            let outliers = crate::campaign::collect::outliers(&table);
+            let page = crate::report::campaign::write_campaign_report(
+                &c.out_dir().join("report"),
+                &c.name,
+                &table,
+                &outliers,
+            )?;
             let done = table.rows.iter().filter(|r| r.state == "done").count();
             println!(
-                "{done} of {} recordings collected into {}",
+                "{done} of {} recordings collected into {}; report page {}",
                 table.rows.len(),
-                path.display()
+                path.display(),
+                page.display()
             );
+            for o in &outliers {
+                println!(
+                    "  outlier {}: {} = {:.6} (robust z {:.1})",
+                    o.id, o.param, o.value, o.robust_z
+                );
+            }
             for r in table.rows.iter().filter(|r| r.state != "done") {
                 println!("  {}: {} {}", r.id, r.state, r.reason);
             }

@@ -3,7 +3,9 @@
 //! * [`plot`]: SVG line charts (traces, PSDs with peak markers) and spectrogram heat maps.
 //! * [`figures`]: which figures each command writes.
 //! * [`html`]: the report page `reports/<job>/index.html`.
+//! * [`campaign`]: a campaign's report page, `<campaign dir>/<name>/report/index.html`.
 
+pub mod campaign;
 pub mod figures;
 pub mod html;
 pub mod plot;
