@@ -120,7 +120,7 @@ pub struct MoreRecording {
 }
 
 /// Spectral estimator settings shared by measurement and model.
-#[derive(Debug, Clone, Deserialize, Serialize)]
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct SpectrumSection {
     pub signal: SignalKind,
@@ -141,7 +141,7 @@ impl Default for SpectrumSection {
 }
 
 /// Cost weights (see [`super::SpectralProblem::cost_of`]).
-#[derive(Debug, Clone, Copy, Deserialize, Serialize)]
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct Weights {
     /// Weight of the squared log peak-frequency error in units of 1 % (`(Δln f / 0.01)²`).
@@ -171,7 +171,7 @@ impl Default for Weights {
 }
 
 /// Which parameters to fit and how.
-#[derive(Debug, Clone, Deserialize, Serialize)]
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct FitSection {
     /// Parameter name → `[lower, upper]` bounds. Names: see [`PARAM_NAMES`].
@@ -215,7 +215,7 @@ pub struct FitSection {
 }
 
 /// Settings of the parametric bootstrap that gives each fitted parameter an interval.
-#[derive(Debug, Clone, Copy, Deserialize, Serialize)]
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct UncertaintySection {
     /// Bootstrap replicates (0: no intervals, only the curvature's 1σ).
@@ -241,7 +241,7 @@ impl Default for UncertaintySection {
 }
 
 /// Bounds `[lower, upper]` of the shoulder parameters (see [`crate::model::Shoulder`]).
-#[derive(Debug, Clone, Copy, Deserialize, Serialize)]
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ShoulderBounds {
     /// Neck stiffness while touching the shoulder, N·m/rad.

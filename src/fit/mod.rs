@@ -21,6 +21,7 @@ use crate::model::BladeParams;
 use crate::model::blade::StickForm;
 use crate::simulate::SolverOptions;
 use crate::simulate::blade::{BladeSimulation, ModelKind, simulate_model};
+use crate::spectrum::stats::quantile_sorted;
 use crate::trace::Trace;
 use crate::{Error, Result};
 use argmin::core::observers::{Observe, ObserverMode};
@@ -1295,6 +1296,10 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         warnings,
         input_sha256,
         settings,
+        target_job: job.job.targets.is_some(),
+        spectrum: Some(job.job.spectrum.clone()),
+        fit_settings: Some(job.job.fit.clone()),
+        fitted_at: Some(jiff::Timestamp::now()),
         history: cf.history.clone(),
     };
     Ok(FitOutcome {
@@ -1381,8 +1386,8 @@ pub fn bootstrap_intervals(
             // bias the replicates show (Davison & Hinkley 1997, *Bootstrap Methods*, eq. 5.6).
             let est = problem.free[i].value(best_u[i]);
             Interval {
-                lo: 2.0 * est - percentile(&v, 0.841_345),
-                hi: 2.0 * est - percentile(&v, 0.158_655),
+                lo: 2.0 * est - quantile_sorted(&v, 0.841_345),
+                hi: 2.0 * est - quantile_sorted(&v, 0.158_655),
                 level: 0.6827,
                 method: format!(
                     "basic parametric bootstrap, {b} replicates (best-fit model + white noise σ = {} from the measured floor{}; {})",
@@ -1477,20 +1482,6 @@ impl ReplicateSource {
             first_failure: Mutex::new(None),
             progress: problem.progress.clone(),
         })
-    }
-}
-
-/// Linear-interpolation percentile (NumPy's default, "linear") of sorted `v` at fraction `q`.
-fn percentile(v: &[f64], q: f64) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    let pos = q * (v.len() - 1) as f64;
-    let (i, f) = (pos.floor() as usize, pos.fract());
-    if i + 1 < v.len() {
-        v[i] + f * (v[i + 1] - v[i])
-    } else {
-        v[i]
     }
 }
 

@@ -4,6 +4,7 @@
 //! Every type here is `Serialize + Deserialize`. Fields added after the first release carry
 //! `#[serde(default)]`, so result files written before them still load (with the field empty).
 
+use super::job::{FitSection, SpectrumSection};
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -128,6 +129,21 @@ pub struct FitResult {
     /// The job file's text as the fit read it (settings provenance); empty if not recorded.
     #[serde(default)]
     pub settings: String,
+    /// True when the job gave target frequencies (`[targets]`) instead of a recording.
+    #[serde(default)]
+    pub target_job: bool,
+    /// The spectral settings the fit used (signal, bands, gap filling); `None` in results written
+    /// before this field.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spectrum: Option<SpectrumSection>,
+    /// The fit settings the fit used (swarm, polish, restarts, seed, weights); `None` in results
+    /// written before this field.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fit_settings: Option<FitSection>,
+    /// When the fit finished (UTC, RFC 3339 in the file); `None` in results written before this
+    /// field.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fitted_at: Option<jiff::Timestamp>,
     pub history: Vec<HistoryPoint>,
 }
 
@@ -247,6 +263,12 @@ mod tests {
             warnings: vec!["w".into()],
             input_sha256: "ab".into(),
             settings: "name = \"j\"\n".into(),
+            target_job: true,
+            spectrum: Some(SpectrumSection::default()),
+            fit_settings: Some(
+                toml::from_str("[parameters]\nk1 = [0.005, 0.15]\n").expect("fit section"),
+            ),
+            fitted_at: Some("2026-11-22T10:00:00.5Z".parse().expect("RFC 3339 time")),
             history: vec![HistoryPoint {
                 stage: "swarm".into(),
                 iteration: 0,
@@ -279,6 +301,10 @@ mod tests {
             "warnings",
             "input_sha256",
             "settings",
+            "target_job",
+            "spectrum",
+            "fit_settings",
+            "fitted_at",
         ] {
             assert!(t.remove(k).is_some(), "{k}");
         }
@@ -292,5 +318,7 @@ mod tests {
         assert!(r.model_trials.is_empty() && r.warnings.is_empty());
         assert!(r.input_sha256.is_empty() && r.settings.is_empty());
         assert_eq!(r.parameters[0].interval, None);
+        assert!(!r.target_job && r.spectrum.is_none() && r.fit_settings.is_none());
+        assert_eq!(r.fitted_at, None);
     }
 }

@@ -7,11 +7,13 @@
 //! (`model_trials`, or with one trial or none a line saying that only one model was fitted, and
 //! why); the correlation matrix; warnings; every SVG figure of `reports/<job>/`; provenance
 //! (recording path and SHA-256 at fit time and now, wiperlab version, solver tolerances, bands, fit
-//! settings, dates).
+//! settings, the fit's own timestamp and the page's).
 //!
 //! Figures are `<img src="NAME.svg">` links relative to the page (the SVGs sit beside it), so the
 //! page stays small and each figure is also a file of its own. Nothing is fetched from the network:
-//! the style sheet and the figure check are inline. All text from results and jobs is HTML-escaped.
+//! the style sheet and the figure check are inline. The page is the minijinja template
+//! `templates/report.html` filled from a view model of already-formatted values; all text from
+//! results and jobs is HTML-escaped by the template engine.
 //!
 //! The figure check: an inline script, run on the window's `load` event (after every image has
 //! loaded or failed), counts the `<img class="figure">` elements whose `naturalWidth` is 0 and
@@ -19,10 +21,11 @@
 //! `data-total`, `data-broken` = the failing `src`s separated by spaces). A reader sees it as a
 //! line at the end of the page; `tests/report_browser.rs` reads it from headless Chromium's DOM.
 
-use crate::fit::job::{FitJob, PARAM_NAMES};
+use crate::fit::features::SignalKind;
+use crate::fit::job::{FitSection, PARAM_NAMES};
 use crate::fit::result::{FitResult, sha256_file};
 use crate::{Error, Result};
-use std::fmt::Write as _;
+use serde::Serialize;
 use std::path::PathBuf;
 
 /// File name of the page inside the report directory.
@@ -54,16 +57,10 @@ pub struct ReportSummary {
     pub warnings: Vec<String>,
 }
 
-/// True when the result comes from a target job (`[targets]`: frequencies to reach, no recording),
-/// read from the settings the result records.
-fn is_target_job(result: &FitResult) -> bool {
-    toml::from_str::<FitJob>(&result.settings).is_ok_and(|j| j.targets.is_some())
-}
-
 /// The figures `wiperlab fit` always writes for a result (file name, caption), in page order; the
 /// PSD figures follow the result's bands.
 pub fn fit_figure_list(result: &FitResult) -> Vec<(String, String)> {
-    let (compared, psd) = if is_target_job(result) {
+    let (compared, psd) = if result.target_job {
         (
             "the fitted model (a target job has no recording)",
             "the fitted model's PSD against the target frequency or range",
@@ -113,35 +110,6 @@ pub const OPTIONAL_FIGURES: &[(&str, &str)] = &[(
      point and an estimate in the band).",
 )];
 
-/// Escapes text for HTML element content and double- or single-quoted attribute values.
-pub fn escape(s: &str) -> String {
-    let mut o = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => o.push_str("&amp;"),
-            '<' => o.push_str("&lt;"),
-            '>' => o.push_str("&gt;"),
-            '"' => o.push_str("&quot;"),
-            '\'' => o.push_str("&#39;"),
-            c => o.push(c),
-        }
-    }
-    o
-}
-
-/// Percent-encodes a file name for a relative URL (RFC 3986 unreserved characters kept).
-fn url_path(name: &str) -> String {
-    let mut o = String::new();
-    for b in name.bytes() {
-        if b.is_ascii_alphanumeric() || b"-._~".contains(&b) {
-            o.push(b as char);
-        } else {
-            let _ = write!(o, "%{b:02X}");
-        }
-    }
-    o
-}
-
 /// A number with `sig` significant digits: plain for 1e-3 ≤ |x| < 1e5, else scientific; "—" for
 /// NaN, "±∞" spelled out.
 fn num(x: f64, sig: usize) -> String {
@@ -171,35 +139,9 @@ fn pct(x: f64) -> String {
     }
 }
 
-/// Days since 1970-01-01 → (year, month, day), proleptic Gregorian (H. Hinnant, "chrono-Compatible
-/// Low-Level Date Algorithms", `civil_from_days`).
-fn civil_from_days(z: i64) -> (i64, u32, u32) {
-    let z = z + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z.rem_euclid(146_097);
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let y = yoe + era * 400;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
-    (if m <= 2 { y + 1 } else { y }, m, d)
-}
-
-/// `YYYY-MM-DD hh:mm:ss UTC` of a system time.
-fn utc(t: std::time::SystemTime) -> String {
-    let s = match t.duration_since(std::time::UNIX_EPOCH) {
-        Ok(d) => d.as_secs() as i64,
-        Err(e) => -(e.duration().as_secs() as i64),
-    };
-    let (y, mo, d) = civil_from_days(s.div_euclid(86_400));
-    let r = s.rem_euclid(86_400);
-    format!(
-        "{y:04}-{mo:02}-{d:02} {:02}:{:02}:{:02} UTC",
-        r / 3600,
-        r / 60 % 60,
-        r % 60
-    )
+/// `YYYY-MM-DD hh:mm:ss UTC` of an instant.
+fn utc(t: jiff::Timestamp) -> String {
+    t.strftime("%Y-%m-%d %H:%M:%S UTC").to_string()
 }
 
 /// One figure on the page.
@@ -220,390 +162,383 @@ pub struct Provenance {
     pub recording_sha256_now: std::result::Result<String, String>,
     /// When the page was written.
     pub written_utc: String,
-    /// Modification time of the result file.
-    pub result_modified_utc: Option<String>,
 }
 
-const STYLE: &str = "body{font-family:sans-serif;max-width:1000px;margin:1.5em auto;padding:0 1em;\
-color:#222;line-height:1.4}h1{font-size:1.6em}h2{margin-top:1.6em;border-bottom:1px solid #ccc}\
-table{border-collapse:collapse;margin:.6em 0}th,td{border:1px solid #ccc;padding:.25em .6em;\
-text-align:right;white-space:nowrap}th{background:#f2f2f2}td.l,th.l{text-align:left;white-space:normal}tr.chosen td{font-weight:bold}\
-.warn{color:#a33}.ok{color:#262}figure{margin:1.2em 0}figure img{max-width:100%;height:auto;\
-border:1px solid #ddd}figcaption,.note{font-size:.9em;color:#444}pre{background:#f6f6f6;padding:.6em;\
-overflow-x:auto;font-size:.85em}code{font-size:.9em}";
+/// The page template, its style sheet and its figure check (see the module docs).
+const TEMPLATE: &str = include_str!("templates/report.html");
+const STYLE: &str = include_str!("templates/report.css");
+const FIGURE_CHECK: &str = include_str!("templates/figure_check.js");
 
-/// The figure check run by the browser (see the module docs).
-const FIGURE_CHECK: &str = "window.addEventListener('load',function(){\
-var imgs=document.querySelectorAll('img.figure');var broken=[];\
-for(var i=0;i<imgs.length;i++){var m=imgs[i];\
-if(!(m.complete&&m.naturalWidth>0&&m.naturalHeight>0)){broken.push(m.getAttribute('src'));}}\
-var el=document.getElementById('figure-check');\
-el.setAttribute('data-total',String(imgs.length));\
-el.setAttribute('data-loaded',String(imgs.length-broken.length));\
-el.setAttribute('data-broken',broken.join(' '));\
-el.setAttribute('data-status',broken.length?'broken':'ok');\
-el.className=broken.length?'warn':'ok';\
-el.textContent='Figure check (in this browser): '+(imgs.length-broken.length)+' of '+imgs.length+\
-' figures loaded'+(broken.length?'; broken: '+broken.join(', '):'.');});";
+/// What a model of the hierarchy is, in words (the result stores its short name); empty for a
+/// name this page does not know.
+fn model_label(name: &str) -> &'static str {
+    match name {
+        "head1dof" => "1-DOF head on its spring",
+        "necklip" => "neck and lip",
+        "necklip+shoulder" => "neck and lip with shoulder contact",
+        "blade2dof" => "2-DOF blade",
+        "blade2dof+shoulder" => "2-DOF blade with shoulder contact",
+        _ => "",
+    }
+}
 
-/// Renders the page. `warnings` are shown as given (the caller collects them, see
-/// [`write_report`]); all text is escaped here.
+/// A readable name for the analysed signal.
+fn signal_label(s: SignalKind) -> &'static str {
+    match s {
+        SignalKind::TipRelX => "lip tip x − head x (horizontal, relative to the head)",
+        SignalKind::HeadY => "head y (vertical)",
+        SignalKind::TipX => "lip tip x (horizontal)",
+    }
+}
+
+#[derive(Serialize)]
+struct IntervalView {
+    lo: String,
+    hi: String,
+    level_pct: String,
+    footnote: usize,
+}
+
+#[derive(Serialize)]
+struct ParamView {
+    name: String,
+    meaning: &'static str,
+    value: String,
+    std_error: String,
+    interval: Option<IntervalView>,
+    lower: String,
+    upper: String,
+    determined: bool,
+    true_value: String,
+    rel_error: String,
+}
+
+/// Parameter rows and the interval methods their footnotes number (each method named once).
+fn parameter_rows(r: &FitResult) -> (Vec<ParamView>, Vec<String>) {
+    let mut methods: Vec<String> = Vec::new();
+    let rows = r
+        .parameters
+        .iter()
+        .map(|p| {
+            let interval = p.interval.as_ref().map(|i| {
+                if !methods.contains(&i.method) {
+                    methods.push(i.method.clone());
+                }
+                IntervalView {
+                    lo: num(i.lo, 4),
+                    hi: num(i.hi, 4),
+                    level_pct: format!("{:.0}", 100.0 * i.level),
+                    footnote: methods.iter().position(|m| *m == i.method).unwrap_or(0) + 1,
+                }
+            });
+            ParamView {
+                name: p.name.clone(),
+                meaning: PARAM_NAMES
+                    .iter()
+                    .find(|(n, _)| *n == p.name)
+                    .map_or("", |(_, m)| *m),
+                value: num(p.value, 5),
+                std_error: num(p.std_error, 3),
+                interval,
+                lower: num(p.lower, 4),
+                upper: num(p.upper, 4),
+                determined: p.determined,
+                true_value: p.true_value.map_or_else(|| "—".into(), |t| num(t, 5)),
+                rel_error: p.rel_error.map_or_else(|| "—".into(), pct),
+            }
+        })
+        .collect();
+    (rows, methods)
+}
+
+#[derive(Serialize)]
+struct PeakView {
+    band: String,
+    measured: String,
+    model_hz: String,
+    rel_diff: String,
+    measured_level: String,
+    model_level: String,
+}
+
+fn peak_rows(r: &FitResult) -> Vec<PeakView> {
+    r.peaks
+        .iter()
+        .map(|p| PeakView {
+            band: p.band.clone(),
+            measured: match p.target_range_hz {
+                Some([lo, hi]) => format!("target {}–{}", num(lo, 4), num(hi, 4)),
+                None if r.target_job => format!("target {}", num(p.measured_hz, 5)),
+                None => num(p.measured_hz, 5),
+            },
+            model_hz: num(p.model_hz, 5),
+            rel_diff: pct(p.rel_diff),
+            measured_level: num(p.measured_level, 3),
+            model_level: num(p.model_level, 3),
+        })
+        .collect()
+}
+
+#[derive(Serialize)]
+struct TrialView {
+    model: String,
+    parameters: String,
+    cost: String,
+    wall_time_s: String,
+    model_evaluations: usize,
+    chosen: bool,
+    reason: String,
+}
+
+fn trial_rows(r: &FitResult) -> Vec<TrialView> {
+    r.model_trials
+        .iter()
+        .map(|t| TrialView {
+            model: t.model.clone(),
+            parameters: t.parameters.join(", "),
+            cost: num(t.cost, 5),
+            wall_time_s: num(t.wall_time_s, 3),
+            model_evaluations: t.model_evaluations,
+            chosen: t.chosen,
+            reason: t.reason.clone(),
+        })
+        .collect()
+}
+
+#[derive(Serialize)]
+struct CorrelationRow {
+    name: String,
+    cells: Vec<String>,
+}
+
+/// True when the cost's curvature at the optimum was positive definite: the fit then fills the
+/// correlation matrix with finite numbers (NaN otherwise, see [`FitResult::correlation`]).
+fn curvature_positive_definite(r: &FitResult) -> bool {
+    let n = r.parameters.len();
+    r.correlation.len() == n
+        && r.correlation
+            .iter()
+            .all(|row| row.len() == n && row.iter().all(|c| c.is_finite()))
+}
+
+fn correlation_rows(r: &FitResult) -> Vec<CorrelationRow> {
+    r.parameters
+        .iter()
+        .zip(&r.correlation)
+        .map(|(p, row)| CorrelationRow {
+            name: p.name.clone(),
+            cells: row.iter().map(|c| format!("{c:+.3}")).collect(),
+        })
+        .collect()
+}
+
+#[derive(Serialize)]
+struct BandView {
+    name: String,
+    lo_hz: String,
+    hi_hz: String,
+    nperseg: usize,
+}
+
+#[derive(Serialize)]
+struct SignalView {
+    label: &'static str,
+    max_fill: usize,
+}
+
+/// One line on the fit's settings (restarts, swarm, polish, seed, cost weights).
+fn fit_settings_line(f: &FitSection) -> String {
+    format!(
+        "{} × (particle swarm {} particles × {} iterations{}, Nelder–Mead ≤ {} iterations), \
+         best kept (seed {}); weights peak {}, level {}, shape {}",
+        f.restarts.max(1),
+        f.particles,
+        f.swarm_iterations,
+        f.swarm_rtol
+            .map_or_else(String::new, |r| format!(" at rtol {r:e}")),
+        f.polish_iterations,
+        f.seed,
+        f.weights.peak,
+        f.weights.level,
+        f.weights.shape
+    )
+}
+
+#[derive(Serialize)]
+struct ProvenanceView<'a> {
+    job_path: &'a str,
+    result_path: &'a str,
+    recording_path: &'a str,
+    sha256_now: Option<&'a str>,
+    sha256_error: Option<&'a str>,
+    written_utc: &'a str,
+}
+
+#[derive(Serialize)]
+struct FigureView<'a> {
+    file: &'a str,
+    caption: &'a str,
+}
+
+/// Everything the template shows, already formatted (the template only lays it out).
+#[derive(Serialize)]
+struct PageView<'a> {
+    style: &'static str,
+    figure_check: &'static str,
+    job: &'a str,
+    recording: &'a str,
+    model: &'a str,
+    model_label: &'static str,
+    cost: String,
+    model_evaluations: usize,
+    failed_evaluations: usize,
+    swarm_iterations: u64,
+    polish_iterations: u64,
+    wall_time_s: String,
+    threads: usize,
+    transitions: usize,
+    fitted_utc: Option<String>,
+    sigma_shown: bool,
+    parameters: Vec<ParamView>,
+    interval_methods: Vec<String>,
+    peaks: Vec<PeakView>,
+    trials: Vec<TrialView>,
+    correlation: Vec<CorrelationRow>,
+    warnings: &'a [String],
+    figures: Vec<FigureView<'a>>,
+    prov: ProvenanceView<'a>,
+    sha256_fit: &'a str,
+    version_fit: &'a str,
+    version_page: &'static str,
+    solver_rtol: String,
+    solver_atol: String,
+    bands: Vec<BandView>,
+    signal: Option<SignalView>,
+    fit_settings: Option<String>,
+    settings: &'a str,
+}
+
+/// The settings part of the view: bands, signal and fit settings as the result records them.
+fn settings_views(r: &FitResult) -> (Vec<BandView>, Option<SignalView>, Option<String>) {
+    let bands = r.spectrum.as_ref().map_or_else(Vec::new, |s| {
+        s.bands
+            .iter()
+            .map(|b| BandView {
+                name: b.name.clone(),
+                lo_hz: num(b.range_hz[0], 4),
+                hi_hz: num(b.range_hz[1], 4),
+                nperseg: b.nperseg,
+            })
+            .collect()
+    });
+    let signal = r.spectrum.as_ref().map(|s| SignalView {
+        label: signal_label(s.signal),
+        max_fill: s.max_fill,
+    });
+    (
+        bands,
+        signal,
+        r.fit_settings.as_ref().map(fit_settings_line),
+    )
+}
+
+fn provenance_view(prov: &Provenance) -> ProvenanceView<'_> {
+    ProvenanceView {
+        job_path: &prov.job_path,
+        result_path: &prov.result_path,
+        recording_path: &prov.recording_path,
+        sha256_now: prov.recording_sha256_now.as_deref().ok(),
+        sha256_error: prov.recording_sha256_now.as_ref().err().map(String::as_str),
+        written_utc: &prov.written_utc,
+    }
+}
+
+fn page_view<'a>(
+    r: &'a FitResult,
+    figures: &'a [Figure],
+    warnings: &'a [String],
+    prov: &'a Provenance,
+) -> PageView<'a> {
+    let (parameters, interval_methods) = parameter_rows(r);
+    let (bands, signal, fit_settings) = settings_views(r);
+    let pd = curvature_positive_definite(r);
+    PageView {
+        style: STYLE,
+        figure_check: FIGURE_CHECK,
+        job: &r.job,
+        recording: &r.recording,
+        model: &r.model,
+        model_label: model_label(&r.model),
+        cost: num(r.cost, 5),
+        model_evaluations: r.model_evaluations,
+        failed_evaluations: r.failed_evaluations,
+        swarm_iterations: r.swarm_iterations,
+        polish_iterations: r.polish_iterations,
+        wall_time_s: num(r.wall_time_s, 3),
+        threads: r.threads,
+        transitions: r.transitions_in_best_model,
+        fitted_utc: r.fitted_at.map(utc),
+        sigma_shown: pd,
+        parameters,
+        interval_methods,
+        peaks: peak_rows(r),
+        trials: trial_rows(r),
+        correlation: if pd { correlation_rows(r) } else { Vec::new() },
+        warnings,
+        figures: figures
+            .iter()
+            .map(|f| FigureView {
+                file: &f.file,
+                caption: &f.caption,
+            })
+            .collect(),
+        prov: provenance_view(prov),
+        sha256_fit: &r.input_sha256,
+        version_fit: &r.wiperlab_version,
+        version_page: env!("CARGO_PKG_VERSION"),
+        solver_rtol: format!("{:e}", r.solver_rtol),
+        solver_atol: format!("{:e}", r.solver_atol),
+        bands,
+        signal,
+        fit_settings,
+        settings: &r.settings,
+    }
+}
+
+/// Writes a template value: as given when marked safe, nothing for none, else escaped for HTML
+/// text and quoted attributes (`&`, `<`, `>`, `"`, `'`; `html_escape`'s quoted-attribute rules,
+/// which unlike minijinja's own escaper leave `/` readable in paths).
+fn escape_html(
+    out: &mut minijinja::Output,
+    _state: &minijinja::State,
+    value: &minijinja::Value,
+) -> std::result::Result<(), minijinja::Error> {
+    let written = if value.is_safe() {
+        write!(out, "{value}")
+    } else if value.is_none() || value.is_undefined() {
+        Ok(())
+    } else {
+        out.write_str(&html_escape::encode_quoted_attribute(&value.to_string()))
+    };
+    written.map_err(|e| minijinja::Error::new(minijinja::ErrorKind::WriteFailure, e.to_string()))
+}
+
+/// Renders the page from [`TEMPLATE`]. `warnings` are shown as given (the caller collects them,
+/// see [`write_report`]); the template engine escapes all text for HTML.
+///
+/// # Errors
+/// The template engine's error (a template that does not compile or render is a bug).
 pub fn render_html(
     r: &FitResult,
     figures: &[Figure],
     warnings: &[String],
     prov: &Provenance,
-) -> String {
-    let e = |s: &str| escape(s);
-    let mut h = String::new();
-    let _ = write!(
-        h,
-        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
-         <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-         <title>wiperlab fit report: {}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n",
-        e(&r.job)
-    );
-    let _ = writeln!(h, "<h1>Fit report: {}</h1>", e(&r.job));
-    let _ = writeln!(
-        h,
-        "<p>Recording <code>{}</code>, model <b>{}</b>, cost <b>{}</b> after {} model evaluations \
-         ({} failed), {} swarm + {} Nelder–Mead iterations, {} s on {} threads; the best model \
-         has {} stick–slip transitions.</p>",
-        e(&r.recording),
-        e(&r.model),
-        num(r.cost, 5),
-        r.model_evaluations,
-        r.failed_evaluations,
-        r.swarm_iterations,
-        r.polish_iterations,
-        num(r.wall_time_s, 3),
-        r.threads,
-        r.transitions_in_best_model
-    );
-
-    // Parameters.
-    h.push_str("<h2 id=\"parameters\">Fitted parameters</h2>\n");
-    h.push_str(
-        "<p>1σ: from the cost's curvature at the optimum (cost read as χ²); indicative. \
-         Interval: a confidence interval when the fit computed one, with its level and method.</p>\n",
-    );
-    h.push_str(
-        "<table id=\"parameter-table\">\n<tr><th class=\"l\">parameter</th><th class=\"l\">meaning, unit</th>\
-         <th>fitted</th><th>± 1σ</th><th>interval</th><th>search bounds</th><th>determined</th>\
-         <th>true</th><th>rel. error</th></tr>\n",
-    );
-    let mut methods: Vec<String> = Vec::new();
-    for p in &r.parameters {
-        let meaning = PARAM_NAMES
-            .iter()
-            .find(|(n, _)| *n == p.name)
-            .map(|(_, m)| *m)
-            .unwrap_or("");
-        // The method is named once below the table (footnote number), not in every row.
-        let interval = match &p.interval {
-            Some(i) => {
-                if !methods.contains(&i.method) {
-                    methods.push(i.method.clone());
-                }
-                let k = methods.iter().position(|m| *m == i.method).unwrap_or(0) + 1;
-                format!(
-                    "[{}, {}] ({:.0} %)<sup>{k}</sup>",
-                    num(i.lo, 4),
-                    num(i.hi, 4),
-                    100.0 * i.level
-                )
-            }
-            None => "—".into(),
-        };
-        let _ = writeln!(
-            h,
-            "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td>\
-             <td>[{}, {}]</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-            e(&p.name),
-            e(meaning),
-            num(p.value, 5),
-            num(p.std_error, 3),
-            interval,
-            num(p.lower, 4),
-            num(p.upper, 4),
-            if p.determined {
-                "yes".to_string()
-            } else {
-                "<span class=\"warn\">NO</span>".to_string()
-            },
-            p.true_value
-                .map(|t| num(t, 5))
-                .unwrap_or_else(|| "—".into()),
-            p.rel_error.map(pct).unwrap_or_else(|| "—".into())
-        );
-    }
-    h.push_str("</table>\n");
-    for (k, m) in methods.iter().enumerate() {
-        let _ = writeln!(
-            h,
-            "<p class=\"note\"><sup>{}</sup> Interval method: {}</p>",
-            k + 1,
-            e(m)
-        );
-    }
-
-    // Peaks.
-    h.push_str("<h2 id=\"peaks\">Measured against model peaks</h2>\n");
-    h.push_str(
-        "<table id=\"peak-table\">\n<tr><th class=\"l\">band</th><th>measured or target [Hz]</th>\
-         <th>model [Hz]</th><th>(model − measured)/measured</th><th>measured PSD [m²/Hz]</th>\
-         <th>model PSD [m²/Hz]</th></tr>\n",
-    );
-    let target = is_target_job(r);
-    for p in &r.peaks {
-        let _ = writeln!(
-            h,
-            "<tr><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-            e(&p.band),
-            match p.target_range_hz {
-                Some([lo, hi]) => format!("target {}–{}", num(lo, 4), num(hi, 4)),
-                None if target => format!("target {}", num(p.measured_hz, 5)),
-                None => num(p.measured_hz, 5),
-            },
-            num(p.model_hz, 5),
-            pct(p.rel_diff),
-            num(p.measured_level, 3),
-            num(p.model_level, 3)
-        );
-    }
-    h.push_str("</table>\n");
-
-    // Model comparison.
-    h.push_str("<h2 id=\"models\">Model comparison</h2>\n");
-    if r.model_trials.len() <= 1 {
-        let _ = writeln!(
-            h,
-            "<p id=\"model-comparison\">Only one model ({}) was fitted; no comparison{}.</p>",
-            e(&r.model),
-            r.model_trials
-                .first()
-                .map(|t| format!(
-                    " (chosen as {}; cost {}, {} model evaluations, {} s)",
-                    e(&t.reason),
-                    num(t.cost, 5),
-                    t.model_evaluations,
-                    num(t.wall_time_s, 3)
-                ))
-                .unwrap_or_default()
-        );
-    } else {
-        h.push_str(
-            "<table id=\"model-comparison\">\n<tr><th class=\"l\">model</th><th class=\"l\">freed parameters</th>\
-             <th>cost</th><th>wall time [s]</th><th>model evaluations</th><th>chosen</th>\
-             <th class=\"l\">reason</th></tr>\n",
-        );
-        for t in &r.model_trials {
-            let _ = writeln!(
-                h,
-                "<tr{}><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td>\
-                 <td>{}</td><td class=\"l\">{}</td></tr>",
-                if t.chosen { " class=\"chosen\"" } else { "" },
-                e(&t.model),
-                e(&t.parameters.join(", ")),
-                num(t.cost, 5),
-                num(t.wall_time_s, 3),
-                t.model_evaluations,
-                if t.chosen { "yes" } else { "no" },
-                e(&t.reason)
-            );
-        }
-        h.push_str("</table>\n");
-    }
-
-    // Correlations.
-    h.push_str("<h2 id=\"correlation\">Parameter correlations</h2>\n");
-    let n = r.parameters.len();
-    let finite = r.correlation.len() == n
-        && r.correlation
-            .iter()
-            .all(|row| row.len() == n && row.iter().all(|c| c.is_finite()));
-    if n == 0 {
-        h.push_str("<p>No parameters.</p>\n");
-    } else if !finite {
-        h.push_str(
-            "<p>Not available: the cost's curvature matrix at the optimum is not positive \
-             definite (the 1σ values come from its diagonal alone).</p>\n",
-        );
-    } else {
-        h.push_str("<table id=\"correlation-table\">\n<tr><th></th>");
-        for p in &r.parameters {
-            let _ = write!(h, "<th>{}</th>", e(&p.name));
-        }
-        h.push_str("</tr>\n");
-        for (p, row) in r.parameters.iter().zip(&r.correlation) {
-            let _ = write!(h, "<tr><th class=\"l\">{}</th>", e(&p.name));
-            for c in row {
-                let _ = write!(h, "<td>{c:+.3}</td>");
-            }
-            h.push_str("</tr>\n");
-        }
-        h.push_str("</table>\n");
-    }
-
-    // Warnings.
-    h.push_str("<h2 id=\"warnings\">Warnings</h2>\n");
-    if warnings.is_empty() {
-        h.push_str("<p id=\"warning-list\">None.</p>\n");
-    } else {
-        h.push_str("<ul id=\"warning-list\" class=\"warn\">\n");
-        for w in warnings {
-            let _ = writeln!(h, "<li>{}</li>", e(w));
-        }
-        h.push_str("</ul>\n");
-    }
-
-    // Figures.
-    h.push_str("<h2 id=\"figures\">Figures</h2>\n");
-    if figures.is_empty() {
-        h.push_str("<p class=\"warn\">No figures in the report directory.</p>\n");
-    }
-    for f in figures {
-        let _ = writeln!(
-            h,
-            "<figure><img class=\"figure\" src=\"{}\" alt=\"{}\" width=\"900\">\
-             <figcaption><code>{}</code>: {}</figcaption></figure>",
-            e(&url_path(&f.file)),
-            e(&f.caption),
-            e(&f.file),
-            e(&f.caption)
-        );
-    }
-
-    // Provenance.
-    h.push_str("<h2 id=\"provenance\">Provenance</h2>\n<table id=\"provenance-table\">\n");
-    let row = |h: &mut String, k: &str, v: String| {
-        let _ = writeln!(
-            h,
-            "<tr><th class=\"l\">{k}</th><td class=\"l\">{v}</td></tr>"
-        );
-    };
-    row(
-        &mut h,
-        "job file",
-        format!("<code>{}</code>", e(&prov.job_path)),
-    );
-    row(
-        &mut h,
-        "result file",
-        format!(
-            "<code>{}</code>{}",
-            e(&prov.result_path),
-            prov.result_modified_utc
-                .as_ref()
-                .map(|t| format!(", written {}", e(t)))
-                .unwrap_or_default()
-        ),
-    );
-    row(
-        &mut h,
-        "recording",
-        format!("<code>{}</code>", e(&prov.recording_path)),
-    );
-    row(
-        &mut h,
-        "recording SHA-256 at fit time",
-        if r.input_sha256.is_empty() {
-            "not recorded by this result".into()
-        } else {
-            format!("<code id=\"sha256-fit\">{}</code>", e(&r.input_sha256))
-        },
-    );
-    row(
-        &mut h,
-        "recording SHA-256 now",
-        match &prov.recording_sha256_now {
-            Ok(s) => format!("<code id=\"sha256-now\">{}</code>", e(s)),
-            Err(m) => format!("<span class=\"warn\">{}</span>", e(m)),
-        },
-    );
-    row(
-        &mut h,
-        "wiperlab version",
-        format!(
-            "{} (fit), {} (this page)",
-            e(&r.wiperlab_version),
-            e(env!("CARGO_PKG_VERSION"))
-        ),
-    );
-    row(
-        &mut h,
-        "solver",
-        format!(
-            "DOPRI5 with events, rtol {:e}, atol {:e}",
-            r.solver_rtol, r.solver_atol
-        ),
-    );
-    let job: Option<FitJob> = toml::from_str(&r.settings).ok();
-    if let Some(j) = &job {
-        let bands: Vec<String> = j
-            .spectrum
-            .bands
-            .iter()
-            .map(|b| {
-                format!(
-                    "{} {}–{} Hz (Welch, Hann, nperseg {})",
-                    e(&b.name),
-                    num(b.range_hz[0], 4),
-                    num(b.range_hz[1], 4),
-                    b.nperseg
-                )
-            })
-            .collect();
-        row(&mut h, "spectral bands", bands.join("; "));
-        row(
-            &mut h,
-            "signal",
-            format!(
-                "<code>{}</code>, gaps up to {} samples filled",
-                e(&format!("{:?}", j.spectrum.signal)),
-                j.spectrum.max_fill
-            ),
-        );
-        let f = &j.fit;
-        row(
-            &mut h,
-            "fit settings",
-            format!(
-                "{} × (particle swarm {} particles × {} iterations{}, Nelder–Mead ≤ {} iterations), \
-                 best kept (seed {}); weights peak {}, level {}, shape {}",
-                f.restarts.max(1),
-                f.particles,
-                f.swarm_iterations,
-                match f.swarm_rtol {
-                    Some(r) => format!(" at rtol {r:e}"),
-                    None => String::new(),
-                },
-                f.polish_iterations,
-                f.seed,
-                f.weights.peak,
-                f.weights.level,
-                f.weights.shape
-            ),
-        );
-    }
-    row(&mut h, "page written", e(&prov.written_utc));
-    h.push_str("</table>\n");
-    if r.settings.is_empty() {
-        h.push_str("<p>The result does not record the job's settings.</p>\n");
-    } else {
-        let _ = writeln!(
-            h,
-            "<details><summary>Settings the fit ran with (job, defaults filled in)</summary>\
-             <pre>{}</pre></details>",
-            e(&r.settings)
-        );
-    }
-
-    h.push_str(
-        "<p id=\"figure-check\" data-status=\"not-run\">Figure check: not run (JavaScript is off).</p>\n",
-    );
-    let _ = write!(h, "<script>{FIGURE_CHECK}</script>\n</body>\n</html>\n");
-    h
+) -> std::result::Result<String, minijinja::Error> {
+    let mut env = minijinja::Environment::new();
+    env.set_formatter(escape_html);
+    env.add_template("report.html", TEMPLATE)?;
+    env.get_template("report.html")?
+        .render(page_view(r, figures, warnings, prov))
 }
 
 /// Writes `paths.dir/index.html` for result `r`: links every SVG in `paths.dir` (the fit's own
@@ -697,14 +632,11 @@ pub fn write_report(r: &FitResult, paths: &ReportPaths) -> Result<ReportSummary>
         result_path: paths.result.display().to_string(),
         recording_path: paths.recording.display().to_string(),
         recording_sha256_now: now_hash,
-        written_utc: utc(std::time::SystemTime::now()),
-        result_modified_utc: std::fs::metadata(&paths.result)
-            .and_then(|m| m.modified())
-            .ok()
-            .map(utc),
+        written_utc: utc(jiff::Timestamp::now()),
     };
-    let html = render_html(r, &figures, &warnings, &prov);
     let path = dir.join(INDEX);
+    let html = render_html(r, &figures, &warnings, &prov)
+        .map_err(|e| Error::io(&path, "cannot render", std::io::Error::other(e)))?;
     std::fs::write(&path, html).map_err(|e| Error::io(&path, "cannot write", e))?;
     Ok(ReportSummary {
         path,
@@ -718,16 +650,6 @@ pub fn write_report(r: &FitResult, paths: &ReportPaths) -> Result<ReportSummary>
 mod tests {
     use super::*;
     use crate::fit::result::sha256_hex;
-
-    #[test]
-    fn escape_covers_markup_and_quotes() {
-        assert_eq!(
-            escape(r#"<b a="1" b='2'>&amp;</b>"#),
-            "&lt;b a=&quot;1&quot; b=&#39;2&#39;&gt;&amp;amp;&lt;/b&gt;"
-        );
-        assert_eq!(escape("μ_d = A e^(−B|v|)"), "μ_d = A e^(−B|v|)");
-        assert_eq!(url_path("psd_a b#?.svg"), "psd_a%20b%23%3F.svg");
-    }
 
     #[test]
     fn numbers_keep_significant_digits() {
@@ -797,6 +719,10 @@ mod tests {
             warnings: vec![],
             input_sha256: sha256_hex(b"the recording at fit time"),
             settings: String::new(),
+            target_job: false,
+            spectrum: None,
+            fit_settings: None,
+            fitted_at: None,
             history: vec![],
         }
     }
@@ -880,15 +806,54 @@ mod tests {
     }
 
     #[test]
-    fn civil_dates() {
-        // Day 0 is 1970-01-01; 2000-03-01 is day 11017; 2026-11-21 is day 20778 (date(1) arithmetic).
-        assert_eq!(civil_from_days(0), (1970, 1, 1));
-        assert_eq!(civil_from_days(11_017), (2000, 3, 1));
-        assert_eq!(civil_from_days(20_778), (2026, 11, 21));
-        assert_eq!(civil_from_days(-1), (1969, 12, 31));
+    fn utc_dates() {
+        // 86,400 + 3,723 s after the epoch is 1970-01-02 01:02:03 (1 day, 1 h 2 min 3 s).
         assert_eq!(
-            utc(std::time::UNIX_EPOCH + std::time::Duration::from_secs(86_400 + 3_723)),
+            utc(jiff::Timestamp::from_second(86_400 + 3_723).unwrap()),
             "1970-01-02 01:02:03 UTC"
         );
+        // Day 20,778 after the epoch is 2026-11-21 (date(1) arithmetic).
+        assert_eq!(
+            utc(jiff::Timestamp::from_second(20_778 * 86_400).unwrap()),
+            "2026-11-21 00:00:00 UTC"
+        );
+    }
+
+    /// Text from the result is escaped, file names are percent-encoded in links, the fit's own
+    /// timestamp is shown, and ±1σ and correlations are left out when the curvature is not positive
+    /// definite.
+    #[test]
+    fn page_escapes_encodes_and_hides_sigma_without_curvature() {
+        let mut r = result();
+        r.job = "<b>job</b>".into();
+        r.fitted_at = Some("2026-11-22T09:08:07Z".parse().unwrap());
+        let figures = [Figure {
+            file: "psd_a b#?.svg".into(),
+            caption: "a \"quoted\" <caption>".into(),
+        }];
+        let prov = Provenance {
+            job_path: "job.toml".into(),
+            result_path: "r.toml".into(),
+            recording_path: "rec.csv".into(),
+            recording_sha256_now: Err("gone & away".into()),
+            written_utc: "now".into(),
+        };
+        let html = render_html(&r, &figures, &["<i>w</i>".into()], &prov).unwrap();
+        assert!(
+            html.contains("<h1>Fit report: &lt;b&gt;job&lt;/b&gt;</h1>"),
+            "{html}"
+        );
+        assert!(html.contains("src=\"psd_a%20b%23%3F.svg\""), "{html}");
+        assert!(html.contains("alt=\"a &quot;quoted&quot; &lt;caption&gt;\""));
+        assert!(html.contains("<li>&lt;i&gt;w&lt;/i&gt;</li>"));
+        assert!(html.contains("<span class=\"warn\">gone &amp; away</span>"));
+        assert!(html.contains("Fitted 2026-11-22 09:08:07 UTC."));
+        assert!(html.contains("model <b>blade2dof</b> (2-DOF blade)"));
+        assert!(html.contains("<th>± 1σ</th>"));
+        r.correlation = vec![vec![f64::NAN; 2]; 2];
+        let html = render_html(&r, &figures, &[], &prov).unwrap();
+        assert!(!html.contains("<th>± 1σ</th>"), "{html}");
+        assert!(html.contains("1σ: not shown"));
+        assert!(!html.contains("correlation-table"));
     }
 }

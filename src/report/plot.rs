@@ -4,7 +4,7 @@
 //!   reference lines. NaN (or, on a log axis, a non-positive value) breaks a line: nothing is drawn
 //!   through a gap, and such points never enter the axis-range computation. Lines are clipped to
 //!   the plotted range.
-//! * [`heatmap`]: a spectrogram-style `z[x][y]` image with a viridis-like colour map and colour bar.
+//! * [`heatmap`]: a spectrogram-style `z[x][y]` image with a viridis colour map and colour bar.
 //!
 //! Figures are rendered into memory and written with one `std::fs::write`, so a failed write is an
 //! [`Error::Io`] naming the path; a plotters drawing failure is an [`Error::Numerics`] naming the
@@ -487,23 +487,12 @@ fn draw_xy(
     Ok(())
 }
 
-/// Viridis-like colour map: linear interpolation between five stops of matplotlib's viridis
-/// (t = 0, ¼, ½, ¾, 1). `t` is clamped to [0, 1]; NaN maps to the low end.
+/// Matplotlib's viridis colour map (`colorous::VIRIDIS`). `t` is clamped to [0, 1]; NaN maps to
+/// the low end.
 pub fn viridis(t: f64) -> RGBColor {
-    const STOPS: [(f64, f64, f64); 5] = [
-        (68.0, 1.0, 84.0),
-        (59.0, 82.0, 139.0),
-        (33.0, 145.0, 140.0),
-        (94.0, 201.0, 98.0),
-        (253.0, 231.0, 37.0),
-    ];
     let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
-    let s = t * 4.0;
-    let i = (s.floor() as usize).min(3);
-    let f = s - i as f64;
-    let (a, b) = (STOPS[i], STOPS[i + 1]);
-    let lerp = |u: f64, v: f64| (u + (v - u) * f).round() as u8;
-    RGBColor(lerp(a.0, b.0), lerp(a.1, b.1), lerp(a.2, b.2))
+    let c = colorous::VIRIDIS.eval_continuous(t);
+    RGBColor(c.r, c.g, c.b)
 }
 
 /// Largest number of cells kept along x and y by [`heatmap`]; denser data is decimated by taking

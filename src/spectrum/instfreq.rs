@@ -41,6 +41,7 @@
 //!
 //! Units: seconds, metres, m/s, Hz. Samples are uniform at `fs_hz`; NaN marks a missing sample.
 
+use super::stats::median_in_place;
 use super::stft::spectrogram;
 use crate::{Error, Result};
 
@@ -118,18 +119,6 @@ pub fn noise_sigma(x: &[f64]) -> f64 {
     let med = median_in_place(&mut d2);
     let mut dev: Vec<f64> = d2.iter().map(|v| (v - med).abs()).collect();
     1.4826 * median_in_place(&mut dev) / 6f64.sqrt()
-}
-
-fn median_in_place(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let m = v.len();
-    if m == 0 {
-        f64::NAN
-    } else if m % 2 == 1 {
-        v[m / 2]
-    } else {
-        0.5 * (v[m / 2 - 1] + v[m / 2])
-    }
 }
 
 /// Mean speed `|x(b) − x(a)|·fs/(b − a)` between samples `a < b` of `x` (positions, m → m/s), with

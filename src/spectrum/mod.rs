@@ -12,6 +12,7 @@
 //! * [`peaks`]: [`find_peak`], [`top_peaks`]: largest local maximum with parabolic interpolation of
 //!   the log PSD (J.O. Smith, SASP).
 //! * [`stft`]: [`spectrogram()`] and its [`Spectrogram::ridge`].
+//! * [`stats`]: the median and linear-interpolation quantiles used across the pipeline.
 //! * [`instfreq`]: instantaneous frequency (spectrogram ridge, stick-onset rate) against the lip
 //!   tip's speed; NaN-aware smoothed derivative, robust noise estimate, stick detection.
 //!
@@ -23,6 +24,7 @@
 pub mod instfreq;
 pub mod peaks;
 pub mod resample;
+pub mod stats;
 pub mod stft;
 pub mod welch;
 pub mod window;

@@ -22,17 +22,7 @@ pub fn median_rate_hz(t_s: &[f64]) -> f64 {
         .map(|w| w[1] - w[0])
         .filter(|d| d.is_finite() && *d > 0.0)
         .collect();
-    if dt.is_empty() {
-        return f64::NAN;
-    }
-    dt.sort_by(f64::total_cmp);
-    let m = dt.len();
-    let med = if m % 2 == 1 {
-        dt[m / 2]
-    } else {
-        0.5 * (dt[m / 2 - 1] + dt[m / 2])
-    };
-    1.0 / med
+    1.0 / super::stats::median_in_place(&mut dt)
 }
 
 /// Linear interpolation of `x(t_s)` onto the uniform grid `t0 + k/fs_hz`, `t0 = t_s[0]`, for every
