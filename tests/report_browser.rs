@@ -458,3 +458,101 @@ fn unreadable_result_is_a_clear_input_error() {
         "the result was overwritten"
     );
 }
+
+/// Attribute `name="..."` of the SVG element text `el`, as a number.
+fn num_attr(el: &str, name: &str) -> Option<f64> {
+    let i = el.find(&format!(" {name}=\""))? + name.len() + 3;
+    el[i..].split('"').next()?.parse().ok()
+}
+
+/// Every polyline vertex, point along each polyline segment (32 per segment) and circle of `svg`
+/// that lies inside the legend box (`<g class="legend">`'s first `<rect>`, grown by a circle's
+/// radius), described; and the legend box. `Err` when the figure has no legend group.
+fn data_under_legend(svg: &str) -> Result<(Vec<String>, [f64; 4]), String> {
+    let start = svg.find("<g class=\"legend\">").ok_or("no legend group")?;
+    let end = start + svg[start..].find("</g>").ok_or("legend group not closed")?;
+    let legend = &svg[start..end];
+    let rect = &legend[legend.find("<rect").ok_or("legend without a box")?..];
+    let [x, y, w, h] = ["x", "y", "width", "height"].map(|a| num_attr(rect, a).unwrap_or(f64::NAN));
+    if ![x, y, w, h].iter().all(|v| v.is_finite()) || w <= 0.0 || h <= 0.0 {
+        return Err(format!("legend box unreadable: {rect:.80}"));
+    }
+    let inside = |px: f64, py: f64, grow: f64| {
+        px > x - grow && px < x + w + grow && py > y - grow && py < y + h + grow
+    };
+    let data = format!("{}{}", &svg[..start], &svg[end..]);
+    let mut hits = Vec::new();
+    for el in data.split('<').skip(1) {
+        if el.starts_with("polyline") {
+            let pts: Vec<(f64, f64)> = el
+                .split("points=\"")
+                .nth(1)
+                .and_then(|p| p.split('"').next())
+                .unwrap_or("")
+                .split_whitespace()
+                .filter_map(|p| {
+                    let (a, b) = p.split_once(',')?;
+                    Some((a.parse().ok()?, b.parse().ok()?))
+                })
+                .collect();
+            for s in pts.windows(2) {
+                for k in 0..=32 {
+                    let f = k as f64 / 32.0;
+                    let (px, py) = (
+                        s[0].0 + f * (s[1].0 - s[0].0),
+                        s[0].1 + f * (s[1].1 - s[0].1),
+                    );
+                    if inside(px, py, 0.0) {
+                        hits.push(format!("polyline through ({px:.0}, {py:.0})"));
+                    }
+                }
+            }
+        } else if el.starts_with("circle") {
+            let (cx, cy, r) = (num_attr(el, "cx"), num_attr(el, "cy"), num_attr(el, "r"));
+            if let (Some(cx), Some(cy), Some(r)) = (cx, cy, r)
+                && inside(cx, cy, r)
+            {
+                hits.push(format!("circle at ({cx}, {cy})"));
+            }
+        }
+    }
+    Ok((hits, [x, y, w, h]))
+}
+
+/// The checker finds data under a legend box drawn over it (a hand-made SVG whose polyline
+/// crosses the box without a vertex inside it, and a circle beside it within its radius).
+#[test]
+fn legend_check_can_fail() {
+    let svg = "<svg><polyline points=\"0,50 200,50\"/><circle cx=\"95\" cy=\"10\" r=\"6\"/>\
+               <g class=\"legend\"><rect x=\"100\" y=\"0\" width=\"50\" height=\"60\"/></g></svg>";
+    let (hits, _) = data_under_legend(svg).unwrap();
+    assert!(hits.iter().any(|h| h.starts_with("polyline")), "{hits:?}");
+    assert!(hits.iter().any(|h| h.starts_with("circle")), "{hits:?}");
+    assert!(data_under_legend("<svg><polyline points=\"0,0 1,1\"/></svg>").is_err());
+}
+
+/// Every figure the quick fit writes has a legend, and no data line, point or marker passes under
+/// it. The figures are drawn at 4× scale and shown at 900 × 500 through the viewBox (so
+/// coordinates fall on quarter pixels).
+#[test]
+fn legends_cover_no_data_in_any_fit_figure() {
+    let tmp = TempDir::new("legends");
+    let job = write_quick_job(&tmp.0);
+    ok(
+        &wiperlab(&tmp.0, &["fit", job.to_str().unwrap(), "--quiet"]),
+        "quick fit",
+    );
+    let dir = tmp.0.join("reports/quick");
+    let figs = svgs(&dir);
+    assert!(figs.len() >= 5, "{figs:?}");
+    for f in &figs {
+        let svg = std::fs::read_to_string(dir.join(f)).unwrap();
+        let (hits, b) = data_under_legend(&svg).unwrap_or_else(|e| panic!("{f}: {e}"));
+        assert!(hits.is_empty(), "{f}: legend box {b:?} covers {hits:?}");
+        assert!(
+            svg.starts_with("<svg width=\"900\" height=\"500\" viewBox=\"0 0 3600 2000\""),
+            "{f}: {:.100}",
+            svg
+        );
+    }
+}

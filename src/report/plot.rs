@@ -3,7 +3,9 @@
 //! * [`line_chart`]: x–y series (traces, PSDs) with optional log axes, peak markers and vertical
 //!   reference lines. NaN (or, on a log axis, a non-positive value) breaks a line: nothing is drawn
 //!   through a gap, and such points never enter the axis-range computation. Lines are clipped to
-//!   the plotted range.
+//!   the plotted range. The legend sits in a strip below the plotting area, so it covers no data;
+//!   the chart is drawn at [`SCALE`] times its size and shown at [`FIGURE_SIZE`] through the SVG
+//!   `viewBox`, so coordinates are not rounded to whole pixels.
 //! * [`heatmap`]: a spectrogram-style `z[x][y]` image with a viridis colour map and colour bar.
 //!
 //! Figures are rendered into memory and written with one `std::fs::write`, so a failed write is an
@@ -352,34 +354,144 @@ pub fn line_chart(
     };
     let plane = Plane { ax, ay, bx, by };
 
+    let size = (FIGURE_SIZE.0 * SCALE, FIGURE_SIZE.1 * SCALE);
+    let legend = Legend::of(series);
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, FIGURE_SIZE).into_drawing_area();
-        draw_xy(&root, plane, (title, x_label, y_label), series, opts)
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| draw_err(path, e))?;
+        let (plot_root, _) = root.split_vertically(size.1 - legend.height);
+        draw_xy(&plot_root, plane, (title, x_label, y_label), series, opts)
             .and_then(|_| root.present())
             .map_err(|e| draw_err(path, e))?;
     }
+    let svg =
+        shown_at_figure_size(&svg, size).replace("</svg>", &legend.svg(size.1 - legend.height));
     write_svg(path, &svg)
 }
 
-type DrawResult = std::result::Result<(), DrawingAreaErrorKind<std::io::Error>>;
+/// Internal drawing scale of [`line_chart`]: plotters' SVG backend writes whole-number
+/// coordinates, so figures are drawn `SCALE` times larger and shown at [`FIGURE_SIZE`] through the
+/// SVG `viewBox`, which puts every coordinate on a quarter pixel.
+pub const SCALE: u32 = 4;
 
+/// `n` display pixels in the scaled drawing.
+const fn px(n: u32) -> u32 {
+    n * SCALE
+}
+
+/// Sets the root `<svg>`'s displayed width and height to [`FIGURE_SIZE`]; its `viewBox` keeps the
+/// drawing's own size `size`.
+fn shown_at_figure_size(svg: &str, size: (u32, u32)) -> String {
+    svg.replacen(
+        &format!("<svg width=\"{}\" height=\"{}\"", size.0, size.1),
+        &format!(
+            "<svg width=\"{}\" height=\"{}\"",
+            FIGURE_SIZE.0, FIGURE_SIZE.1
+        ),
+        1,
+    )
+}
+
+/// The series legend of [`line_chart`], drawn in a strip below the plotting area (entries flow
+/// left to right, then onto a new row) so that it covers no data. In the SVG it is the group
+/// `<g class="legend">` whose first `<rect>` is its box.
+struct Legend {
+    /// `(label, colour, drawn as points, x offset from the box, row)` per series.
+    entries: Vec<(String, RGBColor, bool, u32, u32)>,
+    /// Width of the box and height of the strip, in drawing units (height 0 without series).
+    width: u32,
+    height: u32,
+}
+
+impl Legend {
+    const ROW: u32 = px(18);
+
+    fn of(series: &[Series]) -> Legend {
+        let room = px(FIGURE_SIZE.0 - 24);
+        let (mut x, mut row, mut width) = (px(6), 0, 0);
+        let mut entries = Vec::new();
+        for (i, s) in series.iter().enumerate() {
+            // About 7 px per character of 13 px sans-serif, plus the sample and a gap.
+            let w = px(7 * s.label.chars().count() as u32 + 48).min(room);
+            if x + w > room && x > px(6) {
+                (x, row) = (px(6), row + 1);
+            }
+            let points = s.style == SeriesStyle::Points;
+            entries.push((s.label.clone(), series_colour(i), points, x, row));
+            x += w;
+            width = width.max(x);
+        }
+        let height = if entries.is_empty() {
+            0
+        } else {
+            Self::ROW * (row + 1) + px(16)
+        };
+        Legend {
+            entries,
+            width,
+            height,
+        }
+    }
+
+    /// The legend group, then `</svg>`, in the strip that starts at `top`.
+    fn svg(&self, top: u32) -> String {
+        if self.entries.is_empty() {
+            return "</svg>".into();
+        }
+        let (x, y) = (px(12), top + px(4));
+        let h = self.height - px(8);
+        let mut g = format!(
+            "<g class=\"legend\">\n<rect x=\"{x}\" y=\"{y}\" width=\"{}\" height=\"{h}\" \
+             fill=\"#FFFFFF\" stroke=\"#808080\" stroke-width=\"{}\"/>\n",
+            self.width,
+            px(1)
+        );
+        for (label, c, points, dx, row) in &self.entries {
+            let (ex, ey) = (x + dx, y + px(4) + Self::ROW * row + Self::ROW / 2);
+            let colour = format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2);
+            g += &if *points {
+                format!(
+                    "<circle cx=\"{}\" cy=\"{ey}\" r=\"{}\" fill=\"{colour}\"/>\n",
+                    ex + px(10),
+                    px(3)
+                )
+            } else {
+                format!(
+                    "<line x1=\"{ex}\" y1=\"{ey}\" x2=\"{}\" y2=\"{ey}\" stroke=\"{colour}\" \
+                     stroke-width=\"{}\"/>\n",
+                    ex + px(20),
+                    px(2)
+                )
+            };
+            g += &format!(
+                "<text x=\"{}\" y=\"{ey}\" dy=\"0.35em\" font-family=\"sans-serif\" \
+                 font-size=\"{}\">{}</text>\n",
+                ex + px(26),
+                px(13),
+                html_escape::encode_text(label)
+            );
+        }
+        g + "</g>\n</svg>"
+    }
+}
+
+/// Draws the axes, series, reference lines and markers of [`line_chart`] on `root`.
 fn draw_xy(
     root: &DrawingArea<SVGBackend<'_>, Shift>,
     plane: Plane,
     (title, x_label, y_label): (&str, &str, &str),
     series: &[Series],
     opts: &ChartOpts,
-) -> DrawResult {
+) -> std::result::Result<(), DrawingAreaErrorKind<std::io::Error>> {
     let Plane { ax, ay, bx, by } = plane;
     let xt = ax.ticks(bx.0, bx.1, 10);
     let yt = ay.ticks(by.0, by.1, 6);
-    root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(root)
-        .caption(title, ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(75)
+        .caption(title, ("sans-serif", px(22)))
+        .margin(px(12))
+        .x_label_area_size(px(45))
+        .y_label_area_size(px(75))
         .build_cartesian_2d(
             TickAxis::new(bx.0..bx.1, &xt),
             TickAxis::new(by.0..by.1, &yt),
@@ -392,15 +504,17 @@ fn draw_xy(
         .y_desc(y_label)
         .x_label_formatter(&xf)
         .y_label_formatter(&yf)
-        .label_style(("sans-serif", 13))
-        .axis_desc_style(("sans-serif", 15))
-        .light_line_style(BLACK.mix(0.06))
-        .bold_line_style(BLACK.mix(0.18))
+        .label_style(("sans-serif", px(13)))
+        .axis_desc_style(("sans-serif", px(15)))
+        .light_line_style(BLACK.mix(0.06).stroke_width(px(1)))
+        .bold_line_style(BLACK.mix(0.18).stroke_width(px(1)))
+        .axis_style(BLACK.stroke_width(px(1)))
+        .set_all_tick_mark_size(px(5))
         .draw()?;
 
     for (i, s) in series.iter().enumerate() {
         let colour = series_colour(i);
-        let line_style = colour.stroke_width(2);
+        let line_style = colour.stroke_width(px(2));
         let lines = if s.style == SeriesStyle::Points {
             Vec::new()
         } else {
@@ -421,20 +535,10 @@ fn draw_xy(
             .map(|l| PathElement::new(l, line_style).into_dyn())
             .chain(
                 pts.into_iter()
-                    .map(|p| Circle::new(p, 3, colour.filled()).into_dyn()),
+                    .map(|p| Circle::new(p, px(3), colour.filled()).into_dyn()),
             )
             .collect();
-        let legend_is_points = s.style == SeriesStyle::Points;
-        chart
-            .draw_series(elems)?
-            .label(s.label.as_str())
-            .legend(move |(x, y)| {
-                if legend_is_points {
-                    Circle::new((x + 10, y), 3, colour.filled()).into_dyn()
-                } else {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)).into_dyn()
-                }
-            });
+        chart.draw_series(elems)?;
     }
 
     let grey = RGBColor(90, 90, 90);
@@ -442,22 +546,22 @@ fn draw_xy(
         if !ax.valid(*x) {
             continue;
         }
-        let px = ax.fwd(*x);
-        if px < bx.0 || px > bx.1 {
+        let xp = ax.fwd(*x);
+        if xp < bx.0 || xp > bx.1 {
             continue;
         }
         chart.draw_series(DashedLineSeries::new(
-            vec![(px, by.0), (px, by.1)],
-            6,
-            4,
-            grey.stroke_width(1),
+            vec![(xp, by.0), (xp, by.1)],
+            px(6),
+            px(4),
+            grey.stroke_width(px(1)),
         ))?;
         chart.draw_series(std::iter::once(
-            EmptyElement::at((px, by.1))
+            EmptyElement::at((xp, by.1))
                 + Text::new(
                     label.clone(),
-                    (4, 4),
-                    ("sans-serif", 13).into_font().color(&grey),
+                    (px(4) as i32, px(4) as i32),
+                    ("sans-serif", px(13)).into_font().color(&grey),
                 ),
         ))?;
     }
@@ -467,23 +571,19 @@ fn draw_xy(
         };
         // Every other label goes below its marker, so two close peaks (measured and model) keep
         // readable labels.
-        let dy = if i % 2 == 0 { -16 } else { 4 };
+        let dy = px(if i % 2 == 0 { 16 } else { 0 }) as i32;
+        let dy = if i % 2 == 0 { -dy } else { px(4) as i32 };
         chart.draw_series(std::iter::once(
             EmptyElement::at(p)
-                + Circle::new((0, 0), 5, BLACK.stroke_width(2))
-                + Text::new(m.label.clone(), (7, dy), ("sans-serif", 13).into_font()),
+                + Circle::new((0, 0), px(5), BLACK.stroke_width(px(2)))
+                + Text::new(
+                    m.label.clone(),
+                    (px(7) as i32, dy),
+                    ("sans-serif", px(13)).into_font(),
+                ),
         ))?;
     }
 
-    if !series.is_empty() {
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.5))
-            .label_font(("sans-serif", 13))
-            .draw()?;
-    }
     Ok(())
 }
 
