@@ -11,8 +11,8 @@ use std::path::{Path, PathBuf};
 
 use wiperlab::Error;
 use wiperlab::spectrum::{
-    Detrend, WelchConfig, WelchPlan, find_peak, median_rate_hz, resample_uniform, spectrogram,
-    welch, welch_gappy,
+    Average, Detrend, Scaling, WelchConfig, WelchPlan, Window, find_peak, median_rate_hz,
+    resample_uniform, spectrogram, welch, welch_gappy,
 };
 
 fn fixture(name: &str) -> PathBuf {
@@ -46,12 +46,19 @@ fn read_csv(name: &str) -> (Vec<String>, Vec<Vec<f64>>) {
 
 /// `key=value` from the `config:` comment line.
 fn config_value(comments: &[String], key: &str) -> String {
+    config_value_or(comments, key, None)
+}
+
+/// A `key=value` of the fixture's config line, or `default` when the line has no such key (the
+/// fixtures made before the window, scaling and average options use SciPy's defaults).
+fn config_value_or(comments: &[String], key: &str, default: Option<&str>) -> String {
     let line = comments
         .iter()
         .find_map(|c| c.strip_prefix("config:"))
         .expect("config line");
     line.split_whitespace()
         .find_map(|kv| kv.strip_prefix(&format!("{key}=")))
+        .or(default)
         .unwrap_or_else(|| panic!("{key} in config line"))
         .to_string()
 }
@@ -75,13 +82,17 @@ fn max_rel_err(got: &[f64], want: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-const WELCH_FIXTURES: [&str; 6] = [
+const WELCH_FIXTURES: [&str; 10] = [
     "welch_default_even.csv",
     "welch_default_odd.csv",
     "welch_zeropad_linear.csv",
     "welch_overlap_nodetrend.csv",
     "welch_odd_nfft_linear.csv",
     "welch_one_segment.csv",
+    "welch_hamming_spectrum.csv",
+    "welch_blackman_median_odd.csv",
+    "welch_boxcar_median_even.csv",
+    "welch_hann_median_even.csv",
 ];
 
 /// Reference: scipy.signal.welch (fixtures). Density to 1e-10 relative, frequencies bit for bit.
@@ -102,7 +113,25 @@ fn welch_matches_scipy() {
             .unwrap()
             .with_nfft(num("nfft"))
             .unwrap()
-            .with_detrend(detrend);
+            .with_detrend(detrend)
+            .with_window(
+                Window::from_scipy_name(&config_value_or(&comments, "window", Some("hann")))
+                    .expect("a known window"),
+            )
+            .with_scaling(
+                match config_value_or(&comments, "scaling", Some("density")).as_str() {
+                    "density" => Scaling::Density,
+                    "spectrum" => Scaling::Spectrum,
+                    other => panic!("scaling {other}"),
+                },
+            )
+            .with_average(
+                match config_value_or(&comments, "average", Some("mean")).as_str() {
+                    "mean" => Average::Mean,
+                    "median" => Average::Median,
+                    other => panic!("average {other}"),
+                },
+            );
         let psd = welch(&x, fs, &cfg).unwrap();
         let f_want: Vec<f64> = rows.iter().map(|r| r[0]).collect();
         let p_want: Vec<f64> = rows.iter().map(|r| r[1]).collect();

@@ -32,5 +32,8 @@ pub mod window;
 pub use peaks::{Peak, find_peak, parabolic_vertex, top_peaks};
 pub use resample::{median_rate_hz, resample_uniform};
 pub use stft::{Spectrogram, spectrogram};
-pub use welch::{Detrend, GapReport, Psd, WelchConfig, WelchPlan, welch, welch_gappy};
-pub use window::{WindowSums, hann_periodic, hann_symmetric};
+pub use welch::{
+    Average, Detrend, GapReport, Psd, Scaling, WelchConfig, WelchPlan, median_bias, welch,
+    welch_gappy,
+};
+pub use window::{Window, WindowSums, hann_periodic, hann_symmetric};

@@ -20,7 +20,7 @@
 //! `tests/spectrum.rs`), transposed to `[time][freq]`.
 
 use super::peaks::find_peak;
-use super::welch::{Detrend, WelchConfig, WelchPlan, check_fs, fill_freqs};
+use super::welch::{WelchConfig, WelchPlan, check_fs, fill_freqs};
 use crate::{Error, Result};
 
 /// A one-sided spectrogram: `density[i][k]` is the PSD (units²/Hz) of the segment centred at
@@ -76,10 +76,9 @@ pub fn spectrogram(
     nfft: usize,
 ) -> Result<Spectrogram> {
     let cfg = WelchConfig {
-        nperseg,
         noverlap,
         nfft,
-        detrend: Detrend::Constant,
+        ..WelchConfig::new(nperseg)
     };
     cfg.validate()?;
     check_fs(fs_hz)?;

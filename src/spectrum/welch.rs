@@ -4,19 +4,24 @@
 //! on time averaging over short, modified periodograms", IEEE Trans. Audio Electroacoust. 15(2):70–73,
 //! 1967.
 //!
-//! [`welch`] reproduces `scipy.signal.welch(x, fs, window='hann', nperseg, noverlap, nfft, detrend,
-//! scaling='density', average='mean')` (SciPy 1.17; checked against fixtures to 1e-10 relative in
-//! `tests/spectrum.rs`):
+//! [`welch`] reproduces `scipy.signal.welch(x, fs, window, nperseg, noverlap, nfft, detrend, scaling,
+//! average)` with SciPy's names and defaults (`window='hann'`, `noverlap=nperseg//2`,
+//! `nfft=nperseg`, `detrend='constant'`, `scaling='density'`, `average='mean'`; SciPy 1.17; checked
+//! against fixtures to 1e-10 relative in `tests/spectrum.rs`, for every window, both scalings and
+//! both averages):
 //!
-//! * **Window**: periodic Hann of length `nperseg` ([`hann_periodic`]).
+//! * **Window**: periodic Hann of length `nperseg` by default ([`Window`]: also Hamming, Blackman,
+//!   boxcar, as `scipy.signal.get_window(name, nperseg)`).
 //! * **Segments**: start at `0, step, 2·step, …` with `step = nperseg − noverlap`; only full segments
 //!   are used, so `n_segments = (len − noverlap) / step` and trailing samples are dropped.
 //! * **Detrend** per segment before windowing ([`Detrend`]).
 //! * **FFT** of length `nfft ≥ nperseg`; the windowed segment is zero-padded at the end.
-//! * **Scaling** `'density'`: `|X_k|² / (fs·Σw²)`, so the PSD is in units²/Hz.
+//! * **Scaling** ([`Scaling`]) `'density'`: `|X_k|² / (fs·Σw²)`, so the PSD is in units²/Hz;
+//!   `'spectrum'`: `|X_k|² / (Σw)²`, units².
 //! * **One-sided**: bins `1..nfft/2` (exclusive) are doubled for even `nfft` (DC and Nyquist are not);
 //!   bins `1..=nfft/2` for odd `nfft`.
-//! * **Average**: arithmetic mean over segments.
+//! * **Average** ([`Average`]): arithmetic mean over segments, or their median divided by
+//!   [`median_bias`].
 //! * **Frequencies**: `f_k = k·fs/nfft`, `k = 0..=nfft/2`, computed as NumPy's `rfftfreq` does
 //!   (`k · (1/(nfft·(1/fs)))`) so they agree bit for bit.
 //!
@@ -34,7 +39,7 @@ use std::sync::Arc;
 use realfft::num_complex::Complex;
 use realfft::{RealFftPlanner, RealToComplex};
 
-use super::window::{WindowSums, hann_periodic};
+use super::window::{Window, WindowSums};
 use crate::{Error, Result};
 
 /// What is subtracted from each segment before windowing (`scipy.signal.welch`'s `detrend`).
@@ -75,6 +80,86 @@ pub struct WelchConfig {
     pub nfft: usize,
     /// Per-segment detrending.
     pub detrend: Detrend,
+    /// Taper of each segment.
+    pub window: Window,
+    /// Density (units²/Hz) or power spectrum (units²).
+    pub scaling: Scaling,
+    /// How the segments' periodograms are combined.
+    pub average: Average,
+}
+
+/// `scipy.signal.welch`'s `scaling`.
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum Scaling {
+    /// Power spectral density `|X_k|²/(fs·Σw²)`, units²/Hz (SciPy's default).
+    #[default]
+    Density,
+    /// Power spectrum `|X_k|²/(Σw)²`, units²: a sinusoid of amplitude A on a bin shows A²/2.
+    Spectrum,
+}
+
+/// `scipy.signal.welch`'s `average`.
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum Average {
+    /// Arithmetic mean over segments (SciPy's default; Welch 1967).
+    #[default]
+    Mean,
+    /// Median over segments divided by SciPy's bias `1 + Σ_{i=1}^{⌊(n−1)/2⌋} (1/(2i+1) − 1/(2i))`
+    /// for `n` segments (the median of χ²₂ periodogram ordinates; Allen et al., Phys. Rev. D 85,
+    /// 122006 (2012), appendix B): robust to a few segments spoiled by glitches.
+    Median,
+}
+
+impl fmt::Display for Scaling {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Scaling::Density => "density",
+            Scaling::Spectrum => "spectrum",
+        })
+    }
+}
+
+impl fmt::Display for Average {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Average::Mean => "mean",
+            Average::Median => "median",
+        })
+    }
+}
+
+/// SciPy's `_median_bias(n)`: the expected sample median of `n` exponential (χ²₂/2) variables of
+/// mean 1, which tends to ln 2 for large `n`; 1 for `n ≤ 2`.
+pub fn median_bias(n: usize) -> f64 {
+    let m = (n.saturating_sub(1)) / 2;
+    1.0 + (1..=m)
+        .map(|i| {
+            let ii = 2.0 * i as f64;
+            1.0 / (ii + 1.0) - 1.0 / ii
+        })
+        .sum::<f64>()
 }
 
 impl WelchConfig {
@@ -87,7 +172,28 @@ impl WelchConfig {
             noverlap: nperseg / 2,
             nfft: nperseg,
             detrend: Detrend::Constant,
+            window: Window::Hann,
+            scaling: Scaling::Density,
+            average: Average::Mean,
         }
+    }
+
+    /// Sets the window (any value is valid).
+    pub fn with_window(mut self, window: Window) -> Self {
+        self.window = window;
+        self
+    }
+
+    /// Sets the scaling (any value is valid).
+    pub fn with_scaling(mut self, scaling: Scaling) -> Self {
+        self.scaling = scaling;
+        self
+    }
+
+    /// Sets the averaging (any value is valid).
+    pub fn with_average(mut self, average: Average) -> Self {
+        self.average = average;
+        self
     }
 
     /// Sets `noverlap`; [`Error::Config`] unless `noverlap < nperseg`.
@@ -229,6 +335,8 @@ pub struct WelchPlan {
     scratch: Vec<Complex<f64>>,
     /// Σ over segments of |X_k|², `nfft/2 + 1` long.
     acc: Vec<f64>,
+    /// With [`Average::Median`]: every segment's |X_k|², segment after segment.
+    segments: Vec<f64>,
 }
 
 impl fmt::Debug for WelchPlan {
@@ -244,13 +352,14 @@ impl WelchPlan {
     pub fn new(cfg: WelchConfig) -> Result<Self> {
         cfg.validate()?;
         let r2c = RealFftPlanner::<f64>::new().plan_fft_forward(cfg.nfft);
-        let window = hann_periodic(cfg.nperseg);
+        let window = cfg.window.periodic(cfg.nperseg);
         let sums = WindowSums::of(&window);
         Ok(WelchPlan {
             buf: r2c.make_input_vec(),
             spec: r2c.make_output_vec(),
             scratch: r2c.make_scratch_vec(),
             acc: vec![0.0; cfg.n_freqs()],
+            segments: Vec::new(),
             cfg,
             r2c,
             window,
@@ -263,7 +372,7 @@ impl WelchPlan {
         &self.cfg
     }
 
-    /// The periodic Hann window in use (`nperseg` samples).
+    /// The periodic window in use (`nperseg` samples).
     pub fn window(&self) -> &[f64] {
         &self.window
     }
@@ -299,6 +408,7 @@ impl WelchPlan {
             )));
         }
         self.acc.fill(0.0);
+        self.segments.clear();
         let n_seg = self.accumulate_run(x);
         self.finish_into(fs_hz, n_seg, out);
         Ok(())
@@ -360,6 +470,7 @@ impl WelchPlan {
         report.runs = runs.len();
 
         self.acc.fill(0.0);
+        self.segments.clear();
         let mut n_seg = 0;
         for &(s, e) in &runs {
             if e - s >= self.cfg.nperseg {
@@ -392,8 +503,13 @@ impl WelchPlan {
         for s in 0..n_seg {
             let start = s * step;
             self.segment_power(&x[start..start + self.cfg.nperseg]);
-            for (a, c) in self.acc.iter_mut().zip(&self.spec) {
-                *a += c.norm_sqr();
+            match self.cfg.average {
+                Average::Mean => {
+                    for (a, c) in self.acc.iter_mut().zip(&self.spec) {
+                        *a += c.norm_sqr();
+                    }
+                }
+                Average::Median => self.segments.extend(self.spec.iter().map(|c| c.norm_sqr())),
             }
         }
         n_seg
@@ -443,17 +559,27 @@ impl WelchPlan {
 
     /// One-sided density scaling of the squared-magnitude sum `acc` as one segment's spectrum
     /// (`n_seg = 1`) or the mean of `n_seg`; writes frequencies and density into `out`.
-    fn finish_into(&self, fs_hz: f64, n_seg: usize, out: &mut Psd) {
+    fn finish_into(&mut self, fs_hz: f64, n_seg: usize, out: &mut Psd) {
         fill_freqs(&mut out.freq_hz, self.cfg.nfft, fs_hz);
         out.density.clear();
-        out.density.extend_from_slice(&self.acc);
-        scale_one_sided(
-            &mut out.density,
-            self.cfg.nfft,
-            fs_hz,
-            self.sums.sum_sq,
-            n_seg,
-        );
+        let divisor = match self.cfg.average {
+            Average::Mean => {
+                out.density.extend_from_slice(&self.acc);
+                n_seg as f64
+            }
+            Average::Median => {
+                let nf = self.cfg.n_freqs();
+                let mut column = Vec::with_capacity(n_seg);
+                for k in 0..nf {
+                    column.clear();
+                    column.extend((0..n_seg).map(|s| self.segments[s * nf + k]));
+                    out.density.push(median_of(&mut column));
+                }
+                median_bias(n_seg)
+            }
+        };
+        let norm = self.norm(fs_hz);
+        scale_one_sided(&mut out.density, self.cfg.nfft, 1.0 / divisor, norm);
         out.n_segments = n_seg;
         out.fs_hz = fs_hz;
     }
@@ -464,7 +590,16 @@ impl WelchPlan {
         self.segment_power(seg);
         row.clear();
         row.extend(self.spec.iter().map(|c| c.norm_sqr()));
-        scale_one_sided(row, self.cfg.nfft, fs_hz, self.sums.sum_sq, 1);
+        let norm = self.norm(fs_hz);
+        scale_one_sided(row, self.cfg.nfft, 1.0, norm);
+    }
+
+    /// The factor on one segment's `|X_k|²`: `1/(fs·Σw²)` for density, `1/(Σw)²` for spectrum.
+    fn norm(&self, fs_hz: f64) -> f64 {
+        match self.cfg.scaling {
+            Scaling::Density => 1.0 / (fs_hz * self.sums.sum_sq),
+            Scaling::Spectrum => 1.0 / (self.sums.sum * self.sums.sum),
+        }
     }
 }
 
@@ -475,13 +610,23 @@ pub(crate) fn fill_freqs(freq: &mut Vec<f64>, nfft: usize, fs_hz: f64) {
     freq.extend((0..nfft / 2 + 1).map(|k| k as f64 * val));
 }
 
-/// Mean over `n_seg`, density scaling `1/(fs·Σw²)` and one-sided doubling (SciPy's rule).
-fn scale_one_sided(p: &mut [f64], nfft: usize, fs_hz: f64, sum_sq: f64, n_seg: usize) {
-    let scale = 1.0 / (fs_hz * sum_sq);
-    let inv_n = 1.0 / n_seg as f64;
+/// NumPy's median of `v` (the mean of the two middle values for an even count); `v` is reordered.
+fn median_of(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Scales by `inv_n` (the averaging: 1/segments, or 1/median bias) and `norm` (the density or
+/// spectrum factor) and doubles the one-sided bins (SciPy's rule).
+fn scale_one_sided(p: &mut [f64], nfft: usize, inv_n: f64, norm: f64) {
     let last = p.len() - 1;
     for (k, v) in p.iter_mut().enumerate() {
-        let mut d = *v * inv_n * scale;
+        let mut d = *v * inv_n * norm;
         // Even nfft: the Nyquist bin (k = nfft/2) has no mirror image and is not doubled.
         if k > 0 && (nfft % 2 == 1 || k < last) {
             d *= 2.0;
@@ -546,7 +691,8 @@ mod tests {
 
     #[test]
     fn config_defaults_are_scipys() {
-        // scipy.signal.welch docs: noverlap = nperseg // 2, nfft = nperseg, detrend='constant'.
+        // scipy.signal.welch docs: window='hann', noverlap = nperseg // 2, nfft = nperseg,
+        // detrend='constant', scaling='density', average='mean'.
         let c = WelchConfig::new(255);
         assert_eq!(
             c,
@@ -554,7 +700,10 @@ mod tests {
                 nperseg: 255,
                 noverlap: 127,
                 nfft: 255,
-                detrend: Detrend::Constant
+                detrend: Detrend::Constant,
+                window: Window::Hann,
+                scaling: Scaling::Density,
+                average: Average::Mean,
             }
         );
         assert_eq!(c.step(), 128);
@@ -562,6 +711,11 @@ mod tests {
         assert_eq!(c.n_segments(255), 1);
         assert_eq!(c.n_segments(255 + 128), 2);
         assert_eq!(c.n_freqs(), 128);
+        // The median bias: 1 for one or two segments, 1 + 1/3 − 1/2 for three, → ln 2.
+        assert_eq!(median_bias(1), 1.0);
+        assert_eq!(median_bias(2), 1.0);
+        assert!((median_bias(3) - (1.0 + 1.0 / 3.0 - 0.5)).abs() < 1e-15);
+        assert!((median_bias(100_001) - std::f64::consts::LN_2).abs() < 1e-5);
     }
 
     #[test]
