@@ -261,6 +261,7 @@ impl SpectralProblem {
 
 struct HistoryObserver {
     stage: &'static str,
+    restart: usize,
     log: Arc<Mutex<Vec<HistoryPoint>>>,
     evals: Arc<AtomicUsize>,
 }
@@ -276,6 +277,7 @@ impl<I: State<Float = f64>> Observe<I> for HistoryObserver {
             .unwrap_or_else(|e| e.into_inner())
             .push(HistoryPoint {
                 stage: self.stage.into(),
+                restart: self.restart,
                 iteration: state.get_iter(),
                 best_cost: state.get_best_cost(),
                 evaluations: self.evals.load(Ordering::Relaxed),
@@ -712,9 +714,10 @@ fn optimise(
     let n = problem.free.len();
     let fit_err = |e: argmin::core::Error| Error::Fit(e.to_string());
     let evaluations = problem.evaluations.clone();
-    let observer = |stage: &'static str| {
+    let observer = |stage: &'static str, restart: usize| {
         log.map(|(h, _, _)| HistoryObserver {
             stage,
+            restart,
             log: h.clone(),
             evals: evaluations.clone(),
         })
@@ -749,7 +752,7 @@ fn optimise(
                 None => s,
             }
         });
-        if let Some(o) = observer("swarm") {
+        if let Some(o) = observer("swarm", r) {
             ex = ex.add_observer(o, ObserverMode::Always);
         }
         let res = ex.run().map_err(fit_err)?;
@@ -767,7 +770,7 @@ fn optimise(
             &swarm_best,
             0.05,
             fit.polish_iterations,
-            observer("polish"),
+            observer("polish", r),
         )?;
         polish_iters += iters;
         if best.as_ref().is_none_or(|b| cost < b.1) {

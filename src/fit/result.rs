@@ -13,6 +13,10 @@ use std::path::Path;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct HistoryPoint {
     pub stage: String,
+    /// Which of the fit's independent swarm-and-polish runs (`[fit] restarts`), from 0; 0 in
+    /// results written before this field.
+    #[serde(default)]
+    pub restart: usize,
     pub iteration: u64,
     pub best_cost: f64,
     pub evaluations: usize,
@@ -271,6 +275,7 @@ mod tests {
             fitted_at: Some("2026-11-22T10:00:00.5Z".parse().expect("RFC 3339 time")),
             history: vec![HistoryPoint {
                 stage: "swarm".into(),
+                restart: 1,
                 iteration: 0,
                 best_cost: 2.0,
                 evaluations: 3,

@@ -4,6 +4,7 @@
 use super::plot::{ChartOpts, Marker, Series, heatmap, line_chart};
 use crate::fit::features::{Features, noise_floor};
 use crate::fit::instfreq::FreqSpeedComparison;
+use crate::fit::result::HistoryPoint;
 use crate::fit::{FitOutcome, FitResult};
 use crate::model::FrictionLaw;
 use crate::simulate::blade::BladeSimulation;
@@ -61,6 +62,7 @@ pub fn spectrum_figures(
             ),
             "time from first sample [s]",
             "frequency [Hz]",
+            "PSD [m²/Hz]",
             &sg.t_s,
             &sg.freq_hz,
             &sg.density,
@@ -275,25 +277,41 @@ pub fn fit_figures(
         &dir.join("friction_law.svg"),
         "dynamic friction coefficient μ_d = A e^(−B|v|) + C (seed eq. 4)",
         "slip speed |v̇3| [m/s]",
-        "μ",
+        "dynamic friction coefficient μ_d [-]",
         &series,
         &ChartOpts::default(),
     )?;
     if let Some(c) = freq_speed {
         freq_vs_speed_figure(dir, c)?;
     }
-    let (it, c): (Vec<f64>, Vec<f64>) = o
-        .result
-        .history
-        .iter()
-        .map(|h| (h.evaluations as f64, h.best_cost))
-        .unzip();
+    cost_figure(dir, &o.result.history)
+}
+
+/// Writes `cost.svg`: best cost against model evaluations, one series per restart (each restart's
+/// swarm starts anew, so its curve begins above the previous one's end).
+fn cost_figure(dir: &Path, history: &[HistoryPoint]) -> Result<()> {
+    let restarts = history.iter().map(|h| h.restart + 1).max().unwrap_or(0);
+    let series: Vec<Series> = (0..restarts.max(1))
+        .map(|r| {
+            let (it, c): (Vec<f64>, Vec<f64>) = history
+                .iter()
+                .filter(|h| h.restart == r)
+                .map(|h| (h.evaluations as f64, h.best_cost))
+                .unzip();
+            let label = if restarts > 1 {
+                format!("restart {} (swarm, then Nelder–Mead)", r + 1)
+            } else {
+                "best cost (swarm, then Nelder–Mead)".into()
+            };
+            Series::line(label, it, c)
+        })
+        .collect();
     line_chart(
         &dir.join("cost.svg"),
-        "best cost against model evaluations (swarm, then Nelder–Mead; each restart anew)",
+        "best cost against model evaluations",
         "model evaluations",
         "best cost",
-        &[Series::line("best cost", it, c)],
+        &series,
         &ChartOpts {
             log_y: true,
             ..ChartOpts::default()

@@ -648,7 +648,8 @@ fn block_edges(e: &[f64], b: usize) -> Vec<f64> {
 /// A colour-mapped image of `z[i][j]` at cell centres `(x[i], y[j])`, written as SVG (≈ 900×500 px)
 /// to `path`, with a colour bar. For a [`Spectrogram`](crate::spectrum::Spectrogram) pass
 /// `x = t_s`, `y = freq_hz`, `z = density` and `log_z = true` (the colour bar is then logarithmic
-/// and labelled in z units).
+/// and labelled in z units). `z_label` names the colour bar's quantity and unit, e.g.
+/// `"PSD [m²/Hz]"`.
 ///
 /// `x` and `y` must be finite and strictly increasing; `z` must have `x.len()` rows of `y.len()`
 /// values. More than [`HEATMAP_MAX_CELLS`] cells per axis are decimated by block maxima. NaN (and, if
@@ -663,6 +664,7 @@ pub fn heatmap(
     title: &str,
     x_label: &str,
     y_label: &str,
+    z_label: &str,
     x: &[f64],
     y: &[f64],
     z: &[Vec<f64>],
@@ -745,7 +747,8 @@ pub fn heatmap(
     let mut svg = String::new();
     let image = {
         let root = SVGBackend::with_string(&mut svg, FIGURE_SIZE).into_drawing_area();
-        let r = draw_heatmap_axes(&root, (title, x_label, y_label), &xe, &ye, zr, log_z);
+        let labels = (title, x_label, y_label, z_label);
+        let r = draw_heatmap_axes(&root, labels, &xe, &ye, zr, log_z);
         let area = r
             .and_then(|a| root.present().map(|_| a))
             .map_err(|e| draw_err(path, e))?;
@@ -767,7 +770,7 @@ type PixelArea = (i32, i32, u32, u32);
 /// Draws title, axes and colour bar (no cells); returns the plotting area's pixel rectangle.
 fn draw_heatmap_axes(
     root: &DrawingArea<SVGBackend<'_>, Shift>,
-    (title, x_label, y_label): (&str, &str, &str),
+    (title, x_label, y_label, z_label): (&str, &str, &str, &str),
     xe: &[f64],
     ye: &[f64],
     (zlo, zhi): (f64, f64),
@@ -775,7 +778,7 @@ fn draw_heatmap_axes(
 ) -> std::result::Result<PixelArea, DrawingAreaErrorKind<std::io::Error>> {
     root.fill(&WHITE)?;
     let root = root.titled(title, ("sans-serif", 22))?;
-    let (main, bar) = root.split_horizontally(FIGURE_SIZE.0 - 110);
+    let (main, bar) = root.split_horizontally(FIGURE_SIZE.0 - 140);
     let (x0, x1) = (xe[0], xe[xe.len() - 1]);
     let (y0, y1) = (ye[0], ye[ye.len() - 1]);
     let xt = ticks::linear(x0, x1, 10);
@@ -814,17 +817,19 @@ fn draw_heatmap_axes(
         .margin_top(10)
         .margin_bottom(55)
         .margin_right(5)
-        .y_label_area_size(60)
+        .y_label_area_size(90)
         .build_cartesian_2d(0.0..1.0, TickAxis::new(zlo..zhi, &zt))?;
     let zf = |v: &f64| zt.label(*v);
+    let desc = if log_z {
+        format!("{z_label}, log colour scale")
+    } else {
+        z_label.to_string()
+    };
     cb.configure_mesh()
         .disable_mesh()
         .disable_x_axis()
-        .y_desc(if log_z {
-            "log colour scale"
-        } else {
-            "colour scale"
-        })
+        .y_desc(desc)
+        .set_tick_mark_size(LabelAreaPosition::Left, 6)
         .y_label_formatter(&zf)
         .label_style(("sans-serif", 12))
         .axis_desc_style(("sans-serif", 13))
@@ -1065,6 +1070,7 @@ mod tests {
             "Spectrogram of chirp",
             "time [s]",
             "frequency [Hz]",
+            "PSD [1/Hz]",
             &sg.t_s,
             &sg.freq_hz,
             &sg.density,
@@ -1091,6 +1097,7 @@ mod tests {
             "small",
             "i",
             "j",
+            "z [1]",
             &[0.0, 1.0],
             &[0.0, 1.0, 2.0],
             &[vec![1.0, 2.0, 3.0], vec![4.0, f64::NAN, 6.0]],
@@ -1104,18 +1111,30 @@ mod tests {
     #[test]
     fn heatmap_rejects_bad_shapes() {
         let p = Path::new("/nonexistent/h.svg");
-        let e = heatmap(p, "t", "x", "y", &[0.0], &[0.0, 1.0], &[vec![1.0]], false).unwrap_err();
+        let e = heatmap(
+            p,
+            "t",
+            "x",
+            "y",
+            "z",
+            &[0.0],
+            &[0.0, 1.0],
+            &[vec![1.0]],
+            false,
+        )
+        .unwrap_err();
         assert!(
             matches!(e, Error::Numerics(ref m) if m.contains("h.svg")),
             "{e}"
         );
-        assert!(heatmap(p, "t", "x", "y", &[], &[], &[], false).is_err());
+        assert!(heatmap(p, "t", "x", "y", "z", &[], &[], &[], false).is_err());
         assert!(
             heatmap(
                 p,
                 "t",
                 "x",
                 "y",
+                "z",
                 &[1.0, 0.0],
                 &[0.0],
                 &[vec![1.0], vec![1.0]],
@@ -1123,8 +1142,21 @@ mod tests {
             )
             .is_err()
         );
-        assert!(heatmap(p, "t", "x", "y", &[0.0], &[0.0], &[vec![f64::NAN]], false).is_err());
-        assert!(heatmap(p, "t", "x", "y", &[0.0], &[0.0], &[vec![-1.0]], true).is_err());
+        assert!(
+            heatmap(
+                p,
+                "t",
+                "x",
+                "y",
+                "z",
+                &[0.0],
+                &[0.0],
+                &[vec![f64::NAN]],
+                false
+            )
+            .is_err()
+        );
+        assert!(heatmap(p, "t", "x", "y", "z", &[0.0], &[0.0], &[vec![-1.0]], true).is_err());
     }
 
     #[test]
