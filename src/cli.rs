@@ -291,13 +291,14 @@ fn fit_and_write(
     job: &LoadedJob,
     progress: bool,
 ) -> Result<(crate::fit::FitResult, PathBuf, PathBuf)> {
-    let outcome = crate::fit::run_fit(job, progress)?;
+    let mut outcome = crate::fit::run_fit(job, progress)?;
+    let report_dir = report_dir(job);
+    create_dir(&report_dir)?;
+    outcome.result.data_files = crate::report::figures::fit_data_files(&report_dir, &outcome)?;
     let result_path = result_path(job);
     let toml_text = outcome.result.to_toml()?;
     std::fs::write(&result_path, toml_text)
         .map_err(|e| Error::io(&result_path, "cannot write", e))?;
-    let report_dir = report_dir(job);
-    create_dir(&report_dir)?;
     let freq_speed = crate::fit::instfreq::compare_freq_speed(&outcome)?;
     crate::report::figures::fit_figures(&report_dir, &outcome, freq_speed.as_ref())?;
     Ok((outcome.result, result_path, report_dir))

@@ -556,3 +556,75 @@ fn legends_cover_no_data_in_any_fit_figure() {
         );
     }
 }
+
+/// `fit` writes the numbers behind its figures as CSV beside the SVGs, with the column names the
+/// docs give (units in the names), and the result lists them: PSD per band on the band's bins
+/// (frequencies inside the job's band, increasing), measured and model traces.
+#[test]
+fn fit_writes_psd_and_trace_csv_with_named_columns() {
+    let tmp = TempDir::new("csv");
+    let job = write_quick_job(&tmp.0);
+    ok(
+        &wiperlab(&tmp.0, &["fit", job.to_str().unwrap(), "--quiet"]),
+        "quick fit",
+    );
+    let dir = tmp.0.join("reports/quick");
+    let read = |name: &str| -> (Vec<String>, Vec<Vec<f64>>) {
+        let mut r =
+            csv::Reader::from_path(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let header = r.headers().unwrap().iter().map(str::to_string).collect();
+        let rows = r
+            .records()
+            .map(|rec| {
+                rec.unwrap()
+                    .iter()
+                    .map(|v| v.parse::<f64>().unwrap())
+                    .collect()
+            })
+            .collect();
+        (header, rows)
+    };
+    // The quick job's bands: low 30–300 Hz, high 500–5000 Hz.
+    for (band, lo, hi) in [("low", 30.0, 300.0), ("high", 500.0, 5000.0)] {
+        let (h, rows) = read(&format!("psd_{band}.csv"));
+        assert_eq!(
+            h,
+            ["freq_hz", "psd_measured_m2_per_hz", "psd_model_m2_per_hz"]
+        );
+        assert!(rows.len() > 5, "{band}: {} rows", rows.len());
+        assert!(
+            rows.windows(2).all(|w| w[0][0] < w[1][0]),
+            "{band}: bins increase"
+        );
+        assert!(
+            rows.iter().all(|r| r[0] >= lo && r[0] <= hi),
+            "{band}: bins in band"
+        );
+        assert!(
+            rows.iter().all(|r| r[1] > 0.0 && r[2] > 0.0),
+            "{band}: positive PSD"
+        );
+    }
+    for name in ["traces_measured.csv", "traces_model.csv"] {
+        let (h, rows) = read(name);
+        assert_eq!(h, ["t_s", "tip_rel_x_m", "head_y_m"], "{name}");
+        assert!(rows.len() > 100, "{name}: {} rows", rows.len());
+    }
+    let result: toml::Table =
+        toml::from_str(&std::fs::read_to_string(tmp.0.join("quick.result.toml")).unwrap()).unwrap();
+    let listed: Vec<&str> = result["data_files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|v| v.as_str())
+        .collect();
+    assert_eq!(
+        listed,
+        [
+            "psd_low.csv",
+            "psd_high.csv",
+            "traces_measured.csv",
+            "traces_model.csv"
+        ]
+    );
+}

@@ -1303,6 +1303,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         spectrum: Some(job.job.spectrum.clone()),
         fit_settings: Some(job.job.fit.clone()),
         fitted_at: Some(jiff::Timestamp::now()),
+        data_files: Vec::new(),
         history: cf.history.clone(),
     };
     Ok(FitOutcome {

@@ -148,6 +148,11 @@ pub struct FitResult {
     /// field.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fitted_at: Option<jiff::Timestamp>,
+    /// CSV files with the numbers behind the figures (measured and model PSD per band, measured and
+    /// model traces), by name inside the report directory `reports/<job>/`; see
+    /// `report::figures::fit_data_files` for their columns.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub data_files: Vec<String>,
     pub history: Vec<HistoryPoint>,
 }
 
@@ -273,6 +278,7 @@ mod tests {
                 toml::from_str("[parameters]\nk1 = [0.005, 0.15]\n").expect("fit section"),
             ),
             fitted_at: Some("2026-11-22T10:00:00.5Z".parse().expect("RFC 3339 time")),
+            data_files: vec!["psd_low.csv".into()],
             history: vec![HistoryPoint {
                 stage: "swarm".into(),
                 restart: 1,
@@ -310,6 +316,7 @@ mod tests {
             "spectrum",
             "fit_settings",
             "fitted_at",
+            "data_files",
         ] {
             assert!(t.remove(k).is_some(), "{k}");
         }

@@ -319,6 +319,81 @@ fn cost_figure(dir: &Path, history: &[HistoryPoint]) -> Result<()> {
     )
 }
 
+/// Writes one CSV into `dir` from named columns of equal length (NaN written as `NaN`).
+fn write_columns(dir: &Path, name: &str, columns: &[(&str, &[f64])]) -> Result<String> {
+    let path = dir.join(name);
+    let fail = |e: csv::Error| Error::io(&path, "cannot write", std::io::Error::other(e));
+    let mut w = csv::Writer::from_path(&path).map_err(fail)?;
+    w.write_record(columns.iter().map(|c| c.0)).map_err(fail)?;
+    let rows = columns.iter().map(|c| c.1.len()).min().unwrap_or(0);
+    for i in 0..rows {
+        w.write_record(columns.iter().map(|c| format!("{:e}", c.1[i])))
+            .map_err(fail)?;
+    }
+    w.flush().map_err(|e| Error::io(&path, "cannot write", e))?;
+    Ok(name.to_string())
+}
+
+/// Writes the fit's numbers behind its figures as CSV into `dir` and returns the file names:
+/// `psd_<band>.csv` (`freq_hz`, `psd_measured_m2_per_hz` when there is a recording,
+/// `psd_model_m2_per_hz`; Welch one-sided density inside the band, measured and model on the same
+/// bins), `traces_measured.csv` (`t_s`, the job's signal in m, `head_y_m`; absent for a target
+/// job) and `traces_model.csv` (`t_s`, the signal in m, `head_y_m` = −u). Values as the fit
+/// computed them (no means removed).
+///
+/// # Errors
+/// [`Error::Io`] naming the file; [`Error::Config`] if the signal cannot be extracted.
+pub fn fit_data_files(dir: &Path, o: &FitOutcome) -> Result<Vec<String>> {
+    let mut files = Vec::new();
+    let targets_only = o.measured_trace.points.is_empty();
+    for (d, m) in o.measured.bands.iter().zip(&o.model.bands) {
+        let name = format!("psd_{}.csv", d.spec.name);
+        let same_bins = d.freq_hz == m.freq_hz;
+        files.push(if targets_only || !same_bins {
+            let cols: [(&str, &[f64]); 2] =
+                [("freq_hz", &m.freq_hz), ("psd_model_m2_per_hz", &m.psd)];
+            write_columns(dir, &name, &cols)?
+        } else {
+            let cols: [(&str, &[f64]); 3] = [
+                ("freq_hz", &d.freq_hz),
+                ("psd_measured_m2_per_hz", &d.psd),
+                ("psd_model_m2_per_hz", &m.psd),
+            ];
+            write_columns(dir, &name, &cols)?
+        });
+    }
+    let signal_col = format!(
+        "{}_m",
+        serde_json::to_value(o.signal)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_string))
+            .unwrap_or_else(|| "signal".into())
+    );
+    if !targets_only {
+        let sig = o.signal.extract(&o.measured_trace)?;
+        let head: Vec<f64> = o
+            .measured_trace
+            .point("head")
+            .map(|p| p.y_m.clone())
+            .unwrap_or_else(|| vec![f64::NAN; sig.len()]);
+        let cols: [(&str, &[f64]); 3] = [
+            ("t_s", &o.measured_trace.t_s),
+            (&signal_col, &sig),
+            ("head_y_m", &head),
+        ];
+        files.push(write_columns(dir, "traces_measured.csv", &cols)?);
+    }
+    let sig = o.signal.extract(&o.best_sim.to_trace())?;
+    let head: Vec<f64> = o.best_sim.u_m.iter().map(|u| -u).collect();
+    let cols: [(&str, &[f64]); 3] = [
+        ("t_s", &o.best_sim.t_s),
+        (&signal_col, &sig),
+        ("head_y_m", &head),
+    ];
+    files.push(write_columns(dir, "traces_model.csv", &cols)?);
+    Ok(files)
+}
+
 /// Writes `freq_vs_speed.svg` into `dir`: ridge and stick-onset rate against the tip's mean speed
 /// (mm/s), measurement and model on one chart, frequency axis limited to the comparison's band
 /// (computed upstream by [`crate::fit::instfreq::compare_freq_speed`]).

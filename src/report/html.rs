@@ -723,6 +723,7 @@ mod tests {
             spectrum: None,
             fit_settings: None,
             fitted_at: None,
+            data_files: vec![],
             history: vec![],
         }
     }
