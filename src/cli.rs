@@ -410,6 +410,7 @@ pub fn run(cli: Cli) -> Result<()> {
                     summary.n_frames, summary.dt_min_s, summary.dt_max_s
                 );
             }
+            let mut computed = Vec::new();
             for (name, x) in &signals {
                 let f = match features(x, fs, &bands, max_fill) {
                     Ok(f) => f,
@@ -434,8 +435,11 @@ pub fn run(cli: Cli) -> Result<()> {
                 }
                 let sg = crate::spectrum::stft::overview_spectrogram(x, fs)?;
                 crate::report::figures::spectrum_figures(&dir, name, &f, sg.as_ref())?;
+                computed.push((name.to_string(), f));
             }
+            crate::report::figures::spectrum_data_files(&dir, &computed)?;
             println!("figures in {}", dir.display());
+            println!("psd.csv and peaks.json in {}", dir.display());
             Ok(())
         }
         Command::Simulate {

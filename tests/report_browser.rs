@@ -628,3 +628,49 @@ fn fit_writes_psd_and_trace_csv_with_named_columns() {
         ]
     );
 }
+
+/// `spectrum` writes psd.csv (f_hz, then one PSD column per signal, units in the names) and
+/// peaks.json (signal, band, freq_hz, psd_m2_per_hz, prominence per peak) beside its figures, for
+/// the shipped sample recording (import settings of fits/reversal.toml).
+#[test]
+fn spectrum_writes_psd_csv_and_peaks_json() {
+    let tmp = TempDir::new("spectrum_csv");
+    let rec = root().join("data/reversal/wiper_reversal_sample_xypts.csv");
+    let out = tmp.0.join("spec");
+    let args = [
+        "spectrum",
+        rec.to_str().unwrap(),
+        "--fps",
+        "10000",
+        "--m-per-px",
+        "1.5e-5",
+        "--origin-px",
+        "200,300",
+        "--out-dir",
+        out.to_str().unwrap(),
+    ];
+    ok(&wiperlab(&tmp.0, &args), "spectrum");
+    let mut r = csv::Reader::from_path(out.join("psd.csv")).unwrap();
+    let header: Vec<String> = r.headers().unwrap().iter().map(str::to_string).collect();
+    assert_eq!(header[0], "f_hz");
+    assert!(header.len() >= 3, "{header:?}");
+    assert!(
+        header[1..].iter().all(|h| h.ends_with("_psd_m2_per_hz")),
+        "{header:?}"
+    );
+    let rows: Vec<Vec<f64>> = r
+        .records()
+        .map(|rec| rec.unwrap().iter().map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert!(rows.len() > 100 && rows.windows(2).all(|w| w[0][0] < w[1][0]));
+    let peaks: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("peaks.json")).unwrap()).unwrap();
+    let peaks = peaks.as_array().unwrap();
+    assert!(!peaks.is_empty());
+    for p in peaks {
+        for k in ["signal", "band", "freq_hz", "psd_m2_per_hz", "prominence"] {
+            assert!(p.get(k).is_some(), "{p} lacks {k}");
+        }
+        assert!(p["freq_hz"].as_f64().unwrap() > 0.0);
+    }
+}

@@ -319,6 +319,54 @@ fn cost_figure(dir: &Path, history: &[HistoryPoint]) -> Result<()> {
     )
 }
 
+/// Writes the `spectrum` command's numbers into `dir`: `psd.csv` (`f_hz`, then
+/// `<signal>_psd_m2_per_hz` per signal: the full one-sided Welch density of the first band's
+/// settings; signals whose bins differ from the first signal's are left out) and `peaks.json` (an
+/// array of `{signal, band, freq_hz, psd_m2_per_hz, prominence}`, one per band with a peak).
+/// Returns the file names.
+///
+/// # Errors
+/// [`Error::Io`] naming the file.
+pub fn spectrum_data_files(dir: &Path, signals: &[(String, Features)]) -> Result<Vec<String>> {
+    let Some((_, first)) = signals.first() else {
+        return Ok(Vec::new());
+    };
+    let f_hz = &first.bands[0].full_freq_hz;
+    let names: Vec<String> = signals
+        .iter()
+        .map(|(n, _)| format!("{n}_psd_m2_per_hz"))
+        .collect();
+    let mut cols: Vec<(&str, &[f64])> = vec![("f_hz", f_hz)];
+    for ((_, f), n) in signals.iter().zip(&names) {
+        if &f.bands[0].full_freq_hz == f_hz {
+            cols.push((n, &f.bands[0].full_psd));
+        }
+    }
+    let mut files = vec![write_columns(dir, "psd.csv", &cols)?];
+    let peaks: Vec<serde_json::Value> = signals
+        .iter()
+        .flat_map(|(n, f)| {
+            f.bands.iter().filter_map(move |b| {
+                b.peak.map(|p| {
+                    serde_json::json!({
+                        "signal": n,
+                        "band": b.spec.name,
+                        "freq_hz": p.freq_hz,
+                        "psd_m2_per_hz": p.level,
+                        "prominence": if p.prominence.is_finite() { Some(p.prominence) } else { None },
+                    })
+                })
+            })
+        })
+        .collect();
+    let path = dir.join("peaks.json");
+    let text = serde_json::to_string_pretty(&peaks)
+        .map_err(|e| Error::io(&path, "cannot encode", std::io::Error::other(e)))?;
+    std::fs::write(&path, text + "\n").map_err(|e| Error::io(&path, "cannot write", e))?;
+    files.push("peaks.json".into());
+    Ok(files)
+}
+
 /// Writes one CSV into `dir` from named columns of equal length (NaN written as `NaN`).
 fn write_columns(dir: &Path, name: &str, columns: &[(&str, &[f64])]) -> Result<String> {
     let path = dir.join(name);
