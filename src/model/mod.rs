@@ -4,6 +4,7 @@ pub mod belt;
 pub mod benchmarks;
 pub mod blade;
 pub mod friction;
+pub mod modes;
 pub mod necklip;
 pub mod stick_slip;
 
