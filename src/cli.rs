@@ -297,8 +297,7 @@ fn fit_and_write(
     outcome.result.data_files = crate::report::figures::fit_data_files(&report_dir, &outcome)?;
     let result_path = result_path(job);
     let toml_text = outcome.result.to_toml()?;
-    std::fs::write(&result_path, toml_text)
-        .map_err(|e| Error::io(&result_path, "cannot write", e))?;
+    crate::io::write_atomic(&result_path, toml_text.as_bytes())?;
     let freq_speed = crate::fit::instfreq::compare_freq_speed(&outcome)?;
     crate::report::figures::fit_figures(&report_dir, &outcome, freq_speed.as_ref())?;
     Ok((outcome.result, result_path, report_dir))
@@ -313,6 +312,9 @@ pub fn run(cli: Cli) -> Result<()> {
             describe,
             output,
         } => {
+            if let Some(out) = &output {
+                crate::io::refuse_overwriting_input(&file, out)?;
+            }
             let spec = import_spec(&import)?;
             let (trace, summary) = crate::import::read_trace_with_summary(&file, &spec)?;
             if describe {

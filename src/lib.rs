@@ -5,9 +5,10 @@
 //! The module tree is the pipeline; a stage uses only the stages before it (checked by
 //! `tests/architecture.rs`):
 //!
-//! Pipeline order: `error` → `trace` → `import` → `spectrum` → `model` → `simulate` → `fit` → `campaign` → `report` → `bench` → `cli`.
+//! Pipeline order: `error` → `io` → `trace` → `import` → `spectrum` → `model` → `simulate` → `fit` → `campaign` → `report` → `bench` → `cli`.
 //!
 //! * [`error`]: the crate's error type, shared by every stage.
+//! * [`io`]: atomic file writes ([`io::write_atomic`]) and the never-over-an-input check.
 //! * [`trace`]: the canonical [`trace::Trace`] (SI, y up, NaN = missing), the type every stage
 //!   downstream reads.
 //! * [`import`]: tracking-tool exports → [`trace::Trace`] (pixels and frames end here).
@@ -34,6 +35,7 @@ pub mod cli;
 pub mod error;
 pub mod fit;
 pub mod import;
+pub mod io;
 pub mod model;
 pub mod report;
 pub mod simulate;

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 /// The pipeline, upstream first. `error` is the shared error type; `lib` and `main` are the crate
 /// roots and may name anything.
 const STAGES: &[&str] = &[
-    "error", "trace", "import", "spectrum", "model", "simulate", "fit", "campaign", "report",
+    "error", "io", "trace", "import", "spectrum", "model", "simulate", "fit", "campaign", "report",
     "bench", "cli",
 ];
 

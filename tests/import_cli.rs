@@ -191,3 +191,30 @@ fn tracker_resampling_is_reported() {
         "{out}"
     );
 }
+
+/// `import X -o X` (also spelled through another path) is refused with exit code 2 before anything
+/// is written: the export is left as it was.
+#[test]
+fn import_never_writes_over_its_input() {
+    let content = "track,frame_idx,head.x,head.y\nm,0,10,20\nm,1,11,21\n";
+    let f = TempFile::with("overwrite_sleap.csv", content);
+    let path = f.0.to_str().unwrap();
+    let dir = f.0.parent().unwrap();
+    let other_spelling = dir.join(".").join(f.0.file_name().unwrap());
+    for out in [path, other_spelling.to_str().unwrap()] {
+        let o = wiperlab(&[
+            "import",
+            path,
+            "-o",
+            out,
+            "--fps",
+            "50",
+            "--m-per-px",
+            "0.001",
+        ]);
+        let (stdout, err) = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{stdout}{err}");
+        assert!(err.contains("is the input file"), "{err}");
+        assert_eq!(std::fs::read_to_string(&f.0).unwrap(), content);
+    }
+}

@@ -432,17 +432,24 @@ pub fn event_order_rows() -> Result<Vec<BenchRow>> {
     Ok(rows)
 }
 
-/// Writes `work_precision.csv` and the figures into `dir`.
-pub fn write_reports(dir: &Path, rows: &[BenchRow]) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "create directory", e))?;
-    let path = dir.join("work_precision.csv");
-    let mut w = csv::Writer::from_path(&path)
-        .map_err(|e| Error::Numerics(format!("{}: {e}", path.display())))?;
+/// Writes `rows` as a CSV file at `path` (atomically, through [`crate::io::write_atomic`]).
+fn write_csv_rows<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<()> {
+    let mut w = csv::Writer::from_writer(Vec::new());
     for r in rows {
         w.serialize(r)
             .map_err(|e| Error::Numerics(format!("{}: {e}", path.display())))?;
     }
-    w.flush().map_err(|e| Error::io(&path, "write CSV", e))?;
+    let bytes = w
+        .into_inner()
+        .map_err(|e| Error::io(path, "write CSV", e.into_error()))?;
+    crate::io::write_atomic(path, &bytes)
+}
+
+/// Writes `work_precision.csv` and the figures into `dir`.
+pub fn write_reports(dir: &Path, rows: &[BenchRow]) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "create directory", e))?;
+    let path = dir.join("work_precision.csv");
+    write_csv_rows(&path, rows)?;
 
     let mut keys: Vec<(String, String)> = Vec::new();
     for r in rows {
@@ -591,13 +598,7 @@ pub fn write_spectra(
 ) -> Result<Option<f64>> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "create directory", e))?;
     let path = dir.join("spectra_vs_rtol.csv");
-    let mut w = csv::Writer::from_path(&path)
-        .map_err(|e| Error::Numerics(format!("{}: {e}", path.display())))?;
-    for r in rows {
-        w.serialize(r)
-            .map_err(|e| Error::Numerics(format!("{}: {e}", path.display())))?;
-    }
-    w.flush().map_err(|e| Error::io(&path, "write CSV", e))?;
+    write_csv_rows(&path, rows)?;
     let mut names: Vec<&str> = Vec::new();
     for r in rows {
         if !names.contains(&r.blade.as_str()) {

@@ -1,9 +1,10 @@
 //! Collecting a campaign: one row per recording with its conditions, fitted values and intervals,
 //! peaks, chosen model, cost, failures and wall time, written as `campaign.csv`.
 
-use super::run::{EntryPaths, State, read_status, write_atomic};
+use super::run::{EntryPaths, State, read_status};
 use super::{Campaign, Override};
 use crate::fit::result::FitResult;
+use crate::io::write_atomic;
 use crate::model::{BladeParams, FrictionLaw};
 use crate::{Error, Result};
 use std::path::PathBuf;
@@ -244,6 +245,7 @@ pub fn to_csv(t: &Table) -> Result<String> {
 /// Those of [`gather`] and [`to_csv`]; [`Error::Io`] when the file cannot be written.
 pub fn collect(campaign: &Campaign) -> Result<(Table, PathBuf)> {
     let table = gather(campaign)?;
+    crate::io::create_dir(&campaign.out_dir())?;
     let path = campaign.out_dir().join("campaign.csv");
     write_atomic(&path, to_csv(&table)?.as_bytes())?;
     Ok((table, path))

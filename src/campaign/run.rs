@@ -4,6 +4,7 @@
 use super::{Campaign, Entry, Override};
 use crate::fit::job::LoadedJob;
 use crate::fit::result::sha256_hex;
+use crate::io::write_atomic;
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -152,24 +153,6 @@ fn absolutise(t: &mut toml::Table, dir: &Path, keys: &[&str]) {
     }
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same directory, renamed into place, so
-/// that a reader (or an interrupted run) never sees a half-written file.
-///
-/// # Errors
-/// [`Error::Io`] naming `path`.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    use std::io::Write as _;
-    let dir = path.parent().unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "cannot create directory", e))?;
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)
-        .map_err(|e| Error::io(dir, "cannot create a temporary file in", e))?;
-    tmp.write_all(bytes)
-        .map_err(|e| Error::io(path, "cannot write", e))?;
-    tmp.persist(path)
-        .map_err(|e| Error::io(path, "cannot rename into place", e.error))?;
-    Ok(())
-}
-
 /// The status of `entry` when its result is complete for exactly the current inputs.
 pub fn finished_status(paths: &EntryPaths, input_sha256: &str) -> Option<Status> {
     let text = std::fs::read_to_string(&paths.status).ok()?;
@@ -194,6 +177,9 @@ pub fn read_status(paths: &EntryPaths) -> Option<Status> {
 pub fn fit_entry(campaign: &Campaign, entry: &Entry) -> Result<Status> {
     let paths = EntryPaths::new(&campaign.out_dir(), entry);
     let g = generate(campaign, entry, &paths)?;
+    for f in [&paths.blade, &paths.status] {
+        crate::io::create_dir(f.parent().unwrap_or(Path::new(".")))?;
+    }
     write_atomic(&paths.blade, g.blade_text.as_bytes())?;
     write_atomic(&paths.job, g.job_text.as_bytes())?;
     let started = Instant::now();

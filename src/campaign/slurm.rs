@@ -9,7 +9,8 @@
 //! (<https://slurm.schedmd.com/job_array.html>).
 
 use super::Campaign;
-use super::run::{EntryPaths, State, read_status, write_atomic};
+use super::run::{EntryPaths, State, read_status};
+use crate::io::write_atomic;
 use crate::{Error, Result};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};

@@ -69,10 +69,9 @@ pub fn write_trace_csv(path: &Path, trace: &Trace) -> Result<()> {
         }
     }
     let order = column_order(trace);
-    let file = std::fs::File::create(path).map_err(|e| Error::io(path, "create", e))?;
     let mut w = csv::WriterBuilder::new()
         .terminator(csv::Terminator::Any(b'\n'))
-        .from_writer(std::io::BufWriter::new(file));
+        .from_writer(Vec::new());
     let mut header = vec!["t_s".to_owned()];
     for &i in &order {
         let name = &trace.points[i].name;
@@ -93,8 +92,10 @@ pub fn write_trace_csv(path: &Path, trace: &Trace) -> Result<()> {
         w.write_record(&row)
             .map_err(|e| csv_error(path, "write", e))?;
     }
-    w.flush().map_err(|e| Error::io(path, "write", e))?;
-    Ok(())
+    let bytes = w
+        .into_inner()
+        .map_err(|e| Error::io(path, "write", e.into_error()))?;
+    crate::io::write_atomic(path, &bytes)
 }
 
 /// Read a canonical trace CSV (module docs) written by [`write_trace_csv`] or by hand.

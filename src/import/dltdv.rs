@@ -308,7 +308,7 @@ pub fn write(path: &Path, trace: &Trace, spec: &ImportSpec) -> Result<()> {
         out.push_str(&row.join(","));
         out.push('\n');
     }
-    std::fs::write(path, out).map_err(|e| Error::io(path, "write", e))
+    crate::io::write_atomic(path, out.as_bytes())
 }
 
 #[cfg(test)]

@@ -185,7 +185,7 @@ pub fn write(path: &Path, points: &[(Vec<f64>, Vec<f64>)]) -> Result<()> {
         "Sparse format camera coordinates file\n{rows}\t{}\t{nnz}\n{body}",
         2 * points.len()
     );
-    std::fs::write(path, text).map_err(|e| Error::io(path, "write", e))
+    crate::io::write_atomic(path, text.as_bytes())
 }
 
 #[cfg(test)]

@@ -420,7 +420,7 @@ pub fn write(path: &Path, trace: &Trace) -> Result<()> {
         }
         out.push('\n');
     }
-    std::fs::write(path, out).map_err(|e| Error::io(path, "write", e))
+    crate::io::write_atomic(path, out.as_bytes())
 }
 
 #[cfg(test)]

@@ -280,7 +280,7 @@ pub fn write_campaign_report(
         .render_str(TEMPLATE, ctx)
         .map_err(|e| Error::Numerics(format!("campaign report template: {e}")))?;
     let path = dir.join("index.html");
-    crate::campaign::run::write_atomic(&path, html.as_bytes())?;
+    crate::io::write_atomic(&path, html.as_bytes())?;
     Ok(path)
 }
 

@@ -2,6 +2,7 @@
 //! [`super::plot`]).
 
 use super::plot::{ChartOpts, Marker, Series, heatmap, line_chart};
+use crate::Result;
 use crate::fit::features::{Features, noise_floor};
 use crate::fit::instfreq::FreqSpeedComparison;
 use crate::fit::result::HistoryPoint;
@@ -10,7 +11,6 @@ use crate::model::FrictionLaw;
 use crate::simulate::blade::BladeSimulation;
 use crate::spectrum::Spectrogram;
 use crate::spectrum::instfreq::FreqSpeedPoint;
-use crate::{Error, Result};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -80,7 +80,7 @@ pub fn write_simulation(dir: &Path, sim: &BladeSimulation) -> Result<()> {
     for t in &sim.transitions {
         let _ = writeln!(s, "{:.17e},{},{}", t.t_s, t.from, t.to);
     }
-    std::fs::write(&tpath, s).map_err(|e| Error::io(&tpath, "cannot write", e))?;
+    crate::io::write_atomic(&tpath, s.as_bytes())?;
     let rel: Vec<f64> = sim
         .v3_m
         .iter()

@@ -637,7 +637,7 @@ pub fn write_report(r: &FitResult, paths: &ReportPaths) -> Result<ReportSummary>
     let path = dir.join(INDEX);
     let html = render_html(r, &figures, &warnings, &prov)
         .map_err(|e| Error::io(&path, "cannot render", std::io::Error::other(e)))?;
-    std::fs::write(&path, html).map_err(|e| Error::io(&path, "cannot write", e))?;
+    crate::io::write_atomic(&path, html.as_bytes())?;
     Ok(ReportSummary {
         path,
         figures: figures.into_iter().map(|f| f.file).collect(),

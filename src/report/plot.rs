@@ -8,7 +8,7 @@
 //!   `viewBox`, so coordinates are not rounded to whole pixels.
 //! * [`heatmap`]: a spectrogram-style `z[x][y]` image with a viridis colour map and colour bar.
 //!
-//! Figures are rendered into memory and written with one `std::fs::write`, so a failed write is an
+//! Figures are rendered into memory and written with one `crate::io::write_atomic`, so a failed write is an
 //! [`Error::Io`] naming the path; a plotters drawing failure is an [`Error::Numerics`] naming the
 //! path, as is data with nothing plottable.
 //!
@@ -131,7 +131,7 @@ fn draw_err(path: &Path, e: impl std::fmt::Display) -> Error {
 }
 
 fn write_svg(path: &Path, svg: &str) -> Result<()> {
-    std::fs::write(path, svg).map_err(|e| Error::io(path, "write SVG figure", e))
+    crate::io::write_atomic(path, svg.as_bytes())
 }
 
 /// Maps data to the plotting plane: identity for a linear axis, `log10` for a log axis. Everything

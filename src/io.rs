@@ -1,0 +1,93 @@
+//! Writing files safely: every file wiperlab writes goes through [`write_atomic`], so a reader, a
+//! crash or an interrupt never leaves a half-written file, and an existing file is replaced only
+//! by a complete new one.
+
+use crate::{Error, Result};
+use std::path::Path;
+
+/// Writes `bytes` to `path` through a temporary file in the same directory, renamed into place
+/// (`tempfile`'s `persist`, an atomic rename on POSIX file systems). The directory must exist
+/// (see [`create_dir`]): a mistyped output path is an error, not a new directory tree.
+///
+/// # Errors
+/// [`Error::Io`] naming the directory when it does not exist or is not writable, or `path` when the
+/// file cannot be written or renamed.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    use std::io::Write as _;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::NamedTempFile::new_in(dir)
+        .map_err(|e| Error::io(dir, "cannot create a temporary file in", e))?;
+    tmp.write_all(bytes)
+        .map_err(|e| Error::io(path, "cannot write", e))?;
+    tmp.persist(path)
+        .map_err(|e| Error::io(path, "cannot rename into place", e.error))?;
+    Ok(())
+}
+
+/// Creates `dir` and its parents if missing.
+///
+/// # Errors
+/// [`Error::Io`] naming `dir`.
+pub fn create_dir(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "cannot create directory", e))
+}
+
+/// Refuses to write `output` over `input` (the same file, also through another path or a link).
+///
+/// # Errors
+/// [`Error::Config`] naming both paths when they are the same file.
+pub fn refuse_overwriting_input(input: &Path, output: &Path) -> Result<()> {
+    let same = match (std::fs::canonicalize(input), std::fs::canonicalize(output)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    if same {
+        return Err(Error::Config(format!(
+            "output {} is the input file {}: choose another output path (the input is never overwritten)",
+            output.display(),
+            input.display()
+        )));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn replaces_whole_files_and_leaves_no_temporary_behind() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("sub/out.txt");
+        assert!(
+            matches!(write_atomic(&p, b"x"), Err(Error::Io { .. })),
+            "no sub/ yet"
+        );
+        create_dir(&dir.path().join("sub")).unwrap();
+        write_atomic(&p, b"first").unwrap();
+        write_atomic(&p, b"second, longer").unwrap();
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "second, longer");
+        let names: Vec<_> = std::fs::read_dir(p.parent().unwrap()).unwrap().collect();
+        assert_eq!(names.len(), 1, "only the file itself");
+    }
+
+    #[test]
+    fn an_output_equal_to_the_input_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let a = dir.path().join("a.csv");
+        std::fs::write(&a, "x").unwrap();
+        let via_dot = dir.path().join(".").join("a.csv");
+        assert!(refuse_overwriting_input(&a, &via_dot).is_err());
+        assert!(refuse_overwriting_input(&a, &dir.path().join("b.csv")).is_ok());
+    }
+
+    #[test]
+    fn an_unwritable_place_is_an_io_error_naming_it() {
+        let e = write_atomic(Path::new("/proc/wiperlab/x.txt"), b"x").unwrap_err();
+        assert!(matches!(e, Error::Io { .. }), "{e}");
+        assert!(e.to_string().contains("/proc/wiperlab"), "{e}");
+    }
+}
