@@ -2,7 +2,6 @@
 //! [`super::plot`]).
 
 use super::plot::{ChartOpts, Marker, Series, heatmap, line_chart};
-use crate::Result;
 use crate::fit::features::{Features, noise_floor};
 use crate::fit::instfreq::FreqSpeedComparison;
 use crate::fit::result::HistoryPoint;
@@ -11,6 +10,7 @@ use crate::model::FrictionLaw;
 use crate::simulate::blade::BladeSimulation;
 use crate::spectrum::Spectrogram;
 use crate::spectrum::instfreq::FreqSpeedPoint;
+use crate::{Error, Result};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -362,7 +362,7 @@ pub fn spectrum_data_files(dir: &Path, signals: &[(String, Features)]) -> Result
     let path = dir.join("peaks.json");
     let text = serde_json::to_string_pretty(&peaks)
         .map_err(|e| Error::io(&path, "cannot encode", std::io::Error::other(e)))?;
-    std::fs::write(&path, text + "\n").map_err(|e| Error::io(&path, "cannot write", e))?;
+    crate::io::write_atomic(&path, (text + "\n").as_bytes())?;
     files.push("peaks.json".into());
     Ok(files)
 }
@@ -371,14 +371,17 @@ pub fn spectrum_data_files(dir: &Path, signals: &[(String, Features)]) -> Result
 fn write_columns(dir: &Path, name: &str, columns: &[(&str, &[f64])]) -> Result<String> {
     let path = dir.join(name);
     let fail = |e: csv::Error| Error::io(&path, "cannot write", std::io::Error::other(e));
-    let mut w = csv::Writer::from_path(&path).map_err(fail)?;
+    let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record(columns.iter().map(|c| c.0)).map_err(fail)?;
     let rows = columns.iter().map(|c| c.1.len()).min().unwrap_or(0);
     for i in 0..rows {
         w.write_record(columns.iter().map(|c| format!("{:e}", c.1[i])))
             .map_err(fail)?;
     }
-    w.flush().map_err(|e| Error::io(&path, "cannot write", e))?;
+    let bytes = w
+        .into_inner()
+        .map_err(|e| Error::io(&path, "cannot write", e.into_error()))?;
+    crate::io::write_atomic(&path, &bytes)?;
     Ok(name.to_string())
 }
 
