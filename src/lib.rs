@@ -5,9 +5,10 @@
 //! The module tree is the pipeline; a stage uses only the stages before it (checked by
 //! `tests/architecture.rs`):
 //!
-//! Pipeline order: `error` → `io` → `trace` → `import` → `spectrum` → `model` → `simulate` → `fit` → `campaign` → `report` → `bench` → `cli`.
+//! Pipeline order: `error` → `names` → `io` → `trace` → `import` → `spectrum` → `model` → `simulate` → `fit` → `campaign` → `report` → `bench` → `cli`.
 //!
 //! * [`error`]: the crate's error type, shared by every stage.
+//! * [`names`]: typed names (model kinds, parameter ids, ...), each spelled once.
 //! * [`io`]: atomic file writes ([`io::write_atomic`]) and the never-over-an-input check.
 //! * [`trace`]: the canonical [`trace::Trace`] (SI, y up, NaN = missing), the type every stage
 //!   downstream reads.
@@ -37,6 +38,7 @@ pub mod fit;
 pub mod import;
 pub mod io;
 pub mod model;
+pub mod names;
 pub mod report;
 pub mod simulate;
 pub mod spectrum;

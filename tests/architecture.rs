@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 /// The pipeline, upstream first. `error` is the shared error type; `lib` and `main` are the crate
 /// roots and may name anything.
 const STAGES: &[&str] = &[
-    "error", "io", "trace", "import", "spectrum", "model", "simulate", "fit", "campaign", "report",
-    "bench", "cli",
+    "error", "names", "io", "trace", "import", "spectrum", "model", "simulate", "fit", "campaign",
+    "report", "bench", "cli",
 ];
 
 fn rank(stage: &str) -> Option<usize> {

@@ -122,7 +122,7 @@ keys = {{ k1 = "/k1", C = "/C" }}
                 iv.hi,
                 if inside { "covers" } else { "misses" }
             );
-            *covered.entry(p.name.clone()).or_default() += usize::from(inside);
+            *covered.entry(p.name.to_string()).or_default() += usize::from(inside);
         }
     }
     std::fs::remove_dir_all(&dir).ok();

@@ -2,9 +2,10 @@
 //!
 //! Paths inside a job are relative to the job file. Example: `fits/reversal.toml`.
 
+use super::Candidate;
 use super::features::{BandSpec, SignalKind, default_bands};
 use crate::import::ImportSpec;
-use crate::model::BladeParams;
+use crate::model::{BladeParams, ParamId};
 use crate::simulate::SolverOptions;
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
@@ -174,8 +175,8 @@ impl Default for Weights {
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct FitSection {
-    /// Parameter name → `[lower, upper]` bounds. Names: see [`PARAM_NAMES`].
-    pub parameters: BTreeMap<String, [f64; 2]>,
+    /// Parameter → `[lower, upper]` bounds (see [`ParamId`] for the names).
+    pub parameters: BTreeMap<ParamId, [f64; 2]>,
     /// Particles of the global particle-swarm stage.
     #[serde(default = "d_particles")]
     pub particles: usize,
@@ -200,12 +201,12 @@ pub struct FitSection {
     pub swarm_rtol: Option<f64>,
     #[serde(default)]
     pub weights: Weights,
-    /// Models of the hierarchy to fit and compare, from [`MODEL_NAMES`], e.g. `["head1dof",
+    /// Models of the hierarchy to fit and compare ([`Candidate`]), e.g. `["head1dof",
     /// "blade2dof", "blade2dof+shoulder"]`. Empty (the default): only the smallest model that can produce every
     /// band the job asks for (see [`crate::fit::smallest_capable_model`]). With several, each is
     /// fitted and the one with the lowest Akaike criterion (cost + 2k) is reported.
     #[serde(default)]
-    pub models: Vec<String>,
+    pub models: Vec<Candidate>,
     /// Bounds of the shoulder-contact parameters freed by the `+shoulder` candidates.
     #[serde(default)]
     pub shoulder: Option<ShoulderBounds>,
@@ -250,15 +251,6 @@ pub struct ShoulderBounds {
     pub theta_c: [f64; 2],
 }
 
-/// Names of the candidate models a job may list in `[fit] models`.
-pub const MODEL_NAMES: &[&str] = &[
-    "head1dof",
-    "necklip",
-    "necklip+shoulder",
-    "blade2dof",
-    "blade2dof+shoulder",
-];
-
 fn d_particles() -> usize {
     12
 }
@@ -280,113 +272,91 @@ fn d_restarts() -> usize {
 #[serde(deny_unknown_fields)]
 pub struct TruthSection {
     pub json: PathBuf,
-    /// Parameter name → JSON pointer (RFC 6901), e.g. `A = "/params/A"`.
-    pub keys: BTreeMap<String, String>,
+    /// Parameter → JSON pointer (RFC 6901), e.g. `A = "/params/A"`.
+    pub keys: BTreeMap<ParamId, String>,
 }
 
-/// Parameters a job may free, with their field in [`BladeParams`].
-pub const PARAM_NAMES: &[(&str, &str)] = &[
-    ("A", "friction A (seed eq. 4), 1"),
-    ("B", "friction B, s/m"),
-    ("C", "friction C, 1"),
-    ("k1", "neck stiffness k1, N·m/rad"),
-    ("k0", "head spring k0, N/m"),
-    ("k2", "lip stiffness k2, N·m/rad"),
-    ("c0", "head damper c0, N·s/m"),
-    ("c1", "neck damper c1, N·m·s/rad"),
-    ("c2", "lip damper c2, N·m·s/rad"),
-    ("hd", "preload compression h_d, m"),
-    (
-        "k1c",
-        "neck stiffness touching the shoulder, N·m/rad (needs a [shoulder] in the blade)",
-    ),
-    (
-        "theta_c",
-        "shoulder contact angle, rad (needs a [shoulder] in the blade)",
-    ),
-];
-
-/// Reads parameter `name` of `p` (`None` for an unknown name).
-pub fn get_param(p: &BladeParams, name: &str) -> Option<f64> {
-    use crate::model::FrictionLaw::Exponential;
-    let (a, b, c) = match p.friction {
-        Exponential { a, b_s_per_m, c } => (a, b_s_per_m, c),
-        _ => (f64::NAN, f64::NAN, f64::NAN),
-    };
-    Some(match name {
-        "A" => a,
-        "B" => b,
-        "C" => c,
-        "k1" => p.k1_nm_per_rad,
-        "k0" => p.k0_n_per_m,
-        "k2" => p.k2_nm_per_rad,
-        "c0" => p.c0_ns_per_m,
-        "c1" => p.c1_nms_per_rad,
-        "c2" => p.c2_nms_per_rad,
-        "hd" => p.hd_m,
-        "k1c" => p.shoulder?.k1_contact_nm_per_rad,
-        "theta_c" => p.shoulder?.contact_angle_rad,
-        _ => return None,
-    })
+/// One step of a path into a TOML document: a key of a table or an index into an array.
+#[derive(Debug, Clone, Copy)]
+pub enum Key<'k> {
+    Name(&'k str),
+    Index(usize),
 }
 
-/// Sets parameter `name` of `p` (false for an unknown name).
-pub fn set_param(p: &mut BladeParams, name: &str, v: f64) -> bool {
-    use crate::model::FrictionLaw::Exponential;
-    match name {
-        "A" | "B" | "C" => {
-            if let Exponential { a, b_s_per_m, c } = &mut p.friction {
-                match name {
-                    "A" => *a = v,
-                    "B" => *b_s_per_m = v,
-                    _ => *c = v,
-                }
-            } else {
-                return false;
-            }
+/// Where the keys and values of a TOML file are, from the TOML parser's spans: validation errors
+/// found after deserialising name the line and column of the offending value.
+pub struct Spans<'t> {
+    text: &'t str,
+    doc: Option<toml::Spanned<toml::de::DeTable<'t>>>,
+}
+
+impl<'t> Spans<'t> {
+    /// Parses `text` for its spans (a document that does not parse has none: every lookup then
+    /// answers line 1, column 1; such a document never reaches validation).
+    pub fn new(text: &'t str) -> Self {
+        Spans {
+            text,
+            doc: toml::de::DeTable::parse(text).ok(),
         }
-        "k1" => p.k1_nm_per_rad = v,
-        "k0" => p.k0_n_per_m = v,
-        "k2" => p.k2_nm_per_rad = v,
-        "c0" => p.c0_ns_per_m = v,
-        "c1" => p.c1_nms_per_rad = v,
-        "c2" => p.c2_nms_per_rad = v,
-        "hd" => p.hd_m = v,
-        "k1c" | "theta_c" => match &mut p.shoulder {
-            Some(sh) if name == "k1c" => sh.k1_contact_nm_per_rad = v,
-            Some(sh) => sh.contact_angle_rad = v,
-            None => return false,
-        },
-        _ => return false,
     }
-    true
+
+    /// 1-based `(line, column)` of the value at `path` (e.g. `[Name("fit"), Name("swarm_rtol")]`);
+    /// of the deepest part of `path` present when the rest is missing.
+    pub fn at(&self, path: &[Key]) -> (usize, usize) {
+        let Some(doc) = &self.doc else {
+            return (1, 1);
+        };
+        let mut span = doc.span();
+        let mut value: Option<&toml::de::DeValue> = None;
+        let mut table = Some(doc.get_ref());
+        for key in path {
+            let next = match (key, value, table) {
+                (Key::Name(n), _, Some(t)) => t
+                    .iter()
+                    .find(|(k, _)| k.get_ref().as_ref() == *n)
+                    .map(|(_, v)| v),
+                (Key::Index(i), Some(toml::de::DeValue::Array(a)), _) => a.get(*i),
+                _ => None,
+            };
+            let Some(next) = next else { break };
+            span = next.span();
+            value = Some(next.get_ref());
+            table = match next.get_ref() {
+                toml::de::DeValue::Table(t) => Some(t),
+                _ => None,
+            };
+        }
+        line_col(self.text, span.start)
+    }
+
+    /// [`Error::Parse`] in `path` at the value at `key_path`.
+    pub fn error(&self, path: &Path, key_path: &[Key], message: impl Into<String>) -> Error {
+        let (line, column) = self.at(key_path);
+        Error::parse(path, line, column, message)
+    }
 }
 
-/// 1-based line of the first occurrence of `needle` in `text` (0 if absent).
-pub(crate) fn line_of(text: &str, needle: &str) -> usize {
-    text.find(needle)
-        .map(|i| text[..i].matches('\n').count() + 1)
+/// 1-based line and column (in characters) of byte offset `at` of `text`.
+fn line_col(text: &str, at: usize) -> (usize, usize) {
+    let before = &text[..at.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let col = before
+        .rsplit('\n')
+        .next()
+        .map(|s| s.chars().count())
         .unwrap_or(0)
+        + 1;
+    (line, col)
 }
 
 /// Parses TOML `text` from `path` into `T`, turning syntax and schema errors into
 /// [`Error::Parse`] with line and column.
 pub fn parse_toml<T: serde::de::DeserializeOwned>(path: &Path, text: &str) -> Result<T> {
     toml::from_str(text).map_err(|e| {
-        let (line, col) = match e.span() {
-            Some(sp) => {
-                let before = &text[..sp.start.min(text.len())];
-                let line = before.matches('\n').count() + 1;
-                let col = before
-                    .rsplit('\n')
-                    .next()
-                    .map(|s| s.chars().count())
-                    .unwrap_or(0)
-                    + 1;
-                (line, col)
-            }
-            None => (0, 0),
-        };
+        let (line, col) = e
+            .span()
+            .map(|sp| line_col(text, sp.start))
+            .unwrap_or((0, 0));
         Error::parse(path, line, col, e.message().to_string())
     })
 }
@@ -404,21 +374,23 @@ pub struct LoadedJob {
     pub path: PathBuf,
     pub recording_path: PathBuf,
     pub blade: BladeParams,
-    /// Freed parameters in a fixed order: (name, lower, upper).
-    pub free: Vec<(String, f64, f64)>,
+    /// Freed parameters in a fixed order: (parameter, lower, upper).
+    pub free: Vec<(ParamId, f64, f64)>,
     /// True values of freed parameters, when the job names a truth file.
-    pub truth: BTreeMap<String, f64>,
+    pub truth: BTreeMap<ParamId, f64>,
 }
 
 impl LoadedJob {
     /// Loads and validates the job at `path`.
     ///
     /// # Errors
-    /// [`Error::Io`] for unreadable files; [`Error::Parse`] (file, line, column) for TOML syntax,
-    /// unknown fields, an unknown parameter name or bounds the wrong way round.
+    /// [`Error::Io`] for unreadable files; [`Error::Parse`] (file, line, column, from the TOML
+    /// parser's spans) for TOML syntax, unknown fields, an unknown parameter or model name, bounds
+    /// the wrong way round and other invalid settings.
     pub fn load(path: &Path) -> Result<LoadedJob> {
         let text = read_text(path)?;
         let job: FitJob = parse_toml(path, &text)?;
+        let spans = Spans::new(&text);
         let dir = path.parent().unwrap_or(Path::new("."));
         let name = job.name.clone().unwrap_or_else(|| {
             path.file_stem()
@@ -429,221 +401,18 @@ impl LoadedJob {
         let blade_text = read_text(&blade_path)?;
         let blade: BladeParams = parse_toml(&blade_path, &blade_text)?;
         blade.validate().map_err(|m| Error::input(&blade_path, m))?;
-        let mut free = Vec::new();
-        for (pname, [lo, hi]) in &job.fit.parameters {
-            let line =
-                line_of(&text, &format!("{pname} =")).max(line_of(&text, &format!("{pname}=")));
-            if (pname == "k1c" || pname == "theta_c") && blade.shoulder.is_none() {
-                return Err(Error::parse(
-                    path,
-                    line,
-                    1,
-                    format!(
-                        "[fit.parameters]: '{pname}' is a shoulder parameter but the blade file {} has no [shoulder] section (or list \"blade2dof+shoulder\" in [fit] models with [fit.shoulder] bounds)",
-                        blade_path.display()
-                    ),
-                ));
-            }
-            if get_param(&blade, pname).is_none() {
-                return Err(Error::parse(
-                    path,
-                    line,
-                    1,
-                    format!(
-                        "[fit.parameters]: unknown parameter '{pname}' (known: {})",
-                        PARAM_NAMES
-                            .iter()
-                            .map(|(n, _)| *n)
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    ),
-                ));
-            }
-            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
-                return Err(Error::parse(
-                    path,
-                    line,
-                    1,
-                    format!(
-                        "[fit.parameters]: bounds of '{pname}' must be finite with lower < upper (got [{lo}, {hi}])"
-                    ),
-                ));
-            }
-            if *lo < 0.0 {
-                return Err(Error::parse(
-                    path,
-                    line,
-                    1,
-                    format!(
-                        "[fit.parameters]: '{pname}' is a physical magnitude; its lower bound must be >= 0 (got {lo})"
-                    ),
-                ));
-            }
-            free.push((pname.clone(), *lo, *hi));
-        }
-        if free.is_empty() {
-            return Err(Error::parse(
-                path,
-                line_of(&text, "[fit"),
-                1,
-                "[fit.parameters] frees no parameter",
-            ));
-        }
-        if job.fit.particles < 2 {
-            return Err(Error::parse(
-                path,
-                line_of(&text, "particles"),
-                1,
-                "[fit] particles must be >= 2",
-            ));
-        }
-        for m in &job.fit.models {
-            if !MODEL_NAMES.contains(&m.as_str()) {
-                return Err(Error::parse(
-                    path,
-                    line_of(&text, "models"),
-                    1,
-                    format!(
-                        "[fit] models: unknown model '{m}' (known: {})",
-                        MODEL_NAMES.join(", ")
-                    ),
-                ));
-            }
-            if m.ends_with("+shoulder") && job.fit.shoulder.is_none() {
-                return Err(Error::parse(
-                    path,
-                    line_of(&text, "models"),
-                    1,
-                    format!(
-                        "[fit] models lists \"{m}\": give its bounds in [fit.shoulder] (k1c = [lo, hi], theta_c = [lo, hi])"
-                    ),
-                ));
-            }
-        }
-        if let Some(sb) = &job.fit.shoulder {
-            for (name, [lo, hi]) in [("k1c", sb.k1c), ("theta_c", sb.theta_c)] {
-                if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && lo < hi) {
-                    return Err(Error::parse(
-                        path,
-                        line_of(&text, "[fit.shoulder]"),
-                        1,
-                        format!("[fit.shoulder] {name}: need 0 < lower < upper (got [{lo}, {hi}])"),
-                    ));
-                }
-            }
-        }
-        match (&job.recording, &job.targets) {
-            (Some(_), None) => {}
-            (None, Some(t)) => {
-                for tp in &t.peaks {
-                    let line = line_of(&text, &format!("\"{}\"", tp.band));
-                    if !job.spectrum.bands.iter().any(|b| b.name == tp.band) {
-                        return Err(Error::parse(
-                            path,
-                            line,
-                            1,
-                            format!(
-                                "[targets] peak for band '{}', which [spectrum] does not define",
-                                tp.band
-                            ),
-                        ));
-                    }
-                    let [lo, hi] = tp.range();
-                    if tp.freq_hz.is_some() == tp.range_hz.is_some() || !(lo > 0.0 && lo <= hi) {
-                        return Err(Error::parse(
-                            path,
-                            line,
-                            1,
-                            format!(
-                                "[targets] band '{}': give exactly one of freq_hz = F or range_hz = [LO, HI] with 0 < LO <= HI",
-                                tp.band
-                            ),
-                        ));
-                    }
-                }
-                if !(t.fps_hz.is_finite() && t.fps_hz > 0.0) {
-                    return Err(Error::parse(
-                        path,
-                        line_of(&text, "fps_hz"),
-                        1,
-                        "[targets] fps_hz must be > 0",
-                    ));
-                }
-            }
-            _ => {
-                return Err(Error::parse(
-                    path,
-                    1,
-                    1,
-                    "a fit job gives either [recording] (a tracked recording) or [targets] (frequencies to reach), and exactly one of them",
-                ));
-            }
-        }
-        if !job.more_recordings.is_empty() && job.recording.is_none() {
-            return Err(Error::parse(
-                path,
-                line_of(&text, "[[more_recordings]]"),
-                1,
-                "[[more_recordings]] needs a [recording] to join (not a [targets] job)",
-            ));
-        }
-        for m in &job.more_recordings {
-            for (what, v) in [
-                ("drive_a_m", m.drive_a_m),
-                ("drive_omega_rad_per_s", m.drive_omega_rad_per_s),
-            ] {
-                if let Some(x) = v
-                    && !(x.is_finite() && x > 0.0)
-                {
-                    return Err(Error::parse(
-                        path,
-                        line_of(&text, &m.name),
-                        1,
-                        format!(
-                            "[[more_recordings]] '{}': {what} must be > 0 (got {x})",
-                            m.name
-                        ),
-                    ));
-                }
-            }
-        }
+        let check = Check {
+            path,
+            spans: &spans,
+            job: &job,
+        };
+        let free = check.parameters(&blade, &blade_path)?;
+        check.fit_settings()?;
+        check.source()?;
+        check.more_recordings()?;
         job.solver.validate()?;
-        if let Some(r) = job.fit.swarm_rtol
-            && !(r.is_finite() && r > 0.0 && r < 1.0)
-        {
-            return Err(Error::parse(
-                path,
-                line_of(&text, "swarm_rtol"),
-                1,
-                format!("[fit] swarm_rtol must be in (0, 1) (got {r})"),
-            ));
-        }
-        for b in &job.spectrum.bands {
-            if !(b.range_hz[0] >= 0.0 && b.range_hz[0] < b.range_hz[1]) || b.nperseg < 8 {
-                return Err(Error::parse(
-                    path,
-                    line_of(&text, &b.name),
-                    1,
-                    format!(
-                        "[spectrum] band '{}': need 0 <= lower < upper and nperseg >= 8 (got {:?}, nperseg {})",
-                        b.name, b.range_hz, b.nperseg
-                    ),
-                ));
-            }
-        }
-        let mut truth = BTreeMap::new();
-        if let Some(t) = &job.truth {
-            let tp = dir.join(&t.json);
-            let v: serde_json::Value = serde_json::from_str(&read_text(&tp)?).map_err(|e| {
-                Error::parse(&tp, e.line(), e.column(), format!("not valid JSON: {e}"))
-            })?;
-            for (k, ptr) in &t.keys {
-                let x = v.pointer(ptr).and_then(|x| x.as_f64()).ok_or_else(|| {
-                    Error::input(&tp, format!("no number at JSON pointer {ptr} (for '{k}')"))
-                })?;
-                truth.insert(k.clone(), x);
-            }
-        }
+        check.bands()?;
+        let truth = read_truth(dir, job.truth.as_ref())?;
         Ok(LoadedJob {
             recording_path: match &job.recording {
                 Some(r) => dir.join(&r.file),
@@ -657,5 +426,261 @@ impl LoadedJob {
             free,
             truth,
         })
+    }
+}
+
+/// The validation of a parsed job, each error at its value's line and column.
+struct Check<'a> {
+    path: &'a Path,
+    spans: &'a Spans<'a>,
+    job: &'a FitJob,
+}
+
+impl Check<'_> {
+    fn error(&self, at: &[Key], message: impl Into<String>) -> Error {
+        self.spans.error(self.path, at, message)
+    }
+
+    /// The freed parameters in a fixed order, with bounds checked against the blade.
+    fn parameters(
+        &self,
+        blade: &BladeParams,
+        blade_path: &Path,
+    ) -> Result<Vec<(ParamId, f64, f64)>> {
+        let mut free = Vec::new();
+        for (&id, &[lo, hi]) in &self.job.fit.parameters {
+            let at = [
+                Key::Name("fit"),
+                Key::Name("parameters"),
+                Key::Name(id.name()),
+            ];
+            if id.is_shoulder() && blade.shoulder.is_none() {
+                return Err(self.error(
+                    &at,
+                    format!(
+                        "[fit.parameters]: '{id}' is a shoulder parameter but the blade file {} has no [shoulder] section (or list \"blade2dof+shoulder\" in [fit] models with [fit.shoulder] bounds)",
+                        blade_path.display()
+                    ),
+                ));
+            }
+            if id.get(blade).is_none() {
+                return Err(self.error(
+                    &at,
+                    format!(
+                        "[fit.parameters]: '{id}' is not a parameter of the blade's friction law (A, B, C need the exponential law)"
+                    ),
+                ));
+            }
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                return Err(self.error(
+                    &at,
+                    format!(
+                        "[fit.parameters]: bounds of '{id}' must be finite with lower < upper (got [{lo}, {hi}])"
+                    ),
+                ));
+            }
+            if lo < 0.0 {
+                return Err(self.error(
+                    &at,
+                    format!(
+                        "[fit.parameters]: '{id}' is a physical magnitude; its lower bound must be >= 0 (got {lo})"
+                    ),
+                ));
+            }
+            free.push((id, lo, hi));
+        }
+        if free.is_empty() {
+            return Err(self.error(
+                &[Key::Name("fit"), Key::Name("parameters")],
+                "[fit.parameters] frees no parameter",
+            ));
+        }
+        Ok(free)
+    }
+
+    /// Optimiser settings, candidate models and shoulder bounds.
+    fn fit_settings(&self) -> Result<()> {
+        let fit = &self.job.fit;
+        if fit.particles < 2 {
+            return Err(self.error(
+                &[Key::Name("fit"), Key::Name("particles")],
+                "[fit] particles must be >= 2",
+            ));
+        }
+        for (i, m) in fit.models.iter().enumerate() {
+            if m.shoulder && fit.shoulder.is_none() {
+                return Err(self.error(
+                    &[Key::Name("fit"), Key::Name("models"), Key::Index(i)],
+                    format!(
+                        "[fit] models lists \"{m}\": give its bounds in [fit.shoulder] (k1c = [lo, hi], theta_c = [lo, hi])"
+                    ),
+                ));
+            }
+        }
+        if let Some(sb) = &fit.shoulder {
+            for (id, [lo, hi]) in [(ParamId::K1c, sb.k1c), (ParamId::ThetaC, sb.theta_c)] {
+                if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && lo < hi) {
+                    return Err(self.error(
+                        &[
+                            Key::Name("fit"),
+                            Key::Name("shoulder"),
+                            Key::Name(id.name()),
+                        ],
+                        format!("[fit.shoulder] {id}: need 0 < lower < upper (got [{lo}, {hi}])"),
+                    ));
+                }
+            }
+        }
+        if let Some(r) = fit.swarm_rtol
+            && !(r.is_finite() && r > 0.0 && r < 1.0)
+        {
+            return Err(self.error(
+                &[Key::Name("fit"), Key::Name("swarm_rtol")],
+                format!("[fit] swarm_rtol must be in (0, 1) (got {r})"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Exactly one of `[recording]` and `[targets]`, and a target job's peaks.
+    fn source(&self) -> Result<()> {
+        let t = match (&self.job.recording, &self.job.targets) {
+            (Some(_), None) => return Ok(()),
+            (None, Some(t)) => t,
+            _ => {
+                return Err(Error::parse(
+                    self.path,
+                    1,
+                    1,
+                    "a fit job gives either [recording] (a tracked recording) or [targets] (frequencies to reach), and exactly one of them",
+                ));
+            }
+        };
+        for (i, tp) in t.peaks.iter().enumerate() {
+            let at = [Key::Name("targets"), Key::Name("peaks"), Key::Index(i)];
+            if !self.job.spectrum.bands.iter().any(|b| b.name == tp.band) {
+                return Err(self.error(
+                    &at,
+                    format!(
+                        "[targets] peak for band '{}', which [spectrum] does not define",
+                        tp.band
+                    ),
+                ));
+            }
+            let [lo, hi] = tp.range();
+            if tp.freq_hz.is_some() == tp.range_hz.is_some() || !(lo > 0.0 && lo <= hi) {
+                return Err(self.error(
+                    &at,
+                    format!(
+                        "[targets] band '{}': give exactly one of freq_hz = F or range_hz = [LO, HI] with 0 < LO <= HI",
+                        tp.band
+                    ),
+                ));
+            }
+        }
+        if !(t.fps_hz.is_finite() && t.fps_hz > 0.0) {
+            return Err(self.error(
+                &[Key::Name("targets"), Key::Name("fps_hz")],
+                "[targets] fps_hz must be > 0",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Further recordings of a joint fit.
+    fn more_recordings(&self) -> Result<()> {
+        if !self.job.more_recordings.is_empty() && self.job.recording.is_none() {
+            return Err(self.error(
+                &[Key::Name("more_recordings")],
+                "[[more_recordings]] needs a [recording] to join (not a [targets] job)",
+            ));
+        }
+        for (i, m) in self.job.more_recordings.iter().enumerate() {
+            for (what, v) in [
+                ("drive_a_m", m.drive_a_m),
+                ("drive_omega_rad_per_s", m.drive_omega_rad_per_s),
+            ] {
+                if let Some(x) = v
+                    && !(x.is_finite() && x > 0.0)
+                {
+                    return Err(self.error(
+                        &[Key::Name("more_recordings"), Key::Index(i), Key::Name(what)],
+                        format!(
+                            "[[more_recordings]] '{}': {what} must be > 0 (got {x})",
+                            m.name
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Spectral bands: ordered edges and a usable segment length.
+    fn bands(&self) -> Result<()> {
+        for (i, b) in self.job.spectrum.bands.iter().enumerate() {
+            if !(b.range_hz[0] >= 0.0 && b.range_hz[0] < b.range_hz[1]) || b.nperseg < 8 {
+                return Err(self.error(
+                    &[Key::Name("spectrum"), Key::Name("bands"), Key::Index(i)],
+                    format!(
+                        "[spectrum] band '{}': need 0 <= lower < upper and nperseg >= 8 (got {:?}, nperseg {})",
+                        b.name, b.range_hz, b.nperseg
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// True values of the freed parameters from the job's `[truth]` JSON file (empty without one).
+fn read_truth(dir: &Path, truth: Option<&TruthSection>) -> Result<BTreeMap<ParamId, f64>> {
+    let mut values = BTreeMap::new();
+    let Some(t) = truth else {
+        return Ok(values);
+    };
+    let tp = dir.join(&t.json);
+    let v: serde_json::Value = serde_json::from_str(&read_text(&tp)?)
+        .map_err(|e| Error::parse(&tp, e.line(), e.column(), format!("not valid JSON: {e}")))?;
+    for (k, ptr) in &t.keys {
+        let x = v.pointer(ptr).and_then(|x| x.as_f64()).ok_or_else(|| {
+            Error::input(&tp, format!("no number at JSON pointer {ptr} (for '{k}')"))
+        })?;
+        values.insert(*k, x);
+    }
+    Ok(values)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spans_locate_keys_tables_and_array_entries() {
+        let text = "name = \"x\"\n\n[fit]\nparticles = 1\n\n[[spectrum.bands]]\nname = \"low\"\n\n[[spectrum.bands]]\nname = \"high\"\nnperseg = 4\n";
+        let spans = Spans::new(text);
+        assert_eq!(
+            spans.at(&[Key::Name("fit"), Key::Name("particles")]),
+            (4, 13)
+        );
+        let second = [Key::Name("spectrum"), Key::Name("bands"), Key::Index(1)];
+        assert_eq!(
+            spans
+                .at(&[second[0], second[1], second[2], Key::Name("nperseg")])
+                .0,
+            11
+        );
+        // A missing key answers its deepest present ancestor.
+        assert_eq!(spans.at(&[Key::Name("fit"), Key::Name("seed")]).0, 3);
+    }
+
+    #[test]
+    fn candidates_round_trip_by_name() {
+        for c in Candidate::all() {
+            assert_eq!(c.to_string().parse::<Candidate>(), Ok(c));
+            assert_eq!(c, c.to_string().as_str());
+        }
+        let e = "head1dof+shoulder".parse::<Candidate>().unwrap_err();
+        assert!(e.to_string().contains("known: head1dof, necklip"), "{e}");
     }
 }

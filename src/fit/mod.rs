@@ -15,9 +15,13 @@ pub mod instfreq;
 pub mod job;
 pub mod result;
 
-pub use result::{FitResult, FittedParam, HistoryPoint, Interval, ModelTrial, PeakComparison};
+pub use result::{
+    FitResult, FittedParam, HistoryPoint, Interval, IntervalMethod, ModelTrial, PeakComparison,
+    SearchStage,
+};
 
 use crate::model::BladeParams;
+use crate::model::ParamId;
 use crate::model::blade::StickForm;
 use crate::simulate::SolverOptions;
 use crate::simulate::blade::{BladeSimulation, ModelKind, simulate_model};
@@ -29,7 +33,7 @@ use argmin::core::{CostFunction, Executor, KV, State};
 use argmin::solver::neldermead::NelderMead;
 use argmin::solver::particleswarm::ParticleSwarm;
 use features::{BandSpec, Features, SignalKind, features, noise_floor};
-use job::{LoadedJob, Weights, set_param};
+use job::{LoadedJob, Weights};
 use rand::SeedableRng;
 use serde::Serialize;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -39,19 +43,19 @@ use std::sync::{Arc, Mutex};
 /// are counted and the first message is reported; they are never silent.
 pub const FAILED_COST: f64 = 1e9;
 
-/// One freed parameter: name, bounds, and whether it is searched on a log scale.
+/// One freed parameter: which, bounds, and whether it is searched on a log scale.
 #[derive(Debug, Clone, Serialize)]
 pub struct FreeParam {
-    pub name: String,
+    pub name: ParamId,
     pub lower: f64,
     pub upper: f64,
     pub log: bool,
 }
 
 impl FreeParam {
-    fn new(name: &str, lower: f64, upper: f64) -> Self {
+    fn new(name: ParamId, lower: f64, upper: f64) -> Self {
         FreeParam {
-            name: name.into(),
+            name,
             lower,
             upper,
             log: lower > 0.0 && upper / lower >= 10.0,
@@ -127,7 +131,7 @@ impl SpectralProblem {
     pub fn params_at(&self, u: &[f64]) -> BladeParams {
         let mut p = self.base;
         for (fp, ui) in self.free.iter().zip(u) {
-            set_param(&mut p, &fp.name, fp.value(*ui));
+            fp.name.set(&mut p, fp.value(*ui));
         }
         p
     }
@@ -222,14 +226,14 @@ impl SpectralProblem {
 
     /// Cost at normalised coordinates, with a quadratic penalty outside the box.
     pub fn cost_at(&self, u: &[f64]) -> f64 {
-        self.cost_at_stage(u, Stage::Polish)
+        self.cost_at_stage(u, SearchStage::Polish)
     }
 
     /// [`SpectralProblem::cost_at`] with the simulations of `stage` (the swarm's may be coarser).
-    fn cost_at_stage(&self, u: &[f64], stage: Stage) -> f64 {
+    fn cost_at_stage(&self, u: &[f64], stage: SearchStage) -> f64 {
         let solver = match stage {
-            Stage::Swarm => &self.swarm_solver,
-            Stage::Polish => &self.solver,
+            SearchStage::Swarm => &self.swarm_solver,
+            SearchStage::Polish => &self.solver,
         };
         let outside: f64 = u
             .iter()
@@ -260,7 +264,7 @@ impl SpectralProblem {
 }
 
 struct HistoryObserver {
-    stage: &'static str,
+    stage: SearchStage,
     restart: usize,
     log: Arc<Mutex<Vec<HistoryPoint>>>,
     evals: Arc<AtomicUsize>,
@@ -276,7 +280,7 @@ impl<I: State<Float = f64>> Observe<I> for HistoryObserver {
             .lock()
             .unwrap_or_else(|e| e.into_inner())
             .push(HistoryPoint {
-                stage: self.stage.into(),
+                stage: self.stage,
                 restart: self.restart,
                 iteration: state.get_iter(),
                 best_cost: state.get_best_cost(),
@@ -298,17 +302,9 @@ pub struct FitOutcome {
     pub signal: SignalKind,
 }
 
-/// Which stage of the optimiser evaluates the cost: the swarm may simulate at a looser tolerance
-/// (`[fit] swarm_rtol`) than the polish and everything after it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Stage {
-    Swarm,
-    Polish,
-}
-
 /// The problem as argmin sees it in one stage: shared by the swarm's threads.
 #[derive(Clone)]
-struct Shared(Arc<SpectralProblem>, Stage);
+struct Shared(Arc<SpectralProblem>, SearchStage);
 
 impl CostFunction for Shared {
     type Param = Vec<f64>;
@@ -356,23 +352,26 @@ pub struct Candidate {
 }
 
 impl Candidate {
-    /// Parses a name of [`job::MODEL_NAMES`].
-    pub fn parse(name: &str) -> Option<Candidate> {
-        let (base, shoulder) = match name.strip_suffix("+shoulder") {
-            Some(b) => (b, true),
-            None => (name, false),
-        };
-        let kind = ModelKind::ALL.into_iter().find(|k| k.name() == base)?;
-        Some(Candidate { kind, shoulder })
+    /// Every candidate a job may list, smallest first.
+    pub fn all() -> Vec<Candidate> {
+        ModelKind::ALL
+            .iter()
+            .flat_map(|&kind| {
+                let shoulders: &[bool] = if kind.has_neck_mode() {
+                    &[false, true]
+                } else {
+                    &[false]
+                };
+                shoulders
+                    .iter()
+                    .map(move |&shoulder| Candidate { kind, shoulder })
+            })
+            .collect()
     }
 
-    /// The name used in jobs and reports.
+    /// The name used in jobs and reports: the model's name, with `+shoulder` when it has one.
     pub fn name(&self) -> String {
-        if self.shoulder {
-            format!("{}+shoulder", self.kind.name())
-        } else {
-            self.kind.name().into()
-        }
+        self.to_string()
     }
 
     /// Why this candidate cannot produce `bands` (None if it can).
@@ -400,6 +399,60 @@ impl Candidate {
                     b.name, b.range_hz[0], b.range_hz[1]
                 )
             })
+    }
+}
+
+/// Suffix of a candidate's name that adds shoulder contact.
+const SHOULDER_SUFFIX: &str = "+shoulder";
+
+impl std::fmt::Display for Candidate {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.kind.name())?;
+        if self.shoulder {
+            f.write_str(SHOULDER_SUFFIX)?;
+        }
+        Ok(())
+    }
+}
+
+impl std::str::FromStr for Candidate {
+    type Err = crate::names::UnknownName;
+    /// Parses a model name with an optional `+shoulder` (the head model has no shoulder).
+    fn from_str(name: &str) -> std::result::Result<Self, Self::Err> {
+        Candidate::all()
+            .into_iter()
+            .find(|c| *c == name)
+            .ok_or_else(|| crate::names::UnknownName {
+                kind: "model",
+                given: name.to_string(),
+                known: Candidate::all()
+                    .iter()
+                    .map(|c| c.to_string())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })
+    }
+}
+
+impl Serialize for Candidate {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for Candidate {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let s = String::deserialize(d)?;
+        s.parse().map_err(serde::de::Error::custom)
+    }
+}
+
+impl PartialEq<&str> for Candidate {
+    fn eq(&self, other: &&str) -> bool {
+        match other.strip_suffix(SHOULDER_SUFFIX) {
+            Some(base) => self.shoulder && self.kind.name() == base,
+            None => !self.shoulder && self.kind.name() == *other,
+        }
     }
 }
 
@@ -520,7 +573,7 @@ fn build_problem(
     let mut free: Vec<FreeParam> = job
         .free
         .iter()
-        .map(|(n, lo, hi)| FreeParam::new(n, *lo, *hi))
+        .map(|&(n, lo, hi)| FreeParam::new(n, lo, hi))
         .collect();
     if candidate.shoulder {
         let sb = fit.shoulder.ok_or_else(|| {
@@ -530,8 +583,12 @@ fn build_problem(
             contact_angle_rad: 0.5 * (sb.theta_c[0] + sb.theta_c[1]),
             k1_contact_nm_per_rad: 0.5 * (sb.k1c[0] + sb.k1c[1]),
         });
-        free.push(FreeParam::new("k1c", sb.k1c[0], sb.k1c[1]));
-        free.push(FreeParam::new("theta_c", sb.theta_c[0], sb.theta_c[1]));
+        free.push(FreeParam::new(ParamId::K1c, sb.k1c[0], sb.k1c[1]));
+        free.push(FreeParam::new(
+            ParamId::ThetaC,
+            sb.theta_c[0],
+            sb.theta_c[1],
+        ));
     }
     let evaluations = Arc::new(AtomicUsize::new(0));
     let build = |m: &Measurement, base: BladeParams, label: String, progress| -> Result<_> {
@@ -595,15 +652,13 @@ fn build_problem(
     Ok((main, free))
 }
 
-/// The cost problem of the candidate model named `model` (a name of [`job::MODEL_NAMES`]) on the
+/// The cost problem of the candidate `model` on the
 /// job's recording or targets, without fitting it: for evaluating the cost at given parameters
 /// ([`SpectralProblem::cost_at`], [`SpectralProblem::params_at`]).
 ///
 /// # Errors
-/// An unknown model name, and every error of reading and measuring the recording.
-pub fn problem_for(job: &LoadedJob, model: &str) -> Result<SpectralProblem> {
-    let candidate =
-        Candidate::parse(model).ok_or_else(|| Error::Config(format!("unknown model '{model}'")))?;
+/// Every error of reading and measuring the recording.
+pub fn problem_for(job: &LoadedJob, candidate: Candidate) -> Result<SpectralProblem> {
     let meas = measure(job)?;
     Ok(build_problem(job, &meas, candidate, &None)?.0)
 }
@@ -635,7 +690,11 @@ fn fit_candidate(
         let params = smaller.problem.params_at(&smaller.best_u);
         free.iter()
             .map(|fp| {
-                let source = if fp.name == "k1c" { "k1" } else { &fp.name };
+                let source = if fp.name == ParamId::K1c {
+                    ParamId::K1
+                } else {
+                    fp.name
+                };
                 // The smaller model's own coordinate where the scales agree: then the values are
                 // bitwise the same (a value → u → value round trip through ln/exp can move them by
                 // an ulp, and on this chaotic cost surface one ulp of k1 moved the main job's cost by
@@ -648,10 +707,10 @@ fn fit_candidate(
                 }) {
                     return smaller.best_u[i];
                 }
-                let v = match fp.name.as_str() {
-                    "k1c" => params.k1_nm_per_rad,
-                    "theta_c" => fp.upper,
-                    name => job::get_param(&params, name).unwrap_or(fp.lower),
+                let v = match fp.name {
+                    ParamId::K1c => params.k1_nm_per_rad,
+                    ParamId::ThetaC => fp.upper,
+                    id => id.get(&params).unwrap_or(fp.lower),
                 };
                 fp.u_of(v)
             })
@@ -714,7 +773,7 @@ fn optimise(
     let n = problem.free.len();
     let fit_err = |e: argmin::core::Error| Error::Fit(e.to_string());
     let evaluations = problem.evaluations.clone();
-    let observer = |stage: &'static str, restart: usize| {
+    let observer = |stage: SearchStage, restart: usize| {
         log.map(|(h, _, _)| HistoryObserver {
             stage,
             restart,
@@ -745,14 +804,15 @@ fn optimise(
             }
             _ => None,
         };
-        let mut ex = Executor::new(Shared(problem.clone(), Stage::Swarm), pso).configure(|s| {
-            let s = s.max_iters(fit.swarm_iterations);
-            match population {
-                Some(p) => s.population(p),
-                None => s,
-            }
-        });
-        if let Some(o) = observer("swarm", r) {
+        let mut ex =
+            Executor::new(Shared(problem.clone(), SearchStage::Swarm), pso).configure(|s| {
+                let s = s.max_iters(fit.swarm_iterations);
+                match population {
+                    Some(p) => s.population(p),
+                    None => s,
+                }
+            });
+        if let Some(o) = observer(SearchStage::Swarm, r) {
             ex = ex.add_observer(o, ObserverMode::Always);
         }
         let res = ex.run().map_err(fit_err)?;
@@ -770,7 +830,7 @@ fn optimise(
             &swarm_best,
             0.05,
             fit.polish_iterations,
-            observer("polish", r),
+            observer(SearchStage::Polish, r),
         )?;
         polish_iters += iters;
         if best.as_ref().is_none_or(|b| cost < b.1) {
@@ -805,7 +865,7 @@ fn warm_population(
     start
         .into_par_iter()
         .map(|(x, v)| {
-            let c = problem.cost_at_stage(&x, Stage::Swarm);
+            let c = problem.cost_at_stage(&x, SearchStage::Swarm);
             argmin::solver::particleswarm::Particle::new(x, c, v)
         })
         .collect()
@@ -834,7 +894,7 @@ fn polish(
     let nm = NelderMead::new(simplex)
         .with_sd_tolerance(1e-3)
         .map_err(fit_err)?;
-    let mut ex = Executor::new(Shared(problem.clone(), Stage::Polish), nm)
+    let mut ex = Executor::new(Shared(problem.clone(), SearchStage::Polish), nm)
         .configure(|s| s.max_iters(iterations));
     if let Some(o) = observer {
         ex = ex.add_observer(o, ObserverMode::Always);
@@ -1023,13 +1083,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
             shoulder: false,
         }]
     } else {
-        fit.models
-            .iter()
-            .map(|m| {
-                Candidate::parse(m)
-                    .ok_or_else(|| Error::Config(format!("[fit] models: unknown model '{m}'")))
-            })
-            .collect::<Result<_>>()?
+        fit.models.clone()
     };
     let pb = if progress {
         let mut budget = 0u64;
@@ -1145,8 +1199,8 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
                 r
             };
             ModelTrial {
-                model: f.candidate.name(),
-                parameters: f.free.iter().map(|p| p.name.clone()).collect(),
+                model: f.candidate,
+                parameters: f.free.iter().map(|p| p.name).collect(),
                 cost: f.cost,
                 wall_time_s: f.wall_time_s,
                 model_evaluations: f.problem.evaluations.load(Ordering::Relaxed),
@@ -1172,7 +1226,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
             let value = fp.value(*u);
             let truth = job.truth.get(&fp.name).copied();
             FittedParam {
-                name: fp.name.clone(),
+                name: fp.name,
                 value,
                 lower: fp.lower,
                 upper: fp.upper,
@@ -1244,10 +1298,10 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
             p.interval = Some(iv);
         }
     }
-    let undetermined: Vec<String> = parameters
+    let undetermined: Vec<ParamId> = parameters
         .iter()
         .filter(|p| !p.determined)
-        .map(|p| p.name.clone())
+        .map(|p| p.name)
         .collect();
     if let Some(pb) = &pb {
         pb.finish_and_clear();
@@ -1275,7 +1329,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         job: job.name.clone(),
         recording: job.recording_path.display().to_string(),
         wiperlab_version: env!("CARGO_PKG_VERSION").into(),
-        model: cf.candidate.name(),
+        model: cf.candidate,
         cost,
         parameters,
         peaks,
@@ -1393,16 +1447,11 @@ pub fn bootstrap_intervals(
                 lo: 2.0 * est - quantile_sorted(&v, 0.841_345),
                 hi: 2.0 * est - quantile_sorted(&v, 0.158_655),
                 level: 0.6827,
-                method: format!(
-                    "basic parametric bootstrap, {b} replicates (best-fit model + white noise σ = {} from the measured floor{}; {})",
-                    references
-                        .iter()
-                        .map(|r| format!("{:.3e}", r.sigma))
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                    if references.len() > 1 { "s of the recordings" } else { "" },
-                    if settings.full_refit { "full refit" } else { "Nelder–Mead polish from the optimum" }
-                ),
+                method: IntervalMethod::Bootstrap {
+                    replicates: b,
+                    noise_sigma_m: references.iter().map(|r| r.sigma).collect(),
+                    full_refit: settings.full_refit,
+                },
             }
         })
         .collect())
@@ -1632,7 +1681,7 @@ mod tests {
             ModelKind::Blade2dof
         );
         // The neck/lip model imposes a low band, so it cannot produce one.
-        let nl = Candidate::parse("necklip+shoulder").unwrap();
+        let nl = "necklip+shoulder".parse::<Candidate>().unwrap();
         assert!(nl.shoulder && nl.kind == ModelKind::Necklip);
         assert!(nl.cannot_produce(&[low]).is_some());
     }
@@ -1661,7 +1710,7 @@ mod tests {
             std::fs::write(&path, t).unwrap();
             LoadedJob::load(&path).unwrap()
         };
-        let p = problem_for(&load("with.toml", &with), "blade2dof").unwrap();
+        let p = problem_for(&load("with.toml", &with), "blade2dof".parse().unwrap()).unwrap();
         assert_eq!(p.solver.rtol, 1e-8);
         assert_eq!(p.swarm_solver.rtol, 1e-5);
         assert!(
@@ -1679,17 +1728,21 @@ mod tests {
         let u: Vec<f64> = p
             .free
             .iter()
-            .map(|f| f.u_of(truth.iter().find(|t| t.0 == f.name).unwrap().1))
+            .map(|f| f.u_of(truth.iter().find(|t| f.name == t.0).unwrap().1))
             .collect();
-        let (polish, swarm) = (p.cost_at(&u), p.cost_at_stage(&u, Stage::Swarm));
+        let (polish, swarm) = (p.cost_at(&u), p.cost_at_stage(&u, SearchStage::Swarm));
         assert!(polish < 1.0 && swarm < 1.0, "{polish}, {swarm}");
         assert_ne!(
             polish, swarm,
             "rtol 1e-5 and 1e-8 should not give the same cost"
         );
-        let q = problem_for(&load("without.toml", &without), "blade2dof").unwrap();
+        let q = problem_for(
+            &load("without.toml", &without),
+            "blade2dof".parse().unwrap(),
+        )
+        .unwrap();
         assert_eq!(q.swarm_solver.rtol, q.solver.rtol);
-        assert_eq!(q.cost_at(&u), q.cost_at_stage(&u, Stage::Swarm));
+        assert_eq!(q.cost_at(&u), q.cost_at_stage(&u, SearchStage::Swarm));
         std::fs::remove_dir_all(&dir).ok();
     }
 }

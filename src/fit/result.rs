@@ -4,15 +4,30 @@
 //! Every type here is `Serialize + Deserialize`. Fields added after the first release carry
 //! `#[serde(default)]`, so result files written before them still load (with the field empty).
 
+use super::Candidate;
 use super::job::{FitSection, SpectrumSection};
+use crate::model::ParamId;
+use crate::names::named_enum;
+use crate::simulate::blade::ModelKind;
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+named_enum! {
+    /// A stage of the optimiser. The swarm may simulate at a looser tolerance (`[fit] swarm_rtol`)
+    /// than the polish and everything after it.
+    pub enum SearchStage: "search stage" {
+        /// The global particle swarm.
+        Swarm => "swarm",
+        /// The Nelder–Mead polish from the swarm's best particle.
+        Polish => "polish",
+    }
+}
+
 /// Best cost after each iteration of each stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct HistoryPoint {
-    pub stage: String,
+    pub stage: SearchStage,
     /// Which of the fit's independent swarm-and-polish runs (`[fit] restarts`), from 0; 0 in
     /// results written before this field.
     #[serde(default)]
@@ -29,14 +44,65 @@ pub struct Interval {
     pub hi: f64,
     /// Coverage probability, e.g. 0.68 for a 1σ-equivalent interval.
     pub level: f64,
-    /// How it was obtained: `"profile"` (cost profile), `"bootstrap"` or `"curvature"`.
-    pub method: String,
+    /// How it was obtained.
+    pub method: IntervalMethod,
+}
+
+/// How a confidence interval was obtained.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum IntervalMethod {
+    /// Where the cost's profile crosses its threshold.
+    Profile,
+    /// Basic parametric bootstrap ([`crate::fit::bootstrap_intervals`]).
+    Bootstrap {
+        replicates: usize,
+        /// White-noise σ added to each recording (the best-fit model's signal plus this noise),
+        /// in the signal's unit, m; one per recording.
+        noise_sigma_m: Vec<f64>,
+        /// Each replicate re-ran the whole estimator (else: a Nelder–Mead polish from the optimum).
+        full_refit: bool,
+    },
+    /// From the cost's curvature at the optimum.
+    Curvature,
+}
+
+impl std::fmt::Display for IntervalMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            IntervalMethod::Profile => f.write_str("profile"),
+            IntervalMethod::Curvature => f.write_str("curvature"),
+            IntervalMethod::Bootstrap {
+                replicates,
+                noise_sigma_m,
+                full_refit,
+            } => write!(
+                f,
+                "basic parametric bootstrap, {replicates} replicates (best-fit model + white noise σ = {} from the measured floor{}; {})",
+                noise_sigma_m
+                    .iter()
+                    .map(|s| format!("{s:.3e}"))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                if noise_sigma_m.len() > 1 {
+                    "s of the recordings"
+                } else {
+                    ""
+                },
+                if *full_refit {
+                    "full refit"
+                } else {
+                    "Nelder–Mead polish from the optimum"
+                }
+            ),
+        }
+    }
 }
 
 /// A fitted parameter with its uncertainty and, for synthetic data, the truth.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FittedParam {
-    pub name: String,
+    pub name: ParamId,
     pub value: f64,
     pub lower: f64,
     pub upper: f64,
@@ -74,10 +140,10 @@ pub struct PeakComparison {
 /// model).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ModelTrial {
-    /// Model name, e.g. `"blade2dof"`.
-    pub model: String,
+    /// The model, e.g. `"blade2dof"`.
+    pub model: Candidate,
     /// Parameters freed in this trial.
-    pub parameters: Vec<String>,
+    pub parameters: Vec<ParamId>,
     /// Best cost reached (same cost function for every trial).
     pub cost: f64,
     /// Wall-clock time of the trial, s.
@@ -89,8 +155,11 @@ pub struct ModelTrial {
     pub reason: String,
 }
 
-fn default_model() -> String {
-    "blade2dof".into()
+fn default_model() -> Candidate {
+    Candidate {
+        kind: ModelKind::Blade2dof,
+        shoulder: false,
+    }
 }
 
 /// Everything a fit reports; written as `fits/<job>.result.toml` and, with `--json`, to stdout.
@@ -101,12 +170,12 @@ pub struct FitResult {
     pub wiperlab_version: String,
     /// Name of the model whose parameters are reported (default `"blade2dof"`, the 2-DOF blade).
     #[serde(default = "default_model")]
-    pub model: String,
+    pub model: Candidate,
     pub cost: f64,
     pub parameters: Vec<FittedParam>,
     pub peaks: Vec<PeakComparison>,
-    /// Names of parameters the data leave undetermined.
-    pub undetermined: Vec<String>,
+    /// Parameters the data leave undetermined.
+    pub undetermined: Vec<ParamId>,
     /// Correlation matrix of the freed parameters (row-major, order of `parameters`); NaN where the
     /// curvature matrix is not positive definite.
     pub correlation: Vec<Vec<f64>>,
@@ -221,10 +290,10 @@ mod tests {
             job: "j".into(),
             recording: "r.csv".into(),
             wiperlab_version: "0.1.0".into(),
-            model: "blade2dof".into(),
+            model: default_model(),
             cost: 1.5,
             parameters: vec![FittedParam {
-                name: "k1".into(),
+                name: ParamId::K1,
                 value: 0.03,
                 lower: 0.005,
                 upper: 0.15,
@@ -236,7 +305,7 @@ mod tests {
                     lo: 0.028,
                     hi: 0.032,
                     level: 0.68,
-                    method: "profile".into(),
+                    method: IntervalMethod::Profile,
                 }),
             }],
             peaks: vec![PeakComparison {
@@ -261,8 +330,8 @@ mod tests {
             solver_atol: 1e-10,
             transitions_in_best_model: 10,
             model_trials: vec![ModelTrial {
-                model: "head1dof".into(),
-                parameters: vec!["k0".into()],
+                model: "head1dof".parse().unwrap(),
+                parameters: vec![ParamId::K0],
                 cost: 3.0,
                 wall_time_s: 0.1,
                 model_evaluations: 5,
@@ -280,7 +349,7 @@ mod tests {
             fitted_at: Some("2026-11-22T10:00:00.5Z".parse().expect("RFC 3339 time")),
             data_files: vec!["psd_low.csv".into()],
             history: vec![HistoryPoint {
-                stage: "swarm".into(),
+                stage: SearchStage::Swarm,
                 restart: 1,
                 iteration: 0,
                 best_cost: 2.0,

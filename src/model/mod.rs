@@ -6,7 +6,9 @@ pub mod blade;
 pub mod friction;
 pub mod modes;
 pub mod necklip;
+pub mod params;
 pub mod stick_slip;
 
 pub use blade::{Blade, BladeParams, Shoulder, StickForm};
 pub use friction::FrictionLaw;
+pub use params::ParamId;

@@ -533,7 +533,7 @@ pub fn fit_summary(r: &FitResult) -> String {
         let _ = writeln!(
             s,
             "  warning: the data leave {} undetermined (flat cost in that direction; see the correlation matrix)",
-            r.undetermined.join(", ")
+            crate::names::join(&r.undetermined, ", ")
         );
     }
     if let Some(f) = &r.first_failure {

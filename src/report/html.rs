@@ -21,9 +21,11 @@
 //! `data-total`, `data-broken` = the failing `src`s separated by spaces). A reader sees it as a
 //! line at the end of the page; `tests/report_browser.rs` reads it from headless Chromium's DOM.
 
+use crate::fit::Candidate;
 use crate::fit::features::SignalKind;
-use crate::fit::job::{FitSection, PARAM_NAMES};
+use crate::fit::job::FitSection;
 use crate::fit::result::{FitResult, sha256_file};
+use crate::simulate::blade::ModelKind;
 use crate::{Error, Result};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -171,14 +173,13 @@ const FIGURE_CHECK: &str = include_str!("templates/figure_check.js");
 
 /// What a model of the hierarchy is, in words (the result stores its short name); empty for a
 /// name this page does not know.
-fn model_label(name: &str) -> &'static str {
-    match name {
-        "head1dof" => "1-DOF head on its spring",
-        "necklip" => "neck and lip",
-        "necklip+shoulder" => "neck and lip with shoulder contact",
-        "blade2dof" => "2-DOF blade",
-        "blade2dof+shoulder" => "2-DOF blade with shoulder contact",
-        _ => "",
+fn model_label(c: Candidate) -> &'static str {
+    match (c.kind, c.shoulder) {
+        (ModelKind::Head1dof, _) => "1-DOF head on its spring",
+        (ModelKind::Necklip, false) => "neck and lip",
+        (ModelKind::Necklip, true) => "neck and lip with shoulder contact",
+        (ModelKind::Blade2dof, false) => "2-DOF blade",
+        (ModelKind::Blade2dof, true) => "2-DOF blade with shoulder contact",
     }
 }
 
@@ -221,22 +222,20 @@ fn parameter_rows(r: &FitResult) -> (Vec<ParamView>, Vec<String>) {
         .iter()
         .map(|p| {
             let interval = p.interval.as_ref().map(|i| {
-                if !methods.contains(&i.method) {
-                    methods.push(i.method.clone());
+                let method = i.method.to_string();
+                if !methods.contains(&method) {
+                    methods.push(method.clone());
                 }
                 IntervalView {
                     lo: num(i.lo, 4),
                     hi: num(i.hi, 4),
                     level_pct: format!("{:.0}", 100.0 * i.level),
-                    footnote: methods.iter().position(|m| *m == i.method).unwrap_or(0) + 1,
+                    footnote: methods.iter().position(|m| *m == method).unwrap_or(0) + 1,
                 }
             });
             ParamView {
-                name: p.name.clone(),
-                meaning: PARAM_NAMES
-                    .iter()
-                    .find(|(n, _)| *n == p.name)
-                    .map_or("", |(_, m)| *m),
+                name: p.name.to_string(),
+                meaning: p.name.meaning(),
                 value: num(p.value, 5),
                 std_error: num(p.std_error, 3),
                 interval,
@@ -294,8 +293,8 @@ fn trial_rows(r: &FitResult) -> Vec<TrialView> {
     r.model_trials
         .iter()
         .map(|t| TrialView {
-            model: t.model.clone(),
-            parameters: t.parameters.join(", "),
+            model: t.model.to_string(),
+            parameters: crate::names::join(&t.parameters, ", "),
             cost: num(t.cost, 5),
             wall_time_s: num(t.wall_time_s, 3),
             model_evaluations: t.model_evaluations,
@@ -326,7 +325,7 @@ fn correlation_rows(r: &FitResult) -> Vec<CorrelationRow> {
         .iter()
         .zip(&r.correlation)
         .map(|(p, row)| CorrelationRow {
-            name: p.name.clone(),
+            name: p.name.to_string(),
             cells: row.iter().map(|c| format!("{c:+.3}")).collect(),
         })
         .collect()
@@ -387,7 +386,7 @@ struct PageView<'a> {
     figure_check: &'static str,
     job: &'a str,
     recording: &'a str,
-    model: &'a str,
+    model: String,
     model_label: &'static str,
     cost: String,
     model_evaluations: usize,
@@ -467,8 +466,8 @@ fn page_view<'a>(
         figure_check: FIGURE_CHECK,
         job: &r.job,
         recording: &r.recording,
-        model: &r.model,
-        model_label: model_label(&r.model),
+        model: r.model.to_string(),
+        model_label: model_label(r.model),
         cost: num(r.cost, 5),
         model_evaluations: r.model_evaluations,
         failed_evaluations: r.failed_evaluations,
@@ -588,7 +587,7 @@ pub fn write_report(r: &FitResult, paths: &ReportPaths) -> Result<ReportSummary>
 
     let mut warnings = r.warnings.clone();
     for p in &r.parameters {
-        if !p.determined && !warnings.iter().any(|w| w.contains(&p.name)) {
+        if !p.determined && !warnings.iter().any(|w| w.contains(p.name.name())) {
             warnings.push(format!(
                 "the data leave {} undetermined (1σ {} over a search range [{}, {}]); read its \
                  value with care and see the correlations",
@@ -665,7 +664,7 @@ mod tests {
     fn result() -> FitResult {
         use crate::fit::result::{FittedParam, Interval, PeakComparison};
         let p = |name: &str, determined: bool, interval: Option<Interval>| FittedParam {
-            name: name.into(),
+            name: name.parse().unwrap(),
             value: 0.03,
             lower: 0.005,
             upper: 0.15,
@@ -679,7 +678,7 @@ mod tests {
             job: "unit".into(),
             recording: "rec.csv".into(),
             wiperlab_version: "0.1.0".into(),
-            model: "blade2dof".into(),
+            model: "blade2dof".parse().unwrap(),
             cost: 1.5,
             parameters: vec![
                 p(
@@ -689,7 +688,7 @@ mod tests {
                         lo: 0.028,
                         hi: 0.032,
                         level: 0.68,
-                        method: "profile".into(),
+                        method: crate::fit::IntervalMethod::Profile,
                     }),
                 ),
                 p("B", false, None),
@@ -703,7 +702,7 @@ mod tests {
                 model_level: 2e-9,
                 target_range_hz: None,
             }],
-            undetermined: vec!["B".into()],
+            undetermined: vec![crate::model::ParamId::B],
             correlation: vec![vec![1.0, -0.9], vec![-0.9, 1.0]],
             swarm_iterations: 1,
             polish_iterations: 2,

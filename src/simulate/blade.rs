@@ -4,7 +4,6 @@ use super::hybrid::{Mode, ModelFault, Phase, SolverOptions, Stats, Switch, Trans
 use crate::model::blade::{Blade, BladeParams, LockedBlade, StickForm};
 use crate::trace::{PointTrack, Trace};
 use crate::{Error, Result};
-use serde::{Deserialize, Serialize};
 
 /// How far into a neck/lip segment (s) the runner looks for a state the tracks and the contact
 /// allow the model to start from.
@@ -65,39 +64,24 @@ pub fn default_window(params: &BladeParams) -> (f64, f64) {
     )
 }
 
-/// Which member of the model hierarchy to simulate.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum ModelKind {
-    /// The 1-DOF head model: neck and lip locked into one link (no neck–lip mode), the head on its
-    /// spring ([`LockedBlade`]). Explains a low band only.
-    Head1dof,
-    /// The neck/lip model on a prescribed head ([`crate::model::necklip::NeckLip`]): the head's
-    /// vertical motion is taken from the recording, so the low component is imposed, not modelled.
-    /// Explains a high band only.
-    Necklip,
-    /// The full 2-DOF head/neck/lip link model of the seed, eqs. (1)–(5) ([`Blade`]).
-    #[default]
-    Blade2dof,
+crate::names::named_enum! {
+    /// Which member of the model hierarchy to simulate.
+    #[derive(Default)]
+    pub enum ModelKind: "model" {
+        /// The 1-DOF head model: neck and lip locked into one link (no neck–lip mode), the head on its
+        /// spring ([`LockedBlade`]). Explains a low band only.
+        Head1dof => "head1dof",
+        /// The neck/lip model on a prescribed head ([`crate::model::necklip::NeckLip`]): the head's
+        /// vertical motion is taken from the recording, so the low component is imposed, not modelled.
+        /// Explains a high band only.
+        Necklip => "necklip",
+        /// The full 2-DOF head/neck/lip link model of the seed, eqs. (1)–(5) ([`Blade`]).
+        #[default]
+        Blade2dof => "blade2dof",
+    }
 }
 
 impl ModelKind {
-    /// Every kind, smallest first.
-    pub const ALL: [ModelKind; 3] = [
-        ModelKind::Head1dof,
-        ModelKind::Necklip,
-        ModelKind::Blade2dof,
-    ];
-
-    /// Name used in job files and reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            ModelKind::Head1dof => "head1dof",
-            ModelKind::Necklip => "necklip",
-            ModelKind::Blade2dof => "blade2dof",
-        }
-    }
-
     /// Degrees of freedom in slip.
     pub fn dof(self) -> usize {
         match self {
