@@ -117,7 +117,6 @@ fn cost(c: &mut Criterion) {
         evaluations: Arc::new(AtomicUsize::new(0)),
         failures: AtomicUsize::new(0),
         first_failure: Mutex::new(None),
-        progress: None,
     };
     let mut g = c.benchmark_group("fit");
     g.sample_size(10);

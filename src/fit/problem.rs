@@ -1,0 +1,267 @@
+//! The fit's cost problem: the freed parameters in normalised coordinates and everything one cost
+//! evaluation needs ([`SpectralProblem`]), as argmin sees it ([`Shared`]).
+
+use super::features::{BandSpec, Features, SignalKind, features};
+use super::instfreq;
+use super::job::Weights;
+use super::result::SearchStage;
+use crate::model::BladeParams;
+use crate::model::ParamId;
+use crate::model::blade::StickForm;
+use crate::simulate::SolverOptions;
+use crate::simulate::blade::{BladeSimulation, ModelKind, simulate_model};
+use crate::{Error, Result};
+use argmin::core::CostFunction;
+use serde::Serialize;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+
+/// Cost assigned to a parameter set whose simulation fails (contact loss, Painlevé, ...). Failures
+/// are counted and the first message is reported; they are never silent.
+pub const FAILED_COST: f64 = 1e9;
+
+/// One freed parameter: which, bounds, and whether it is searched on a log scale.
+#[derive(Debug, Clone, Serialize)]
+pub struct FreeParam {
+    pub name: ParamId,
+    pub lower: f64,
+    pub upper: f64,
+    pub log: bool,
+}
+
+impl FreeParam {
+    pub(super) fn new(name: ParamId, lower: f64, upper: f64) -> Self {
+        FreeParam {
+            name,
+            lower,
+            upper,
+            log: lower > 0.0 && upper / lower >= 10.0,
+        }
+    }
+    /// Physical value at normalised coordinate `u` (clamped to [0, 1]).
+    pub fn value(&self, u: f64) -> f64 {
+        let u = u.clamp(0.0, 1.0);
+        if self.log {
+            (self.lower.ln() + u * (self.upper / self.lower).ln()).exp()
+        } else {
+            self.lower + u * (self.upper - self.lower)
+        }
+    }
+    /// Normalised coordinate of `value` (the inverse of [`FreeParam::value`], clamped to [0, 1]).
+    pub fn u_of(&self, value: f64) -> f64 {
+        let u = if self.log {
+            (value / self.lower).ln() / (self.upper / self.lower).ln()
+        } else {
+            (value - self.lower) / (self.upper - self.lower)
+        };
+        u.clamp(0.0, 1.0)
+    }
+    /// d(value)/du at `u`.
+    pub fn slope(&self, u: f64) -> f64 {
+        if self.log {
+            self.value(u) * (self.upper / self.lower).ln()
+        } else {
+            self.upper - self.lower
+        }
+    }
+}
+
+/// Everything a cost evaluation needs; shared read-only between threads.
+pub struct SpectralProblem {
+    /// Which model of the hierarchy is simulated.
+    pub model: ModelKind,
+    /// Target ranges per band (a target job): the cost is then [`target_cost`].
+    pub targets: Option<Vec<[f64; 2]>>,
+    /// The recording's head drop, for the neck/lip model on a prescribed head.
+    pub head: Option<Arc<crate::model::necklip::PrescribedHead>>,
+    pub base: BladeParams,
+    pub free: Vec<FreeParam>,
+    pub measured: Features,
+    pub floors: Vec<f64>,
+    pub bands: Vec<BandSpec>,
+    pub signal: SignalKind,
+    pub sample_times: Vec<f64>,
+    /// NaN mask of the measured signal (model samples there are set to NaN too).
+    pub nan_mask: Vec<bool>,
+    pub fs_hz: f64,
+    pub max_fill: usize,
+    pub window: (f64, f64),
+    pub solver: SolverOptions,
+    /// The solver of the particle-swarm stage (`[fit] swarm_rtol`; else `solver`).
+    pub swarm_solver: SolverOptions,
+    pub weights: Weights,
+    /// Optional frequency-against-speed and trace-error terms (`None` when their weights are 0).
+    pub time_targets: Option<instfreq::TimeTargets>,
+    /// Further recordings fitted jointly (`[[more_recordings]]`): each is a problem of its own
+    /// (its measurement, drive and base), sharing `free`; their costs add to this one's.
+    pub others: Vec<SpectralProblem>,
+    /// Name of this problem's recording in joint fits ("" for the main one).
+    pub label: String,
+    pub evaluations: Arc<AtomicUsize>,
+    pub failures: AtomicUsize,
+    pub first_failure: Mutex<Option<String>>,
+}
+
+impl SpectralProblem {
+    /// Blade parameters at normalised coordinates `u`.
+    pub fn params_at(&self, u: &[f64]) -> BladeParams {
+        let mut p = self.base;
+        for (fp, ui) in self.free.iter().zip(u) {
+            fp.name.set(&mut p, fp.value(*ui));
+        }
+        p
+    }
+
+    /// Simulates the model at `params`, sampled at the recording's times.
+    pub fn simulate(&self, params: &BladeParams) -> Result<BladeSimulation> {
+        self.simulate_with(params, &self.solver)
+    }
+
+    /// [`SpectralProblem::simulate`] with the given solver settings.
+    fn simulate_with(
+        &self,
+        params: &BladeParams,
+        solver: &SolverOptions,
+    ) -> Result<BladeSimulation> {
+        if self.model == ModelKind::Necklip {
+            let head = self.head.as_ref().ok_or_else(|| {
+                Error::Config("the neck/lip model needs the recording's head track".into())
+            })?;
+            return crate::simulate::blade::simulate_necklip(
+                params,
+                head,
+                self.window,
+                &self.sample_times,
+                solver,
+            );
+        }
+        simulate_model(
+            self.model,
+            params,
+            self.window,
+            &self.sample_times,
+            solver,
+            StickForm::Reduced,
+        )
+    }
+
+    /// Spectral features of a simulation, through the measurement's estimator and NaN mask.
+    pub fn model_features(&self, sim: &BladeSimulation) -> Result<Features> {
+        let mut x = self.signal.extract(&sim.to_trace())?;
+        for (xi, m) in x.iter_mut().zip(&self.nan_mask) {
+            if *m {
+                *xi = f64::NAN;
+            }
+        }
+        features(&x, self.fs_hz, &self.bands, self.max_fill)
+    }
+
+    /// The cost of model features against the measurement (see the module docs).
+    pub fn cost_of(&self, model: &Features) -> f64 {
+        if let Some(t) = &self.targets {
+            return target_cost(t, model);
+        }
+        let w = &self.weights;
+        let mut total = 0.0;
+        for ((d, m), floor) in self
+            .measured
+            .bands
+            .iter()
+            .zip(&model.bands)
+            .zip(&self.floors)
+        {
+            match (d.peak, m.peak) {
+                (Some(pd), Some(pm)) => {
+                    let df = (pm.freq_hz / pd.freq_hz).ln() / 0.01;
+                    let dl = ((pm.level + floor) / pd.level).ln() / std::f64::consts::LN_2;
+                    total += w.peak * df * df + w.level * dl * dl;
+                }
+                _ => total += 100.0 * (w.peak + w.level),
+            }
+            let n = d.psd.len().min(m.psd.len()).max(1);
+            let mut s = 0.0;
+            for (pd, pm) in d.psd.iter().zip(&m.psd) {
+                let r = ((pm + floor) / pd.max(f64::MIN_POSITIVE)).ln();
+                if r.is_finite() {
+                    s += r * r;
+                }
+            }
+            total += w.shape * s / n as f64;
+        }
+        total
+    }
+
+    /// Spectral cost of a simulation plus the optional time-domain terms ([`instfreq::TimeTargets`]).
+    pub fn total_cost(&self, sim: &BladeSimulation) -> Result<f64> {
+        let spectral = self.cost_of(&self.model_features(sim)?);
+        Ok(match &self.time_targets {
+            Some(t) => spectral + t.cost(sim)?,
+            None => spectral,
+        })
+    }
+
+    /// Cost at normalised coordinates, with a quadratic penalty outside the box.
+    pub fn cost_at(&self, u: &[f64]) -> f64 {
+        self.cost_at_stage(u, SearchStage::Polish)
+    }
+
+    /// [`SpectralProblem::cost_at`] with the simulations of `stage` (the swarm's may be coarser).
+    pub(super) fn cost_at_stage(&self, u: &[f64], stage: SearchStage) -> f64 {
+        let solver = match stage {
+            SearchStage::Swarm => &self.swarm_solver,
+            SearchStage::Polish => &self.solver,
+        };
+        let outside: f64 = u
+            .iter()
+            .map(|x| (x - x.clamp(0.0, 1.0)).powi(2))
+            .sum::<f64>();
+        let p = self.params_at(u);
+        self.evaluations.fetch_add(1, Ordering::Relaxed);
+        let c = match self
+            .simulate_with(&p, solver)
+            .and_then(|s| self.total_cost(&s))
+        {
+            Ok(c) => c,
+            Err(e) => {
+                self.failures.fetch_add(1, Ordering::Relaxed);
+                let mut g = self.first_failure.lock().unwrap_or_else(|e| e.into_inner());
+                if g.is_none() {
+                    *g = Some(e.to_string());
+                }
+                FAILED_COST
+            }
+        };
+        let joint: f64 = self.others.iter().map(|o| o.cost_at_stage(u, stage)).sum();
+        c + joint + 1e4 * outside
+    }
+}
+
+/// The problem as argmin sees it in one stage: shared by the swarm's threads.
+#[derive(Clone)]
+pub(super) struct Shared(pub(super) Arc<SpectralProblem>, pub(super) SearchStage);
+
+impl CostFunction for Shared {
+    type Param = Vec<f64>;
+    type Output = f64;
+    fn cost(&self, u: &Self::Param) -> std::result::Result<f64, argmin::core::Error> {
+        Ok(self.0.cost_at_stage(u, self.1))
+    }
+}
+
+/// Cost of a target job: per band, `(ln f_m/f_edge / 0.01)²` when the model's peak `f_m` lies outside
+/// the target range (`f_edge` the nearest edge; 0 inside), 100 when the model has no peak in the band.
+pub fn target_cost(targets: &[[f64; 2]], model: &Features) -> f64 {
+    targets
+        .iter()
+        .zip(&model.bands)
+        .map(|(r, b)| match b.peak {
+            Some(p) => {
+                let f = p.freq_hz;
+                let edge = f.clamp(r[0], r[1]);
+                let d = (f / edge).ln() / 0.01;
+                d * d
+            }
+            None => 1e4,
+        })
+        .sum()
+}
