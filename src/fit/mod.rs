@@ -11,7 +11,8 @@
 //! coordinates `u ∈ [0, 1]` (logarithmic for bounds spanning a factor ≥ 10).
 
 mod candidate;
-pub mod features;
+/// The spectral features the fit compares (they belong to the spectrum stage).
+pub use crate::spectrum::features;
 pub mod instfreq;
 pub mod job;
 mod measure;

@@ -21,6 +21,7 @@
 //! References: P.D. Welch, IEEE Trans. Audio Electroacoust. 15(2):70–73, 1967; SciPy
 //! `scipy.signal.welch` (1.17); J.O. Smith, *Spectral Audio Signal Processing*, CCRMA.
 
+pub mod features;
 pub mod instfreq;
 pub mod peaks;
 pub mod resample;
@@ -30,10 +31,10 @@ pub mod welch;
 pub mod window;
 
 pub use peaks::{Peak, find_peak, parabolic_vertex, top_peaks};
-pub use resample::{median_rate_hz, resample_uniform};
+pub use resample::{UniformSignals, median_rate_hz, resample_uniform, uniform_signals};
 pub use stft::{Spectrogram, spectrogram};
 pub use welch::{
-    Average, Detrend, GapReport, Psd, Scaling, WelchConfig, WelchPlan, median_bias, welch,
-    welch_gappy,
+    Average, Detrend, GapReport, Psd, Scaling, WelchConfig, WelchPlan, default_nperseg,
+    median_bias, welch, welch_gappy,
 };
 pub use window::{Window, WindowSums, hann_periodic, hann_symmetric};

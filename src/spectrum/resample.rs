@@ -130,3 +130,51 @@ mod tests {
         assert!(resample_uniform(&t, &x, 0.0).is_err());
     }
 }
+
+/// Every coordinate of a trace on one uniform time grid, ready for Welch.
+#[derive(Debug, Clone)]
+pub struct UniformSignals {
+    /// Sampling rate of the grid, Hz: the median frame rate of the trace.
+    pub fs_hz: f64,
+    /// False when the frame times were uniform already (within 1e-6 of a step) and the samples
+    /// are the trace's own; true when they were linearly interpolated onto the grid.
+    pub resampled: bool,
+    /// `(<point>_x | <point>_y | tip_rel_x, samples)`, in m, NaN where missing.
+    pub signals: Vec<(String, Vec<f64>)>,
+}
+
+/// Every tracked coordinate of `trace` (and the tip relative to the head, when both are tracked)
+/// on a uniform grid at the median frame rate. Frame-indexed files (t = frame/fps) are uniform
+/// already: resampling them would only smear each NaN over its neighbours through the rounding of
+/// the grid, so their samples are taken as they are.
+///
+/// # Errors
+/// As [`resample_uniform`].
+pub fn uniform_signals(trace: &crate::trace::Trace) -> Result<UniformSignals> {
+    let fs = median_rate_hz(&trace.t_s);
+    let t0 = trace.t_s.first().copied().unwrap_or(0.0);
+    let already_uniform = trace
+        .t_s
+        .iter()
+        .enumerate()
+        .all(|(k, t)| (t - (t0 + k as f64 / fs)).abs() <= 1e-6 / fs);
+    let uniform = |x: &[f64]| -> Result<Vec<f64>> {
+        if already_uniform {
+            return Ok(x.to_vec());
+        }
+        Ok(resample_uniform(&trace.t_s, x, fs)?.1)
+    };
+    let mut signals = Vec::new();
+    for p in &trace.points {
+        signals.push((format!("{}_x", p.name), uniform(&p.x_m)?));
+        signals.push((format!("{}_y", p.name), uniform(&p.y_m)?));
+    }
+    if let Ok(x) = super::features::SignalKind::TipRelX.extract(trace) {
+        signals.push(("tip_rel_x".into(), uniform(&x)?));
+    }
+    Ok(UniformSignals {
+        fs_hz: fs,
+        resampled: !already_uniform,
+        signals,
+    })
+}

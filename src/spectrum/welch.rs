@@ -645,6 +645,16 @@ pub(crate) fn check_fs(fs_hz: f64) -> Result<()> {
     }
 }
 
+/// The default Welch segment length for `n` samples: the largest power of two (at least 8) that
+/// leaves at least four segments, `nperseg ≤ n/4` (with 50 % overlap, seven averaged segments).
+pub fn default_nperseg(n: usize) -> usize {
+    let mut p = 8usize;
+    while p * 2 <= n / 4 {
+        p *= 2;
+    }
+    p
+}
+
 /// Welch PSD of the uniformly sampled `x` at `fs_hz` (Hz): `scipy.signal.welch(x, fs,
 /// window='hann', nperseg, noverlap, nfft, detrend, scaling='density', average='mean')`.
 ///

@@ -1,0 +1,93 @@
+//! `wiperlab fit` and `wiperlab report`: a fit job's result, figures and report page.
+
+use crate::fit::job::LoadedJob;
+use crate::{Error, Result};
+use std::path::{Path, PathBuf};
+
+/// Fits the job, writes the result and figures, and prints the summary (or the JSON result).
+pub(super) fn fit(job: &Path, json: bool, quiet: bool) -> Result<()> {
+    let loaded = LoadedJob::load(job)?;
+    let (result, result_path, report_dir) = fit_and_write(&loaded, !quiet && !json)?;
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string(&result).map_err(|e| Error::Numerics(e.to_string()))?
+        );
+        return Ok(());
+    }
+    print!("{}", crate::report::figures::fit_summary(&result));
+    println!(
+        "wrote {} and figures in {}",
+        result_path.display(),
+        report_dir.display()
+    );
+    println!(
+        "report page: `wiperlab report {}` writes {}",
+        job.display(),
+        report_dir.join(crate::report::html::INDEX).display()
+    );
+    Ok(())
+}
+
+/// Writes the report page from the job's result, fitting first when there is none (or `refit`).
+pub(super) fn report(job: &Path, refit: bool, quiet: bool) -> Result<()> {
+    let loaded = LoadedJob::load(job)?;
+    let result_path = result_path(&loaded);
+    let report_dir = report_dir(&loaded);
+    let result = if refit || !result_path.exists() {
+        if !refit {
+            eprintln!("{} not found: running the fit first", result_path.display());
+        }
+        fit_and_write(&loaded, !quiet)?.0
+    } else {
+        crate::fit::FitResult::read(&result_path)?
+    };
+    let summary = crate::report::html::write_report(
+        &result,
+        &crate::report::html::ReportPaths {
+            job: job.to_path_buf(),
+            result: result_path,
+            recording: loaded.recording_path.clone(),
+            dir: report_dir,
+        },
+    )?;
+    for w in &summary.warnings {
+        eprintln!("warning: {w}");
+    }
+    println!(
+        "wrote {} ({} figures); open it in a browser",
+        summary.path.display(),
+        summary.figures.len()
+    );
+    Ok(())
+}
+
+/// `<job dir>/<name>.result.toml`.
+fn result_path(job: &LoadedJob) -> PathBuf {
+    job.path
+        .parent()
+        .unwrap_or(Path::new("."))
+        .join(format!("{}.result.toml", job.name))
+}
+
+/// `reports/<name>/` (relative to the working directory).
+fn report_dir(job: &LoadedJob) -> PathBuf {
+    Path::new("reports").join(&job.name)
+}
+
+/// Runs the fit, writes the result TOML and the fit's figures; returns the result and both paths.
+fn fit_and_write(
+    job: &LoadedJob,
+    progress: bool,
+) -> Result<(crate::fit::FitResult, PathBuf, PathBuf)> {
+    let mut outcome = crate::fit::run_fit(job, progress)?;
+    let report_dir = report_dir(job);
+    crate::io::create_dir(&report_dir)?;
+    outcome.result.data_files = crate::report::figures::fit_data_files(&report_dir, &outcome)?;
+    let result_path = result_path(job);
+    let toml_text = outcome.result.to_toml()?;
+    crate::io::write_atomic(&result_path, toml_text.as_bytes())?;
+    let freq_speed = crate::fit::instfreq::compare_freq_speed(&outcome)?;
+    crate::report::figures::fit_figures(&report_dir, &outcome, freq_speed.as_ref())?;
+    Ok((outcome.result, result_path, report_dir))
+}

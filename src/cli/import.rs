@@ -1,0 +1,106 @@
+//! `wiperlab import`: a tracking-tool export to the canonical trace CSV; and the import options
+//! that `spectrum` shares.
+
+use super::ImportArgs;
+use crate::fit::job::{parse_toml, read_text};
+use crate::import::{Format, ImportSpec};
+use crate::{Error, Result};
+use std::path::{Path, PathBuf};
+
+/// Converts `file` (or only describes it) and writes `output` (default `<stem>.trace.csv`).
+pub(super) fn run(
+    file: &Path,
+    import: &ImportArgs,
+    describe: bool,
+    output: Option<PathBuf>,
+) -> Result<()> {
+    if let Some(out) = &output {
+        crate::io::refuse_overwriting_input(file, out)?;
+    }
+    let spec = import_spec(import)?;
+    let (trace, summary) = crate::import::read_trace_with_summary(file, &spec)?;
+    if describe {
+        println!("{summary}");
+        return Ok(());
+    }
+    let out = output.unwrap_or_else(|| file.with_extension("trace.csv"));
+    crate::import::canonical::write_trace_csv(&out, &trace)?;
+    eprintln!("{summary}");
+    println!("wrote {}", out.display());
+    Ok(())
+}
+
+pub(super) fn import_spec(a: &ImportArgs) -> Result<ImportSpec> {
+    let mut spec = match &a.spec {
+        Some(p) => parse_toml::<ImportSpec>(p, &read_text(p)?)?,
+        None => ImportSpec::default(),
+    };
+    if let Some(f) = &a.format {
+        spec.format = Format::from_name(f);
+    }
+    if let Some(p) = &a.scale_points_px {
+        let &[x1, y1, x2, y2] = p.as_slice() else {
+            return Err(Error::Config(format!(
+                "--scale-points-px: expected X1,Y1,X2,Y2 in pixels (got {} values)",
+                p.len()
+            )));
+        };
+        spec.scale_points_px = Some([[x1, y1], [x2, y2]]);
+    }
+    if a.scale_distance_m.is_some() {
+        spec.scale_distance_m = a.scale_distance_m;
+    }
+    if a.units_to_m.is_some() {
+        spec.units_to_m = a.units_to_m;
+    }
+    if a.y_down.is_some() {
+        spec.y_down = a.y_down;
+    }
+    if a.sweep_angle_deg.is_some() {
+        spec.sweep_angle_deg = a.sweep_angle_deg;
+    }
+    if a.sweep_from_head {
+        spec.sweep_from_head = true;
+    }
+    if a.time_to_s.is_some() {
+        spec.time_to_s = a.time_to_s;
+    }
+    if a.min_likelihood.is_some() {
+        spec.min_likelihood = a.min_likelihood;
+    }
+    if let Some(c) = a.camera {
+        spec.camera = c;
+    }
+    if let Some(n) = a.n_cameras {
+        spec.n_cameras = n;
+    }
+    if a.fps.is_some() {
+        spec.fps_hz = a.fps;
+    }
+    if a.m_per_px.is_some() {
+        spec.m_per_px = a.m_per_px;
+    }
+    if let Some(o) = &a.origin_px {
+        let &[x, y] = o.as_slice() else {
+            return Err(Error::Config(format!(
+                "--origin-px: expected X,Y in pixels, e.g. 200,300 (got {} values)",
+                o.len()
+            )));
+        };
+        spec.origin_px = [x, y];
+    }
+    if let Some(h) = &a.head {
+        spec.points.insert("head".into(), h.clone());
+    }
+    if let Some(t) = &a.tip {
+        spec.points.insert("tip".into(), t.clone());
+    }
+    Ok(spec)
+}
+
+pub(super) fn read_any(file: &Path, a: &ImportArgs) -> Result<crate::trace::Trace> {
+    if a.format.as_deref() == Some("canonical") {
+        return crate::import::canonical::read_trace_csv(file);
+    }
+    crate::import::read_trace(file, &import_spec(a)?)
+}

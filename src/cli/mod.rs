@@ -1,0 +1,255 @@
+//! Command-line interface: argument parsing and dispatch only; the library does the work. Each
+//! command's glue (reading its inputs, calling the library, printing) is a module of its own.
+//!
+//! The doc comments on the argument types are clap's `--help` text, which names placeholders the
+//! way command-line help does (`<file stem>`, `reports/<job>/`); rustdoc would read them as HTML.
+#![allow(rustdoc::invalid_html_tags)]
+
+use crate::Result;
+use crate::simulate::blade::ModelKind;
+use clap::{Parser, Subcommand};
+use std::path::{Path, PathBuf};
+
+mod bench;
+mod campaign;
+mod fit;
+mod import;
+mod simulate;
+mod spectrum;
+
+pub use simulate::{BAUMGARTE_OMEGA_PER_S, StickChoice};
+pub use spectrum::BandArg;
+
+/// wiperlab: a wiper blade's tracked motion beside a stick–slip model of it.
+#[derive(Parser, Debug)]
+#[command(name = "wiperlab", version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Import options shared by `import` and `spectrum`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct ImportArgs {
+    /// Sidecar TOML with the import settings (format, fps_hz, m_per_px, origin_px, points ...).
+    #[arg(long)]
+    pub spec: Option<PathBuf>,
+    /// File layout (default: detect from the content).
+    #[arg(long, value_parser = ["dltdv", "dltdv-sparse", "tracker", "kinovea-csv", "kinovea-txt",
+        "kinovea-kinematics", "deeplabcut", "sleap", "trackmate", "generic", "canonical"])]
+    pub format: Option<String>,
+    /// Frame rate, Hz (required for DLTdv).
+    #[arg(long)]
+    pub fps: Option<f64>,
+    /// Image scale, metres per pixel (DLTdv).
+    #[arg(long)]
+    pub m_per_px: Option<f64>,
+    /// Pixel coordinates X,Y of the physical origin (DLTdv).
+    // No `num_args = 2`: clap checks num_args before splitting on the delimiter, so it would reject
+    // the documented `--origin-px 200,300`; the count is checked in `import_spec`.
+    #[arg(long, value_delimiter = ',')]
+    pub origin_px: Option<Vec<f64>>,
+    /// Scale from two image points a known distance apart: X1,Y1,X2,Y2 in pixels (with
+    /// --scale-distance-m).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    pub scale_points_px: Option<Vec<f64>>,
+    /// Distance in metres between the --scale-points-px.
+    #[arg(long)]
+    pub scale_distance_m: Option<f64>,
+    /// Metres per calibrated unit of the file (cm: 0.01; Tracker, Kinovea, TrackMate, generic).
+    #[arg(long)]
+    pub units_to_m: Option<f64>,
+    /// Whether the file's y axis points down (default: the format's convention).
+    #[arg(long)]
+    pub y_down: Option<bool>,
+    /// Rotate so x runs along the sweep: sweep direction in degrees from +x (counter-clockwise).
+    #[arg(long, allow_negative_numbers = true)]
+    pub sweep_angle_deg: Option<f64>,
+    /// Rotate so x runs along the head's own principal axis of motion (angle reported).
+    #[arg(long)]
+    pub sweep_from_head: bool,
+    /// Seconds per unit of the file's time column where the file does not say (ms: 0.001).
+    #[arg(long)]
+    pub time_to_s: Option<f64>,
+    /// DeepLabCut/SLEAP: likelihood below which a point becomes a gap (default 0.6).
+    #[arg(long)]
+    pub min_likelihood: Option<f64>,
+    /// DLTdv: 1-based camera to read; DLTdv sparse: --n-cameras gives how many there are.
+    #[arg(long)]
+    pub camera: Option<usize>,
+    /// DLTdv sparse: number of cameras in the file (default 1).
+    #[arg(long)]
+    pub n_cameras: Option<usize>,
+    /// Name of the tracked point that is the head.
+    #[arg(long)]
+    pub head: Option<String>,
+    /// Name of the tracked point that is the lip tip.
+    #[arg(long)]
+    pub tip: Option<String>,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Import a tracking-tool export into the canonical trace CSV (t_s, head_x_m, head_y_m, tip_x_m, tip_y_m, ...).
+    Import {
+        file: PathBuf,
+        #[command(flatten)]
+        import: ImportArgs,
+        /// Print what the file holds (format, points, frames, time base, gaps) without converting.
+        #[arg(long)]
+        describe: bool,
+        /// Output CSV (default: <file stem>.trace.csv beside the input).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// Welch PSD, peaks and spectrogram of every tracked coordinate (and tip − head).
+    Spectrum {
+        file: PathBuf,
+        #[command(flatten)]
+        import: ImportArgs,
+        /// Welch segment length (samples); default: the largest power of two ≤ len/4.
+        #[arg(long)]
+        nperseg: Option<usize>,
+        /// Band LO:HI in Hz to pick a peak in (repeatable); default: the whole spectrum above 2 bins.
+        #[arg(long)]
+        band: Vec<BandArg>,
+        /// Directory for the SVG figures (default: reports/spectrum/<file stem>).
+        #[arg(long)]
+        out_dir: Option<PathBuf>,
+        /// Longest gap (samples) filled by linear interpolation; longer gaps split the record
+        /// into separate Welch runs.
+        #[arg(long, default_value_t = crate::import::FILL_MAX_SAMPLES)]
+        max_fill: usize,
+    },
+    /// Simulate the blade model over its reversal window.
+    Simulate {
+        /// Blade parameter TOML (see data/reversal/blade_true.toml).
+        params: PathBuf,
+        /// Window T0,T1 in s on the model clock (default: fastest forward to fastest backward).
+        // No `num_args = 2` (see `origin_px`); the count is checked in `run`.
+        #[arg(long, value_delimiter = ',')]
+        window: Option<Vec<f64>>,
+        /// Output sampling rate, Hz.
+        #[arg(long, default_value_t = 10000.0)]
+        fps: f64,
+        #[arg(long, default_value_t = 1e-10)]
+        rtol: f64,
+        #[arg(long, default_value_t = 1e-12)]
+        atol: f64,
+        /// Stick-phase form: reduced (drift-free) or baumgarte.
+        #[arg(long, value_enum, default_value_t = StickChoice::Reduced)]
+        stick: StickChoice,
+        /// Model of the hierarchy: blade2dof (full head/neck/lip) or head1dof (neck and lip locked;
+        /// necklip needs a recorded head and runs only inside a fit).
+        #[arg(long, value_enum, default_value_t = ModelKind::Blade2dof)]
+        model: ModelKind,
+        /// Output directory (default: reports/simulate/<params stem>).
+        #[arg(long)]
+        out_dir: Option<PathBuf>,
+    },
+    /// Fit friction (A, B, C) and neck stiffness to a recording's spectra.
+    Fit {
+        job: PathBuf,
+        /// Print the result as one JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Write the report page reports/<job>/index.html from fits/<job>.result.toml (fitting first
+    /// if the result is missing).
+    Report {
+        job: PathBuf,
+        /// Run the fit again even if the result file exists.
+        #[arg(long)]
+        refit: bool,
+        /// No progress bar when fitting.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Campaigns: one fit job over many recordings, locally or as a Slurm job array.
+    Campaign {
+        #[command(subcommand)]
+        action: campaign::CampaignCommand,
+    },
+    /// Work–precision of the simulation methods (event-driven, Moreau–Jean, smoothed friction) on
+    /// the belt benchmark and the blade; writes work_precision.csv and SVG figures.
+    Bench {
+        /// Fewer settings and shorter timing loops (about 10 s instead of 20 s).
+        #[arg(long)]
+        quick: bool,
+        /// Blade parameter TOMLs, comma-separated: the first is used for the work–precision problems,
+        /// all of them for the spectra-against-tolerance study.
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "data/reversal/blade_true.toml,data/reversal/blade.toml"
+        )]
+        blade: Vec<PathBuf>,
+        /// Output directory.
+        #[arg(long, default_value = "reports/bench")]
+        out_dir: PathBuf,
+    },
+}
+
+/// `<file stem>` of `p` (default `out`), for default output directories.
+fn stem(p: &Path) -> String {
+    p.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into())
+}
+
+/// Runs the parsed command.
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Import {
+            file,
+            import,
+            describe,
+            output,
+        } => import::run(&file, &import, describe, output),
+        Command::Spectrum {
+            file,
+            import,
+            nperseg,
+            band,
+            out_dir,
+            max_fill,
+        } => spectrum::run(spectrum::SpectrumArgs {
+            file,
+            import,
+            nperseg,
+            band,
+            out_dir,
+            max_fill,
+        }),
+        Command::Simulate {
+            params,
+            window,
+            fps,
+            rtol,
+            atol,
+            stick,
+            model,
+            out_dir,
+        } => simulate::run(simulate::SimulateArgs {
+            params,
+            window,
+            fps,
+            rtol,
+            atol,
+            stick,
+            model,
+            out_dir,
+        }),
+        Command::Bench {
+            quick,
+            blade,
+            out_dir,
+        } => bench::run(quick, &blade, &out_dir),
+        Command::Campaign { action } => campaign::run(action),
+        Command::Fit { job, json, quiet } => fit::fit(&job, json, quiet),
+        Command::Report { job, refit, quiet } => fit::report(&job, refit, quiet),
+    }
+}

@@ -1,0 +1,138 @@
+//! `wiperlab spectrum`: Welch PSD, peaks and spectrogram of every tracked coordinate.
+
+use super::ImportArgs;
+use crate::Result;
+use crate::spectrum::features::{BandSpec, features};
+use std::path::{Path, PathBuf};
+
+/// A `--band LO:HI` in Hz, as given.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BandArg {
+    /// The text given, used as the band's name.
+    pub text: String,
+    pub range_hz: [f64; 2],
+}
+
+impl std::str::FromStr for BandArg {
+    type Err = String;
+    fn from_str(text: &str) -> std::result::Result<Self, String> {
+        let (lo, hi) = text
+            .split_once(':')
+            .and_then(|(l, h)| Some((l.parse::<f64>().ok()?, h.parse::<f64>().ok()?)))
+            .ok_or_else(|| "expected LO:HI in Hz, e.g. 30:300".to_string())?;
+        Ok(BandArg {
+            text: text.to_string(),
+            range_hz: [lo, hi],
+        })
+    }
+}
+
+/// The `spectrum` command's settings.
+pub(super) struct SpectrumArgs {
+    pub file: PathBuf,
+    pub import: ImportArgs,
+    pub nperseg: Option<usize>,
+    pub band: Vec<BandArg>,
+    pub out_dir: Option<PathBuf>,
+    pub max_fill: usize,
+}
+
+/// Reads the file, prints each signal's peaks per band and writes the figures, psd.csv and
+/// peaks.json.
+pub(super) fn run(a: SpectrumArgs) -> Result<()> {
+    let trace = super::import::read_any(&a.file, &a.import)?;
+    let uniform = crate::spectrum::uniform_signals(&trace)?;
+    let fs = uniform.fs_hz;
+    let n = uniform.signals.first().map(|s| s.1.len()).unwrap_or(0);
+    let nperseg = a
+        .nperseg
+        .unwrap_or_else(|| crate::spectrum::default_nperseg(n));
+    let mut bands: Vec<BandSpec> = a
+        .band
+        .iter()
+        .map(|b| BandSpec {
+            name: b.text.clone(),
+            range_hz: b.range_hz,
+            nperseg,
+        })
+        .collect();
+    if bands.is_empty() {
+        bands.push(BandSpec {
+            name: "all".into(),
+            range_hz: [2.0 * fs / nperseg as f64, fs / 2.0],
+            nperseg,
+        });
+    }
+    let dir = a
+        .out_dir
+        .unwrap_or_else(|| Path::new("reports/spectrum").join(super::stem(&a.file)));
+    crate::io::create_dir(&dir)?;
+    println!(
+        "{}: {} samples at {:.6} Hz (median frame rate), Welch nperseg {nperseg} (Hann, 50 % overlap), bin {:.4} Hz",
+        a.file.display(),
+        n,
+        fs,
+        fs / nperseg as f64
+    );
+    print_grid(&trace, &uniform, n, a.max_fill);
+    let mut computed = Vec::new();
+    for (name, x) in &uniform.signals {
+        let f = match features(x, fs, &bands, a.max_fill) {
+            Ok(f) => f,
+            Err(e) => {
+                println!("  {name:>12}: skipped: {e}");
+                continue;
+            }
+        };
+        print_peaks(name, x, &f);
+        let sg = crate::spectrum::stft::overview_spectrogram(x, fs)?;
+        crate::report::figures::spectrum_figures(&dir, name, &f, sg.as_ref())?;
+        computed.push((name.to_string(), f));
+    }
+    crate::report::figures::spectrum_data_files(&dir, &computed)?;
+    println!("figures in {}", dir.display());
+    println!("psd.csv and peaks.json in {}", dir.display());
+    Ok(())
+}
+
+/// Says whether the samples were resampled onto the grid and how gaps are treated.
+fn print_grid(
+    trace: &crate::trace::Trace,
+    uniform: &crate::spectrum::UniformSignals,
+    n: usize,
+    max_fill: usize,
+) {
+    let summary = crate::import::describe(trace);
+    if uniform.resampled {
+        println!(
+            "  resampled: {} frame times (step {} … {} s) → {n} uniform samples at \
+             {:.6} Hz by linear interpolation; gaps ≤ {max_fill} samples filled, longer \
+             ones split the record",
+            summary.n_frames, summary.dt_min_s, summary.dt_max_s, uniform.fs_hz
+        );
+    } else {
+        println!(
+            "  not resampled: the {} frame times are uniform (within 1e-6 of a step); \
+             gaps ≤ {max_fill} samples filled, longer ones split the record",
+            summary.n_frames
+        );
+    }
+}
+
+/// One signal's missing samples and its peak per band.
+fn print_peaks(name: &str, x: &[f64], f: &crate::spectrum::features::Features) {
+    let nan = x.iter().filter(|v| v.is_nan()).count();
+    println!("  {name:>12}: {nan} missing samples, {} filled", f.filled);
+    for b in &f.bands {
+        match b.peak {
+            Some(p) => println!(
+                "  {name:>12} band {:>10}: peak {:.6} Hz (period {:.6} s), PSD {:.4e}",
+                b.spec.name,
+                p.freq_hz,
+                1.0 / p.freq_hz,
+                p.level
+            ),
+            None => println!("  {name:>12} band {:>10}: no peak", b.spec.name),
+        }
+    }
+}
