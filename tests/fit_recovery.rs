@@ -89,5 +89,14 @@ keys = {{ C = "/C", k1 = "/k1" }}
             p.rel_error.unwrap()
         );
     }
+    // The result carries the blade's modes at the fitted parameters: one stick mode and the two
+    // slip modes at each of the window's three speeds (model::modes::WINDOW_SPEED_FRACTIONS).
+    assert_eq!(out.result.modes.len(), 7, "{:?}", out.result.warnings);
+    assert!(
+        out.result
+            .modes
+            .iter()
+            .all(|m| m.freq_hz.is_finite() && m.freq_hz > 0.0)
+    );
     std::fs::remove_dir_all(&dir).ok();
 }

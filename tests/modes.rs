@@ -105,3 +105,39 @@ fn sample_blade_modes_explain_the_lines() {
         assert!(s[1].participation.head < 0.01 && s[1].participation.neck_lip == 1.0);
     }
 }
+
+/// `wiperlab modes --json` on the shipped true blade: one stick mode and two slip modes at each of
+/// the window's three speeds; the stick mode is truth.json's f_pinned_upright_Hz (1154.0332254739806,
+/// from the independent Python implementation that made the sample).
+#[test]
+fn modes_command_prints_the_window_modes_as_json() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_wiperlab"))
+        .args(["modes", "data/reversal/blade_true.toml", "--json"])
+        .current_dir(root)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let modes: Vec<serde_json::Value> = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(modes.len(), 7);
+    let stick: Vec<_> = modes.iter().filter(|m| m["phase"] == "stick").collect();
+    assert_eq!(stick.len(), 1);
+    let f = stick[0]["freq_hz"].as_f64().unwrap();
+    assert!((f - 1154.0332254739806).abs() < 1e-5 * 1154.0, "{f}");
+    for m in modes.iter().filter(|m| m["phase"] == "slip") {
+        assert!(m["speed_m_per_s"].as_f64().unwrap() > 0.0);
+        assert!(m["participation"]["neck_lip"].as_f64().unwrap() <= 1.0);
+    }
+    // A speed the drive never reaches is an input error (exit 2) that names the flag.
+    let bad = std::process::Command::new(env!("CARGO_BIN_EXE_wiperlab"))
+        .args(["modes", "data/reversal/blade_true.toml", "--speeds", "5"])
+        .current_dir(root)
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--speeds"));
+}

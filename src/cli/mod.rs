@@ -14,6 +14,7 @@ mod bench;
 mod campaign;
 mod fit;
 mod import;
+mod modes;
 mod simulate;
 mod spectrum;
 
@@ -147,6 +148,19 @@ pub enum Command {
         #[arg(long)]
         out_dir: Option<PathBuf>,
     },
+    /// The linearised blade's modes in stick and in steady slip: frequency, damping ratio
+    /// (negative: self-excited) and which coordinates move (head, head–link, neck–lip).
+    Modes {
+        /// Blade parameter TOML (see data/reversal/blade_true.toml).
+        blade: PathBuf,
+        /// Slip speeds in m/s, comma-separated (default: 25, 50 and 100 % of the drive's peak
+        /// head speed aω).
+        #[arg(long, value_delimiter = ',')]
+        speeds: Option<Vec<f64>>,
+        /// Print the modes as a JSON array on stdout.
+        #[arg(long)]
+        json: bool,
+    },
     /// Fit friction (A, B, C) and neck stiffness to a recording's spectra.
     Fit {
         job: PathBuf,
@@ -249,6 +263,11 @@ pub fn run(cli: Cli) -> Result<()> {
             out_dir,
         } => bench::run(quick, &blade, &out_dir),
         Command::Campaign { action } => campaign::run(action),
+        Command::Modes {
+            blade,
+            speeds,
+            json,
+        } => modes::run(&blade, speeds.as_deref(), json),
         Command::Fit { job, json, quiet } => fit::fit(&job, json, quiet),
         Command::Report { job, refit, quiet } => fit::report(&job, refit, quiet),
     }

@@ -102,6 +102,13 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     }
     warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
     warnings.extend(failure_warning(&cf.problem));
+    let modes = match blade_modes(&best.params) {
+        Ok(m) => m,
+        Err(e) => {
+            warnings.push(format!("no blade modes at the fitted parameters: {e}"));
+            Vec::new()
+        }
+    };
     let result = assemble_result(
         job,
         &cf,
@@ -114,6 +121,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
             transitions: best.sim.transitions.len(),
             wall_time_s: started.elapsed().as_secs_f64(),
             input_sha256,
+            modes,
         },
     );
     Ok(FitOutcome {
@@ -274,6 +282,7 @@ struct Assembled {
     transitions: usize,
     wall_time_s: f64,
     input_sha256: String,
+    modes: Vec<crate::model::modes::BladeMode>,
 }
 
 /// The result of the chosen fit, with the job's provenance (the recording's hash and the effective
@@ -318,8 +327,17 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         fit_settings: Some(job.job.fit.clone()),
         fitted_at: Some(jiff::Timestamp::now()),
         data_files: Vec::new(),
+        modes: a.modes,
         history: cf.history.clone(),
     }
+}
+
+/// The linearised 2-DOF blade's modes at `params` (whatever candidate was fitted: the modes say
+/// which lines the full blade has at these parameters).
+fn blade_modes(
+    params: &BladeParams,
+) -> std::result::Result<Vec<crate::model::modes::BladeMode>, crate::model::modes::ModesError> {
+    crate::model::Blade::new(*params, crate::model::StickForm::Reduced).window_modes()
 }
 
 #[cfg(test)]

@@ -222,6 +222,11 @@ pub struct FitResult {
     /// `report::figures::fit_data_files` for their columns.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub data_files: Vec<String>,
+    /// The linearised 2-DOF blade's modes at the fitted parameters, in stick and in steady slip at
+    /// the window's speeds ([`crate::model::Blade::window_modes`]); empty when they could not be
+    /// computed (a warning says why) and in results written before this field.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub modes: Vec<crate::model::modes::BladeMode>,
     pub history: Vec<HistoryPoint>,
 }
 
@@ -348,6 +353,7 @@ mod tests {
             ),
             fitted_at: Some("2026-11-22T10:00:00.5Z".parse().expect("RFC 3339 time")),
             data_files: vec!["psd_low.csv".into()],
+            modes: vec![],
             history: vec![HistoryPoint {
                 stage: SearchStage::Swarm,
                 restart: 1,

@@ -38,7 +38,7 @@ pub enum ModesError {
 }
 
 /// A phase of the stick–slip cycle.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
 #[serde(tag = "phase", rename_all = "snake_case")]
 pub enum Phase {
     /// Tip held on the glass.
@@ -68,7 +68,7 @@ pub struct Mode {
 }
 
 /// How much each physical coordinate moves in a blade mode, normalised so the largest is 1.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
 pub struct Participation {
     /// Head vertical drop δu = l1 sin θ δθ + l2 sin φ δφ, as an angle δu/(l1 + l2).
     pub head: f64,
@@ -79,7 +79,7 @@ pub struct Participation {
 }
 
 /// One mode of the blade in a phase.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
 pub struct BladeMode {
     #[serde(flatten)]
     pub phase: Phase,
@@ -144,7 +144,23 @@ fn null_vector(m: &DMatrix<Complex<f64>>) -> Vec<Complex<f64>> {
     v_t.row(k).iter().map(|c| c.conj()).collect()
 }
 
+/// The slip speeds, as fractions of the drive's peak head speed `aω`, at which
+/// [`Blade::window_modes`] linearises: the reversal window runs from the fastest forward sweep
+/// through rest to the fastest backward sweep, so its slip speeds span (0, aω].
+pub const WINDOW_SPEED_FRACTIONS: [f64; 3] = [0.25, 0.5, 1.0];
+
 impl Blade {
+    /// Modes in stick and in steady slip at the window's speeds ([`WINDOW_SPEED_FRACTIONS`] of the
+    /// drive's peak head speed `aω`).
+    ///
+    /// # Errors
+    /// As [`Blade::modes`].
+    pub fn window_modes(&self) -> Result<Vec<BladeMode>, ModesError> {
+        let peak = self.params.drive_a_m * self.params.drive_omega_rad_per_s;
+        let speeds: Vec<f64> = WINDOW_SPEED_FRACTIONS.iter().map(|f| f * peak).collect();
+        self.modes(&speeds)
+    }
+
     /// Modes in stick and in steady slip at each of `speeds_m_per_s` (m/s, > 0).
     ///
     /// # Errors

@@ -289,6 +289,38 @@ struct TrialView {
     reason: String,
 }
 
+#[derive(Serialize)]
+struct ModeView {
+    phase: String,
+    freq_hz: String,
+    damping_ratio: String,
+    self_excited: bool,
+    head: String,
+    head_link: String,
+    neck_lip: String,
+}
+
+/// The blade's modes at the fitted parameters, one row per mode.
+fn mode_rows(r: &FitResult) -> Vec<ModeView> {
+    r.modes
+        .iter()
+        .map(|m| ModeView {
+            phase: match m.phase {
+                crate::model::modes::Phase::Stick => "stick".into(),
+                crate::model::modes::Phase::Slip { speed_m_per_s } => {
+                    format!("slip at {} m/s", num(speed_m_per_s, 3))
+                }
+            },
+            freq_hz: num(m.freq_hz, 5),
+            damping_ratio: num(m.damping_ratio, 3),
+            self_excited: m.damping_ratio < 0.0,
+            head: num(m.participation.head, 2),
+            head_link: num(m.participation.head_link, 2),
+            neck_lip: num(m.participation.neck_lip, 2),
+        })
+        .collect()
+}
+
 fn trial_rows(r: &FitResult) -> Vec<TrialView> {
     r.model_trials
         .iter()
@@ -402,6 +434,7 @@ struct PageView<'a> {
     interval_methods: Vec<String>,
     peaks: Vec<PeakView>,
     trials: Vec<TrialView>,
+    modes: Vec<ModeView>,
     correlation: Vec<CorrelationRow>,
     warnings: &'a [String],
     figures: Vec<FigureView<'a>>,
@@ -482,6 +515,7 @@ fn page_view<'a>(
         interval_methods,
         peaks: peak_rows(r),
         trials: trial_rows(r),
+        modes: mode_rows(r),
         correlation: if pd { correlation_rows(r) } else { Vec::new() },
         warnings,
         figures: figures
@@ -723,6 +757,7 @@ mod tests {
             fit_settings: None,
             fitted_at: None,
             data_files: vec![],
+            modes: vec![],
             history: vec![],
         }
     }
