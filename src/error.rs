@@ -37,13 +37,13 @@ pub enum Error {
     /// A setting (command-line flag or job field) is out of range or inconsistent.
     #[error("{0}")]
     Config(String),
-    /// The simulation could not continue; `t_s` is the simulated time, `state` a readable snapshot.
-    #[error("simulation stopped at t = {t_s:.9} s: {message} (state: {state})")]
-    Simulation {
-        t_s: f64,
-        message: String,
-        state: String,
-    },
+    /// The simulation could not continue: the simulated time, a readable snapshot of the state and
+    /// the typed cause.
+    #[error(transparent)]
+    Simulation(#[from] crate::simulate::SimulationError),
+    /// A spectral estimate could not be made (settings or samples), with its numbers.
+    #[error(transparent)]
+    Spectrum(#[from] crate::spectrum::SpectrumError),
     /// A numerical routine was given data it cannot work on (too short a record, all NaN, ...).
     #[error("{0}")]
     Numerics(String),
@@ -55,10 +55,11 @@ pub enum Error {
 impl Error {
     /// True for errors caused by the user's input (files, jobs, flags): the CLI exits with code 2.
     pub fn is_input_error(&self) -> bool {
-        matches!(
-            self,
-            Error::Io { .. } | Error::Parse { .. } | Error::Input { .. } | Error::Config(_)
-        )
+        match self {
+            Error::Io { .. } | Error::Parse { .. } | Error::Input { .. } | Error::Config(_) => true,
+            Error::Spectrum(e) => e.is_setting(),
+            _ => false,
+        }
     }
 
     /// Shorthand for [`Error::Parse`].

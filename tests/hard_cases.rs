@@ -87,11 +87,8 @@ fn expect_simulation_error(
     window: (f64, f64),
 ) -> (f64, String) {
     match r {
-        Err(Error::Simulation {
-            t_s,
-            message,
-            state,
-        }) => {
+        Err(Error::Simulation(wiperlab::simulate::SimulationError { t_s, cause, state })) => {
+            let message = cause.to_string();
             eprintln!("stopped at t = {t_s}: {message}; state: {state}");
             assert!(
                 t_s.is_finite() && t_s >= window.0 && t_s <= window.1,
@@ -152,8 +149,15 @@ fn accumulation_of_transitions_keeps_period_and_budget() {
         ..tight()
     };
     match limit_cycle(&belt, 0.0, t_end, &small) {
-        Err(Error::Simulation { t_s, message, .. }) => {
+        Err(Error::Simulation(wiperlab::simulate::SimulationError { t_s, cause, .. })) => {
+            let message = cause.to_string();
             assert!(message.contains("more than 100 transitions"), "{message}");
+            assert_eq!(
+                cause,
+                wiperlab::simulate::StopCause::TooManyTransitions {
+                    max_transitions: 100
+                }
+            );
             assert!(t_s > 0.0 && t_s < t_end);
         }
         other => panic!("expected a budget error, got {other:?}"),

@@ -10,6 +10,7 @@ use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 use wiperlab::Error;
+use wiperlab::spectrum::SpectrumError;
 use wiperlab::spectrum::{
     Average, Detrend, Scaling, WelchConfig, WelchPlan, Window, find_peak, median_rate_hz,
     resample_uniform, spectrogram, welch, welch_gappy,
@@ -319,11 +320,14 @@ fn welch_gappy_equals_welch_without_nan_and_errors_on_bad_input() {
 
     let e = welch_gappy(&[f64::NAN; 5000], fs, &cfg, 10).unwrap_err();
     assert!(
-        matches!(e, Error::Numerics(ref m) if m.contains("NaN")),
+        matches!(
+            e,
+            Error::Spectrum(SpectrumError::AllMissing { len: 5000, .. })
+        ) && e.to_string().contains("NaN"),
         "{e}"
     );
     let e = welch_gappy(&[], fs, &cfg, 10).unwrap_err();
-    assert!(matches!(e, Error::Numerics(_)), "{e}");
+    assert!(matches!(e, Error::Spectrum(_)), "{e}");
     // Every run shorter than nperseg: the message names the longest run (700 samples).
     let mut y = x[..2200].to_vec();
     for v in &mut y[700..720] {
@@ -334,7 +338,10 @@ fn welch_gappy_equals_welch_without_nan_and_errors_on_bad_input() {
     }
     let e = welch_gappy(&y, fs, &cfg, 10).unwrap_err();
     assert!(
-        matches!(e, Error::Numerics(ref m) if m.contains("longest run 880")),
+        matches!(
+            e,
+            Error::Spectrum(SpectrumError::NoFiniteRun { longest: 880, .. })
+        ) && e.to_string().contains("longest run 880"),
         "{e}"
     );
 }

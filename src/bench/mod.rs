@@ -244,11 +244,9 @@ where
 pub fn blade_burst_start(params: &BladeParams) -> Result<(f64, [f64; 4], f64)> {
     let blade = Blade::new(*params, StickForm::Reduced);
     let (t0, t1) = default_window(params);
-    let y0 = blade.slip_equilibrium(t0).map_err(|e| Error::Simulation {
-        t_s: t0,
-        message: e.to_string(),
-        state: "initial equilibrium".into(),
-    })?;
+    let y0 = blade
+        .slip_equilibrium(t0)
+        .map_err(|e| crate::simulate::SimulationError::at_start(t0, e))?;
     let mode = Mode {
         phase: Phase::SlipPos,
         anchor: 0.0,
@@ -358,11 +356,9 @@ pub fn run_bench(opts: &BenchOptions) -> Result<Vec<BenchRow>> {
 
     // Whole window, event-driven: cost.
     let (w0, w1) = default_window(&opts.blade);
-    let y0 = blade.slip_equilibrium(w0).map_err(|e| Error::Simulation {
-        t_s: w0,
-        message: e.to_string(),
-        state: "initial equilibrium".into(),
-    })?;
+    let y0 = blade
+        .slip_equilibrium(w0)
+        .map_err(|e| crate::simulate::SimulationError::at_start(w0, e))?;
     let slip = Mode {
         phase: Phase::SlipPos,
         anchor: 0.0,

@@ -23,6 +23,7 @@ use super::features::SignalKind;
 use super::job::Weights;
 use crate::simulate::blade::BladeSimulation;
 use crate::simulate::hybrid::Phase;
+use crate::spectrum::SpectrumError;
 use crate::spectrum::instfreq::{
     FreqSpeedPoint, RidgeConfig, StickDetector, band_floor, bin_by_speed, detect_stick_onsets,
     onset_rate_vs_speed, ridge_vs_speed,
@@ -76,7 +77,9 @@ pub fn measured_freq_speed(
             onset_rate_vs_speed(&d.onsets_s, t0, fs_hz, tip, det.half_width),
             None,
         ),
-        Err(Error::Numerics(m)) => (Vec::new(), Some(m)),
+        Err(e @ Error::Spectrum(SpectrumError::NoNoiseEstimate { .. })) => {
+            (Vec::new(), Some(e.to_string()))
+        }
         Err(e) => return Err(e),
     };
     Ok(FreqSpeed {

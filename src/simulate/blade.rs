@@ -124,11 +124,7 @@ pub fn simulate_model(
             let model = LockedBlade::new(*params);
             let y0 = model
                 .slip_equilibrium(window.0)
-                .map_err(|e| Error::Simulation {
-                    t_s: window.0,
-                    message: e.to_string(),
-                    state: "initial equilibrium".into(),
-                })?;
+                .map_err(|e| crate::simulate::SimulationError::at_start(window.0, e))?;
             run_to_simulation(&model, &model.blade, y0, params, window, sample_times, opts)
         }
     }
@@ -166,14 +162,14 @@ pub fn simulate_necklip(
     let reach = params.l1_m + params.l2_m;
     let segments = head.segments(window, FLIP_GUARD_OF_REACH * reach);
     if segments.is_empty() {
-        return Err(Error::Simulation {
-            t_s: window.0,
-            message: format!(
-                "the recorded lean stays within {:.3e} m of upright over the whole window: nothing for the neck/lip model to run on",
-                FLIP_GUARD_OF_REACH * reach
-            ),
-            state: "no segment".into(),
-        });
+        return Err(super::error::SimulationError::new(
+            window.0,
+            super::error::StopCause::NoSegment {
+                guard_m: FLIP_GUARD_OF_REACH * reach,
+            },
+            "no segment",
+        )
+        .into());
     }
     let n = sample_times.len();
     let drive_dir = |t: f64| {
@@ -201,10 +197,13 @@ pub fn simulate_necklip(
     };
     for (i, &(a0, b)) in segments.iter().enumerate() {
         let mut a = a0;
-        let fail = |e: ModelFault| Error::Simulation {
-            t_s: a0,
-            message: e.to_string(),
-            state: format!("start of neck/lip segment {} ({a0:.6}–{b:.6} s)", i + 1),
+        let fail = |e: ModelFault| -> Error {
+            super::error::SimulationError::new(
+                a0,
+                e,
+                format!("start of neck/lip segment {} ({a0:.6}–{b:.6} s)", i + 1),
+            )
+            .into()
         };
         let (y0, mode0) = if i == 0 {
             (
@@ -314,11 +313,9 @@ pub fn simulate_blade(
     params.validate().map_err(Error::Config)?;
     let blade = Blade::new(*params, stick_form);
     let t0 = window.0;
-    let y0 = blade.slip_equilibrium(t0).map_err(|e| Error::Simulation {
-        t_s: t0,
-        message: e.to_string(),
-        state: "initial equilibrium".into(),
-    })?;
+    let y0 = blade
+        .slip_equilibrium(t0)
+        .map_err(|e| crate::simulate::SimulationError::at_start(t0, e))?;
     run_to_simulation(&blade, &blade, y0, params, window, sample_times, opts)
 }
 

@@ -22,6 +22,7 @@
 //! it is armed by the first strictly positive value, and if its first sample is already negative the
 //! sub-interval is searched for a positive maximum (a departure and a return within one sub-step).
 
+use super::error::{SimulationError, StopCause};
 use super::rk;
 use crate::{Error, Result};
 
@@ -280,10 +281,8 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
             "simulation window must have t_end > t0 (got {t0} .. {t_end})"
         )));
     }
-    let fail = |t: f64, y: &[f64; N], msg: String| Error::Simulation {
-        t_s: t,
-        message: msg,
-        state: model.describe(t, y),
+    let fail = |t: f64, y: &[f64; N], cause: StopCause| -> Error {
+        SimulationError::new(t, cause, model.describe(t, y)).into()
     };
     let mut stats = Stats::default();
     let mut run = Run {
@@ -303,7 +302,7 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
     let mut mode = mode0;
     model
         .complete(&mode, t, &mut y)
-        .map_err(|e| fail(t, &y, e.to_string()))?;
+        .map_err(|e| fail(t, &y, e.into()))?;
     if model.switching_surfaces() > MAX_SWITCHING_SURFACES {
         return Err(Error::Config(format!(
             "model declares {} switching surfaces; at most {MAX_SWITCHING_SURFACES} are supported",
@@ -328,16 +327,19 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
         let mut f = [0.0; N];
         model
             .rhs(&mode, t, &y, &mut f)
-            .map_err(|e| fail(t, &y, e.to_string()))?;
+            .map_err(|e| fail(t, &y, e.into()))?;
         stats.rhs_evals += 1;
         let (mut g_prev, c0) =
-            event_values(model, &mode, t, &y).map_err(|e| fail(t, &y, e.to_string()))?;
+            event_values(model, &mode, t, &y).map_err(|e| fail(t, &y, e.into()))?;
         stats.event_evals += 1;
         if c0.normal <= 0.0 {
             return Err(fail(
                 t,
                 &y,
-                format!("contact lost: normal force N = {:.6e} N <= 0", c0.normal),
+                StopCause::ContactLost {
+                    phase: None,
+                    normal_n: c0.normal,
+                },
             ));
         }
         // The previous accepted step of this phase: its continuous extension and its last interior
@@ -351,7 +353,9 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                 return Err(fail(
                     t,
                     &y,
-                    format!("step budget of {} steps exhausted", opts.max_steps),
+                    StopCause::StepBudget {
+                        max_steps: opts.max_steps,
+                    },
                 ));
             }
             h = h.min(opts.h_max);
@@ -363,7 +367,10 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                 return Err(fail(
                     t,
                     &y,
-                    format!("step size collapsed to {h:.3e} s in {}", mode.phase),
+                    StopCause::StepSizeCollapse {
+                        h_s: h,
+                        phase: Some(mode.phase),
+                    },
                 ));
             }
             let mut rhs = |tt: f64, yy: &[f64; N], dy: &mut [f64; N]| {
@@ -426,8 +433,8 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                 } else {
                     a.dense.eval(tj)
                 };
-                let (gj, _) = event_values(model, &mode, tj, &yj)
-                    .map_err(|e| fail(tj, &yj, e.to_string()))?;
+                let (gj, _) =
+                    event_values(model, &mode, tj, &yj).map_err(|e| fail(tj, &yj, e.into()))?;
                 stats.event_evals += 1;
                 // Refine every function that crossed in [ta, tj]; keep the earliest.
                 for k in 0..N_EVENTS {
@@ -446,7 +453,7 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                         // (a slip that reverses again within the first sub-step): look for a
                         // positive maximum.
                         let (tm, gm, n) = golden_extremum(|tt| g_at(k, tt).map(|g| -g), ta, tj)
-                            .map_err(|e| fail(tj, &yj, e.to_string()))?;
+                            .map_err(|e| fail(tj, &yj, e.into()))?;
                         stats.event_evals += n;
                         if -gm > 0.0 {
                             bracket = Some((tm, tj, -gm, gj[k]));
@@ -461,7 +468,7 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                         // The samples have an interior minimum above zero: the function may dip
                         // across zero and back between samples. Find the minimum.
                         let (tm, gm, n) = golden_extremum(|tt| g_at(k, tt), tb, tj)
-                            .map_err(|e| fail(tj, &yj, e.to_string()))?;
+                            .map_err(|e| fail(tj, &yj, e.into()))?;
                         stats.event_evals += n;
                         if gm <= 0.0 {
                             bracket = Some((tb, tm, gb[k], gm));
@@ -469,7 +476,7 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                     }
                     if let Some((lo, hi, glo, ghi)) = bracket {
                         let tk = illinois_right(|tt| g_at(k, tt), lo, hi, glo, ghi)
-                            .map_err(|e| fail(tj, &yj, e.to_string()))?;
+                            .map_err(|e| fail(tj, &yj, e.into()))?;
                         if found.is_none_or(|(_, te)| tk < te) {
                             found = Some((k, tk));
                         }
@@ -494,7 +501,7 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                 };
                 model
                     .complete(&mode, to, &mut yo)
-                    .map_err(|e| fail(to, &yo, e.to_string()))?;
+                    .map_err(|e| fail(to, &yo, e.into()))?;
                 run.t_s.push(to);
                 run.y.push(yo);
                 run.phase.push(mode.phase);
@@ -521,7 +528,7 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                     }
                     model
                         .complete(&mode, te, &mut ye)
-                        .map_err(|e| fail(te, &ye, e.to_string()))?;
+                        .map_err(|e| fail(te, &ye, e.into()))?;
                     if k >= 3 {
                         // A switching surface: same phase, the other branch of the right-hand side.
                         let i = k - 3;
@@ -538,19 +545,19 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                     }
                     if k == 2 {
                         let (_, c) = event_values(model, &mode, te, &ye)
-                            .map_err(|e| fail(te, &ye, e.to_string()))?;
+                            .map_err(|e| fail(te, &ye, e.into()))?;
                         return Err(fail(
                             te,
                             &ye,
-                            format!(
-                                "contact lost in {}: normal force N fell to {:.3e} N (the model assumes the lip tip stays on the glass)",
-                                mode.phase, c.normal
-                            ),
+                            StopCause::ContactLost {
+                                phase: Some(mode.phase),
+                                normal_n: c.normal,
+                            },
                         ));
                     }
                     let from = mode.phase;
                     let new_mode = decide_after_event(model, &mode, k, te, &mut ye)
-                        .map_err(|e| fail(te, &ye, e.to_string()))?;
+                        .map_err(|e| fail(te, &ye, e.into()))?;
                     stats.event_evals += 1;
                     run.transitions.push(Transition {
                         t_s: te,
@@ -562,17 +569,15 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
                         return Err(fail(
                             te,
                             &ye,
-                            format!("more than {} transitions", opts.max_transitions),
+                            StopCause::TooManyTransitions {
+                                max_transitions: opts.max_transitions,
+                            },
                         ));
                     }
                     if te - last_transition_t <= 1e-12 * te.abs().max(1.0) {
                         quick_transitions += 1;
                         if quick_transitions > 50 {
-                            return Err(fail(
-                                te,
-                                &ye,
-                                "transitions accumulate (more than 50 within 1e-12 s of each other): a Zeno point; the event-driven method cannot pass it".into(),
-                            ));
+                            return Err(fail(te, &ye, StopCause::Zeno { count: 50 }));
                         }
                     } else {
                         quick_transitions = 0;

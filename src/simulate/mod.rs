@@ -4,8 +4,10 @@
 
 pub mod belt;
 pub mod blade;
+pub mod error;
 pub mod hybrid;
 pub mod rk;
 pub mod timestep;
 
+pub use error::{SimulationError, StopCause};
 pub use hybrid::{Phase, SolverOptions, Transition};

@@ -58,12 +58,12 @@ pub struct Trajectory {
     pub stats: Stats,
 }
 
-fn sim_err<const N: usize>(t: f64, y: &[f64; N], e: impl std::fmt::Display) -> Error {
-    Error::Simulation {
-        t_s: t,
-        message: e.to_string(),
-        state: format!("{y:?}"),
-    }
+fn sim_err<const N: usize>(
+    t: f64,
+    y: &[f64; N],
+    cause: impl Into<super::error::StopCause>,
+) -> Error {
+    super::error::SimulationError::new(t, cause, format!("{y:?}")).into()
 }
 
 /// Moreau–Jean time-stepping with fixed step `h_s` over `[t0, t1]`, starting from `y0` (any phase;
@@ -155,10 +155,14 @@ pub fn smoothed<M: NonsmoothModel<N>, const N: usize>(
     while t < t1 {
         h = h.min(t1 - t);
         if h < 1e-15 * t.abs().max(1.0) {
+            // Smoothed friction is stiff near zero slip speed.
             return Err(sim_err(
                 t,
                 &y,
-                "step size collapsed (smoothed friction is stiff)",
+                super::error::StopCause::StepSizeCollapse {
+                    h_s: h,
+                    phase: None,
+                },
             ));
         }
         let a = match rk::attempt(&mut rhs, t, &y, &f, h, rtol, rtol * 1e-2) {

@@ -391,10 +391,11 @@ pub fn detect_stick_onsets(
     }
     let sigma = noise_sigma(tip_x_m);
     if !(sigma.is_finite() && sigma > 0.0) {
-        return Err(Error::Numerics(format!(
-            "stick detector: cannot estimate the tracking noise of the tip trace (σ̂ = {sigma} m from {} samples); it needs a noisy trace with at least 10 samples",
-            tip_x_m.len()
-        )));
+        return Err(super::SpectrumError::NoNoiseEstimate {
+            sigma_m: sigma,
+            samples: tip_x_m.len(),
+        }
+        .into());
     }
     let h = det.half_width as f64;
     let sum_k2 = h * (h + 1.0) * (2.0 * h + 1.0) / 3.0;
@@ -643,7 +644,9 @@ mod tests {
         // A noise-free trace has no noise to set the stick threshold.
         assert!(matches!(
             detect_stick_onsets(0.0, 1e4, &x, &StickDetector::default()),
-            Err(Error::Numerics(_))
+            Err(Error::Spectrum(
+                crate::spectrum::SpectrumError::NoNoiseEstimate { .. }
+            ))
         ));
         let bad = StickDetector {
             enter_sigmas: 3.0,

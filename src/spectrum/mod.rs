@@ -21,6 +21,7 @@
 //! References: P.D. Welch, IEEE Trans. Audio Electroacoust. 15(2):70–73, 1967; SciPy
 //! `scipy.signal.welch` (1.17); J.O. Smith, *Spectral Audio Signal Processing*, CCRMA.
 
+pub mod error;
 pub mod features;
 pub mod instfreq;
 pub mod peaks;
@@ -30,6 +31,7 @@ pub mod stft;
 pub mod welch;
 pub mod window;
 
+pub use error::SpectrumError;
 pub use peaks::{Peak, find_peak, parabolic_vertex, top_peaks};
 pub use resample::{UniformSignals, median_rate_hz, resample_uniform, uniform_signals};
 pub use stft::{Spectrogram, spectrogram};

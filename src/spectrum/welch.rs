@@ -28,7 +28,7 @@
 //! With these conventions, `Σ_k density_k · Δf` equals the window-weighted mean square of the
 //! detrended segments (Parseval), i.e. the signal's power: `A²/2` for a sinusoid of amplitude `A`.
 //!
-//! Where SciPy warns and shrinks `nperseg` to a short record, we return [`Error::Numerics`] instead.
+//! Where SciPy warns and shrinks `nperseg` to a short record, we return [`SpectrumError::TooShort`] instead.
 //!
 //! For plan-once/process-many use (the fit evaluates spectra hundreds of times) build a
 //! [`WelchPlan`] once and call [`WelchPlan::process`] or [`WelchPlan::process_into`].
@@ -39,8 +39,9 @@ use std::sync::Arc;
 use realfft::num_complex::Complex;
 use realfft::{RealFftPlanner, RealToComplex};
 
+use super::error::SpectrumError;
 use super::window::{Window, WindowSums};
-use crate::{Error, Result};
+use crate::Result;
 
 /// What is subtracted from each segment before windowing (`scipy.signal.welch`'s `detrend`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -196,14 +197,14 @@ impl WelchConfig {
         self
     }
 
-    /// Sets `noverlap`; [`Error::Config`] unless `noverlap < nperseg`.
+    /// Sets `noverlap`; [`SpectrumError`] unless `noverlap < nperseg`.
     pub fn with_noverlap(mut self, noverlap: usize) -> Result<Self> {
         self.noverlap = noverlap;
         self.validate()?;
         Ok(self)
     }
 
-    /// Sets `nfft`; [`Error::Config`] unless `nfft ≥ nperseg`.
+    /// Sets `nfft`; [`SpectrumError`] unless `nfft ≥ nperseg`.
     pub fn with_nfft(mut self, nfft: usize) -> Result<Self> {
         self.nfft = nfft;
         self.validate()?;
@@ -216,25 +217,27 @@ impl WelchConfig {
         self
     }
 
-    /// [`Error::Config`] unless `nperseg ≥ 2`, `noverlap < nperseg` and `nfft ≥ nperseg`.
+    /// [`SpectrumError`] unless `nperseg ≥ 2`, `noverlap < nperseg` and `nfft ≥ nperseg`.
     pub fn validate(&self) -> Result<()> {
         if self.nperseg < 2 {
-            return Err(Error::Config(format!(
-                "Welch nperseg = {} must be at least 2",
-                self.nperseg
-            )));
+            return Err(SpectrumError::NpersegTooSmall {
+                nperseg: self.nperseg,
+            }
+            .into());
         }
         if self.noverlap >= self.nperseg {
-            return Err(Error::Config(format!(
-                "Welch noverlap = {} must be less than nperseg = {}",
-                self.noverlap, self.nperseg
-            )));
+            return Err(SpectrumError::OverlapTooLarge {
+                noverlap: self.noverlap,
+                nperseg: self.nperseg,
+            }
+            .into());
         }
         if self.nfft < self.nperseg {
-            return Err(Error::Config(format!(
-                "Welch nfft = {} must be at least nperseg = {}",
-                self.nfft, self.nperseg
-            )));
+            return Err(SpectrumError::NfftTooSmall {
+                nfft: self.nfft,
+                nperseg: self.nperseg,
+            }
+            .into());
         }
         Ok(())
     }
@@ -348,7 +351,7 @@ impl fmt::Debug for WelchPlan {
 }
 
 impl WelchPlan {
-    /// Plans the FFT and window for `cfg`; [`Error::Config`] if `cfg` is invalid.
+    /// Plans the FFT and window for `cfg`; [`SpectrumError`] if `cfg` is invalid.
     pub fn new(cfg: WelchConfig) -> Result<Self> {
         cfg.validate()?;
         let r2c = RealFftPlanner::<f64>::new().plan_fft_forward(cfg.nfft);
@@ -393,19 +396,19 @@ impl WelchPlan {
     pub fn process_into(&mut self, x: &[f64], fs_hz: f64, out: &mut Psd) -> Result<()> {
         check_fs(fs_hz)?;
         if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-            return Err(Error::Numerics(format!(
-                "Welch PSD: sample {i} of {} is {} (expected finite samples; use welch_gappy for \
-                 records with gaps)",
-                x.len(),
-                x[i]
-            )));
+            return Err(SpectrumError::NonFinite {
+                index: i,
+                len: x.len(),
+                value: x[i],
+            }
+            .into());
         }
         if x.len() < self.cfg.nperseg {
-            return Err(Error::Numerics(format!(
-                "Welch PSD: record has {} samples, expected at least nperseg = {}",
-                x.len(),
-                self.cfg.nperseg
-            )));
+            return Err(SpectrumError::TooShort {
+                len: x.len(),
+                nperseg: self.cfg.nperseg,
+            }
+            .into());
         }
         self.acc.fill(0.0);
         self.segments.clear();
@@ -426,12 +429,11 @@ impl WelchPlan {
             x.iter().position(|v| v.is_finite()),
             x.iter().rposition(|v| v.is_finite()),
         ) else {
-            return Err(Error::Numerics(format!(
-                "Welch PSD: all {} samples are NaN or non-finite (expected at least nperseg = {} \
-                 consecutive finite samples)",
-                x.len(),
-                self.cfg.nperseg
-            )));
+            return Err(SpectrumError::AllMissing {
+                len: x.len(),
+                nperseg: self.cfg.nperseg,
+            }
+            .into());
         };
         let mut report = GapReport {
             dropped: first + (x.len() - 1 - last),
@@ -479,15 +481,14 @@ impl WelchPlan {
         }
         if n_seg == 0 {
             let longest = runs.iter().map(|(s, e)| e - s).max().unwrap_or(0);
-            return Err(Error::Numerics(format!(
-                "Welch PSD: no finite run of at least nperseg = {} samples (longest run {} samples \
-                 of {}; {} runs after filling NaN gaps of up to {} samples)",
-                self.cfg.nperseg,
+            return Err(SpectrumError::NoFiniteRun {
+                nperseg: self.cfg.nperseg,
                 longest,
-                x.len(),
-                runs.len(),
-                max_fill
-            )));
+                len: x.len(),
+                runs: runs.len(),
+                max_fill,
+            }
+            .into());
         }
         report.segments_used = n_seg;
         let mut out = Psd::default();
@@ -639,9 +640,7 @@ pub(crate) fn check_fs(fs_hz: f64) -> Result<()> {
     if fs_hz.is_finite() && fs_hz > 0.0 {
         Ok(())
     } else {
-        Err(Error::Config(format!(
-            "sampling rate fs = {fs_hz} Hz must be finite and positive"
-        )))
+        Err(SpectrumError::SamplingRate { fs_hz }.into())
     }
 }
 
@@ -698,6 +697,7 @@ pub fn welch_gappy(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Error;
 
     #[test]
     fn config_defaults_are_scipys() {
@@ -732,7 +732,9 @@ mod tests {
     fn config_validation() {
         assert!(matches!(
             WelchConfig::new(1).validate(),
-            Err(Error::Config(_))
+            Err(Error::Spectrum(SpectrumError::NpersegTooSmall {
+                nperseg: 1
+            }))
         ));
         assert!(WelchConfig::new(2).validate().is_ok());
         assert!(WelchConfig::new(64).with_noverlap(64).is_err());
@@ -748,20 +750,28 @@ mod tests {
         for x in [vec![], vec![1.0; 15]] {
             let e = welch(&x, 100.0, &cfg).unwrap_err();
             assert!(
-                matches!(e, Error::Numerics(ref m) if m.contains("nperseg = 16")),
+                matches!(
+                    e,
+                    Error::Spectrum(SpectrumError::TooShort { nperseg: 16, .. })
+                ) && e.to_string().contains("nperseg = 16"),
                 "{e}"
             );
         }
         let mut x = vec![0.5; 64];
         x[10] = f64::NAN;
-        assert!(matches!(welch(&x, 100.0, &cfg), Err(Error::Numerics(_))));
         assert!(matches!(
-            welch(&[0.0; 64], 0.0, &cfg),
-            Err(Error::Config(_))
+            welch(&x, 100.0, &cfg),
+            Err(Error::Spectrum(SpectrumError::NonFinite { index: 10, .. }))
         ));
+        let e = welch(&[0.0; 64], 0.0, &cfg).unwrap_err();
+        assert!(matches!(
+            e,
+            Error::Spectrum(SpectrumError::SamplingRate { .. })
+        ));
+        assert!(e.is_input_error());
         assert!(matches!(
             welch(&[0.0; 64], f64::NAN, &cfg),
-            Err(Error::Config(_))
+            Err(Error::Spectrum(SpectrumError::SamplingRate { .. }))
         ));
     }
 
