@@ -37,13 +37,15 @@ pub enum Error {
     /// A setting (command-line flag or job field) is out of range or inconsistent.
     #[error("{0}")]
     Config(String),
-    /// The simulation could not continue: the simulated time, a readable snapshot of the state and
-    /// the typed cause.
-    #[error(transparent)]
-    Simulation(#[from] crate::simulate::SimulationError),
-    /// A spectral estimate could not be made (settings or samples), with its numbers.
-    #[error(transparent)]
-    Spectrum(#[from] crate::spectrum::SpectrumError),
+    /// A later stage's typed error (`spectrum::SpectrumError`, `simulate::SimulationError`, ...),
+    /// kept as that type: each stage's error type gives `of(&Error)` to read it back. The error
+    /// module names no later stage, so the stages depend on it and not the other way round.
+    /// `input`: caused by the user's settings (exit code 2), else by the data or the numerics.
+    #[error("{source}")]
+    Stage {
+        source: Box<dyn std::error::Error + Send + Sync + 'static>,
+        input: bool,
+    },
     /// A numerical routine was given data it cannot work on (too short a record, all NaN, ...).
     #[error("{0}")]
     Numerics(String),
@@ -57,7 +59,7 @@ impl Error {
     pub fn is_input_error(&self) -> bool {
         match self {
             Error::Io { .. } | Error::Parse { .. } | Error::Input { .. } | Error::Config(_) => true,
-            Error::Spectrum(e) => e.is_setting(),
+            Error::Stage { input, .. } => *input,
             _ => false,
         }
     }
@@ -77,6 +79,22 @@ impl Error {
         Error::Input {
             path: path.to_path_buf(),
             message: message.into(),
+        }
+    }
+
+    /// A later stage's typed error `e` (see [`Error::Stage`]).
+    pub fn stage<E: std::error::Error + Send + Sync + 'static>(e: E, input: bool) -> Self {
+        Error::Stage {
+            source: Box::new(e),
+            input,
+        }
+    }
+
+    /// The later stage's error of type `E` inside, if this is one.
+    pub fn stage_error<E: std::error::Error + 'static>(&self) -> Option<&E> {
+        match self {
+            Error::Stage { source, .. } => source.downcast_ref::<E>(),
+            _ => None,
         }
     }
 

@@ -2,7 +2,6 @@
 //! against an independent number, or stops with `Error::Simulation` naming the time and state. None
 //! may panic or return NaN.
 
-use wiperlab::Error;
 use wiperlab::model::belt::Belt;
 use wiperlab::model::benchmarks::{CoulombBelt, seed_law_belt};
 use wiperlab::model::{Blade, BladeParams, FrictionLaw, StickForm};
@@ -87,7 +86,9 @@ fn expect_simulation_error(
     window: (f64, f64),
 ) -> (f64, String) {
     match r {
-        Err(Error::Simulation(wiperlab::simulate::SimulationError { t_s, cause, state })) => {
+        Err(e) if wiperlab::simulate::SimulationError::of(&e).is_some() => {
+            let wiperlab::simulate::SimulationError { t_s, cause, state } =
+                wiperlab::simulate::SimulationError::of(&e).unwrap().clone();
             let message = cause.to_string();
             eprintln!("stopped at t = {t_s}: {message}; state: {state}");
             assert!(
@@ -149,7 +150,9 @@ fn accumulation_of_transitions_keeps_period_and_budget() {
         ..tight()
     };
     match limit_cycle(&belt, 0.0, t_end, &small) {
-        Err(Error::Simulation(wiperlab::simulate::SimulationError { t_s, cause, .. })) => {
+        Err(e) if wiperlab::simulate::SimulationError::of(&e).is_some() => {
+            let wiperlab::simulate::SimulationError { t_s, cause, .. } =
+                wiperlab::simulate::SimulationError::of(&e).unwrap().clone();
             let message = cause.to_string();
             assert!(message.contains("more than 100 transitions"), "{message}");
             assert_eq!(

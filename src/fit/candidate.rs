@@ -130,7 +130,7 @@ impl PartialEq<&str> for Candidate {
 /// on a tracked recording it costs more, not less. On the shipped recording with the true blade one
 /// run takes 1.7 s against 0.066 s for the full blade (158 thousand steps against 22 thousand;
 /// the tracking noise in the prescribed head drives extra stick–slip transitions, 218 against 144).
-/// Fitting the high band alone (README, "Which model the scene needs"): 227 runs took 280 s and left
+/// Fitting the high band alone (docs/fit.md, "Which model the scene needs"): 227 runs took 280 s and left
 /// k1 77 % off (the peak matched with the wrong parameters), where the full blade took 20 s for 824
 /// runs and came within 0.12 %. Name it in `[fit] models`
 /// when the head's suspension (k0, c0, the head mass) is unknown: it takes the head's motion from

@@ -77,7 +77,12 @@ pub fn measured_freq_speed(
             onset_rate_vs_speed(&d.onsets_s, t0, fs_hz, tip, det.half_width),
             None,
         ),
-        Err(e @ Error::Spectrum(SpectrumError::NoNoiseEstimate { .. })) => {
+        Err(e)
+            if matches!(
+                SpectrumError::of(&e),
+                Some(SpectrumError::NoNoiseEstimate { .. })
+            ) =>
+        {
             (Vec::new(), Some(e.to_string()))
         }
         Err(e) => return Err(e),

@@ -52,13 +52,13 @@ pub(super) fn intervals(
 ///    features, and re-runs the estimator: the whole fit (its restarts of swarm and polish,
 ///    `full_refit = true`) or only a
 ///    Nelder–Mead polish from the optimum (cheaper, but blind to the swarm's own scatter, so the
-///    intervals come out too narrow: README, "Uncertainty"); replicates run in parallel with rayon;
+///    intervals come out too narrow: docs/fit.md, "Uncertainty"); replicates run in parallel with rayon;
 /// 4. the interval is the basic bootstrap interval `[2θ̂ − q(84.13 %), 2θ̂ − q(15.87 %)]` of the
 ///    replicates' estimates `θ*` (Davison & Hinkley 1997, eq. 5.6), which corrects the replicates' bias.
 ///
 /// What it covers: the spread from tracking noise and spectral estimation. What it does not: the
 /// optimiser ending in a different local minimum of the (rough) stick–slip cost surface, which can
-/// be larger (README, "Uncertainty").
+/// be larger (docs/fit.md, "Uncertainty").
 ///
 /// # Errors
 /// [`Error::Fit`] when argmin fails; simulation failures inside replicates count as failed

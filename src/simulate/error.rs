@@ -63,3 +63,16 @@ impl SimulationError {
         SimulationError::new(t_s, fault, "initial equilibrium")
     }
 }
+
+impl From<SimulationError> for crate::Error {
+    fn from(e: SimulationError) -> Self {
+        crate::Error::stage(e, false)
+    }
+}
+
+impl SimulationError {
+    /// The simulate stage's error inside `e`, if it is one.
+    pub fn of(e: &crate::Error) -> Option<&SimulationError> {
+        e.stage_error()
+    }
+}

@@ -64,3 +64,17 @@ impl SpectrumError {
         )
     }
 }
+
+impl From<SpectrumError> for crate::Error {
+    fn from(e: SpectrumError) -> Self {
+        let input = e.is_setting();
+        crate::Error::stage(e, input)
+    }
+}
+
+impl SpectrumError {
+    /// The spectrum stage's error inside `e`, if it is one.
+    pub fn of(e: &crate::Error) -> Option<&SpectrumError> {
+        e.stage_error()
+    }
+}

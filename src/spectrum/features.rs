@@ -29,9 +29,9 @@ pub struct BandSpec {
 /// but still resolve bumps ~18 Hz apart on the envelope, and the largest one changes as the
 /// parameters move: the peak jumps by ~2 % (883 → 866 Hz) between neighbouring parameter sets and
 /// the cost surface gets steps of 3–4. With 512 samples (19.5 Hz bins) the envelope is one hump
-/// and the cost has no steps (README, "Restarts"), and the model-made recordings of
+/// and the cost has no steps (docs/fit.md, "Restarts"), and the model-made recordings of
 /// `tests/fit_recovery.rs`, `shoulder_fit.rs` and `joint_fit.rs` are recovered as well or better
-/// (README, "Spectra against tolerance"). A job that wants the finer estimate names its bands.
+/// (docs/validation.md, "Spectra against tolerance"). A job that wants the finer estimate names its bands.
 pub fn default_bands() -> Vec<BandSpec> {
     vec![
         BandSpec {
