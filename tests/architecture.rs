@@ -157,3 +157,47 @@ fn lib_docs_state_the_checked_order() {
         .collect();
     assert_eq!(stated, STAGES);
 }
+
+/// README is a user manual: at most 12 KB, it holds the exact test command CI runs, every `docs/`
+/// file it names exists, and no source file cites it for a number (numbers live in `docs/`).
+#[test]
+fn readme_is_a_short_manual_and_sources_cite_docs() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).expect("README.md");
+    assert!(
+        readme.len() <= 12 * 1024,
+        "README.md is {} bytes (at most 12,288)",
+        readme.len()
+    );
+    assert!(
+        readme
+            .lines()
+            .any(|l| l.starts_with("cargo test --release")),
+        "README.md must give `cargo test --release` on a line of its own (.ci/run runs it)"
+    );
+    for word in readme.split(|c: char| c == '`' || c.is_whitespace() || c == '(' || c == ')') {
+        if let Some(rest) = word.strip_prefix("docs/") {
+            let name = rest.trim_end_matches([',', '.', ':', ';']);
+            assert!(
+                root.join("docs").join(name).is_file(),
+                "README.md names docs/{name}, which does not exist"
+            );
+        }
+    }
+    let mut files = Vec::new();
+    rust_files(&root.join("src"), &mut files);
+    for f in files {
+        let text = std::fs::read_to_string(&f).expect("readable source");
+        for (i, line) in text.lines().enumerate() {
+            let cites_readme = line.contains("README")
+                && !line.contains("data/reversal/README.md")
+                && !line.contains("sample/README.md");
+            assert!(
+                !cites_readme,
+                "{}:{}: cites the README; numbers and methods live in docs/",
+                f.display(),
+                i + 1
+            );
+        }
+    }
+}

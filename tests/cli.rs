@@ -240,7 +240,7 @@ fn main_job_end_to_end() {
         );
     }
     // The measured peaks themselves. data/reversal/truth.json /peaks/recording/v3rel reports
-    // low_Hz 49.002 and high_Hz 887.612 (README: "49.0 Hz and 887.6 Hz") with a different estimator
+    // low_Hz 49.002 and high_Hz 887.612 (data/reversal/README.md: "49.0 Hz and 887.6 Hz") with a different estimator
     // (one Hann window over the whole record, not Welch), hence ranges rather than equality.
     let truth = truth();
     let (low, _) = peak("low");
@@ -311,7 +311,7 @@ fn main_job_end_to_end() {
         // The fit must find the truth's basin: the sample was made by an independent
         // implementation with these parameters (truth.json), so what is left is tracking noise and
         // the two implementations' differences. Measured: A −0.37 %, B +0.06 %, C −0.76 %,
-        // k1 −1.15 % (README, "What the main job finds"); a single swarm (restarts = 1) ended at B +29.5 %, C −12.4 %, k1 −11 % (README, "Restarts").
+        // k1 −1.15 % (docs/fit.md, "What the main job finds"); a single swarm (restarts = 1) ended at B +29.5 %, C −12.4 %, k1 −11 % (README, "Restarts").
         assert!(
             rel.abs() <= 0.05,
             "{name}: fitted {value} against the true {true_value} ({:+.2} %)",
@@ -630,7 +630,7 @@ fn import_describe_and_convert() {
     assert_eq!(header, "t_s,head_x_m,head_y_m,tip_x_m,tip_y_m");
     assert_eq!(rows.len(), n_frames);
     // First data row of the xypts file: 200.204092,312.696557,106.569660,699.943223 (px), mapped
-    // with x = (X - 200)·1.5e-5, y = -(Y - 300)·1.5e-5 (y up, README "Camera and coordinates").
+    // with x = (X - 200)·1.5e-5, y = -(Y - 300)·1.5e-5 (y up, data/reversal/README.md, "Camera and coordinates").
     let first: Vec<f64> = rows[0].iter().map(|c| c.parse().unwrap()).collect();
     let want = [
         0.0,

@@ -323,7 +323,7 @@ fn sample_matches_clean_ground_truth_within_noise() {
     };
     let clean = read_clean(&gz);
     assert_eq!(clean.v.len(), 18869);
-    // Camera model (truth.json camera.pixel_model / README): x_m = X − a, y_m = Z with
+    // Camera model (truth.json camera.pixel_model / data/reversal/README.md): x_m = X − a, y_m = Z with
     // head X = v, Z = −u; tip X = v3, Z = −(l1 + l2) = −0.006 m.
     let a_m = num(&truth, "/camera/a_m");
     let lip = num(&truth, "/params/l1") + num(&truth, "/params/l2");
@@ -596,7 +596,7 @@ fn spec_from_toml_sidecar() {
     let Some(xy) = shared("sample/wiper_reversal_sample_xypts.csv") else {
         return;
     };
-    // The sample's camera (README.md): 10,000 fps, 15 µm/px, origin (200, 300) px, pt1/pt2.
+    // The sample's camera (data/reversal/README.md): 10,000 fps, 15 µm/px, origin (200, 300) px, pt1/pt2.
     let spec: ImportSpec = toml::from_str(
         r#"
         format = "dltdv"

@@ -253,7 +253,7 @@ fn model_onset_rate_matches_the_independent_transition_list() {
     // implementation's slip→stick times (truth.json), before the reversal, where the stick–slip is
     // one regular burst of ~22 cycles.
     //
-    // How the burst opens is seeded by truncation error (README, "Agreement with the independent
+    // How the burst opens is seeded by truncation error (docs/validation.md, "Agreement with the independent
     // implementation"): the reference's first stick is a grazing 0.22 ms stick at 1.83023 s, and
     // whether our run has one too, and where its first onset falls, changes with the tolerance and
     // even with rounding alone. The burst's end is tied to the drive's reversal, so the bursts are

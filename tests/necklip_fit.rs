@@ -18,7 +18,7 @@ fn necklip_is_fitted_but_not_chosen_for_a_low_band() {
     let dir = std::env::temp_dir().join(format!("wiperlab_necklip_fit_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     // The main job's recording and bands (fits/reversal.toml) on the true blade, with a tiny
-    // optimiser budget: this checks the plumbing, not the fitted values (README, "Which model the
+    // optimiser budget: this checks the plumbing, not the fitted values (docs/fit.md, "Which model the
     // scene needs"). Here blade2dof also has the lower cost, so what shows the rule is the reason.
     let job = format!(
         r#"name = "necklip_fit"
