@@ -231,3 +231,51 @@ fn tangential_departures_take_the_consistent_direction() {
     }
     assert!(checked > n / 10, "{checked} slip samples");
 }
+
+/// The step API: on the Coulomb belt (physics.md §3.1) started in stick, the first event is the
+/// static limit at the closed-form departure time t_d = 10 s·F_s/k (stick is exact), then the slip
+/// ends at the closed-form stick onset; every event the solver reports is a transition it records,
+/// the settled time never goes back, and the last reason is the stop time.
+#[test]
+fn step_reports_why_it_stopped() {
+    use wiperlab::simulate::hybrid::{Event, HybridSolver, StopReason};
+    let case = CoulombBelt::ONE_HZ;
+    let (belt, vb) = (case.belt(), case.v_belt_m_per_s);
+    let t_onset = case.first_stick_onset_s();
+    let mode = Mode {
+        phase: Phase::Stick,
+        anchor: 0.0,
+        region: 0,
+    };
+    let opts = SolverOptions::default();
+    let t_end = t_onset + 0.05;
+    let mut solver = HybridSolver::new(&belt, 0.0, [0.0, vb], mode, t_end, &opts).unwrap();
+    let (mut events, mut steps, mut settled) = (Vec::new(), 0, 0.0);
+    let last = loop {
+        let reason = solver.step().unwrap();
+        assert!(solver.settled_s() >= settled);
+        settled = solver.settled_s();
+        match reason {
+            StopReason::InternalStep { .. } => steps += 1,
+            StopReason::Event { t_s, event } => events.push((t_s, event)),
+            StopReason::StopTime { .. } => break reason,
+        }
+    };
+    assert_eq!(last, StopReason::StopTime { t_s: t_end });
+    assert!(steps > 10, "{steps} internal steps");
+    assert_eq!(events.len(), solver.transitions.len());
+    let (t_dep, e0) = events[0];
+    assert!(matches!(e0, Event::StaticLimit { .. }), "{e0:?}");
+    assert!(
+        (t_dep - 10.0 / (4.0 * std::f64::consts::PI.powi(2))).abs() < 1e-9,
+        "{t_dep}"
+    );
+    let (t_stick, e1) = events[1];
+    assert_eq!(e1, Event::SlipEnds);
+    assert!((t_stick - t_onset).abs() < 1e-6, "{t_stick} vs {t_onset}");
+    // The solver's run equals integrate's.
+    let run = integrate(&belt, 0.0, [0.0, vb], mode, t_end, &[], &opts).unwrap();
+    let times: Vec<f64> = run.transitions.iter().map(|t| t.t_s).collect();
+    let stepped: Vec<f64> = events.iter().map(|e| e.0).collect();
+    assert_eq!(times, stepped);
+}

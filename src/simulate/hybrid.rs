@@ -258,13 +258,528 @@ fn illinois_right<F: FnMut(f64) -> std::result::Result<f64, ModelFault>>(
     Ok(b)
 }
 
+/// An event of the one-contact system, located on a step's continuous extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(tag = "event", rename_all = "snake_case")]
+pub enum Event {
+    /// In slip: the slip velocity reached zero (the contact may stick or reverse).
+    SlipEnds,
+    /// In stick: friction reached its static limit, `function` 0 for `μ_s·N − f`, 1 for
+    /// `μ_s·N + f` (seed eq. 5).
+    StaticLimit { function: usize },
+    /// The normal force reached zero (the contact lifts off; always ends the run with an error).
+    LiftOff,
+    /// Switching surface `index` of the model was crossed (same phase, other branch).
+    Surface { index: usize },
+}
+
+impl Event {
+    /// The event of event function `k` in a phase that is slip (`slipping`) or stick.
+    fn of_function(k: usize, slipping: bool) -> Event {
+        match k {
+            0 if slipping => Event::SlipEnds,
+            0 | 1 => Event::StaticLimit { function: k },
+            2 => Event::LiftOff,
+            i => Event::Surface { index: i - 3 },
+        }
+    }
+
+    /// The index of the event function.
+    fn function(self) -> usize {
+        match self {
+            Event::SlipEnds => 0,
+            Event::StaticLimit { function } => function,
+            Event::LiftOff => 2,
+            Event::Surface { index } => 3 + index,
+        }
+    }
+}
+
+/// Why [`HybridSolver::step`] returned (after diffsol's `OdeSolverStopReason`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub enum StopReason {
+    /// An accepted step of the current phase ended at `t_s`, with no event in it.
+    InternalStep { t_s: f64 },
+    /// `event` was located at `t_s` and handled: the phase (or the region) changes there.
+    Event { t_s: f64, event: Event },
+    /// The stop time `t_s` was reached.
+    StopTime { t_s: f64 },
+}
+
+/// One accepted step as the outputs see it: its continuous extension on `[t0, t1]` in `mode`;
+/// `y1` is the step's exact end state when it ended without an event at `t1`.
+struct Segment<const N: usize> {
+    t1: f64,
+    dense: rk::Dense<N>,
+    y1: Option<[f64; N]>,
+    mode: Mode,
+}
+
+/// The event-driven integrator, one step at a time: [`HybridSolver::step`] advances to the next
+/// accepted step, located event or the stop time and says which ([`StopReason`]). The state at
+/// any time up to [`HybridSolver::settled_s`] is final (a later step can locate an event no earlier
+/// than that, see the module docs on the dip search) and is read with
+/// [`HybridSolver::state_at`].
+pub struct HybridSolver<'m, M: StickSlipModel<N>, const N: usize> {
+    model: &'m M,
+    opts: SolverOptions,
+    t_end: f64,
+    span: f64,
+    t: f64,
+    y: [f64; N],
+    mode: Mode,
+    h: f64,
+    /// Set after an event: the next step starts a phase (derivative and event values anew).
+    phase_start: bool,
+    f: [f64; N],
+    g_prev: [f64; N_EVENTS],
+    /// The previous accepted step of this phase: its continuous extension and its last interior
+    /// event sample, so that a minimum of the samples at a step boundary is searched too.
+    prev: Option<(rk::Dense<N>, f64, [f64; N_EVENTS])>,
+    settled: f64,
+    segments: Vec<Segment<N>>,
+    quick_transitions: usize,
+    last_transition_t: f64,
+    /// Transitions, the states just after them, switching-surface crossings and counters so far.
+    pub transitions: Vec<Transition>,
+    pub transition_states: Vec<[f64; N]>,
+    pub switches: Vec<Switch>,
+    pub stats: Stats,
+}
+
+impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
+    /// A solver at `(t0, y0)` in `mode0` (made consistent with it) that will stop at `t_end`.
+    ///
+    /// # Errors
+    /// [`Error::Config`] for invalid options or `t_end ≤ t0`; a simulation error when `y0` cannot
+    /// be made consistent with `mode0`.
+    pub fn new(
+        model: &'m M,
+        t0: f64,
+        y0: [f64; N],
+        mode0: Mode,
+        t_end: f64,
+        opts: &SolverOptions,
+    ) -> Result<Self> {
+        opts.validate()?;
+        if t_end <= t0 {
+            return Err(Error::Config(format!(
+                "simulation window must have t_end > t0 (got {t0} .. {t_end})"
+            )));
+        }
+        if model.switching_surfaces() > MAX_SWITCHING_SURFACES {
+            return Err(Error::Config(format!(
+                "model declares {} switching surfaces; at most {MAX_SWITCHING_SURFACES} are supported",
+                model.switching_surfaces()
+            )));
+        }
+        let mut y = y0;
+        let mut mode = mode0;
+        model
+            .complete(&mode, t0, &mut y)
+            .map_err(|e| SimulationError::new(t0, e, model.describe(t0, &y)))?;
+        mode.region = region_of(model, t0, &y);
+        let span = t_end - t0;
+        Ok(HybridSolver {
+            model,
+            opts: *opts,
+            t_end,
+            span,
+            t: t0,
+            y,
+            mode,
+            h: (1e-6 * span).min(opts.h_max),
+            phase_start: true,
+            f: [0.0; N],
+            g_prev: [NO_EVENT; N_EVENTS],
+            prev: None,
+            settled: t0,
+            segments: Vec::new(),
+            quick_transitions: 0,
+            last_transition_t: f64::NEG_INFINITY,
+            transitions: Vec::new(),
+            transition_states: Vec::new(),
+            switches: Vec::new(),
+            stats: Stats::default(),
+        })
+    }
+
+    /// Current time, state and mode (at the end of the last step or at the last event).
+    pub fn current(&self) -> (f64, [f64; N], Mode) {
+        (self.t, self.y, self.mode)
+    }
+
+    /// Up to this time the solution is final: no later step can place an event before it.
+    pub fn settled_s(&self) -> f64 {
+        self.settled
+    }
+
+    /// The state at `t` and the phase there, made consistent with that phase. `t` lies between
+    /// the settled time before the last [`HybridSolver::step`] and [`HybridSolver::settled_s`], and
+    /// does not go back before an earlier read: read every time you need after each step.
+    ///
+    /// # Errors
+    /// The model's fault when the state cannot be completed (see [`StickSlipModel::complete`]).
+    pub fn state_at(&mut self, t: f64) -> Result<([f64; N], Phase)> {
+        while self.segments.len() > 1 && self.segments[0].t1 < t {
+            self.segments.remove(0);
+        }
+        let (mut y, mode) = match self.segments.first() {
+            Some(s) if t <= s.t1 => (
+                match s.y1 {
+                    Some(y1) if t == s.t1 => y1,
+                    _ => s.dense.eval(t),
+                },
+                s.mode,
+            ),
+            _ => (self.y, self.mode),
+        };
+        self.model
+            .complete(&mode, t, &mut y)
+            .map_err(|e| self.fail(t, &y, e.into()))?;
+        Ok((y, mode.phase))
+    }
+
+    fn fail(&self, t: f64, y: &[f64; N], cause: StopCause) -> Error {
+        SimulationError::new(t, cause, self.model.describe(t, y)).into()
+    }
+
+    /// Advances to the next accepted step, located event or the stop time.
+    ///
+    /// # Errors
+    /// A simulation error naming the time and state when the contact lifts off (N ≤ 0), the slip
+    /// system is singular (Painlevé), the step size collapses, or the step/transition budget runs out.
+    pub fn step(&mut self) -> Result<StopReason> {
+        // Steps that ended before the settled time are no longer read (outputs up to it were
+        // read after the last step): keep the list short and its storage reused.
+        let settled = self.settled;
+        self.segments.retain(|s| s.t1 >= settled);
+        if self.phase_start {
+            self.begin_phase()?;
+        }
+        loop {
+            if self.t >= self.t_end {
+                self.settled = self.t_end;
+                return Ok(StopReason::StopTime { t_s: self.t });
+            }
+            if self.stats.steps >= self.opts.max_steps {
+                return Err(self.fail(
+                    self.t,
+                    &self.y,
+                    StopCause::StepBudget {
+                        max_steps: self.opts.max_steps,
+                    },
+                ));
+            }
+            let Some((a, last)) = self.attempt()? else {
+                continue;
+            };
+            self.stats.steps += 1;
+            let t_new = if last { self.t_end } else { self.t + self.h };
+            return match self.locate(&a, t_new)? {
+                None => Ok(self.accept(a, t_new)),
+                Some((k, te)) => self.handle_event(&a, k, te, t_new),
+            };
+        }
+    }
+
+    /// The derivative and event values at the start of a phase; contact must hold there.
+    fn begin_phase(&mut self) -> Result<()> {
+        let (model, mode, t, y) = (self.model, self.mode, self.t, self.y);
+        model
+            .rhs(&mode, t, &y, &mut self.f)
+            .map_err(|e| self.fail(t, &y, e.into()))?;
+        self.stats.rhs_evals += 1;
+        let (g, c0) = event_values(model, &mode, t, &y).map_err(|e| self.fail(t, &y, e.into()))?;
+        self.stats.event_evals += 1;
+        if c0.normal <= 0.0 {
+            return Err(self.fail(
+                t,
+                &y,
+                StopCause::ContactLost {
+                    phase: None,
+                    normal_n: c0.normal,
+                },
+            ));
+        }
+        self.g_prev = g;
+        self.prev = None;
+        self.phase_start = false;
+        Ok(())
+    }
+
+    /// One DOPRI5 attempt of size `h` (cut to the stop time): the accepted attempt and whether it
+    /// is the last step, or `None` after a rejection (the step size is reduced).
+    fn attempt(&mut self) -> Result<Option<(rk::Attempt<N>, bool)>> {
+        self.h = self.h.min(self.opts.h_max);
+        let last = self.t + self.h >= self.t_end;
+        if last {
+            self.h = self.t_end - self.t;
+        }
+        if self.h <= 4.0 * f64::EPSILON * self.t.abs().max(1.0) * 16.0 {
+            return Err(self.fail(
+                self.t,
+                &self.y,
+                StopCause::StepSizeCollapse {
+                    h_s: self.h,
+                    phase: Some(self.mode.phase),
+                },
+            ));
+        }
+        let (model, mode) = (self.model, self.mode);
+        let mut rhs =
+            |tt: f64, yy: &[f64; N], dy: &mut [f64; N]| model.rhs(&mode, tt, yy, dy).map(|_| ());
+        let attempt = rk::attempt(
+            &mut rhs,
+            self.t,
+            &self.y,
+            &self.f,
+            self.h,
+            self.opts.rtol,
+            self.opts.atol,
+        );
+        self.stats.rhs_evals += 6;
+        match attempt {
+            // The right-hand side failed inside the step, or the error estimate or state is not
+            // finite (e.g. near a singular constraint): shrink, so the collapse check ends the run.
+            Err(_) => {}
+            Ok(a) if !a.err.is_finite() || !a.y_new.iter().all(|v| v.is_finite()) => {}
+            Ok(a) if a.err > 1.0 => {
+                self.stats.rejected += 1;
+                self.h = rk::next_step(self.h, a.err).min(self.h * 0.9);
+                return Ok(None);
+            }
+            Ok(a) => return Ok(Some((a, last))),
+        }
+        self.stats.rejected += 1;
+        self.h *= 0.25;
+        Ok(None)
+    }
+
+    /// The earliest event in the accepted step `a` ending at `t_new`: its function and its time.
+    /// The event function is sampled at `event_samples` interior points and the end; a crossing
+    /// is refined by the Illinois method, a dip between samples found by golden-section search.
+    fn locate(&mut self, a: &rk::Attempt<N>, t_new: f64) -> Result<Option<(usize, f64)>> {
+        let (model, mode, t, h) = (self.model, self.mode, self.t, self.h);
+        let m = self.opts.event_samples;
+        let mut found: Option<(usize, f64)> = None;
+        let mut ta = t;
+        let mut ga = self.g_prev;
+        // The sample before `ta` (for the minimum test): the previous step's last interior sample.
+        let (mut tb, mut gb) = self
+            .prev
+            .map_or((f64::NAN, [f64::NAN; N_EVENTS]), |(_, tp, gp)| (tp, gp));
+        let prev = self.prev;
+        let dense = a.dense;
+        // State on [previous step, this step] from the continuous extensions.
+        let y_at = |tt: f64| match prev {
+            Some((pd, _, _)) if tt < t => pd.eval(tt),
+            _ => dense.eval(tt),
+        };
+        let g_at = |k: usize, tt: f64| {
+            let yy = y_at(tt);
+            event_values(model, &mode, tt, &yy).map(|(g, _)| g[k])
+        };
+        for j in 1..=m + 1 {
+            let tj = if j == m + 1 {
+                t_new
+            } else {
+                t + h * j as f64 / (m + 1) as f64
+            };
+            let yj = if j == m + 1 { a.y_new } else { dense.eval(tj) };
+            let (gj, _) =
+                event_values(model, &mode, tj, &yj).map_err(|e| self.fail(tj, &yj, e.into()))?;
+            self.stats.event_evals += 1;
+            for k in 0..N_EVENTS {
+                let bracket = if k >= 3 {
+                    // A switching surface: fires on leaving the current region, also when the
+                    // function leaves exactly 0 on the wrong side (a graze right after a switch).
+                    (ga[k] >= 0.0 && gj[k] < 0.0).then_some((ta, tj, ga[k], gj[k]))
+                } else if ga[k] > 0.0 && gj[k] <= 0.0 {
+                    Some((ta, tj, ga[k], gj[k]))
+                } else if ga[k] == 0.0 && j == 1 && gj[k] < 0.0 {
+                    // Just after a transition the function starts at 0; if it is already negative
+                    // at the first sample it may have risen and fallen back in between (a slip that
+                    // reverses again within the first sub-step): look for a positive maximum.
+                    let (tm, gm, n) = golden_extremum(|tt| g_at(k, tt).map(|g| -g), ta, tj)
+                        .map_err(|e| self.fail(tj, &yj, e.into()))?;
+                    self.stats.event_evals += n;
+                    (-gm > 0.0).then_some((tm, tj, -gm, gj[k]))
+                } else if gb[k] > 0.0
+                    && ga[k] > 0.0
+                    && gj[k] > 0.0
+                    && ga[k].is_finite()
+                    && ga[k] <= gb[k]
+                    && ga[k] <= gj[k]
+                {
+                    // The samples have an interior minimum above zero: the function may dip
+                    // across zero and back between samples. Find the minimum.
+                    let (tm, gm, n) = golden_extremum(|tt| g_at(k, tt), tb, tj)
+                        .map_err(|e| self.fail(tj, &yj, e.into()))?;
+                    self.stats.event_evals += n;
+                    (gm <= 0.0).then_some((tb, tm, gb[k], gm))
+                } else {
+                    None
+                };
+                if let Some((lo, hi, glo, ghi)) = bracket {
+                    let tk = illinois_right(|tt| g_at(k, tt), lo, hi, glo, ghi)
+                        .map_err(|e| self.fail(tj, &yj, e.into()))?;
+                    if found.is_none_or(|(_, te)| tk < te) {
+                        found = Some((k, tk));
+                    }
+                }
+            }
+            if found.is_some() {
+                break;
+            }
+            tb = ta;
+            gb = ga;
+            ta = tj;
+            ga = gj;
+        }
+        if found.is_none() {
+            self.g_prev = ga;
+            self.prev = Some((dense, tb, gb));
+        }
+        Ok(found)
+    }
+
+    /// Takes the accepted step without an event.
+    fn accept(&mut self, a: rk::Attempt<N>, t_new: f64) -> StopReason {
+        self.segments.push(Segment {
+            t1: t_new,
+            dense: a.dense,
+            y1: Some(a.y_new),
+            mode: self.mode,
+        });
+        // A later step looks back no earlier than this step's last interior sample.
+        self.settled = self.prev.map_or(self.t, |(_, tb, _)| tb);
+        self.t = t_new;
+        self.y = a.y_new;
+        self.f = a.f_new;
+        self.h = rk::next_step(self.h, a.err);
+        if self.t >= self.t_end {
+            self.settled = self.t_end;
+            StopReason::StopTime { t_s: self.t }
+        } else {
+            StopReason::InternalStep { t_s: t_new }
+        }
+    }
+
+    /// Ends the step at event `k` located at `te` (possibly in the previous step: a dip at the
+    /// boundary), and starts the phase that follows it.
+    fn handle_event(
+        &mut self,
+        a: &rk::Attempt<N>,
+        k: usize,
+        te: f64,
+        t_new: f64,
+    ) -> Result<StopReason> {
+        let t_start = self.t;
+        let mut ye = if te >= t_new {
+            a.y_new
+        } else if te < t_start {
+            self.prev.map_or(a.dense.eval(te), |(pd, _, _)| pd.eval(te))
+        } else {
+            a.dense.eval(te)
+        };
+        // The solution now ends at `te`: cut the segments there (a dip found at the boundary with
+        // the previous step lies before this step, which is then dropped).
+        if te >= t_start {
+            self.segments.push(Segment {
+                t1: te,
+                dense: a.dense,
+                y1: None,
+                mode: self.mode,
+            });
+        }
+        if let Some(s) = self.segments.last_mut()
+            && s.t1 > te
+        {
+            s.t1 = te;
+            s.y1 = None;
+        }
+        self.settled = te;
+        self.model
+            .complete(&self.mode, te, &mut ye)
+            .map_err(|e| self.fail(te, &ye, e.into()))?;
+        let event = Event::of_function(k, self.mode.phase.slip_dir().is_some());
+        self.phase_start = true;
+        self.t = te;
+        match event {
+            Event::Surface { index } => {
+                // Same phase, the other branch of the right-hand side.
+                self.mode.region ^= 1 << index;
+                self.switches.push(Switch {
+                    t_s: te,
+                    surface: index,
+                    entered: self.mode.region & (1 << index) != 0,
+                });
+                self.y = ye;
+            }
+            Event::LiftOff => {
+                let (_, c) = event_values(self.model, &self.mode, te, &ye)
+                    .map_err(|e| self.fail(te, &ye, e.into()))?;
+                return Err(self.fail(
+                    te,
+                    &ye,
+                    StopCause::ContactLost {
+                        phase: Some(self.mode.phase),
+                        normal_n: c.normal,
+                    },
+                ));
+            }
+            Event::SlipEnds | Event::StaticLimit { .. } => {
+                self.transition(event.function(), te, ye)?
+            }
+        }
+        self.h = self.h.max(1e-12 * self.span);
+        Ok(StopReason::Event { t_s: te, event })
+    }
+
+    /// A phase transition at `te` from the state `ye`: the next phase, checked against the
+    /// transition budget and against accumulation (Zeno).
+    fn transition(&mut self, k: usize, te: f64, mut ye: [f64; N]) -> Result<()> {
+        let from = self.mode.phase;
+        let new_mode = decide_after_event(self.model, &self.mode, k, te, &mut ye)
+            .map_err(|e| self.fail(te, &ye, e.into()))?;
+        self.stats.event_evals += 1;
+        self.transitions.push(Transition {
+            t_s: te,
+            from,
+            to: new_mode.phase,
+        });
+        self.transition_states.push(ye);
+        if self.transitions.len() > self.opts.max_transitions {
+            return Err(self.fail(
+                te,
+                &ye,
+                StopCause::TooManyTransitions {
+                    max_transitions: self.opts.max_transitions,
+                },
+            ));
+        }
+        if te - self.last_transition_t <= 1e-12 * te.abs().max(1.0) {
+            self.quick_transitions += 1;
+            if self.quick_transitions > 50 {
+                return Err(self.fail(te, &ye, StopCause::Zeno { count: 50 }));
+            }
+        } else {
+            self.quick_transitions = 0;
+        }
+        self.last_transition_t = te;
+        self.y = ye;
+        self.mode = new_mode;
+        Ok(())
+    }
+}
+
 /// Integrates `model` from `(t0, y0)` in `mode0` to `t_end`, recording the state at `out_times`
-/// (sorted ascending, inside `[t0, t_end]`), every transition, and counters.
+/// (sorted ascending, inside `[t0, t_end]`), every transition, and counters: a loop over
+/// [`HybridSolver::step`] that reads each output time once the solution has settled past it.
 ///
 /// # Errors
-/// [`Error::Simulation`] naming the time and state when the contact lifts off (N ≤ 0), the slip
-/// system is singular (Painlevé), the step size collapses, or the step/transition budget runs out;
-/// [`Error::Config`] for invalid options.
+/// As [`HybridSolver::new`] and [`HybridSolver::step`].
 pub fn integrate<M: StickSlipModel<N>, const N: usize>(
     model: &M,
     t0: f64,
@@ -274,17 +789,7 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
     out_times: &[f64],
     opts: &SolverOptions,
 ) -> Result<Run<N>> {
-    opts.validate()?;
-    let forward = t_end > t0;
-    if !forward {
-        return Err(Error::Config(format!(
-            "simulation window must have t_end > t0 (got {t0} .. {t_end})"
-        )));
-    }
-    let fail = |t: f64, y: &[f64; N], cause: StopCause| -> Error {
-        SimulationError::new(t, cause, model.describe(t, y)).into()
-    };
-    let mut stats = Stats::default();
+    let mut solver = HybridSolver::new(model, t0, y0, mode0, t_end, opts)?;
     let mut run = Run {
         t_s: Vec::with_capacity(out_times.len()),
         y: Vec::with_capacity(out_times.len()),
@@ -292,310 +797,40 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
         transitions: Vec::new(),
         transition_states: Vec::new(),
         switches: Vec::new(),
-        stats,
+        stats: Stats::default(),
         y_end: y0,
         mode_end: mode0,
     };
     let mut next_out = out_times.partition_point(|&to| to < t0);
-    let mut t = t0;
-    let mut y = y0;
-    let mut mode = mode0;
-    model
-        .complete(&mode, t, &mut y)
-        .map_err(|e| fail(t, &y, e.into()))?;
-    if model.switching_surfaces() > MAX_SWITCHING_SURFACES {
-        return Err(Error::Config(format!(
-            "model declares {} switching surfaces; at most {MAX_SWITCHING_SURFACES} are supported",
-            model.switching_surfaces()
-        )));
-    }
-    mode.region = region_of(model, t, &y);
-    // Emit outputs at exactly t0.
+    // Outputs at exactly t0: the consistent start state.
+    let (_, y_start, mode_start) = solver.current();
     while next_out < out_times.len() && out_times[next_out] <= t0 {
         run.t_s.push(out_times[next_out]);
-        run.y.push(y);
-        run.phase.push(mode.phase);
+        run.y.push(y_start);
+        run.phase.push(mode_start.phase);
         next_out += 1;
     }
-    let span = t_end - t0;
-    let mut h = (1e-6 * span).min(opts.h_max);
-    let mut quick_transitions = 0usize;
-    let mut last_transition_t = f64::NEG_INFINITY;
-
-    'phases: loop {
-        // Start of a phase.
-        let mut f = [0.0; N];
-        model
-            .rhs(&mode, t, &y, &mut f)
-            .map_err(|e| fail(t, &y, e.into()))?;
-        stats.rhs_evals += 1;
-        let (mut g_prev, c0) =
-            event_values(model, &mode, t, &y).map_err(|e| fail(t, &y, e.into()))?;
-        stats.event_evals += 1;
-        if c0.normal <= 0.0 {
-            return Err(fail(
-                t,
-                &y,
-                StopCause::ContactLost {
-                    phase: None,
-                    normal_n: c0.normal,
-                },
-            ));
+    loop {
+        let reason = solver.step()?;
+        while next_out < out_times.len() && out_times[next_out] <= solver.settled_s() {
+            let to = out_times[next_out];
+            let (yo, phase) = solver.state_at(to)?;
+            run.t_s.push(to);
+            run.y.push(yo);
+            run.phase.push(phase);
+            next_out += 1;
         }
-        // The previous accepted step of this phase: its continuous extension and its last interior
-        // event sample, so that a minimum of the samples at a step boundary is searched too.
-        let mut prev: Option<(rk::Dense<N>, f64, [f64; N_EVENTS])> = None;
-        loop {
-            if t >= t_end {
-                break 'phases;
-            }
-            if stats.steps >= opts.max_steps {
-                return Err(fail(
-                    t,
-                    &y,
-                    StopCause::StepBudget {
-                        max_steps: opts.max_steps,
-                    },
-                ));
-            }
-            h = h.min(opts.h_max);
-            let last = t + h >= t_end;
-            if last {
-                h = t_end - t;
-            }
-            if h <= 4.0 * f64::EPSILON * t.abs().max(1.0) * 16.0 {
-                return Err(fail(
-                    t,
-                    &y,
-                    StopCause::StepSizeCollapse {
-                        h_s: h,
-                        phase: Some(mode.phase),
-                    },
-                ));
-            }
-            let mut rhs = |tt: f64, yy: &[f64; N], dy: &mut [f64; N]| {
-                model.rhs(&mode, tt, yy, dy).map(|_| ())
-            };
-            let attempt = rk::attempt(&mut rhs, t, &y, &f, h, opts.rtol, opts.atol);
-            stats.rhs_evals += 6;
-            let a = match attempt {
-                Ok(a) => a,
-                Err(_) => {
-                    // The right-hand side failed inside the step: shrink and retry.
-                    stats.rejected += 1;
-                    h *= 0.25;
-                    continue;
-                }
-            };
-            if !a.err.is_finite() || !a.y_new.iter().all(|v| v.is_finite()) {
-                // A non-finite error estimate or state (e.g. near a singular constraint): shrink
-                // like a failed right-hand side, so the step-size collapse check ends the run.
-                stats.rejected += 1;
-                h *= 0.25;
-                continue;
-            }
-            if a.err > 1.0 {
-                stats.rejected += 1;
-                h = rk::next_step(h, a.err).min(h * 0.9);
-                continue;
-            }
-            stats.steps += 1;
-            let t_new = if last { t_end } else { t + h };
-            // Event detection: sample g at interior points and the end.
-            // Earliest located crossing in this step: (event function, time).
-            let mut found: Option<(usize, f64)> = None;
-            let m = opts.event_samples;
-            let mut ta = t;
-            let mut ga = g_prev;
-            // The sample before `ta` (for the minimum test): the previous step's last interior
-            // sample at the step start, if the previous step belongs to this phase.
-            let (mut tb, mut gb) =
-                prev.map_or((f64::NAN, [f64::NAN; N_EVENTS]), |(_, tp, gp)| (tp, gp));
-            let dense = a.dense;
-            let t_start = t;
-            // State on [previous step, this step] from the continuous extensions.
-            let y_at = |tt: f64| match prev {
-                Some((pd, _, _)) if tt < t_start => pd.eval(tt),
-                _ => dense.eval(tt),
-            };
-            let g_at = |k: usize, tt: f64| {
-                let yy = y_at(tt);
-                event_values(model, &mode, tt, &yy).map(|(g, _)| g[k])
-            };
-            for j in 1..=m + 1 {
-                let tj = if j == m + 1 {
-                    t_new
-                } else {
-                    t + h * j as f64 / (m + 1) as f64
-                };
-                let yj = if j == m + 1 {
-                    a.y_new
-                } else {
-                    a.dense.eval(tj)
-                };
-                let (gj, _) =
-                    event_values(model, &mode, tj, &yj).map_err(|e| fail(tj, &yj, e.into()))?;
-                stats.event_evals += 1;
-                // Refine every function that crossed in [ta, tj]; keep the earliest.
-                for k in 0..N_EVENTS {
-                    let mut bracket = None;
-                    if k >= 3 {
-                        // A switching surface: fires on leaving the current region, also when the
-                        // function leaves exactly 0 on the wrong side (a graze right after a switch).
-                        if ga[k] >= 0.0 && gj[k] < 0.0 {
-                            bracket = Some((ta, tj, ga[k], gj[k]));
-                        }
-                    } else if ga[k] > 0.0 && gj[k] <= 0.0 {
-                        bracket = Some((ta, tj, ga[k], gj[k]));
-                    } else if ga[k] == 0.0 && j == 1 && gj[k] < 0.0 {
-                        // Just after a transition the function starts at 0; if it is already
-                        // negative at the first sample it may have risen and fallen back in between
-                        // (a slip that reverses again within the first sub-step): look for a
-                        // positive maximum.
-                        let (tm, gm, n) = golden_extremum(|tt| g_at(k, tt).map(|g| -g), ta, tj)
-                            .map_err(|e| fail(tj, &yj, e.into()))?;
-                        stats.event_evals += n;
-                        if -gm > 0.0 {
-                            bracket = Some((tm, tj, -gm, gj[k]));
-                        }
-                    } else if gb[k] > 0.0
-                        && ga[k] > 0.0
-                        && gj[k] > 0.0
-                        && ga[k].is_finite()
-                        && ga[k] <= gb[k]
-                        && ga[k] <= gj[k]
-                    {
-                        // The samples have an interior minimum above zero: the function may dip
-                        // across zero and back between samples. Find the minimum.
-                        let (tm, gm, n) = golden_extremum(|tt| g_at(k, tt), tb, tj)
-                            .map_err(|e| fail(tj, &yj, e.into()))?;
-                        stats.event_evals += n;
-                        if gm <= 0.0 {
-                            bracket = Some((tb, tm, gb[k], gm));
-                        }
-                    }
-                    if let Some((lo, hi, glo, ghi)) = bracket {
-                        let tk = illinois_right(|tt| g_at(k, tt), lo, hi, glo, ghi)
-                            .map_err(|e| fail(tj, &yj, e.into()))?;
-                        if found.is_none_or(|(_, te)| tk < te) {
-                            found = Some((k, tk));
-                        }
-                    }
-                }
-                if found.is_some() {
-                    break;
-                }
-                tb = ta;
-                gb = ga;
-                ta = tj;
-                ga = gj;
-            }
-            // Output samples up to the (possibly truncated) step end.
-            let t_stop = found.map_or(t_new, |(_, te)| te);
-            while next_out < out_times.len() && out_times[next_out] <= t_stop {
-                let to = out_times[next_out];
-                let mut yo = if to == t_new && found.is_none() {
-                    a.y_new
-                } else {
-                    a.dense.eval(to)
-                };
-                model
-                    .complete(&mode, to, &mut yo)
-                    .map_err(|e| fail(to, &yo, e.into()))?;
-                run.t_s.push(to);
-                run.y.push(yo);
-                run.phase.push(mode.phase);
-                next_out += 1;
-            }
-            match found {
-                None => {
-                    prev = Some((a.dense, tb, gb));
-                    t = t_new;
-                    y = a.y_new;
-                    f = a.f_new;
-                    g_prev = ga;
-                    h = rk::next_step(h, a.err);
-                }
-                Some((k, te)) => {
-                    let mut ye = if te >= t_new { a.y_new } else { y_at(te) };
-                    // A dip found at the boundary with the previous step may lie before this step:
-                    // withdraw the outputs already recorded after it.
-                    while run.t_s.last().is_some_and(|&to| to > te) {
-                        run.t_s.pop();
-                        run.y.pop();
-                        run.phase.pop();
-                        next_out -= 1;
-                    }
-                    model
-                        .complete(&mode, te, &mut ye)
-                        .map_err(|e| fail(te, &ye, e.into()))?;
-                    if k >= 3 {
-                        // A switching surface: same phase, the other branch of the right-hand side.
-                        let i = k - 3;
-                        mode.region ^= 1 << i;
-                        run.switches.push(Switch {
-                            t_s: te,
-                            surface: i,
-                            entered: mode.region & (1 << i) != 0,
-                        });
-                        t = te;
-                        y = ye;
-                        h = h.max(1e-12 * span);
-                        continue 'phases;
-                    }
-                    if k == 2 {
-                        let (_, c) = event_values(model, &mode, te, &ye)
-                            .map_err(|e| fail(te, &ye, e.into()))?;
-                        return Err(fail(
-                            te,
-                            &ye,
-                            StopCause::ContactLost {
-                                phase: Some(mode.phase),
-                                normal_n: c.normal,
-                            },
-                        ));
-                    }
-                    let from = mode.phase;
-                    let new_mode = decide_after_event(model, &mode, k, te, &mut ye)
-                        .map_err(|e| fail(te, &ye, e.into()))?;
-                    stats.event_evals += 1;
-                    run.transitions.push(Transition {
-                        t_s: te,
-                        from,
-                        to: new_mode.phase,
-                    });
-                    run.transition_states.push(ye);
-                    if run.transitions.len() > opts.max_transitions {
-                        return Err(fail(
-                            te,
-                            &ye,
-                            StopCause::TooManyTransitions {
-                                max_transitions: opts.max_transitions,
-                            },
-                        ));
-                    }
-                    if te - last_transition_t <= 1e-12 * te.abs().max(1.0) {
-                        quick_transitions += 1;
-                        if quick_transitions > 50 {
-                            return Err(fail(te, &ye, StopCause::Zeno { count: 50 }));
-                        }
-                    } else {
-                        quick_transitions = 0;
-                    }
-                    last_transition_t = te;
-                    t = te;
-                    y = ye;
-                    mode = new_mode;
-                    // Keep the step size of the last accepted step (a fresh phase starts smooth).
-                    h = h.max(1e-12 * span);
-                    continue 'phases;
-                }
-            }
+        if let StopReason::StopTime { .. } = reason {
+            break;
         }
     }
-    run.stats = stats;
-    run.y_end = y;
-    run.mode_end = mode;
+    let (_, y_end, mode_end) = solver.current();
+    run.transitions = solver.transitions;
+    run.transition_states = solver.transition_states;
+    run.switches = solver.switches;
+    run.stats = solver.stats;
+    run.y_end = y_end;
+    run.mode_end = mode_end;
     Ok(run)
 }
 
