@@ -115,7 +115,7 @@ fn cost(c: &mut Criterion) {
         swarm_solver: solver,
         weights: Weights::default(),
         evaluations: Arc::new(AtomicUsize::new(0)),
-        failures: AtomicUsize::new(0),
+        failures: std::sync::Arc::new(AtomicUsize::new(0)),
         first_failure: Mutex::new(None),
     };
     let mut g = c.benchmark_group("fit");

@@ -100,3 +100,94 @@ keys = {{ C = "/C", k1 = "/k1" }}
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Counts add up across candidates and the bootstrap, and the failure warning fires: the preload
+/// h_d is freed down to 0.2 of its value, where the contact lifts off (tests/hard_cases.rs: at half
+/// the sample's preload the normal force reaches zero inside the window), so a large share of the
+/// evaluations fail. Two candidates and a polish-only bootstrap run on the same recording.
+#[test]
+fn evaluation_and_failure_counts_add_up_and_failures_are_reported() {
+    let truth = common::true_blade();
+    let (t0, t1) = default_window(&truth);
+    let fps = 1e4;
+    let n = ((t1 - t0) * fps) as usize;
+    let times: Vec<f64> = (0..n).map(|k| t0 + k as f64 / fps).collect();
+    let sim = simulate_blade(
+        &truth,
+        (t0, *times.last().unwrap()),
+        &times,
+        &SolverOptions::default(),
+        StickForm::Reduced,
+    )
+    .unwrap();
+    let dir = std::env::temp_dir().join(format!("wiperlab_fit_counts_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    common::write_dltdv(&dir.join("rec_xypts.csv"), &sim, &mut || 0.0);
+    std::fs::write(dir.join("blade.toml"), toml::to_string(&truth).unwrap()).unwrap();
+    let hd = truth.hd_m;
+    let job = format!(
+        r#"name = "counts"
+blade = "blade.toml"
+{recording}[fit]
+particles = 6
+swarm_iterations = 3
+polish_iterations = 6
+models = ["head1dof", "blade2dof"]
+[fit.parameters]
+C = [0.3, 0.8]
+hd = [{lo}, {hi}]
+[fit.uncertainty]
+bootstrap = 2
+full_refit = false
+polish_iterations = 4
+"#,
+        recording = common::dltdv_recording("rec_xypts.csv", t0),
+        lo = 0.2 * hd,
+        hi = 1.2 * hd,
+    );
+    std::fs::write(dir.join("job.toml"), job).unwrap();
+    let loaded = LoadedJob::load(&dir.join("job.toml")).unwrap();
+    let r = run_fit(&loaded, false).unwrap().result;
+    let trials = &r.model_trials;
+    assert_eq!(trials.len(), 2);
+    let evals: usize = trials.iter().map(|t| t.model_evaluations).sum();
+    let failed: usize = trials.iter().map(|t| t.failed_evaluations).sum();
+    eprintln!(
+        "evaluations {evals} ({failed} failed); per trial {:?}; warnings {:?}",
+        trials
+            .iter()
+            .map(|t| (t.model_evaluations, t.failed_evaluations))
+            .collect::<Vec<_>>(),
+        r.warnings
+    );
+    assert_eq!(r.model_evaluations, evals);
+    assert_eq!(r.failed_evaluations, failed);
+    for t in trials {
+        assert!(t.failed_evaluations <= t.model_evaluations);
+        // Each restart's history ends at no more evaluations than the trial counted.
+        let last = r.history.iter().map(|h| h.evaluations).max().unwrap_or(0);
+        if t.chosen {
+            assert!(last <= t.model_evaluations);
+        }
+    }
+    assert!(failed > 0, "no evaluation failed down to 0.2 h_d");
+    assert!(
+        r.warnings
+            .iter()
+            .any(|w| w.contains("model evaluations failed") && w.contains("contact lost")),
+        "{:?}",
+        r.warnings
+    );
+    // The warning counts the chosen model's evaluations, bootstrap replicates included.
+    let chosen = trials.iter().find(|t| t.chosen).unwrap();
+    assert!(
+        r.warnings.iter().any(|w| w.starts_with(&format!(
+            "{} of {} model evaluations failed",
+            chosen.failed_evaluations, chosen.model_evaluations
+        ))),
+        "{:?}",
+        r.warnings
+    );
+    assert_eq!(r.first_failure.is_some(), chosen.failed_evaluations > 0);
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -83,7 +83,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     };
     let pb = progress.then(|| progress_bar(job, &candidates));
     let mut fits = fit_candidates(job, &meas, &candidates, &pb)?;
-    let selection = select::choose(&fits, &job.job.spectrum.bands, !fit.models.is_empty());
+    let mut selection = select::choose(&fits, &job.job.spectrum.bands, !fit.models.is_empty());
     let cf = fits.swap_remove(selection.chosen);
     let best = BestModel::of(&cf)?;
     let mut parameters = fitted_parameters(job, &cf);
@@ -102,6 +102,10 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     }
     warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
     warnings.extend(failure_warning(&cf.problem));
+    // The chosen model's counts include its bootstrap replicates (they share its counters).
+    let chosen = &mut selection.trials[selection.chosen];
+    chosen.model_evaluations = cf.problem.evaluations.load(Ordering::Relaxed);
+    chosen.failed_evaluations = failures(&cf.problem).0;
     let modes = match blade_modes(&best.params) {
         Ok(m) => m,
         Err(e) => {
@@ -245,7 +249,7 @@ fn peak_comparison(
 
 /// The chosen problem's failed evaluations (its own and its joint recordings'), with the first
 /// failure's message.
-fn failures(problem: &SpectralProblem) -> (usize, Option<String>) {
+pub(crate) fn failures(problem: &SpectralProblem) -> (usize, Option<String>) {
     let failed = problem.failures.load(Ordering::Relaxed)
         + problem
             .others
@@ -291,7 +295,7 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
     let settings = toml::to_string_pretty(&job.job)
         .or_else(|_| job::read_text(&job.path))
         .unwrap_or_default();
-    let (failed, first_failure) = failures(&cf.problem);
+    let (_, first_failure) = failures(&cf.problem);
     let undetermined = a
         .parameters
         .iter()
@@ -311,7 +315,7 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         swarm_iterations: cf.swarm_iters,
         polish_iterations: cf.polish_iters,
         model_evaluations: a.trials.iter().map(|t| t.model_evaluations).sum(),
-        failed_evaluations: failed,
+        failed_evaluations: a.trials.iter().map(|t| t.failed_evaluations).sum(),
         first_failure,
         wall_time_s: a.wall_time_s,
         threads: rayon::current_num_threads(),

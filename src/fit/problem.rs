@@ -98,7 +98,8 @@ pub struct SpectralProblem {
     /// Name of this problem's recording in joint fits ("" for the main one).
     pub label: String,
     pub evaluations: Arc<AtomicUsize>,
-    pub failures: AtomicUsize,
+    /// Failed evaluations, shared like `evaluations` with the bootstrap's replicate problems.
+    pub failures: Arc<AtomicUsize>,
     pub first_failure: Mutex<Option<String>>,
 }
 

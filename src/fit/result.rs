@@ -149,6 +149,11 @@ pub struct ModelTrial {
     /// Wall-clock time of the trial, s.
     pub wall_time_s: f64,
     pub model_evaluations: usize,
+    /// Of those, the evaluations whose simulation failed (they cost [`crate::fit::FAILED_COST`]).
+    /// For the chosen model both counts include its bootstrap replicates; the result's totals are
+    /// the sums over the trials.
+    #[serde(default)]
+    pub failed_evaluations: usize,
     /// True for the model whose parameters the result reports.
     pub chosen: bool,
     /// Why it was (not) chosen, with numbers.
@@ -340,6 +345,7 @@ mod tests {
                 cost: 3.0,
                 wall_time_s: 0.1,
                 model_evaluations: 5,
+                failed_evaluations: 0,
                 chosen: false,
                 reason: "cost 3.0 > 1.5".into(),
             }],

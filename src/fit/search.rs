@@ -206,7 +206,7 @@ pub(super) fn build_problem(
             },
             weights: fit.weights,
             evaluations: evaluations.clone(),
-            failures: AtomicUsize::new(0),
+            failures: Arc::new(AtomicUsize::new(0)),
             first_failure: Mutex::new(None),
         })
     };

@@ -64,6 +64,7 @@ pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) ->
             cost: f.cost,
             wall_time_s: f.wall_time_s,
             model_evaluations: f.problem.evaluations.load(Ordering::Relaxed),
+            failed_evaluations: super::failures(&f.problem).0,
             chosen: i == chosen,
             reason: scored.reason(fits, i, bands, listed),
         })

@@ -9,7 +9,6 @@ use crate::simulate::blade::BladeSimulation;
 use crate::spectrum::stats::quantile_sorted;
 use crate::{Error, Result};
 use rand::SeedableRng;
-use std::sync::atomic::AtomicUsize;
 use std::sync::{Arc, Mutex};
 
 /// The uncertainty stage: bootstrap intervals for the chosen fit when the job asks for them
@@ -198,7 +197,7 @@ impl ReplicateSource {
             swarm_solver: problem.swarm_solver,
             weights: problem.weights,
             evaluations: problem.evaluations.clone(),
-            failures: AtomicUsize::new(0),
+            failures: problem.failures.clone(),
             first_failure: Mutex::new(None),
         })
     }
