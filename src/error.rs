@@ -49,6 +49,10 @@ pub enum Error {
     /// A numerical routine was given data it cannot work on (too short a record, all NaN, ...).
     #[error("{0}")]
     Numerics(String),
+    /// SIGINT or SIGTERM stopped the work; `written` is the interrupted result, when one was
+    /// written (never over a complete result).
+    #[error("interrupted{}", written.as_ref().map(|p| format!("; the best result so far is in {}", p.display())).unwrap_or_default())]
+    Interrupted { written: Option<PathBuf> },
     /// The optimiser failed.
     #[error("fit failed: {0}")]
     Fit(String),
@@ -61,6 +65,16 @@ impl Error {
             Error::Io { .. } | Error::Parse { .. } | Error::Input { .. } | Error::Config(_) => true,
             Error::Stage { input, .. } => *input,
             _ => false,
+        }
+    }
+
+    /// The process exit code for this error: 2 for bad input, 130 for an interrupt (128 + SIGINT),
+    /// 1 for a computation that failed.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            Error::Interrupted { .. } => 130,
+            e if e.is_input_error() => 2,
+            _ => 1,
         }
     }
 

@@ -6,6 +6,6 @@ fn main() {
     let cli = wiperlab::cli::Cli::parse();
     if let Err(e) = wiperlab::cli::run(cli) {
         eprintln!("error: {e}");
-        std::process::exit(if e.is_input_error() { 2 } else { 1 });
+        std::process::exit(e.exit_code());
     }
 }

@@ -678,3 +678,54 @@ fn import_describe_and_convert() {
         "{desc}"
     );
 }
+
+/// SIGINT during the main job's search: the fit stops within about a second, writes the best
+/// result so far to `reversal.interrupted.result.toml` marked `interrupted = true` with its
+/// evaluation count, leaves the previous complete result untouched, and exits 130.
+#[test]
+fn sigint_stops_the_fit_and_keeps_the_previous_result() {
+    let dir = TempDir::new("sigint");
+    let job = dir.write("reversal.toml", &job_text());
+    let previous = "# a previous complete result\n";
+    let complete = dir.write("reversal.result.toml", previous);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_wiperlab"))
+        .args(["fit", s(&job), "--quiet"])
+        .current_dir(&dir.0)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("cannot start the wiperlab binary");
+    // The job loads and measures in well under a second; its search then runs for a minute.
+    std::thread::sleep(std::time::Duration::from_secs(4));
+    assert!(child.try_wait().unwrap().is_none(), "the fit ended early");
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(kill.success());
+    let signalled = std::time::Instant::now();
+    let status = loop {
+        if let Some(st) = child.try_wait().unwrap() {
+            break st;
+        }
+        assert!(
+            signalled.elapsed().as_secs_f64() < 10.0,
+            "still running 10 s after SIGINT"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    let stopped_s = signalled.elapsed().as_secs_f64();
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+    eprintln!("stopped {stopped_s:.2} s after SIGINT: {err}");
+    assert_eq!(status.code(), Some(130), "{err}");
+    assert!(stopped_s < 3.0, "{stopped_s} s");
+    assert!(err.contains("interrupted"), "{err}");
+    assert_eq!(std::fs::read_to_string(&complete).unwrap(), previous);
+    let text = std::fs::read_to_string(dir.join("reversal.interrupted.result.toml"))
+        .expect("the interrupted result");
+    let r: toml::Value = toml::from_str(&text).unwrap();
+    assert_eq!(r["interrupted"].as_bool(), Some(true));
+    assert!(r["model_evaluations"].as_integer().unwrap() > 0);
+    assert!(r["parameters"].as_array().unwrap().len() == 4);
+}

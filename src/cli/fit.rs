@@ -75,12 +75,36 @@ fn report_dir(job: &LoadedJob) -> PathBuf {
     Path::new("reports").join(&job.name)
 }
 
+/// `<job dir>/<name>.interrupted.result.toml`: where an interrupted fit's result goes, so that a
+/// previous complete result stays in place.
+fn interrupted_path(job: &LoadedJob) -> PathBuf {
+    job.path
+        .parent()
+        .unwrap_or(Path::new("."))
+        .join(format!("{}.interrupted.result.toml", job.name))
+}
+
 /// Runs the fit, writes the result TOML and the fit's figures; returns the result and both paths.
+/// SIGINT or SIGTERM stops the fit: the best result so far is written to
+/// `<name>.interrupted.result.toml` and the error is [`Error::Interrupted`] (exit code 130).
 fn fit_and_write(
     job: &LoadedJob,
     progress: bool,
 ) -> Result<(crate::fit::FitResult, PathBuf, PathBuf)> {
-    let mut outcome = crate::fit::run_fit(job, progress)?;
+    crate::fit::interrupt::install_signal_handler()?;
+    let mut outcome = match crate::fit::run_fit(job, progress) {
+        Err(_) if crate::fit::interrupt::stop_requested() => {
+            return Err(Error::Interrupted { written: None });
+        }
+        other => other?,
+    };
+    if outcome.result.interrupted {
+        let path = interrupted_path(job);
+        crate::io::write_atomic(&path, outcome.result.to_toml()?.as_bytes())?;
+        return Err(Error::Interrupted {
+            written: Some(path),
+        });
+    }
     let report_dir = report_dir(job);
     crate::io::create_dir(&report_dir)?;
     outcome.result.data_files = crate::report::figures::fit_data_files(&report_dir, &outcome)?;

@@ -14,6 +14,7 @@ mod candidate;
 /// The spectral features the fit compares (they belong to the spectrum stage).
 pub use crate::spectrum::features;
 pub mod instfreq;
+pub mod interrupt;
 pub mod job;
 mod measure;
 mod problem;
@@ -91,7 +92,20 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     if let (Some(pb), true) = (&pb, fit.uncertainty.bootstrap > 0) {
         pb.set_message("bootstrap");
     }
-    let (intervals, mut warnings) = uncertainty::intervals(&cf, &best.sim, fit)?;
+    let (intervals, mut warnings) = if interrupt::stop_requested() {
+        (None, Vec::new())
+    } else {
+        match uncertainty::intervals(&cf, &best.sim, fit) {
+            Err(_) if interrupt::stop_requested() => (None, Vec::new()),
+            other => other?,
+        }
+    };
+    let interrupted = interrupt::stop_requested();
+    if interrupted {
+        warnings.push(
+            "interrupted: the best point the search had reached, without the remaining restarts, candidates, curvature or intervals".into(),
+        );
+    }
     if let Some(intervals) = intervals {
         for (p, iv) in parameters.iter_mut().zip(intervals) {
             p.interval = Some(iv);
@@ -126,6 +140,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
             wall_time_s: started.elapsed().as_secs_f64(),
             input_sha256,
             modes,
+            interrupted,
         },
     );
     Ok(FitOutcome {
@@ -287,6 +302,7 @@ struct Assembled {
     wall_time_s: f64,
     input_sha256: String,
     modes: Vec<crate::model::modes::BladeMode>,
+    interrupted: bool,
 }
 
 /// The result of the chosen fit, with the job's provenance (the recording's hash and the effective
@@ -332,6 +348,7 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         fitted_at: Some(jiff::Timestamp::now()),
         data_files: Vec::new(),
         modes: a.modes,
+        interrupted: a.interrupted,
         history: cf.history.clone(),
     }
 }

@@ -216,6 +216,10 @@ impl SpectralProblem {
             .iter()
             .map(|x| (x - x.clamp(0.0, 1.0)).powi(2))
             .sum::<f64>();
+        if super::interrupt::stop_requested() {
+            // Stopping: no more simulations (not counted as an evaluation).
+            return FAILED_COST;
+        }
         let p = self.params_at(u);
         self.evaluations.fetch_add(1, Ordering::Relaxed);
         let c = match self
@@ -245,6 +249,9 @@ impl CostFunction for Shared {
     type Param = Vec<f64>;
     type Output = f64;
     fn cost(&self, u: &Self::Param) -> std::result::Result<f64, argmin::core::Error> {
+        if super::interrupt::stop_requested() {
+            return Err(argmin::core::Error::msg("interrupted"));
+        }
         Ok(self.0.cost_at_stage(u, self.1))
     }
 }

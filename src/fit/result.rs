@@ -232,6 +232,10 @@ pub struct FitResult {
     /// computed (a warning says why) and in results written before this field.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub modes: Vec<crate::model::modes::BladeMode>,
+    /// True when the fit was stopped by SIGINT or SIGTERM: the values are the best point the
+    /// search had reached, `model_evaluations` says how far it got.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub interrupted: bool,
     pub history: Vec<HistoryPoint>,
 }
 
@@ -360,6 +364,7 @@ mod tests {
             fitted_at: Some("2026-11-22T10:00:00.5Z".parse().expect("RFC 3339 time")),
             data_files: vec!["psd_low.csv".into()],
             modes: vec![],
+            interrupted: false,
             history: vec![HistoryPoint {
                 stage: SearchStage::Swarm,
                 restart: 1,

@@ -2,6 +2,7 @@
 //! history and progress reported through argmin observers, and the cost's curvature at the optimum.
 
 use super::candidate::Candidate;
+use super::interrupt;
 use super::job::{self, LoadedJob};
 use super::measure::{Measurement, measure, measure_recording, necklip_view};
 use super::problem::{FreeParam, Shared, SpectralProblem};
@@ -19,10 +20,16 @@ use rand::SeedableRng;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
+/// A point of the normalised search space with its cost.
+pub(super) type Scored = (Vec<f64>, f64);
+
 /// What a candidate's search reports, and where: its cost history and the job's progress bar.
 #[derive(Clone)]
 pub(super) struct Reporting {
     pub(super) history: Arc<Mutex<Vec<HistoryPoint>>>,
+    /// The best point any iteration of this candidate's search reached, with its cost: what an
+    /// interrupted search returns.
+    pub(super) best: Arc<Mutex<Option<Scored>>>,
     pub(super) progress: Option<indicatif::ProgressBar>,
     /// The progress bar's position when this candidate started: its model runs count on from here.
     pub(super) base: u64,
@@ -48,7 +55,28 @@ pub(super) struct SearchObserver {
     evals: Arc<AtomicUsize>,
 }
 
-impl<I: State<Float = f64>> Observe<I> for SearchObserver {
+/// A point of the search space as the solvers' states hold it.
+pub(super) trait AsPoint {
+    fn point(&self) -> &[f64];
+}
+
+impl AsPoint for Vec<f64> {
+    fn point(&self) -> &[f64] {
+        self
+    }
+}
+
+impl AsPoint for argmin::solver::particleswarm::Particle<Vec<f64>, f64> {
+    fn point(&self) -> &[f64] {
+        &self.position
+    }
+}
+
+impl<I> Observe<I> for SearchObserver
+where
+    I: State<Float = f64>,
+    I::Param: AsPoint,
+{
     fn observe_iter(
         &mut self,
         state: &I,
@@ -68,6 +96,17 @@ impl<I: State<Float = f64>> Observe<I> for SearchObserver {
             });
         if let Some(pb) = &self.reporting.progress {
             pb.set_position(self.reporting.base + evaluations as u64);
+        }
+        let cost = state.get_best_cost();
+        if let Some(p) = state.get_best_param() {
+            let mut best = self
+                .reporting
+                .best
+                .lock()
+                .unwrap_or_else(|e| e.into_inner());
+            if best.as_ref().is_none_or(|b| cost < b.1) {
+                *best = Some((p.point().to_vec(), cost));
+            }
         }
         Ok(())
     }
@@ -129,6 +168,9 @@ pub(super) fn fit_candidates(
             .find(|f| c.shoulder && f.candidate.kind == c.kind && !f.candidate.shoulder);
         let fitted = fit_candidate(job, meas, *c, pb, nested)?;
         fits.push(fitted);
+        if interrupt::stop_requested() {
+            break;
+        }
     }
     Ok(fits)
 }
@@ -254,6 +296,7 @@ pub(super) fn fit_candidate(
     let fit = &job.job.fit;
     let reporting = Reporting {
         history: Arc::new(Mutex::new(Vec::new())),
+        best: Arc::new(Mutex::new(None)),
         progress: pb.clone(),
         base: pb.as_ref().map_or(0, |pb| pb.position()),
         candidate,
@@ -296,7 +339,12 @@ pub(super) fn fit_candidate(
 
     // Curvature of the cost at the optimum → standard errors, correlations, identifiability.
     reporting.stage(format_args!("curvature"));
-    let (sigma_u, corr) = curvature(&problem, &best_u);
+    let (sigma_u, corr) = if interrupt::stop_requested() {
+        let n = best_u.len();
+        (vec![f64::NAN; n], vec![vec![f64::NAN; n]; n])
+    } else {
+        curvature(&problem, &best_u)
+    };
     if let Some(pb) = pb {
         pb.set_position(reporting.base + problem.evaluations.load(Ordering::Relaxed) as u64);
     }
@@ -385,7 +433,11 @@ pub(super) fn optimise(
         if let Some(o) = observer(SearchStage::Swarm, r) {
             ex = ex.add_observer(o, ObserverMode::Always);
         }
-        let res = ex.run().map_err(fit_err)?;
+        let res = match ex.run() {
+            Ok(res) => res,
+            Err(_) if interrupt::stop_requested() => break,
+            Err(e) => return Err(fit_err(e)),
+        };
         let swarm_best = res
             .state()
             .get_best_param()
@@ -395,19 +447,37 @@ pub(super) fn optimise(
         if let Some(reporting) = log {
             reporting.stage(format_args!("polish"));
         }
-        let (u, iters, cost) = polish(
+        let (u, iters, cost) = match polish(
             problem,
             &swarm_best,
             0.05,
             fit.polish_iterations,
             observer(SearchStage::Polish, r),
-        )?;
+        ) {
+            Ok(p) => p,
+            Err(_) if interrupt::stop_requested() => break,
+            Err(e) => return Err(e),
+        };
         polish_iters += iters;
         if best.as_ref().is_none_or(|b| cost < b.1) {
             best = Some((u, cost));
         }
     }
-    let (u, cost) = best.ok_or_else(|| Error::Fit("no optimiser run".into()))?;
+    if interrupt::stop_requested()
+        && let Some(seen) =
+            log.and_then(|r| r.best.lock().unwrap_or_else(|e| e.into_inner()).clone())
+        && best.as_ref().is_none_or(|b| seen.1 < b.1)
+    {
+        // Interrupted: the best point the observer saw in the unfinished run.
+        best = Some(seen);
+    }
+    let (u, cost) = best.ok_or_else(|| {
+        if interrupt::stop_requested() {
+            Error::Fit("interrupted before the first iteration".into())
+        } else {
+            Error::Fit("no optimiser run".into())
+        }
+    })?;
     Ok((u, swarm_iters, polish_iters, cost))
 }
 

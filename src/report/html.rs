@@ -758,6 +758,7 @@ mod tests {
             fitted_at: None,
             data_files: vec![],
             modes: vec![],
+            interrupted: false,
             history: vec![],
         }
     }

@@ -1,0 +1,30 @@
+//! Stopping a fit on SIGINT or SIGTERM: the signal sets a flag; the cost function then refuses to
+//! simulate (argmin ends the running search with an error), the search keeps the best point its
+//! observer saw, and the fit assembles what it has, marked interrupted.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+static STOP: AtomicBool = AtomicBool::new(false);
+
+/// Asks every running fit to stop as soon as it can.
+pub fn request_stop() {
+    STOP.store(true, Ordering::SeqCst);
+}
+
+/// Whether a stop was requested.
+pub fn stop_requested() -> bool {
+    STOP.load(Ordering::Relaxed)
+}
+
+/// Routes SIGINT and SIGTERM (Ctrl-C, `kill`) to [`request_stop`]. Installing it twice is harmless.
+///
+/// # Errors
+/// [`crate::Error::Config`] when the handler cannot be installed.
+pub fn install_signal_handler() -> crate::Result<()> {
+    match ctrlc::set_handler(request_stop) {
+        Ok(()) | Err(ctrlc::Error::MultipleHandlers) => Ok(()),
+        Err(e) => Err(crate::Error::Config(format!(
+            "cannot install the interrupt handler: {e}"
+        ))),
+    }
+}
