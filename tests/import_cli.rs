@@ -218,3 +218,74 @@ fn import_never_writes_over_its_input() {
         assert_eq!(std::fs::read_to_string(&f.0).unwrap(), content);
     }
 }
+
+/// `spectrum --window boxcar --scaling spectrum` against the closed form: a sine of amplitude A
+/// centred on a bin (f = 100 fs/nperseg), boxcar-windowed, has one-sided power A²/2 in that bin
+/// (scipy.signal.welch's `scaling='spectrum'`), and the CSV column says which quantity it holds.
+#[test]
+fn spectrum_welch_options_match_the_closed_form() {
+    let (fs, n, amp) = (1000.0_f64, 8192usize, 1e-3_f64);
+    let f = 100.0 * fs / 1024.0;
+    // Tracking-noise stand-in for the other coordinates (xorshift, 1e-6 m).
+    let mut state = 0x2545_F491_4F6C_DD1Du64;
+    let mut noise = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        1e-6 * ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5)
+    };
+    let mut text = String::from("t_s,head_x_m,head_y_m,tip_x_m,tip_y_m\n");
+    for k in 0..n {
+        let t = k as f64 / fs;
+        let x = amp * (2.0 * std::f64::consts::PI * f * t).sin();
+        text.push_str(&format!(
+            "{t:.6},{:e},{:e},{x:e},{:e}\n",
+            noise(),
+            noise(),
+            noise()
+        ));
+    }
+    let dir = std::env::temp_dir().join(format!("wiperlab_welch_cli_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("sine.csv");
+    std::fs::write(&path, text).unwrap();
+    let out = dir.join("out");
+    let o = wiperlab(&[
+        "spectrum",
+        path.to_str().unwrap(),
+        "--format",
+        "canonical",
+        "--nperseg",
+        "1024",
+        "--window",
+        "boxcar",
+        "--scaling",
+        "spectrum",
+        "--out-dir",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(out.join("psd.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = header
+        .iter()
+        .position(|h| *h == "tip_x_power_spectrum_m2")
+        .unwrap_or_else(|| panic!("{header:?}"));
+    let row: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse().unwrap())
+                .collect::<Vec<f64>>()
+        })
+        .find(|r| (r[0] - f).abs() < 1e-9)
+        .expect("the sine's bin");
+    let expected = amp * amp / 2.0;
+    assert!(
+        (row[col] - expected).abs() < 1e-9 * expected,
+        "{} vs {expected}",
+        row[col]
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

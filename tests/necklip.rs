@@ -144,11 +144,7 @@ fn necklip_runs_across_the_flip_in_two_segments() {
         "θ after the flip differs by {worst_after} rad"
     );
     // The high band (500–5000 Hz, nperseg 2048 as the main job) of v3 − v on the same samples.
-    let band = [BandSpec {
-        name: "high".into(),
-        range_hz: [500.0, 5000.0],
-        nperseg: 2048,
-    }];
+    let band = [BandSpec::new("high", [500.0, 5000.0], 2048)];
     let x_nl: Vec<f64> = nl.v3_m.iter().zip(&nl.v_m).map(|(a, b)| a - b).collect();
     let x_full: Vec<f64> = lean
         .iter()

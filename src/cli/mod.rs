@@ -29,6 +29,29 @@ pub struct Cli {
     pub command: Command,
 }
 
+/// Welch settings of `spectrum`, named and defaulted as `scipy.signal.welch`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct WelchArgs {
+    /// Window of each segment.
+    #[arg(long, value_enum, default_value_t = crate::spectrum::Window::Hann)]
+    pub window: crate::spectrum::Window,
+    /// Samples shared by consecutive segments (default nperseg/2).
+    #[arg(long)]
+    pub noverlap: Option<usize>,
+    /// FFT length, ≥ nperseg (default nperseg; longer zero-pads).
+    #[arg(long)]
+    pub nfft: Option<usize>,
+    /// What is subtracted from each segment.
+    #[arg(long, value_enum, default_value_t = crate::spectrum::Detrend::Constant)]
+    pub detrend: crate::spectrum::Detrend,
+    /// density (m²/Hz) or spectrum (m²).
+    #[arg(long, value_enum, default_value_t = crate::spectrum::Scaling::Density)]
+    pub scaling: crate::spectrum::Scaling,
+    /// How the segments' periodograms are combined (median with SciPy's bias correction).
+    #[arg(long, value_enum, default_value_t = crate::spectrum::Average::Mean)]
+    pub average: crate::spectrum::Average,
+}
+
 /// Import options shared by `import` and `spectrum`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct ImportArgs {
@@ -108,9 +131,14 @@ pub enum Command {
         file: PathBuf,
         #[command(flatten)]
         import: ImportArgs,
-        /// Welch segment length (samples); default: the largest power of two ≤ len/4.
+        /// Welch segment length (samples); default: the largest power of two ≤ len/4. SciPy's
+        /// default is 256 whatever the record; a long high-speed recording needs longer segments
+        /// to resolve its low component (2.4 Hz bins at 10,000 frames/s need 4096).
         #[arg(long)]
         nperseg: Option<usize>,
+        /// Welch settings with scipy.signal.welch's names and defaults.
+        #[command(flatten)]
+        welch: WelchArgs,
         /// Band LO:HI in Hz to pick a peak in (repeatable); default: the whole spectrum above 2 bins.
         #[arg(long)]
         band: Vec<BandArg>,
@@ -227,6 +255,7 @@ pub fn run(cli: Cli) -> Result<()> {
             file,
             import,
             nperseg,
+            welch,
             band,
             out_dir,
             max_fill,
@@ -234,6 +263,7 @@ pub fn run(cli: Cli) -> Result<()> {
             file,
             import,
             nperseg,
+            welch,
             band,
             out_dir,
             max_fill,

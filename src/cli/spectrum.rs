@@ -32,6 +32,7 @@ pub(super) struct SpectrumArgs {
     pub file: PathBuf,
     pub import: ImportArgs,
     pub nperseg: Option<usize>,
+    pub welch: super::WelchArgs,
     pub band: Vec<BandArg>,
     pub out_dir: Option<PathBuf>,
     pub max_fill: usize,
@@ -50,29 +51,41 @@ pub(super) fn run(a: SpectrumArgs) -> Result<()> {
     let mut bands: Vec<BandSpec> = a
         .band
         .iter()
-        .map(|b| BandSpec {
-            name: b.text.clone(),
-            range_hz: b.range_hz,
-            nperseg,
-        })
+        .map(|b| BandSpec::new(b.text.clone(), b.range_hz, nperseg))
         .collect();
     if bands.is_empty() {
-        bands.push(BandSpec {
-            name: "all".into(),
-            range_hz: [2.0 * fs / nperseg as f64, fs / 2.0],
+        bands.push(BandSpec::new(
+            "all",
+            [2.0 * fs / nperseg as f64, fs / 2.0],
             nperseg,
-        });
+        ));
     }
+    for b in &mut bands {
+        b.window = a.welch.window;
+        b.noverlap = a.welch.noverlap;
+        b.nfft = a.welch.nfft;
+        b.detrend = a.welch.detrend;
+        b.scaling = a.welch.scaling;
+        b.average = a.welch.average;
+    }
+    let cfg = bands[0].welch_config()?;
+
     let dir = a
         .out_dir
         .unwrap_or_else(|| Path::new("reports/spectrum").join(super::stem(&a.file)));
     crate::io::create_dir(&dir)?;
     println!(
-        "{}: {} samples at {:.6} Hz (median frame rate), Welch nperseg {nperseg} (Hann, 50 % overlap), bin {:.4} Hz",
+        "{}: {} samples at {:.6} Hz (median frame rate), Welch nperseg {nperseg} ({} window, noverlap {}, nfft {}, detrend {}, {} scaling, {} average), bin {:.4} Hz",
         a.file.display(),
         n,
         fs,
-        fs / nperseg as f64
+        cfg.window.scipy_name(),
+        cfg.noverlap,
+        cfg.nfft,
+        cfg.detrend,
+        cfg.scaling,
+        cfg.average,
+        fs / cfg.nfft as f64
     );
     print_grid(&trace, &uniform, n, a.max_fill);
     let mut computed = Vec::new();

@@ -628,6 +628,12 @@ impl Check<'_> {
                     ),
                 ));
             }
+            if let Err(e) = b.welch_config() {
+                return Err(self.error(
+                    &[Key::Name("spectrum"), Key::Name("bands"), Key::Index(i)],
+                    format!("[spectrum] band '{}': {e}", b.name),
+                ));
+            }
         }
         Ok(())
     }
@@ -672,6 +678,30 @@ mod tests {
         );
         // A missing key answers its deepest present ancestor.
         assert_eq!(spans.at(&[Key::Name("fit"), Key::Name("seed")]).0, 3);
+    }
+
+    #[test]
+    fn band_welch_settings_read_with_scipy_names() {
+        let b: BandSpec = toml::from_str(
+            "name = \"high\"\nrange_hz = [500.0, 5000.0]\nnperseg = 512\nwindow = \"hamming\"\naverage = \"median\"\nnoverlap = 384",
+        )
+        .unwrap();
+        let cfg = b.welch_config().unwrap();
+        assert_eq!(cfg.window, crate::spectrum::Window::Hamming);
+        assert_eq!(cfg.average, crate::spectrum::Average::Median);
+        assert_eq!((cfg.noverlap, cfg.nfft), (384, 512));
+        // SciPy's defaults when not given, and they are not written back out.
+        let d = BandSpec::new("low", [30.0, 300.0], 4096);
+        assert_eq!(
+            d.welch_config().unwrap(),
+            crate::spectrum::WelchConfig::new(4096)
+        );
+        assert!(!toml::to_string(&d).unwrap().contains("window"));
+        let bad = BandSpec {
+            noverlap: Some(512),
+            ..b
+        };
+        assert!(bad.welch_config().is_err());
     }
 
     #[test]

@@ -368,11 +368,7 @@ mod tests {
     use features::BandSpec;
 
     fn band(name: &str, lo: f64, hi: f64) -> BandSpec {
-        BandSpec {
-            name: name.into(),
-            range_hz: [lo, hi],
-            nperseg: 1024,
-        }
+        BandSpec::new(name, [lo, hi], 1024)
     }
 
     /// The default chain: the head model for low bands only, the full blade as soon as a band

@@ -43,9 +43,20 @@ pub fn spectrum_figures(
         .unzip();
     line_chart(
         &dir.join(format!("psd_{name}.svg")),
-        &format!("Welch PSD of {name} (Hann, nperseg {})", b0.spec.nperseg),
+        &format!(
+            "Welch {} of {name} ({}, nperseg {})",
+            match b0.spec.scaling {
+                crate::spectrum::Scaling::Density => "PSD",
+                crate::spectrum::Scaling::Spectrum => "power spectrum",
+            },
+            b0.spec.window.scipy_name(),
+            b0.spec.nperseg
+        ),
         "frequency [Hz]",
-        "PSD [m²/Hz]",
+        match b0.spec.scaling {
+            crate::spectrum::Scaling::Density => "PSD [m²/Hz]",
+            crate::spectrum::Scaling::Spectrum => "power [m²]",
+        },
         &[Series::line(name, fr, ps)],
         &ChartOpts {
             log_y: true,
@@ -320,7 +331,8 @@ fn cost_figure(dir: &Path, history: &[HistoryPoint]) -> Result<()> {
 }
 
 /// Writes the `spectrum` command's numbers into `dir`: `psd.csv` (`f_hz`, then
-/// `<signal>_psd_m2_per_hz` per signal: the full one-sided Welch density of the first band's
+/// `<signal>_psd_m2_per_hz` per signal, `<signal>_power_spectrum_m2` with `scaling = spectrum`:
+/// the full one-sided Welch estimate of the first band's
 /// settings; signals whose bins differ from the first signal's are left out) and `peaks.json` (an
 /// array of `{signal, band, freq_hz, psd_m2_per_hz, prominence}`, one per band with a peak).
 /// Returns the file names.
@@ -332,9 +344,14 @@ pub fn spectrum_data_files(dir: &Path, signals: &[(String, Features)]) -> Result
         return Ok(Vec::new());
     };
     let f_hz = &first.bands[0].full_freq_hz;
+    // The column's quantity and unit follow the Welch scaling.
+    let quantity = match first.bands[0].spec.scaling {
+        crate::spectrum::Scaling::Density => "psd_m2_per_hz",
+        crate::spectrum::Scaling::Spectrum => "power_spectrum_m2",
+    };
     let names: Vec<String> = signals
         .iter()
-        .map(|(n, _)| format!("{n}_psd_m2_per_hz"))
+        .map(|(n, _)| format!("{n}_{quantity}"))
         .collect();
     let mut cols: Vec<(&str, &[f64])> = vec![("f_hz", f_hz)];
     for ((_, f), n) in signals.iter().zip(&names) {
@@ -352,7 +369,7 @@ pub fn spectrum_data_files(dir: &Path, signals: &[(String, Features)]) -> Result
                         "signal": n,
                         "band": b.spec.name,
                         "freq_hz": p.freq_hz,
-                        "psd_m2_per_hz": p.level,
+                        quantity: p.level,
                         "prominence": if p.prominence.is_finite() { Some(p.prominence) } else { None },
                     })
                 })

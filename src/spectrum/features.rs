@@ -2,7 +2,9 @@
 //! across the band. Measurement and model go through this same estimator at the same sampling
 //! (physics.md §4, "compare like with like").
 
-use crate::spectrum::{Peak, WelchConfig, find_peak, welch_gappy};
+use crate::spectrum::{
+    Average, Detrend, Peak, Scaling, WelchConfig, Window, find_peak, welch_gappy,
+};
 use crate::trace::Trace;
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
@@ -16,8 +18,63 @@ pub struct BandSpec {
     /// Band edges `[lo, hi]` in Hz.
     pub range_hz: [f64; 2],
     /// Welch segment length (samples); longer resolves low frequencies, shorter averages the
-    /// stick–slip comb into its envelope. Hann window, 50 % overlap, constant detrend.
+    /// stick–slip comb into its envelope.
     pub nperseg: usize,
+    /// The other Welch settings, with `scipy.signal.welch`'s names and defaults: Hann window,
+    /// `noverlap = nperseg/2`, `nfft = nperseg`, constant detrend, density scaling, mean average.
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub window: Window,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noverlap: Option<usize>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nfft: Option<usize>,
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub detrend: Detrend,
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub scaling: Scaling,
+    #[serde(default, skip_serializing_if = "is_default")]
+    pub average: Average,
+}
+
+fn is_default<T: Default + PartialEq>(v: &T) -> bool {
+    *v == T::default()
+}
+
+impl BandSpec {
+    /// A band with SciPy's default Welch settings for segments of `nperseg` samples.
+    pub fn new(name: impl Into<String>, range_hz: [f64; 2], nperseg: usize) -> Self {
+        BandSpec {
+            name: name.into(),
+            range_hz,
+            nperseg,
+            window: Window::default(),
+            noverlap: None,
+            nfft: None,
+            detrend: Detrend::default(),
+            scaling: Scaling::default(),
+            average: Average::default(),
+        }
+    }
+
+    /// The band's Welch settings.
+    ///
+    /// # Errors
+    /// A [`crate::spectrum::SpectrumError`] when `noverlap ≥ nperseg` or `nfft < nperseg`.
+    pub fn welch_config(&self) -> Result<WelchConfig> {
+        let mut cfg = WelchConfig::new(self.nperseg)
+            .with_window(self.window)
+            .with_detrend(self.detrend)
+            .with_scaling(self.scaling)
+            .with_average(self.average);
+        if let Some(n) = self.noverlap {
+            cfg = cfg.with_noverlap(n)?;
+        }
+        if let Some(n) = self.nfft {
+            cfg = cfg.with_nfft(n)?;
+        }
+        cfg.validate()?;
+        Ok(cfg)
+    }
 }
 
 /// The default bands of the fit: low 30–300 Hz (nperseg 4096) and high 500–5000 Hz (nperseg 512).
@@ -34,16 +91,8 @@ pub struct BandSpec {
 /// (docs/validation.md, "Spectra against tolerance"). A job that wants the finer estimate names its bands.
 pub fn default_bands() -> Vec<BandSpec> {
     vec![
-        BandSpec {
-            name: "low".into(),
-            range_hz: [30.0, 300.0],
-            nperseg: 4096,
-        },
-        BandSpec {
-            name: "high".into(),
-            range_hz: [500.0, 5000.0],
-            nperseg: 512,
-        },
+        BandSpec::new("low", [30.0, 300.0], 4096),
+        BandSpec::new("high", [500.0, 5000.0], 512),
     ]
 }
 
@@ -123,7 +172,7 @@ pub fn features(x: &[f64], fs_hz: f64, bands: &[BandSpec], max_fill: usize) -> R
     let mut out = Vec::with_capacity(bands.len());
     let mut filled = 0;
     for b in bands {
-        let cfg = WelchConfig::new(b.nperseg);
+        let cfg = b.welch_config()?;
         let (psd, rep) = welch_gappy(x, fs_hz, &cfg, max_fill)?;
         filled = filled.max(rep.filled);
         let (lo, hi) = (b.range_hz[0], b.range_hz[1]);

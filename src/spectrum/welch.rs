@@ -44,7 +44,18 @@ use super::window::{Window, WindowSums};
 use crate::Result;
 
 /// What is subtracted from each segment before windowing (`scipy.signal.welch`'s `detrend`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "snake_case")]
 pub enum Detrend {
     /// Nothing (`detrend=False`).
     None,
