@@ -341,17 +341,28 @@ fn report_page_after_a_quick_fit_loads_every_figure_in_chromium() {
 }
 
 /// The check must be able to fail: a page whose link points at a missing file, and a figure whose
-/// SVG is cut in half, are both reported broken by name. (Also: `report` without a result fits
-/// first.)
+/// SVG is cut in half, are both reported broken by name. (Also: `report` without a result is an
+/// input error that says how to get one, exit 2, nothing written; `--refit` fits first.)
 #[test]
 fn browser_check_catches_a_broken_link_and_a_corrupt_svg() {
     let tmp = TempDir::new("broken");
     let job = write_quick_job(&tmp.0);
-    let (_, err) = ok(
-        &wiperlab(&tmp.0, &["report", job.to_str().unwrap(), "--quiet"]),
-        "report without a result",
+    let o = wiperlab(&tmp.0, &["report", job.to_str().unwrap(), "--quiet"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("no fit result") && err.contains("--refit"),
+        "{err}"
     );
-    assert!(err.contains("running the fit first"), "{err}");
+    assert!(!tmp.0.join("quick.result.toml").exists());
+    assert!(!tmp.0.join("reports/quick/index.html").exists());
+    ok(
+        &wiperlab(
+            &tmp.0,
+            &["report", job.to_str().unwrap(), "--refit", "--quiet"],
+        ),
+        "report --refit",
+    );
     assert!(tmp.0.join("quick.result.toml").is_file());
     let dir = tmp.0.join("reports/quick");
     let page = dir.join("index.html");

@@ -29,16 +29,22 @@ pub(super) fn fit(job: &Path, json: bool, quiet: bool) -> Result<()> {
     Ok(())
 }
 
-/// Writes the report page from the job's result, fitting first when there is none (or `refit`).
+/// Writes the report page from the job's result; `refit` fits first. Without a result (and without
+/// `refit`) it is an input error (exit 2) that says how to get one.
 pub(super) fn report(job: &Path, refit: bool, quiet: bool) -> Result<()> {
     let loaded = LoadedJob::load(job)?;
     let result_path = result_path(&loaded);
     let report_dir = report_dir(&loaded);
-    let result = if refit || !result_path.exists() {
-        if !refit {
-            eprintln!("{} not found: running the fit first", result_path.display());
-        }
+    let result = if refit {
         fit_and_write(&loaded, !quiet)?.0
+    } else if !result_path.exists() {
+        return Err(Error::input(
+            &result_path,
+            format!(
+                "no fit result: run `wiperlab fit {0}` first, or `wiperlab report {0} --refit`",
+                job.display()
+            ),
+        ));
     } else {
         crate::fit::FitResult::read(&result_path)?
     };

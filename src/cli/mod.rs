@@ -199,8 +199,8 @@ pub enum Command {
         #[arg(long)]
         quiet: bool,
     },
-    /// Write the report page reports/<job>/index.html from fits/<job>.result.toml (fitting first
-    /// if the result is missing).
+    /// Write the report page reports/<job>/index.html from fits/<job>.result.toml (with --refit:
+    /// fit first; without a result and without --refit: exit 2).
     Report {
         job: PathBuf,
         /// Run the fit again even if the result file exists.
