@@ -685,3 +685,42 @@ fn spectrum_writes_psd_csv_and_peaks_json() {
         assert!(p["freq_hz"].as_f64().unwrap() > 0.0);
     }
 }
+
+/// A fit whose stderr is not a terminal (here a pipe) prints one-line progress messages instead of
+/// the bar: at most one per interval (5 s by default; 0 here through WIPERLAB_PROGRESS_INTERVAL_S),
+/// each with the stage, the model runs so far and the elapsed time; `--quiet` prints none.
+#[test]
+fn piped_fit_prints_progress_lines() {
+    let tmp = TempDir::new("piped");
+    let job = write_quick_job(&tmp.0);
+    let run = |quiet: bool| {
+        let mut args = vec!["fit", job.to_str().unwrap()];
+        if quiet {
+            args.push("--quiet");
+        }
+        Command::new(env!("CARGO_BIN_EXE_wiperlab"))
+            .args(&args)
+            .current_dir(&tmp.0)
+            .env("WIPERLAB_PROGRESS_INTERVAL_S", "0")
+            .output()
+            .unwrap()
+    };
+    let o = run(false);
+    assert!(o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    let lines: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("progress: "))
+        .collect();
+    assert!(lines.len() >= 2, "{err}");
+    assert!(
+        lines
+            .iter()
+            .all(|l| l.contains("model runs") && l.ends_with(" s")),
+        "{err}"
+    );
+    assert!(lines.iter().any(|l| l.contains("blade2dof")), "{err}");
+    let quiet = run(true);
+    assert!(quiet.status.success());
+    assert!(!String::from_utf8_lossy(&quiet.stderr).contains("progress: "));
+}

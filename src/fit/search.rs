@@ -33,6 +33,9 @@ pub(super) struct Reporting {
     pub(super) progress: Option<indicatif::ProgressBar>,
     /// The progress bar's position when this candidate started: its model runs count on from here.
     pub(super) base: u64,
+    /// When stderr is not a terminal (the bar is not drawn): the time of the last one-line
+    /// progress message, so that one is printed at most every [`piped_interval`].
+    pub(super) last_line: Option<Arc<Mutex<std::time::Instant>>>,
     pub(super) candidate: Candidate,
 }
 
@@ -96,6 +99,19 @@ where
             });
         if let Some(pb) = &self.reporting.progress {
             pb.set_position(self.reporting.base + evaluations as u64);
+            if let Some(last) = &self.reporting.last_line {
+                let mut last = last.lock().unwrap_or_else(|e| e.into_inner());
+                if last.elapsed() >= piped_interval() {
+                    *last = std::time::Instant::now();
+                    eprintln!(
+                        "progress: {}: {}/{} model runs, {:.0} s",
+                        pb.message(),
+                        pb.position(),
+                        pb.length().unwrap_or(0),
+                        pb.elapsed().as_secs_f64()
+                    );
+                }
+            }
         }
         let cost = state.get_best_cost();
         if let Some(p) = state.get_best_param() {
@@ -125,6 +141,17 @@ pub(super) struct CandidateFit {
     pub(super) wall_time_s: f64,
     pub(super) history: Vec<HistoryPoint>,
     pub(super) cost: f64,
+}
+
+/// How often a fit whose stderr is not a terminal prints a one-line progress message: 5 s, or
+/// `WIPERLAB_PROGRESS_INTERVAL_S` seconds when set (tests use 0).
+pub(super) fn piped_interval() -> std::time::Duration {
+    let s = std::env::var("WIPERLAB_PROGRESS_INTERVAL_S")
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+        .filter(|v| v.is_finite() && *v >= 0.0)
+        .unwrap_or(5.0);
+    std::time::Duration::from_secs_f64(s)
 }
 
 /// The job's progress bar, its length the model runs the search is expected to take: per
@@ -294,7 +321,12 @@ pub(super) fn fit_candidate(
 ) -> Result<CandidateFit> {
     let started = std::time::Instant::now();
     let fit = &job.job.fit;
+    let last_line = pb
+        .as_ref()
+        .filter(|_| !std::io::IsTerminal::is_terminal(&std::io::stderr()))
+        .map(|_| Arc::new(Mutex::new(std::time::Instant::now())));
     let reporting = Reporting {
+        last_line,
         history: Arc::new(Mutex::new(Vec::new())),
         best: Arc::new(Mutex::new(None)),
         progress: pb.clone(),
