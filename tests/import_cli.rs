@@ -289,3 +289,40 @@ fn spectrum_welch_options_match_the_closed_form() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Settings that cannot work are refused before any spectrum is computed, naming the flag (exit 2):
+/// a segment longer than the record or shorter than 8, a band upside down, a band past Nyquist.
+#[test]
+fn spectrum_refuses_impossible_settings_naming_the_flag() {
+    let Some(path) = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data/reversal/wiper_reversal_sample_xypts.csv")
+        .canonicalize()
+        .ok()
+    else {
+        panic!("the shipped recording is missing");
+    };
+    let base = [
+        "spectrum",
+        path.to_str().unwrap(),
+        "--fps",
+        "10000",
+        "--m-per-px",
+        "1.5e-5",
+        "--origin-px",
+        "200,300",
+    ];
+    let cases: [(&[&str], &str); 4] = [
+        (&["--nperseg", "4"], "--nperseg 4"),
+        (&["--nperseg", "10000000"], "--nperseg 10000000"),
+        (&["--band", "300:30"], "--band 300:30"),
+        (&["--band", "100:6000"], "Nyquist"),
+    ];
+    for (extra, key) in cases {
+        let mut args = base.to_vec();
+        args.extend_from_slice(extra);
+        let o = wiperlab(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {err}");
+        assert!(err.contains(key), "{extra:?}: {err}");
+    }
+}

@@ -48,6 +48,7 @@ pub(super) fn run(a: SpectrumArgs) -> Result<()> {
     let nperseg = a
         .nperseg
         .unwrap_or_else(|| crate::spectrum::default_nperseg(n));
+    check_settings(nperseg, n, fs, &a.band)?;
     let mut bands: Vec<BandSpec> = a
         .band
         .iter()
@@ -105,6 +106,27 @@ pub(super) fn run(a: SpectrumArgs) -> Result<()> {
     crate::report::figures::spectrum_data_files(&dir, &computed)?;
     println!("figures in {}", dir.display());
     println!("psd.csv and peaks.json in {}", dir.display());
+    Ok(())
+}
+
+/// Checks the segment length and the bands against the record before any spectrum is computed:
+/// 8 ≤ nperseg ≤ samples, and every band ordered inside (0, Nyquist].
+fn check_settings(nperseg: usize, n: usize, fs_hz: f64, bands: &[BandArg]) -> Result<()> {
+    if !(8..=n).contains(&nperseg) {
+        return Err(crate::Error::Config(format!(
+            "--nperseg {nperseg}: expected 8 <= nperseg <= the record's {n} samples"
+        )));
+    }
+    let nyquist = fs_hz / 2.0;
+    for b in bands {
+        let [lo, hi] = b.range_hz;
+        if !(lo >= 0.0 && lo < hi && hi <= nyquist) {
+            return Err(crate::Error::Config(format!(
+                "--band {}: expected 0 <= LO < HI <= {nyquist} Hz (the Nyquist frequency at {fs_hz} Hz)",
+                b.text
+            )));
+        }
+    }
     Ok(())
 }
 
