@@ -326,3 +326,35 @@ fn spectrum_refuses_impossible_settings_naming_the_flag() {
         assert!(err.contains(key), "{extra:?}: {err}");
     }
 }
+
+/// `wiperlab completions SHELL` prints a completion script (clap_complete) that knows every command
+/// and the value enums (e.g. `--window` values); bash checks the script's syntax when it is there.
+#[test]
+fn completions_cover_the_commands() {
+    for shell in ["bash", "zsh", "fish"] {
+        let o = wiperlab(&["completions", shell]);
+        assert!(o.status.success(), "{shell}");
+        let script = String::from_utf8_lossy(&o.stdout);
+        for word in [
+            "import", "spectrum", "simulate", "modes", "fit", "report", "campaign", "bench",
+            "blackman",
+        ] {
+            assert!(script.contains(word), "{shell}: no {word}");
+        }
+        if shell == "bash" && std::path::Path::new("/bin/bash").exists() {
+            let dir = std::env::temp_dir().join(format!("wiperlab_compl_{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            let f = dir.join("wiperlab.bash");
+            std::fs::write(&f, script.as_bytes()).unwrap();
+            let check = Command::new("/bin/bash")
+                .arg("-n")
+                .arg(&f)
+                .status()
+                .unwrap();
+            assert!(check.success(), "bash -n rejects the script");
+            std::fs::remove_dir_all(&dir).ok();
+        }
+    }
+    let o = wiperlab(&["completions", "tcsh-nope"]);
+    assert_eq!(o.status.code(), Some(2));
+}

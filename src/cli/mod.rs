@@ -215,6 +215,13 @@ pub enum Command {
         #[command(subcommand)]
         action: campaign::CampaignCommand,
     },
+    /// Print a shell completion script on stdout, e.g.
+    /// `wiperlab completions bash > ~/.local/share/bash-completion/completions/wiperlab`.
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
     /// Work–precision of the simulation methods (event-driven, Moreau–Jean, smoothed friction) on
     /// the belt benchmark and the blade; writes work_precision.csv and SVG figures.
     Bench {
@@ -293,6 +300,16 @@ pub fn run(cli: Cli) -> Result<()> {
             out_dir,
         } => bench::run(quick, &blade, &out_dir),
         Command::Campaign { action } => campaign::run(action),
+        Command::Completions { shell } => {
+            use clap::CommandFactory;
+            clap_complete::generate(
+                shell,
+                &mut Cli::command(),
+                "wiperlab",
+                &mut std::io::stdout(),
+            );
+            Ok(())
+        }
         Command::Modes {
             blade,
             speeds,
