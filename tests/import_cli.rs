@@ -358,3 +358,35 @@ fn completions_cover_the_commands() {
     let o = wiperlab(&["completions", "tcsh-nope"]);
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// `import -o -` writes the canonical CSV on stdout, byte for byte what `-o FILE` writes, and
+/// creates no file.
+#[test]
+fn import_to_stdout_with_dash() {
+    let rec = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data/reversal/wiper_reversal_sample_xypts.csv");
+    let dir = std::env::temp_dir().join(format!("wiperlab_dash_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("out.trace.csv");
+    let common = [
+        "import",
+        rec.to_str().unwrap(),
+        "--fps",
+        "10000",
+        "--m-per-px",
+        "1.5e-5",
+        "--origin-px",
+        "200,300",
+        "-o",
+    ];
+    let mut to_file = common.to_vec();
+    to_file.push(file.to_str().unwrap());
+    assert!(wiperlab(&to_file).status.success());
+    let mut to_stdout = common.to_vec();
+    to_stdout.push("-");
+    let o = wiperlab(&to_stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(o.stdout, std::fs::read(&file).unwrap());
+    assert!(!std::path::Path::new("-").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -14,7 +14,7 @@ pub(super) fn run(
     describe: bool,
     output: Option<PathBuf>,
 ) -> Result<()> {
-    if let Some(out) = &output {
+    if let Some(out) = output.as_deref().filter(|o| *o != Path::new("-")) {
         crate::io::refuse_overwriting_input(file, out)?;
     }
     let spec = import_spec(import)?;
@@ -24,6 +24,14 @@ pub(super) fn run(
         return Ok(());
     }
     let out = output.unwrap_or_else(|| file.with_extension("trace.csv"));
+    if out == Path::new("-") {
+        // `-o -`: the CSV on stdout, the summary on stderr.
+        let bytes = crate::import::canonical::trace_csv_bytes(&out, &trace)?;
+        std::io::Write::write_all(&mut std::io::stdout().lock(), &bytes)
+            .map_err(|e| Error::io(Path::new("<stdout>"), "cannot write", e))?;
+        eprintln!("{summary}");
+        return Ok(());
+    }
     crate::import::canonical::write_trace_csv(&out, &trace)?;
     eprintln!("{summary}");
     println!("wrote {}", out.display());

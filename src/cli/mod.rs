@@ -122,7 +122,7 @@ pub enum Command {
         /// Print what the file holds (format, points, frames, time base, gaps) without converting.
         #[arg(long)]
         describe: bool,
-        /// Output CSV (default: <file stem>.trace.csv beside the input).
+        /// Output CSV (default: <file stem>.trace.csv beside the input; `-`: stdout).
         #[arg(short, long)]
         output: Option<PathBuf>,
     },

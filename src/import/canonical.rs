@@ -51,6 +51,16 @@ fn column_order(trace: &Trace) -> Vec<usize> {
 ///   name is empty, or two points share a name;
 /// * [`Error::Io`] if the file cannot be created or written.
 pub fn write_trace_csv(path: &Path, trace: &Trace) -> Result<()> {
+    let bytes = trace_csv_bytes(path, trace)?;
+    crate::io::write_atomic(path, &bytes)
+}
+
+/// The canonical CSV of `trace` as bytes (what [`write_trace_csv`] writes); `path` only names the
+/// destination in errors.
+///
+/// # Errors
+/// As [`write_trace_csv`], without the file's.
+pub fn trace_csv_bytes(path: &Path, trace: &Trace) -> Result<Vec<u8>> {
     trace
         .check()
         .map_err(|m| Error::input(path, format!("cannot write trace: {m}")))?;
@@ -92,10 +102,8 @@ pub fn write_trace_csv(path: &Path, trace: &Trace) -> Result<()> {
         w.write_record(&row)
             .map_err(|e| csv_error(path, "write", e))?;
     }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::io(path, "write", e.into_error()))?;
-    crate::io::write_atomic(path, &bytes)
+    w.into_inner()
+        .map_err(|e| Error::io(path, "write", e.into_error()))
 }
 
 /// Read a canonical trace CSV (module docs) written by [`write_trace_csv`] or by hand.
