@@ -408,7 +408,7 @@ pub(super) fn fit_candidate(
 /// Restarts because the cost surface is rough: the stick–slip comb's largest line jumps as the
 /// parameters move, so one swarm can settle in a nearby minimum. On the shipped recording, single
 /// swarms of 24 particles × 25 iterations ended in the truth's basin (cost 0.25) for some seeds and
-/// at 0.97 or 0.45 for others (docs/fit.md, "Restarts").
+/// at 0.30 to 19.7 for others (docs/fit.md, "Restarts"; the seed-by-seed costs: CHANGELOG.md).
 /// `warm`: a point that one particle of the first swarm starts at (the others at random); it is
 /// also returned itself if no restart ends below its cost.
 /// Returns `(best_u, swarm iterations, polish iterations, best cost)`, the iterations summed over
