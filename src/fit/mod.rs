@@ -16,6 +16,7 @@ pub use crate::spectrum::features;
 pub mod instfreq;
 pub mod interrupt;
 pub mod job;
+pub mod likelihood;
 mod measure;
 mod problem;
 pub mod result;
