@@ -114,6 +114,7 @@ fn cost(c: &mut Criterion) {
         solver,
         swarm_solver: solver,
         weights: Weights::default(),
+        likelihood: Err("the bench times the cost only".into()),
         evaluations: Arc::new(AtomicUsize::new(0)),
         failures: std::sync::Arc::new(AtomicUsize::new(0)),
         first_failure: Mutex::new(None),

@@ -176,33 +176,19 @@ fn assert_fresh(path: &Path, since: SystemTime) {
 // The main job
 // ---------------------------------------------------------------------------------------------
 
-/// The shipped main job's estimator end to end: `wiperlab fit reversal.toml --json` on a copy of
-/// `fits/reversal.toml` in a temp dir (working directory there too), without its
-/// `[fit.uncertainty]` section. Everything asserted here (peaks, the model choice, the fitted
-/// values, the result file, the figures) comes from the candidates' searches, which the bootstrap
-/// does not touch: it runs afterwards from the chosen optimum and only adds intervals, and its
-/// replicates are three quarters of the job's time. Intervals are tested by
-/// `tests/interval_coverage.rs` and `tests/joint_fit.rs`.
+/// The shipped main job end to end: `wiperlab fit reversal.toml --json` on a copy of
+/// `fits/reversal.toml` in a temp dir (working directory there too), as shipped: three candidates
+/// and Laplace intervals from the likelihood's Fisher information (no refits). The intervals'
+/// coverage is measured by `tests/interval_coverage.rs`.
 #[test]
 fn main_job_end_to_end() {
     let started = SystemTime::now();
     let dir = TempDir::new("main_job");
-    let shipped = job_text();
-    let lines: Vec<&str> = shipped.lines().collect();
-    let uncertainty: Vec<&&str> = lines
-        .iter()
-        .filter(|l| l.starts_with("[fit.uncertainty]") || l.starts_with("bootstrap ="))
-        .collect();
-    assert_eq!(
-        uncertainty.len(),
-        2,
-        "the main job's uncertainty section: {uncertainty:?}"
+    let text = job_text();
+    assert!(
+        text.contains("method = \"laplace\""),
+        "the main job's intervals are Laplace's"
     );
-    let text: String = lines
-        .iter()
-        .filter(|l| !(l.starts_with("[fit.uncertainty]") || l.starts_with("bootstrap =")))
-        .map(|l| format!("{l}\n"))
-        .collect();
     let job = dir.write("reversal.toml", &text);
     let o = Command::new(env!("CARGO_BIN_EXE_wiperlab"))
         .args(["fit", s(&job), "--json"])
@@ -289,6 +275,22 @@ fn main_job_end_to_end() {
         cost_of("blade2dof+shoulder") <= cost_of("blade2dof"),
         "{trials:?}"
     );
+    // In likelihood units: every trial has its log-likelihood; the shoulder candidate ends at
+    // blade2dof's parameters (above), so its ln L is the same, the likelihood-ratio statistic 0 and
+    // its AIC higher by exactly 2 × its 2 extra parameters (docs/fit.md, "Which model the scene
+    // needs"). The head model, which cannot make the high band, is far less likely.
+    let evidence =
+        |m: &str| trials.iter().find(|t| t["model"] == m).expect("trial")["evidence"].clone();
+    let lnl = |m: &str| num(&evidence(m), "/log_likelihood_nats");
+    let (full, shoulder, head1) = (lnl("blade2dof"), lnl("blade2dof+shoulder"), lnl("head1dof"));
+    println!("ln L: blade2dof {full:.3}, +shoulder {shoulder:.3}, head1dof {head1:.3} nats");
+    assert!((shoulder - full).abs() <= 1e-9 * full.abs(), "{trials:?}");
+    assert!((num(&evidence("blade2dof+shoulder"), "/delta_aic") - 4.0).abs() < 1e-6);
+    assert!(
+        num(&evidence("blade2dof+shoulder"), "/lrt/statistic").abs() < 1e-6,
+        "{trials:?}"
+    );
+    assert!(full - head1 > 100.0, "{trials:?}");
 
     // Parameters: every freed one reported against the truth (job [truth] keys -> truth.json /params).
     let params = r["parameters"].as_array().expect("parameters array");
@@ -317,6 +319,32 @@ fn main_job_end_to_end() {
             "{name}: fitted {value} against the true {true_value} ({:+.2} %)",
             rel * 100.0
         );
+        // Its Laplace interval: 68.27 %, contains the estimate, finite and narrower than the
+        // search range (the recording determines all four).
+        let iv = &p["interval"];
+        assert_eq!(iv["method"]["kind"], "laplace", "{name}: {p}");
+        let (lo, hi) = (num(iv, "/lo"), num(iv, "/hi"));
+        assert!(
+            lo < value && value < hi,
+            "{name}: {value} outside [{lo}, {hi}]"
+        );
+        assert!(
+            hi - lo < num(p, "/upper") - num(p, "/lower"),
+            "{name}: [{lo}, {hi}]"
+        );
+        println!("{name}: Laplace 68 % interval [{lo:.6e}, {hi:.6e}]");
+    }
+    // Correlations from the Fisher information are finite (positive semi-definite by construction).
+    assert_eq!(r["spread_source"], "fisher_information");
+    for row in r["correlation"].as_array().expect("correlation") {
+        for c in row.as_array().expect("row") {
+            let c = c.as_f64().unwrap_or(f64::NAN);
+            assert!(
+                c.is_finite() && c.abs() <= 1.0 + 1e-12,
+                "{}",
+                r["correlation"]
+            );
+        }
     }
 
     // The result file beside the job: written by this run, valid TOML, the same result.

@@ -210,16 +210,41 @@ pub struct FitSection {
     /// Bounds of the shoulder-contact parameters freed by the `+shoulder` candidates.
     #[serde(default)]
     pub shoulder: Option<ShoulderBounds>,
-    /// Confidence intervals by parametric bootstrap (see [`crate::fit::bootstrap_intervals`]).
+    /// Confidence intervals: Laplace (from the likelihood's Fisher information) or parametric
+    /// bootstrap (see [`crate::fit::bootstrap_intervals`]).
     #[serde(default)]
     pub uncertainty: UncertaintySection,
+    /// The likelihood that model choice and Laplace intervals read ([`crate::fit::evidence`]).
+    #[serde(default)]
+    pub likelihood: LikelihoodSection,
+}
+
+/// Which terms the recording's likelihood has (docs/fit.md, "Likelihood").
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct LikelihoodSection {
+    /// Add the Gaussian likelihood of the signal's time-domain residuals to the Welch spectra's.
+    pub time_domain: bool,
+}
+
+crate::names::named_enum! {
+    /// How the fit gives each parameter an interval.
+    pub enum UncertaintyMethod: "uncertainty method" {
+        /// Laplace's approximation: ±1σ from the inverse Fisher information of the recording's
+        /// likelihood at the fit (2k simulations).
+        Laplace => "laplace",
+        /// Basic parametric bootstrap: `bootstrap` replicates, each re-fitted.
+        Bootstrap => "bootstrap",
+    }
 }
 
 /// Settings of the parametric bootstrap that gives each fitted parameter an interval.
 #[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct UncertaintySection {
-    /// Bootstrap replicates (0: no intervals, only the curvature's 1σ).
+    /// How (default: `bootstrap` when `bootstrap > 0`, else `laplace`).
+    pub method: Option<UncertaintyMethod>,
+    /// Bootstrap replicates.
     pub bootstrap: usize,
     /// Re-run the whole estimator (swarm and polish) on each replicate; otherwise only a
     /// Nelder–Mead polish from the optimum.
@@ -230,9 +255,22 @@ pub struct UncertaintySection {
     pub seed: u64,
 }
 
+impl UncertaintySection {
+    /// The method in effect: the one named, else `bootstrap` when replicates are asked for, else
+    /// `laplace`.
+    pub fn method(&self) -> UncertaintyMethod {
+        self.method.unwrap_or(if self.bootstrap > 0 {
+            UncertaintyMethod::Bootstrap
+        } else {
+            UncertaintyMethod::Laplace
+        })
+    }
+}
+
 impl Default for UncertaintySection {
     fn default() -> Self {
         UncertaintySection {
+            method: None,
             bootstrap: 0,
             full_refit: true,
             polish_iterations: 30,

@@ -192,6 +192,7 @@ pub(super) fn measure_targets(job: &LoadedJob, t: &job::TargetsSection) -> Resul
             }),
             full_freq_hz: Vec::new(),
             full_psd: Vec::new(),
+            segments: 0,
         });
     }
     Ok(Measurement {

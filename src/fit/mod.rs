@@ -11,6 +11,7 @@
 //! coordinates `u ∈ [0, 1]` (logarithmic for bounds spanning a factor ≥ 10).
 
 mod candidate;
+pub mod evidence;
 /// The spectral features the fit compares (they belong to the spectrum stage).
 pub use crate::spectrum::features;
 pub mod instfreq;
@@ -29,11 +30,11 @@ pub use measure::HEAD_KERNEL_SIGMA_S;
 pub use problem::{FAILED_COST, FreeParam, SpectralProblem, target_cost};
 pub use result::{
     FitResult, FittedParam, HistoryPoint, Interval, IntervalMethod, ModelTrial, PeakComparison,
-    SearchStage,
+    RatioTest, SearchStage, SpreadSource, TrialEvidence,
 };
 pub use search::problem_for;
 pub use select::aic;
-pub use uncertainty::{bootstrap_intervals, identifiability_warnings};
+pub use uncertainty::{bootstrap_intervals, identifiability_warnings, laplace_intervals};
 
 use crate::Result;
 use crate::model::BladeParams;
@@ -86,11 +87,15 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let pb = progress.then(|| progress_bar(job, &candidates));
     let mut fits = fit_candidates(job, &meas, &candidates, &pb)?;
     let mut selection = select::choose(&fits, &job.job.spectrum.bands, !fit.models.is_empty());
+    let absorbing = select::absorbing_warnings(&fits, selection.chosen, &job.job.spectrum.bands);
     let cf = fits.swap_remove(selection.chosen);
     let best = BestModel::of(&cf)?;
     let mut parameters = fitted_parameters(job, &cf);
     let peaks = peak_comparisons(&cf, &best.features)?;
-    if let (Some(pb), true) = (&pb, fit.uncertainty.bootstrap > 0) {
+    if let (Some(pb), true) = (
+        &pb,
+        fit.uncertainty.method() == job::UncertaintyMethod::Bootstrap,
+    ) {
         pb.set_message("bootstrap");
     }
     let (intervals, mut warnings) = if interrupt::stop_requested() {
@@ -115,6 +120,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     if let Some(pb) = &pb {
         pb.finish_and_clear();
     }
+    warnings.extend(absorbing);
     warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
     warnings.extend(failure_warning(&cf.problem));
     // The chosen model's counts include its bootstrap replicates (they share its counters).
@@ -329,6 +335,11 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         peaks: a.peaks,
         undetermined,
         correlation: cf.corr.clone(),
+        spread_source: if cf.evidence.is_ok() {
+            result::SpreadSource::FisherInformation
+        } else {
+            result::SpreadSource::CostCurvature
+        },
         swarm_iterations: cf.swarm_iters,
         polish_iterations: cf.polish_iters,
         model_evaluations: a.trials.iter().map(|t| t.model_evaluations).sum(),

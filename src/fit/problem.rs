@@ -40,7 +40,11 @@ impl FreeParam {
     }
     /// Physical value at normalised coordinate `u` (clamped to [0, 1]).
     pub fn value(&self, u: f64) -> f64 {
-        let u = u.clamp(0.0, 1.0);
+        self.value_unclamped(u.clamp(0.0, 1.0))
+    }
+    /// [`FreeParam::value`] without the clamp: the same map extended beyond the box (for interval
+    /// ends).
+    pub fn value_unclamped(&self, u: f64) -> f64 {
         if self.log {
             (self.lower.ln() + u * (self.upper / self.lower).ln()).exp()
         } else {
@@ -97,6 +101,9 @@ pub struct SpectralProblem {
     pub others: Vec<SpectralProblem>,
     /// Name of this problem's recording in joint fits ("" for the main one).
     pub label: String,
+    /// The recording's likelihood ([`super::evidence`]), for model choice and intervals; why not,
+    /// for a target job or a recording it cannot be computed for.
+    pub likelihood: std::result::Result<Arc<super::evidence::RecordingLikelihood>, String>,
     pub evaluations: Arc<AtomicUsize>,
     /// Failed evaluations, shared like `evaluations` with the bootstrap's replicate problems.
     pub failures: Arc<AtomicUsize>,

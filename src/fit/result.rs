@@ -24,6 +24,22 @@ named_enum! {
     }
 }
 
+named_enum! {
+    /// Where the fitted parameters' 1σ and correlations come from.
+    pub enum SpreadSource: "spread source" {
+        /// The inverse Fisher information of the recording's likelihood (Gauss–Newton, positive
+        /// semi-definite by construction: [`crate::fit::evidence`]).
+        FisherInformation => "fisher_information",
+        /// The cost's curvature at the optimum, read as a χ² (a target job, which has no
+        /// likelihood; NaN when the curvature is not positive definite).
+        CostCurvature => "cost_curvature",
+    }
+}
+
+fn default_spread_source() -> SpreadSource {
+    SpreadSource::CostCurvature
+}
+
 /// Best cost after each iteration of each stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct HistoryPoint {
@@ -65,6 +81,12 @@ pub enum IntervalMethod {
     },
     /// From the cost's curvature at the optimum.
     Curvature,
+    /// Laplace's approximation: ±1σ of the inverse Fisher information of the recording's
+    /// likelihood at the fit ([`crate::fit::evidence`]), mapped through the search's coordinates.
+    Laplace {
+        /// Central-difference step of the Fisher information, normalised coordinates.
+        fisher_step_u: f64,
+    },
 }
 
 impl std::fmt::Display for IntervalMethod {
@@ -72,6 +94,10 @@ impl std::fmt::Display for IntervalMethod {
         match self {
             IntervalMethod::Profile => f.write_str("profile"),
             IntervalMethod::Curvature => f.write_str("curvature"),
+            IntervalMethod::Laplace { fisher_step_u } => write!(
+                f,
+                "Laplace: ±1σ of the inverse Fisher information of the recording's likelihood (Gauss–Newton, central differences of {fisher_step_u} in the normalised coordinates)"
+            ),
             IntervalMethod::Bootstrap {
                 replicates,
                 noise_sigma_m,
@@ -158,6 +184,49 @@ pub struct ModelTrial {
     pub chosen: bool,
     /// Why it was (not) chosen, with numbers.
     pub reason: String,
+    /// The trial in likelihood units (absent for a target job, which has no likelihood).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub evidence: Option<TrialEvidence>,
+}
+
+/// One candidate's fit in likelihood units ([`crate::fit::evidence`], docs/fit.md, "Likelihood").
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrialEvidence {
+    /// `ln L` at the candidate's fit, nats.
+    pub log_likelihood_nats: f64,
+    /// Whittle NLL of each band (the job's order), nats.
+    pub spectral_nll_nats: Vec<f64>,
+    /// Gaussian NLL of the time-domain residuals, nats, when `[fit.likelihood] time_domain`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_nll_nats: Option<f64>,
+    /// RMS of the signal's de-meaned time-domain residuals, m.
+    pub residual_rms_m: f64,
+    /// Effective number of observations (BIC's n).
+    pub n_effective: f64,
+    /// `2k + 2·NLL`.
+    pub aic: f64,
+    /// `k ln n + 2·NLL`.
+    pub bic: f64,
+    /// AIC minus the chosen model's.
+    pub delta_aic: f64,
+    /// BIC minus the chosen model's.
+    pub delta_bic: f64,
+    /// The likelihood-ratio test against the candidate this one nests (`X` for `X+shoulder`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lrt: Option<RatioTest>,
+}
+
+/// Wilks' likelihood-ratio test of a smaller candidate nested in this one.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RatioTest {
+    /// The smaller candidate.
+    pub against: Candidate,
+    /// `2(NLL_small − NLL_large)`.
+    pub statistic: f64,
+    /// Degrees of freedom, the extra parameters.
+    pub df: usize,
+    /// `P(χ²_df ≥ statistic)`.
+    pub p_value: f64,
 }
 
 fn default_model() -> Candidate {
@@ -181,9 +250,13 @@ pub struct FitResult {
     pub peaks: Vec<PeakComparison>,
     /// Parameters the data leave undetermined.
     pub undetermined: Vec<ParamId>,
-    /// Correlation matrix of the freed parameters (row-major, order of `parameters`); NaN where the
-    /// curvature matrix is not positive definite.
+    /// Correlation matrix of the freed parameters (row-major, order of `parameters`); NaN for a
+    /// parameter the likelihood does not inform, or everywhere when the cost's curvature (without a
+    /// likelihood) is not positive definite.
     pub correlation: Vec<Vec<f64>>,
+    /// Where the 1σ (`std_error`) and the correlations come from.
+    #[serde(default = "default_spread_source")]
+    pub spread_source: SpreadSource,
     pub swarm_iterations: u64,
     pub polish_iterations: u64,
     pub model_evaluations: usize,
@@ -333,6 +406,7 @@ mod tests {
             }],
             undetermined: vec![],
             correlation: vec![vec![f64::NAN]],
+            spread_source: SpreadSource::FisherInformation,
             swarm_iterations: 1,
             polish_iterations: 2,
             model_evaluations: 3,
@@ -352,6 +426,23 @@ mod tests {
                 failed_evaluations: 0,
                 chosen: false,
                 reason: "cost 3.0 > 1.5".into(),
+                evidence: Some(TrialEvidence {
+                    log_likelihood_nats: -12.5,
+                    spectral_nll_nats: vec![10.0, 2.5],
+                    time_nll_nats: None,
+                    residual_rms_m: 1e-5,
+                    n_effective: 40.0,
+                    aic: 27.0,
+                    bic: 28.7,
+                    delta_aic: 4.0,
+                    delta_bic: 2.1,
+                    lrt: Some(RatioTest {
+                        against: "head1dof".parse().unwrap(),
+                        statistic: 0.5,
+                        df: 2,
+                        p_value: 0.78,
+                    }),
+                }),
             }],
             warnings: vec!["w".into()],
             input_sha256: "ab".into(),

@@ -2,6 +2,7 @@
 //! history and progress reported through argmin observers, and the cost's curvature at the optimum.
 
 use super::candidate::Candidate;
+use super::evidence::RecordingLikelihood;
 use super::interrupt;
 use super::job::{self, LoadedJob};
 use super::measure::{Measurement, measure, measure_recording, necklip_view};
@@ -136,6 +137,9 @@ pub(super) struct CandidateFit {
     pub(super) best_u: Vec<f64>,
     pub(super) sigma_u: Vec<f64>,
     pub(super) corr: Vec<Vec<f64>>,
+    /// The recording's NLL at the optimum (`sigma_u` and `corr` then come from its Fisher
+    /// information), or why there is none (then from the cost's curvature).
+    pub(super) evidence: std::result::Result<super::evidence::NllParts, String>,
     pub(super) swarm_iters: u64,
     pub(super) polish_iters: u64,
     pub(super) wall_time_s: f64,
@@ -274,9 +278,20 @@ pub(super) fn build_problem(
                 None => job.job.solver,
             },
             weights: fit.weights,
+            likelihood: Err("not built yet".into()),
             evaluations: evaluations.clone(),
             failures: Arc::new(AtomicUsize::new(0)),
             first_failure: Mutex::new(None),
+        })
+        .map(|mut p: SpectralProblem| {
+            p.likelihood = if p.targets.is_some() {
+                Err("a target job has no measurement noise".into())
+            } else {
+                RecordingLikelihood::new(&p, &m.x, fit.likelihood.time_domain)
+                    .map(Arc::new)
+                    .map_err(|e| e.to_string())
+            };
+            p
         })
     };
     let mut main = build(meas, base, String::new())?;
@@ -369,13 +384,25 @@ pub(super) fn fit_candidate(
     let (best_u, swarm_iters, polish_iters, cost) =
         optimise(&problem, fit, fit.seed, warm.as_deref(), Some(&reporting))?;
 
-    // Curvature of the cost at the optimum → standard errors, correlations, identifiability.
+    // The likelihood at the optimum → NLL for model choice, and the inverse Fisher information →
+    // standard errors, correlations, identifiability; the cost's curvature where there is no
+    // likelihood (a target job).
     reporting.stage(format_args!("curvature"));
-    let (sigma_u, corr) = if interrupt::stop_requested() {
-        let n = best_u.len();
-        (vec![f64::NAN; n], vec![vec![f64::NAN; n]; n])
+    let n = best_u.len();
+    let (sigma_u, corr, evidence) = if interrupt::stop_requested() {
+        (
+            vec![f64::NAN; n],
+            vec![vec![f64::NAN; n]; n],
+            Err("interrupted".to_string()),
+        )
     } else {
-        curvature(&problem, &best_u)
+        match super::evidence::at_fit(&problem, &best_u) {
+            Ok(l) => (l.sigma_u, l.corr, Ok(l.nll)),
+            Err(e) => {
+                let (s, c) = curvature(&problem, &best_u);
+                (s, c, Err(e.to_string()))
+            }
+        }
     };
     if let Some(pb) = pb {
         pb.set_position(reporting.base + problem.evaluations.load(Ordering::Relaxed) as u64);
@@ -392,6 +419,7 @@ pub(super) fn fit_candidate(
         best_u,
         sigma_u,
         corr,
+        evidence,
         swarm_iters,
         polish_iters,
         wall_time_s: started.elapsed().as_secs_f64(),

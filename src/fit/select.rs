@@ -1,13 +1,20 @@
 //! Model-selection stage: which candidate the result reports, and why, in numbers.
+//!
+//! With a recording, candidates are compared in likelihood units ([`super::evidence`]): Akaike's
+//! `AIC = 2k + 2·NLL` chooses, Schwarz's BIC and, for nested candidates, Wilks' likelihood-ratio
+//! test are reported beside it. A target job has no likelihood (its targets carry no noise); it
+//! compares `cost + 2k` ([`aic`]).
 
 use super::features::BandSpec;
+use super::likelihood::{self, Evidence};
 use super::problem::FAILED_COST;
-use super::result::ModelTrial;
+use super::result::{ModelTrial, RatioTest, TrialEvidence};
 use super::search::CandidateFit;
 use std::sync::atomic::Ordering;
 
 /// Akaike's information criterion with the cost read as −2 ln L (a χ² on the cost's scales):
-/// `AIC = cost + 2k` for `k` freed parameters (Akaike 1974, IEEE TAC 19:716).
+/// `AIC = cost + 2k` for `k` freed parameters (Akaike 1974, IEEE TAC 19:716). Used for target
+/// jobs, which have no likelihood.
 pub fn aic(cost: f64, k: usize) -> f64 {
     cost + 2.0 * k as f64
 }
@@ -18,19 +25,39 @@ pub(super) struct Selection {
     pub(super) trials: Vec<ModelTrial>,
 }
 
+/// Each candidate's evidence, when every candidate that produced a model has one (else none: the
+/// comparison falls back to the cost).
+fn evidences(fits: &[CandidateFit]) -> Option<Vec<Option<Evidence>>> {
+    let e: Vec<Option<Evidence>> = fits
+        .iter()
+        .map(|f| {
+            f.evidence
+                .as_ref()
+                .ok()
+                .filter(|_| f.cost < FAILED_COST)
+                .map(|p| p.evidence(f.free.len()))
+        })
+        .collect();
+    let complete = fits
+        .iter()
+        .zip(&e)
+        .all(|(f, e)| e.is_some() || f.cost >= FAILED_COST);
+    (complete && e.iter().any(Option::is_some)).then_some(e)
+}
+
 /// Chooses by AIC among the candidates that produced a model and can produce every band (the
-/// neck/lip model imposes a low band from the head track, so its cost there proves nothing); if
+/// neck/lip model imposes a low band from the head track, so its fit there proves nothing); if
 /// none can, among all. `listed`: the job named its candidates (else the smallest capable model
 /// was the only one).
 pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) -> Selection {
+    let evidence = evidences(fits);
     let aics: Vec<f64> = fits
         .iter()
-        .map(|f| {
-            if f.cost < FAILED_COST {
-                aic(f.cost, f.free.len())
-            } else {
-                f64::INFINITY
-            }
+        .enumerate()
+        .map(|(i, f)| match &evidence {
+            Some(e) => e[i].map_or(f64::INFINITY, |e| e.aic()),
+            None if f.cost < FAILED_COST => aic(f.cost, f.free.len()),
+            None => f64::INFINITY,
         })
         .collect();
     let capable: Vec<bool> = fits
@@ -54,6 +81,7 @@ pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) ->
         aics: &aics,
         scores: &scores,
         chosen,
+        evidence: evidence.as_deref(),
     };
     let trials = fits
         .iter()
@@ -67,6 +95,7 @@ pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) ->
             failed_evaluations: super::failures(&f.problem).0,
             chosen: i == chosen,
             reason: scored.reason(fits, i, bands, listed),
+            evidence: scored.trial_evidence(fits, i),
         })
         .collect();
     Selection { chosen, trials }
@@ -78,9 +107,61 @@ struct Scored<'a> {
     /// AIC where the candidate can be chosen, else infinity.
     scores: &'a [f64],
     chosen: usize,
+    /// Every candidate's evidence, when the comparison is in likelihood units.
+    evidence: Option<&'a [Option<Evidence>]>,
 }
 
 impl Scored<'_> {
+    fn of(&self, i: usize) -> Option<Evidence> {
+        self.evidence.and_then(|e| e[i])
+    }
+
+    /// The likelihood-ratio test of candidate `i` against the candidate it nests (`X` for
+    /// `X+shoulder`), when both have evidence.
+    fn ratio_test(&self, fits: &[CandidateFit], i: usize) -> Option<RatioTest> {
+        let c = fits[i].candidate;
+        if !c.shoulder {
+            return None;
+        }
+        let j = fits
+            .iter()
+            .position(|f| f.candidate.kind == c.kind && !f.candidate.shoulder)?;
+        let t = likelihood::likelihood_ratio_test(&self.of(j)?, &self.of(i)?).ok()?;
+        Some(RatioTest {
+            against: fits[j].candidate,
+            statistic: t.statistic,
+            df: t.df,
+            p_value: t.p_value,
+        })
+    }
+
+    fn trial_evidence(&self, fits: &[CandidateFit], i: usize) -> Option<TrialEvidence> {
+        let e = self.of(i)?;
+        let parts = fits[i].evidence.as_ref().ok()?;
+        let best = self.of(self.chosen)?;
+        Some(TrialEvidence {
+            log_likelihood_nats: e.log_likelihood(),
+            spectral_nll_nats: parts.spectral_nats.clone(),
+            time_nll_nats: parts.time_nats,
+            residual_rms_m: parts.residual_rms_m,
+            n_effective: e.n_effective,
+            aic: e.aic(),
+            bic: e.bic(),
+            delta_aic: e.aic() - best.aic(),
+            delta_bic: e.bic() - best.bic(),
+            lrt: self.ratio_test(fits, i),
+        })
+    }
+
+    /// The criterion's name in the reasons.
+    fn criterion(&self) -> &'static str {
+        if self.evidence.is_some() {
+            "AIC = 2k + 2·NLL"
+        } else {
+            "AIC = cost + 2k"
+        }
+    }
+
     /// Why candidate `i` was (not) chosen, with its numbers.
     fn reason(&self, fits: &[CandidateFit], i: usize, bands: &[BandSpec], listed: bool) -> String {
         let k = fits[i].free.len();
@@ -98,31 +179,108 @@ impl Scored<'_> {
                 )
             };
         }
+        let lnl = self
+            .of(i)
+            .map(|e| format!("ln L = {:.2} nats, ", e.log_likelihood()))
+            .unwrap_or_default();
         if i == self.chosen {
             let next = (0..fits.len())
                 .filter(|&j| j != self.chosen)
                 .map(|j| self.scores[j])
                 .fold(f64::INFINITY, f64::min);
+            let lrt = self
+                .ratio_test(fits, i)
+                .map(|t| {
+                    format!(
+                        "; likelihood-ratio test against {}: 2Δln L = {:.2} on {} df, p = {:.3}",
+                        t.against, t.statistic, t.df, t.p_value
+                    )
+                })
+                .unwrap_or_default();
             return if next.is_finite() {
                 format!(
-                    "lowest AIC = cost + 2k = {:.2} (k = {k}); next best {next:.2}",
+                    "lowest {} = {:.2} ({lnl}k = {k}); next best {next:.2}{lrt}",
+                    self.criterion(),
                     self.scores[i]
                 )
             } else {
                 format!(
-                    "AIC = cost + 2k = {:.2} (k = {k}); the only candidate that produced every band",
+                    "{} = {:.2} ({lnl}k = {k}); the only candidate that produced every band",
+                    self.criterion(),
                     self.scores[i]
                 )
             };
         }
         let mut r = format!(
-            "AIC {:.2} (k = {k}), {:+.2} against the chosen model",
+            "AIC {:.2} ({lnl}k = {k}), {:+.2} against the chosen model",
             self.aics[i],
             self.aics[i] - self.aics[self.chosen]
         );
+        if let (Some(e), Some(best)) = (self.of(i), self.of(self.chosen)) {
+            r.push_str(&format!("; ΔBIC {:+.2}", e.bic() - best.bic()));
+        }
+        if let Some(t) = self.ratio_test(fits, i) {
+            r.push_str(&format!(
+                "; likelihood-ratio test against {}: 2Δln L = {:.2} on {} df, p = {:.3} ({})",
+                t.against,
+                t.statistic,
+                t.df,
+                t.p_value,
+                if t.p_value < 0.05 {
+                    "a gain beyond chance, but not worth its parameters by AIC"
+                } else {
+                    "no gain beyond chance from the extra parameters"
+                }
+            ));
+        }
         if let Some(why) = fits[i].candidate.cannot_produce(bands) {
             r.push_str(&format!("; {why}"));
         }
         r
     }
+}
+
+/// Warnings when a parameter moves between the chosen candidate and another candidate that can
+/// produce every band by more than the larger of their 1σ (both from the likelihood's Fisher
+/// information): the parameter is then absorbing structure that one model has and the other has
+/// not (e.g. a friction law bent to stand in for a missing shoulder), and its value depends on the
+/// model more than on the data.
+pub(super) fn absorbing_warnings(
+    fits: &[CandidateFit],
+    chosen: usize,
+    bands: &[BandSpec],
+) -> Vec<String> {
+    let c = &fits[chosen];
+    if c.evidence.is_err() {
+        return Vec::new();
+    }
+    let mut w = Vec::new();
+    for (j, o) in fits.iter().enumerate() {
+        if j == chosen
+            || o.evidence.is_err()
+            || o.cost >= FAILED_COST
+            || o.candidate.cannot_produce(bands).is_some()
+        {
+            continue;
+        }
+        for (i, fp) in c.free.iter().enumerate() {
+            let Some(m) = o.free.iter().position(|f| f.name == fp.name) else {
+                continue;
+            };
+            let (vc, vo) = (fp.value(c.best_u[i]), o.free[m].value(o.best_u[m]));
+            let sc = c.sigma_u[i] * fp.slope(c.best_u[i]);
+            let so = o.sigma_u[m] * o.free[m].slope(o.best_u[m]);
+            let s = sc.max(so);
+            if s.is_finite() && (vc - vo).abs() > s {
+                w.push(format!(
+                    "{} moves from {vc:.6} ({}) to {vo:.6} ({}), {:.1}σ: it absorbs structure one model has and the other has not, so its value depends on the model choice",
+                    fp.name,
+                    c.candidate,
+                    o.candidate,
+                    (vc - vo).abs() / s
+                ));
+            }
+        }
+    }
+    w
 }

@@ -1,8 +1,8 @@
 //! Uncertainty stage: bootstrap intervals and identifiability warnings for the chosen model.
 
 use super::features::{features, noise_floor};
-use super::job::{self};
-use super::problem::SpectralProblem;
+use super::job::{self, UncertaintyMethod};
+use super::problem::{FreeParam, SpectralProblem};
 use super::result::{FittedParam, Interval, IntervalMethod};
 use super::search::{CandidateFit, optimise, polish};
 use crate::simulate::blade::BladeSimulation;
@@ -11,9 +11,11 @@ use crate::{Error, Result};
 use rand::SeedableRng;
 use std::sync::{Arc, Mutex};
 
-/// The uncertainty stage: bootstrap intervals for the chosen fit when the job asks for them
-/// (`[fit.uncertainty] bootstrap > 0`), and a warning instead for a target job, whose targets carry
-/// no measurement noise. Returns the intervals (in the order of the freed parameters) and warnings.
+/// The uncertainty stage: an interval for every freed parameter of the chosen fit, by the job's
+/// method (`[fit.uncertainty] method`): Laplace's from the likelihood's Fisher information
+/// ([`laplace_intervals`], no further fits) or the parametric bootstrap ([`bootstrap_intervals`]).
+/// A target job gets a warning instead: its targets carry no measurement noise. Returns the
+/// intervals (in the order of the freed parameters) and warnings.
 ///
 /// # Errors
 /// As [`bootstrap_intervals`].
@@ -22,20 +24,61 @@ pub(super) fn intervals(
     best_sim: &BladeSimulation,
     fit: &job::FitSection,
 ) -> Result<(Option<Vec<Interval>>, Vec<String>)> {
-    if fit.uncertainty.bootstrap == 0 {
-        return Ok((None, Vec::new()));
-    }
     if cf.problem.targets.is_some() {
         return Ok((
             None,
-            vec![
-                "no bootstrap intervals for a target job: targets carry no measurement noise"
-                    .into(),
-            ],
+            vec!["no intervals for a target job: targets carry no measurement noise".into()],
         ));
     }
-    let intervals = bootstrap_intervals(&cf.problem, &cf.best_u, best_sim, fit)?;
-    Ok((Some(intervals), Vec::new()))
+    match fit.uncertainty.method() {
+        UncertaintyMethod::Laplace => match &cf.evidence {
+            Ok(_) => Ok((
+                Some(laplace_intervals(&cf.free, &cf.best_u, &cf.sigma_u)),
+                Vec::new(),
+            )),
+            Err(why) => Ok((None, vec![format!("no Laplace intervals: {why}")])),
+        },
+        UncertaintyMethod::Bootstrap if fit.uncertainty.bootstrap == 0 => Ok((
+            None,
+            vec!["no bootstrap intervals: [fit.uncertainty] bootstrap = 0 replicates".into()],
+        )),
+        UncertaintyMethod::Bootstrap => {
+            let intervals = bootstrap_intervals(&cf.problem, &cf.best_u, best_sim, fit)?;
+            Ok((Some(intervals), Vec::new()))
+        }
+    }
+}
+
+/// Laplace intervals (68.27 %): `[θ(u − σ_u), θ(u + σ_u)]` for each freed parameter, with `σ_u`
+/// the 1σ of its normalised coordinate from the inverse Fisher information of the recording's
+/// likelihood ([`super::evidence::at_fit`]); through the search's coordinates, so a parameter
+/// searched on a log scale gets an interval symmetric in `ln θ`. Every interval contains its
+/// estimate. A parameter the likelihood does not inform (`σ_u = ∞`) gets its search range.
+///
+/// Asymptotically (many effectively independent bins, a smooth likelihood) this is the
+/// maximum-likelihood estimate's interval (Pawitan 2001, *In All Likelihood*, §9.4); the fit's
+/// estimate is the spectral cost's minimum, not the likelihood's, and its coverage is measured in
+/// docs/fit.md, "Uncertainty".
+pub fn laplace_intervals(free: &[FreeParam], best_u: &[f64], sigma_u: &[f64]) -> Vec<Interval> {
+    free.iter()
+        .zip(best_u)
+        .zip(sigma_u)
+        .map(|((fp, u), s)| {
+            let (lo, hi) = if s.is_finite() {
+                (fp.value_unclamped(u - s), fp.value_unclamped(u + s))
+            } else {
+                (fp.lower, fp.upper)
+            };
+            Interval {
+                lo,
+                hi,
+                level: 0.6827,
+                method: IntervalMethod::Laplace {
+                    fisher_step_u: super::evidence::FISHER_STEP_U,
+                },
+            }
+        })
+        .collect()
 }
 
 /// Confidence intervals (68.27 %, i.e. ±1σ-equivalent) for every freed parameter by a parametric
@@ -196,6 +239,7 @@ impl ReplicateSource {
             solver: problem.solver,
             swarm_solver: problem.swarm_solver,
             weights: problem.weights,
+            likelihood: Err("a bootstrap replicate".into()),
             evaluations: problem.evaluations.clone(),
             failures: problem.failures.clone(),
             first_failure: Mutex::new(None),

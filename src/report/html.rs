@@ -287,6 +287,9 @@ struct TrialView {
     model_evaluations: usize,
     chosen: bool,
     reason: String,
+    log_likelihood: String,
+    delta_aic: String,
+    delta_bic: String,
 }
 
 #[derive(Serialize)]
@@ -332,6 +335,18 @@ fn trial_rows(r: &FitResult) -> Vec<TrialView> {
             model_evaluations: t.model_evaluations,
             chosen: t.chosen,
             reason: t.reason.clone(),
+            log_likelihood: t
+                .evidence
+                .as_ref()
+                .map_or("—".into(), |e| format!("{:.2}", e.log_likelihood_nats)),
+            delta_aic: t
+                .evidence
+                .as_ref()
+                .map_or("—".into(), |e| format!("{:+.2}", e.delta_aic)),
+            delta_bic: t
+                .evidence
+                .as_ref()
+                .map_or("—".into(), |e| format!("{:+.2}", e.delta_bic)),
         })
         .collect()
 }
@@ -430,6 +445,8 @@ struct PageView<'a> {
     transitions: usize,
     fitted_utc: Option<String>,
     sigma_shown: bool,
+    /// The 1σ come from the likelihood's Fisher information.
+    spread_fisher: bool,
     parameters: Vec<ParamView>,
     interval_methods: Vec<String>,
     peaks: Vec<PeakView>,
@@ -493,7 +510,8 @@ fn page_view<'a>(
 ) -> PageView<'a> {
     let (parameters, interval_methods) = parameter_rows(r);
     let (bands, signal, fit_settings) = settings_views(r);
-    let pd = curvature_positive_definite(r);
+    let fisher = r.spread_source == crate::fit::SpreadSource::FisherInformation;
+    let pd = fisher || curvature_positive_definite(r);
     PageView {
         style: STYLE,
         figure_check: FIGURE_CHECK,
@@ -511,6 +529,7 @@ fn page_view<'a>(
         transitions: r.transitions_in_best_model,
         fitted_utc: r.fitted_at.map(utc),
         sigma_shown: pd,
+        spread_fisher: fisher,
         parameters,
         interval_methods,
         peaks: peak_rows(r),
@@ -738,6 +757,7 @@ mod tests {
             }],
             undetermined: vec![crate::model::ParamId::B],
             correlation: vec![vec![1.0, -0.9], vec![-0.9, 1.0]],
+            spread_source: crate::fit::SpreadSource::CostCurvature,
             swarm_iterations: 1,
             polish_iterations: 2,
             model_evaluations: 30,

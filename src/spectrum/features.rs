@@ -156,6 +156,8 @@ pub struct BandFeatures {
     /// Full PSD (all bins) for figures.
     pub full_freq_hz: Vec<f64>,
     pub full_psd: Vec<f64>,
+    /// Welch segments averaged (`K`, over all finite runs of a gappy record).
+    pub segments: usize,
 }
 
 /// Features of one signal over all bands.
@@ -199,6 +201,7 @@ pub fn features(x: &[f64], fs_hz: f64, bands: &[BandSpec], max_fill: usize) -> R
             peak,
             full_freq_hz: psd.freq_hz,
             full_psd: psd.density,
+            segments: rep.segments_used,
         });
     }
     Ok(Features { bands: out, filled })

@@ -1,0 +1,421 @@
+//! The recording's likelihood of a fitted model, in nats: what model choice and the Laplace
+//! intervals read ([`super::likelihood`] has the statistics and their sources).
+//!
+//! For a recording with measured signal `d` (the job's `[spectrum] signal`) and a simulation `m`:
+//!
+//! - **spectral term**, per band: the Whittle-type NLL of the measured Welch ordinates in the band
+//!   given the simulation's ordinates plus the tracking-noise density `2σ²/fs`
+//!   ([`WelchLikelihood::nll`], with the band's window, overlap and segment count);
+//! - **time-domain term**: the Gaussian NLL of the de-meaned residuals `d − m` at the tracking noise
+//!   `σ`, weighed by the residuals' AR(1) effective sample size ([`likelihood::gaussian_nll`]);
+//! - `σ` is the recording's own tracking noise, `1.4826·MAD(Δ²d)/√6`
+//!   ([`likelihood::tracking_noise_sigma`]), the same for every candidate.
+//!
+//! The **Fisher information** at a fit is the Gauss–Newton form of the same likelihood, positive
+//! semi-definite by construction: per band `(α/φ)·Σ_k ∇ln S_k ∇ln S_kᵀ` (α = ν/2 the Gamma shape, φ
+//! the band's correlated-bin factor; the Fisher information of a Gamma mean on the log scale is α),
+//! plus `(n_eff/n)·Σ_i ∇m_i ∇m_iᵀ / s²` for the residuals, with `s² = max(σ², mean e²)` so that a
+//! model that does not reach the tracking noise does not claim the noise's precision (the
+//! quasi-likelihood dispersion; McCullagh & Nelder 1989, *Generalized Linear Models*, §9.2). The
+//! gradients are central differences in the search's normalised coordinates.
+
+use super::likelihood::{self, Evidence, WelchLikelihood};
+use super::problem::SpectralProblem;
+use crate::Result;
+use crate::simulate::blade::BladeSimulation;
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+/// Step of the central differences of the Fisher information, in normalised coordinates (the
+/// search box is `[0, 1]` per parameter; 1e-3 is 0.1 % of a linear range, 0.3 % of a decade).
+///
+/// Measured on the shipped recording at the main job's fit, steps of
+/// 1e-3 and 3e-3 give the same 1σ within 13 % (A ±2.4/2.5 %, B ±2.9/2.9 %, C ±0.74/0.84 %, k1
+/// ±1.2/1.3 %); at 1e-2 and 3e-2 the stick–slip comb's jumps enter and B's moves by 40 %.
+pub const FISHER_STEP_U: f64 = 3e-3;
+
+/// One band's measured side: its likelihood and its ordinates.
+struct BandTerm {
+    lik: WelchLikelihood,
+    measured: Vec<f64>,
+    noise_psd: f64,
+}
+
+/// The measured side of the likelihood of one recording, built once per fit.
+pub struct RecordingLikelihood {
+    bands: Vec<BandTerm>,
+    /// The measured signal (NaN where missing or masked), m.
+    measured_x: Vec<f64>,
+    /// Tracking noise of the measured signal, m.
+    pub sigma_m: f64,
+    /// Whether the time-domain term is part of the likelihood.
+    pub time_domain: bool,
+}
+
+/// A fit's negative log-likelihood, by term.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NllParts {
+    /// Whittle NLL per band (the job's band order), nats.
+    pub spectral_nats: Vec<f64>,
+    /// Gaussian NLL of the time-domain residuals, nats (absent when the term is off).
+    pub time_nats: Option<f64>,
+    /// RMS of the de-meaned residuals, m.
+    pub residual_rms_m: f64,
+    /// Lag-one autocorrelation of the residuals.
+    pub residual_rho: f64,
+    /// Effective number of observations: the bands' independent bins plus (with the time term) the
+    /// residuals' AR(1) effective sample size.
+    pub n_effective: f64,
+}
+
+impl NllParts {
+    /// The total NLL, nats.
+    pub fn total(&self) -> f64 {
+        self.spectral_nats.iter().sum::<f64>() + self.time_nats.unwrap_or(0.0)
+    }
+
+    /// The candidate's [`Evidence`] with `k` freed parameters.
+    pub fn evidence(&self, k: usize) -> Evidence {
+        Evidence {
+            nll: self.total(),
+            k,
+            n_effective: self.n_effective,
+        }
+    }
+}
+
+impl RecordingLikelihood {
+    /// The likelihood of `problem`'s measurement (its measured features, which hold each band's
+    /// ordinates and segment count) with the measured signal `x` (NaN where missing; the problem's
+    /// NaN mask applied).
+    ///
+    /// # Errors
+    /// Those of [`likelihood::tracking_noise_sigma`] and [`WelchLikelihood::new`] (e.g. a median
+    /// average, whose ordinates are not χ²_ν).
+    pub fn new(problem: &SpectralProblem, x: &[f64], time_domain: bool) -> Result<Self> {
+        let measured_x: Vec<f64> = x
+            .iter()
+            .zip(&problem.nan_mask)
+            .map(|(v, m)| if *m { f64::NAN } else { *v })
+            .collect();
+        let sigma_m = likelihood::tracking_noise_sigma(&measured_x)?;
+        let bands = problem
+            .measured
+            .bands
+            .iter()
+            .map(|b| {
+                let cfg = b.spec.welch_config()?;
+                Ok(BandTerm {
+                    lik: WelchLikelihood::new(&cfg, b.segments, b.psd.len())?,
+                    measured: b.psd.clone(),
+                    noise_psd: likelihood::noise_psd(sigma_m, problem.fs_hz, &cfg),
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(RecordingLikelihood {
+            bands,
+            measured_x,
+            sigma_m,
+            time_domain,
+        })
+    }
+
+    /// The model's expected ordinates of every band: the simulation's plus the noise density.
+    fn model_psd(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<Vec<Vec<f64>>> {
+        let f = problem.model_features(sim)?;
+        Ok(self
+            .bands
+            .iter()
+            .zip(&f.bands)
+            .map(|(b, m)| m.psd.iter().map(|p| p + b.noise_psd).collect())
+            .collect())
+    }
+
+    /// The model's signal at the recording's samples, NaN where the measurement is.
+    fn model_x(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<Vec<f64>> {
+        let mut x = problem.signal.extract(&sim.to_trace())?;
+        for (xi, d) in x.iter_mut().zip(&self.measured_x) {
+            if !d.is_finite() {
+                *xi = f64::NAN;
+            }
+        }
+        Ok(x)
+    }
+
+    /// The NLL of a simulation, by term.
+    ///
+    /// # Errors
+    /// The features' errors, and [`likelihood::LikelihoodError`] for a non-positive ordinate or
+    /// too few residuals.
+    pub fn nll(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<NllParts> {
+        let psd = self.model_psd(problem, sim)?;
+        let mut spectral_nats = Vec::with_capacity(self.bands.len());
+        let mut n_effective = 0.0;
+        for (b, s) in self.bands.iter().zip(&psd) {
+            spectral_nats.push(b.lik.nll(&b.measured, s)?);
+            n_effective += b.lik.effective_bins();
+        }
+        let e = likelihood::demeaned_residuals(&self.measured_x, &self.model_x(problem, sim)?)?;
+        let size = likelihood::effective_sample_size(&e)?;
+        let residual_rms_m = (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt();
+        let time_nats = if self.time_domain {
+            n_effective += size.n_eff;
+            Some(likelihood::gaussian_nll(&e, self.sigma_m, size.n_eff)?)
+        } else {
+            None
+        };
+        Ok(NllParts {
+            spectral_nats,
+            time_nats,
+            residual_rms_m,
+            residual_rho: size.rho,
+            n_effective,
+        })
+    }
+
+    /// What one simulation contributes to the Gauss–Newton Fisher information: the log expected
+    /// ordinates of every band and the de-meaned model signal (over the samples both sides have).
+    fn response(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<Vec<f64>> {
+        let mut r: Vec<f64> = self
+            .model_psd(problem, sim)?
+            .into_iter()
+            .flatten()
+            .map(f64::ln)
+            .collect();
+        if self.time_domain {
+            let m = self.model_x(problem, sim)?;
+            let both: Vec<f64> = m
+                .iter()
+                .zip(&self.measured_x)
+                .filter(|(a, d)| a.is_finite() && d.is_finite())
+                .map(|(a, _)| *a)
+                .collect();
+            let mean = both.iter().sum::<f64>() / both.len().max(1) as f64;
+            r.extend(both.iter().map(|v| v - mean));
+        }
+        Ok(r)
+    }
+
+    /// Weight of each response component in the Fisher information (see the module docs); `parts`
+    /// are the NLL terms at the fit.
+    fn weights(&self, parts: &NllParts, n_time: usize) -> Vec<f64> {
+        let mut w = Vec::new();
+        for b in &self.bands {
+            w.extend(std::iter::repeat_n(
+                b.lik.dof / 2.0 / b.lik.bin_factor,
+                b.measured.len(),
+            ));
+        }
+        if self.time_domain {
+            let s2 = (self.sigma_m * self.sigma_m).max(parts.residual_rms_m.powi(2));
+            let n_eff = if parts.residual_rho > 0.0 {
+                (1.0 - parts.residual_rho) / (1.0 + parts.residual_rho)
+            } else {
+                1.0
+            };
+            w.extend(std::iter::repeat_n(n_eff / s2, n_time));
+        }
+        w
+    }
+
+    /// The Gauss–Newton Fisher information of the likelihood at normalised coordinates `u`, in
+    /// normalised coordinates (`k × k`, positive semi-definite), from `2k` simulations at the
+    /// problem's solver (one-sided at a bound of the box). `parts`: the NLL at `u`.
+    ///
+    /// # Errors
+    /// A simulation that fails at a displaced point, or responses of different lengths (a
+    /// displaced simulation that lost samples).
+    pub fn fisher(
+        &self,
+        problem: &SpectralProblem,
+        u: &[f64],
+        parts: &NllParts,
+    ) -> Result<DMatrix<f64>> {
+        self.fisher_with_step(problem, u, parts, FISHER_STEP_U)
+    }
+
+    /// [`RecordingLikelihood::fisher`] with central differences of step `h` (normalised units).
+    ///
+    /// # Errors
+    /// As [`RecordingLikelihood::fisher`].
+    pub fn fisher_with_step(
+        &self,
+        problem: &SpectralProblem,
+        u: &[f64],
+        parts: &NllParts,
+        h: f64,
+    ) -> Result<DMatrix<f64>> {
+        use rayon::prelude::*;
+        let k = u.len();
+        let columns: Vec<Vec<f64>> = (0..k)
+            .into_par_iter()
+            .map(|i| {
+                let (lo, hi) = ((u[i] - h).max(0.0), (u[i] + h).min(1.0));
+                let at = |v: f64| -> Result<Vec<f64>> {
+                    let mut p = u.to_vec();
+                    p[i] = v;
+                    self.response(problem, &problem.simulate(&problem.params_at(&p))?)
+                };
+                let (a, b) = (at(lo)?, at(hi)?);
+                if a.len() != b.len() {
+                    return Err(likelihood::LikelihoodError::LengthMismatch {
+                        measured: a.len(),
+                        model: b.len(),
+                    }
+                    .into());
+                }
+                Ok(b.iter()
+                    .zip(&a)
+                    .map(|(y1, y0)| (y1 - y0) / (hi - lo))
+                    .collect())
+            })
+            .collect::<Result<_>>()?;
+        let n_time = columns[0].len() - self.bands.iter().map(|b| b.measured.len()).sum::<usize>();
+        let w = self.weights(parts, n_time);
+        Ok(DMatrix::from_fn(k, k, |i, j| {
+            columns[i]
+                .iter()
+                .zip(&columns[j])
+                .zip(&w)
+                .map(|((a, b), wk)| wk * a * b)
+                .sum()
+        }))
+    }
+}
+
+/// A candidate's fit read through the likelihood: its NLL by term and the spread of its normalised
+/// coordinates from the inverse Fisher information.
+#[derive(Debug, Clone)]
+pub struct LocalFit {
+    /// The NLL at the fit (a joint fit's recordings summed: bands in order, recording after
+    /// recording).
+    pub nll: NllParts,
+    /// 1σ of each normalised coordinate (∞ where the likelihood is flat).
+    pub sigma_u: Vec<f64>,
+    /// Correlations (NaN for a parameter with infinite σ).
+    pub corr: Vec<Vec<f64>>,
+}
+
+/// The likelihood of `problem`'s recording (and of a joint fit's further recordings, whose NLLs and
+/// Fisher informations add) at normalised coordinates `u`: `1 + 2k` simulations per recording,
+/// counted as model evaluations.
+///
+/// # Errors
+/// [`crate::Error::Fit`] with the reason when a recording has no likelihood (a target job); the
+/// simulations' and the likelihood's errors.
+pub fn at_fit(problem: &SpectralProblem, u: &[f64]) -> Result<LocalFit> {
+    let mut nll: Option<NllParts> = None;
+    let mut info = DMatrix::<f64>::zeros(u.len(), u.len());
+    for p in std::iter::once(problem).chain(&problem.others) {
+        let lik = p
+            .likelihood
+            .as_ref()
+            .map_err(|why| crate::Error::Fit(format!("no likelihood: {why}")))?;
+        let sim = p.simulate(&p.params_at(u))?;
+        let parts = lik.nll(p, &sim)?;
+        info += lik.fisher(p, u, &parts)?;
+        problem
+            .evaluations
+            .fetch_add(1 + 2 * u.len(), std::sync::atomic::Ordering::Relaxed);
+        nll = Some(match nll {
+            None => parts,
+            Some(mut acc) => {
+                acc.spectral_nats.extend(parts.spectral_nats);
+                acc.time_nats = match (acc.time_nats, parts.time_nats) {
+                    (None, None) => None,
+                    (a, b) => Some(a.unwrap_or(0.0) + b.unwrap_or(0.0)),
+                };
+                acc.n_effective += parts.n_effective;
+                acc.residual_rms_m = acc.residual_rms_m.max(parts.residual_rms_m);
+                acc.residual_rho = acc.residual_rho.max(parts.residual_rho);
+                acc
+            }
+        });
+    }
+    let (sigma_u, corr) = covariance(&info);
+    Ok(LocalFit {
+        nll: nll.expect("the main recording is always there"),
+        sigma_u,
+        corr,
+    })
+}
+
+/// Covariance of the normalised coordinates from a Fisher information `f` (its pseudo-inverse over
+/// the directions the data inform): per parameter the standard deviation (∞ where the parameter
+/// loads on a direction with no information) and the correlation matrix (NaN there).
+pub fn covariance(f: &DMatrix<f64>) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let k = f.nrows();
+    let eig = f.clone().symmetric_eigen();
+    let max = eig.eigenvalues.iter().fold(0.0_f64, |a, b| a.max(*b));
+    // Directions with less than 1e-12 of the largest eigenvalue carry no information.
+    let informed = |l: f64| l > 1e-12 * max && max > 0.0;
+    let uninformed = |i: usize| {
+        (0..k).any(|j| !informed(eig.eigenvalues[j]) && eig.eigenvectors[(i, j)].powi(2) > 1e-6)
+    };
+    let cov = DMatrix::from_fn(k, k, |i, j| {
+        (0..k)
+            .filter(|&m| informed(eig.eigenvalues[m]))
+            .map(|m| eig.eigenvectors[(i, m)] * eig.eigenvectors[(j, m)] / eig.eigenvalues[m])
+            .sum::<f64>()
+    });
+    let sd: Vec<f64> = (0..k)
+        .map(|i| {
+            if uninformed(i) {
+                f64::INFINITY
+            } else {
+                cov[(i, i)].sqrt()
+            }
+        })
+        .collect();
+    let corr = (0..k)
+        .map(|i| {
+            (0..k)
+                .map(|j| {
+                    if sd[i].is_finite() && sd[j].is_finite() {
+                        cov[(i, j)] / (sd[i] * sd[j])
+                    } else {
+                        f64::NAN
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    (sd, corr)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn covariance_of_a_diagonal_information_is_its_inverse() {
+        // Independent parameters: Var = 1/F_ii, correlation 0.
+        let f = DMatrix::from_row_slice(2, 2, &[4.0, 0.0, 0.0, 100.0]);
+        let (sd, corr) = covariance(&f);
+        assert!((sd[0] - 0.5).abs() < 1e-12 && (sd[1] - 0.1).abs() < 1e-12);
+        assert!(corr[0][1].abs() < 1e-12);
+    }
+
+    #[test]
+    fn covariance_of_a_correlated_pair_matches_the_2x2_inverse() {
+        // F = [[a, b], [b, c]]: Var_0 = c/(ac − b²), corr = −b/√(ac).
+        let (a, b, c) = (3.0, 1.5, 2.0);
+        let f = DMatrix::from_row_slice(2, 2, &[a, b, b, c]);
+        let (sd, corr) = covariance(&f);
+        let det: f64 = a * c - b * b;
+        assert!((sd[0] - (c / det).sqrt()).abs() < 1e-12);
+        assert!((sd[1] - (a / det).sqrt()).abs() < 1e-12);
+        assert!((corr[0][1] + b / (a * c).sqrt()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_parameter_without_information_is_undetermined() {
+        // The second parameter does not move the likelihood: infinite spread, NaN correlation,
+        // and the first keeps its own.
+        let f = DMatrix::from_row_slice(2, 2, &[4.0, 0.0, 0.0, 0.0]);
+        let (sd, corr) = covariance(&f);
+        assert!((sd[0] - 0.5).abs() < 1e-12);
+        assert!(sd[1].is_infinite());
+        assert!(corr[0][1].is_nan());
+    }
+}
