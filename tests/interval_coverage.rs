@@ -32,8 +32,21 @@ fn binomial_cdf(k: usize, n: usize, p: f64) -> f64 {
     total
 }
 
-#[test]
-fn bootstrap_intervals_cover_the_truth_at_their_rate() {
+/// What a coverage test accepts.
+#[derive(Clone, Copy, PartialEq)]
+enum Accept {
+    /// The central ~98 % of Binomial(recordings, 0.6827): the stated rate.
+    Rate,
+    /// At least the lower end of that range: intervals that do not under-cover (conservative ones
+    /// pass).
+    NotUnder,
+}
+
+/// Fits `recordings` noisy recordings of the head model with the given `[fit.uncertainty]` section
+/// and counts, per parameter, the 68.27 % intervals that cover the truth; asserts that every
+/// Laplace interval contains its estimate and that the counts are accepted by `accept` under
+/// Binomial(recordings, 0.6827).
+fn coverage(label: &str, recordings: usize, uncertainty: &str, accept: Accept) {
     let base: BladeParams = common::true_blade();
     let (k1_true, c_true) = (0.015, 0.56);
     let mut truth = base;
@@ -58,7 +71,8 @@ fn bootstrap_intervals_cover_the_truth_at_their_rate() {
         StickForm::Reduced,
     )
     .unwrap();
-    let dir = std::env::temp_dir().join(format!("wiperlab_coverage_{}", std::process::id()));
+    let dir =
+        std::env::temp_dir().join(format!("wiperlab_coverage_{label}_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("blade.toml"), toml::to_string(&base).unwrap()).unwrap();
     std::fs::write(
@@ -68,7 +82,7 @@ fn bootstrap_intervals_cover_the_truth_at_their_rate() {
     .unwrap();
     let noise = Normal::new(0.0, 0.1).unwrap();
     let mut covered = std::collections::BTreeMap::<String, usize>::new();
-    for r in 0..RECORDINGS {
+    for r in 0..recordings {
         let mut rng = rand::rngs::StdRng::seed_from_u64(1000 + r as u64);
         common::write_dltdv(&dir.join(format!("rec{r}_xypts.csv")), &sim, &mut || {
             noise.sample(&mut rng)
@@ -85,18 +99,14 @@ swarm_iterations = 5
 polish_iterations = 40
 seed = 3
 restarts = 2
-[fit.uncertainty]
-bootstrap = 12
-polish_iterations = 40
-seed = {seed}
-[fit.parameters]
+{uncertainty}[fit.parameters]
 k1 = [0.008, 0.03]
 C = [0.4, 0.7]
 [truth]
 json = "truth.json"
 keys = {{ k1 = "/k1", C = "/C" }}
 "#,
-            seed = 50 * r,
+            uncertainty = uncertainty.replace("{seed}", &(50 * r).to_string()),
             recording = common::dltdv_recording(&format!("rec{r}_xypts.csv"), t0),
             spectrum = common::spectrum_bands(&[("low", [30.0, 300.0], 2048)]),
         );
@@ -114,8 +124,18 @@ keys = {{ k1 = "/k1", C = "/C" }}
                 .expect("an interval for every parameter");
             let t = p.true_value.unwrap();
             let inside = iv.lo <= t && t <= iv.hi;
+            // Laplace intervals are built around the estimate; a basic bootstrap interval can
+            // exclude it (its replicates' bias moves both ends), which issue 14 lists as open.
+            assert!(
+                accept == Accept::Rate || (iv.lo <= p.value && p.value <= iv.hi),
+                "{label} recording {r}: {} = {} outside its interval [{}, {}]",
+                p.name,
+                p.value,
+                iv.lo,
+                iv.hi
+            );
             eprintln!(
-                "recording {r}: {} = {:.6} (truth {t:.6}), interval [{:.6}, {:.6}] {}",
+                "{label} recording {r}: {} = {:.6} (truth {t:.6}), interval [{:.6}, {:.6}] {}",
                 p.name,
                 p.value,
                 iv.lo,
@@ -128,17 +148,51 @@ keys = {{ k1 = "/k1", C = "/C" }}
     std::fs::remove_dir_all(&dir).ok();
     // Acceptance region [lo, hi] with P(X < lo) ≈ P(X > hi) ≈ 1 % under Binomial(R, 0.6827).
     let p = 0.6827;
-    let lo = (0..=RECORDINGS)
-        .find(|&k| binomial_cdf(k, RECORDINGS, p) > 0.01)
+    let lo = (0..=recordings)
+        .find(|&k| binomial_cdf(k, recordings, p) > 0.01)
         .unwrap();
-    let hi = (0..=RECORDINGS)
-        .find(|&k| binomial_cdf(k, RECORDINGS, p) >= 0.99)
+    let hi = (0..=recordings)
+        .find(|&k| binomial_cdf(k, recordings, p) >= 0.99)
         .unwrap();
     for (name, c) in &covered {
-        eprintln!("{name}: {c} of {RECORDINGS} intervals cover the truth (accepted {lo}..={hi})");
-        assert!(
-            (lo..=hi).contains(c),
-            "{name}: {c} of {RECORDINGS} 68 % intervals cover the truth (accepted {lo}..={hi})"
+        eprintln!(
+            "{label} {name}: {c} of {recordings} intervals cover the truth (accepted {lo}..={hi})"
         );
     }
+    let hi = if accept == Accept::Rate {
+        hi
+    } else {
+        recordings
+    };
+    for (name, c) in &covered {
+        assert!(
+            (lo..=hi).contains(c),
+            "{label} {name}: {c} of {recordings} 68 % intervals cover the truth (accepted {lo}..={hi})"
+        );
+    }
+}
+
+#[test]
+fn bootstrap_intervals_cover_the_truth_at_their_rate() {
+    coverage(
+        "bootstrap",
+        RECORDINGS,
+        "[fit.uncertainty]\nbootstrap = 12\npolish_iterations = 40\nseed = {seed}\n",
+        Accept::Rate,
+    );
+}
+
+/// Laplace intervals (the likelihood's Fisher information, no refits) on 24 recordings do not
+/// under-cover. Measured: they over-cover (C 21/24, k1 22/24 against 16.4 expected; every fit that
+/// found the truth's basin covers it), because the Whittle likelihood treats the deterministic
+/// stick–slip signal's ordinates as scattering like a random process's, about 3× more than they
+/// do under tracking noise (docs/fit.md, "Uncertainty"). So this asserts the conservative side only.
+#[test]
+fn laplace_intervals_do_not_under_cover() {
+    coverage(
+        "laplace",
+        24,
+        "[fit.uncertainty]\nmethod = \"laplace\"\n",
+        Accept::NotUnder,
+    );
 }
