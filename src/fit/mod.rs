@@ -121,6 +121,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         pb.finish_and_clear();
     }
     warnings.extend(absorbing);
+    warnings.extend(line_warnings(&peaks));
     warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
     warnings.extend(failure_warning(&cf.problem));
     // The chosen model's counts include its bootstrap replicates (they share its counters).
@@ -266,7 +267,31 @@ fn peak_comparison(
         measured_level: d.peak.map(|p| p.level).unwrap_or(f64::NAN),
         model_level: m.peak.map(|p| p.level).unwrap_or(f64::NAN),
         target_range_hz: None,
+        measured_line: features::line_origin(d),
+        model_line: features::line_origin(m),
     }
+}
+
+/// Warnings for lines that are harmonics of stronger lines or lie more than 100× below their
+/// spectrum's dominant line ([`crate::spectrum::harmonics`]): the band then does not see the
+/// component it was meant for.
+fn line_warnings(peaks: &[PeakComparison]) -> Vec<String> {
+    let mut w = Vec::new();
+    for p in peaks {
+        if let Some(c) = p
+            .measured_line
+            .and_then(|o| o.concern(&format!("the recording's line in band '{}'", p.band)))
+        {
+            w.push(c);
+        }
+        if let Some(c) = p
+            .model_line
+            .and_then(|o| o.concern(&format!("the model's line in band '{}'", p.band)))
+        {
+            w.push(c);
+        }
+    }
+    w
 }
 
 /// The chosen problem's failed evaluations (its own and its joint recordings'), with the first

@@ -248,9 +248,14 @@ impl SpectralProblem {
     }
 }
 
-/// The problem as argmin sees it in one stage: shared by the swarm's threads.
+/// The problem as argmin sees it in one stage: shared by the swarm's threads. The third field counts
+/// this run's evaluations (restarts run in parallel; the problem's own counter sums them all).
 #[derive(Clone)]
-pub(super) struct Shared(pub(super) Arc<SpectralProblem>, pub(super) SearchStage);
+pub(super) struct Shared(
+    pub(super) Arc<SpectralProblem>,
+    pub(super) SearchStage,
+    pub(super) Arc<AtomicUsize>,
+);
 
 impl CostFunction for Shared {
     type Param = Vec<f64>;
@@ -259,6 +264,7 @@ impl CostFunction for Shared {
         if super::interrupt::stop_requested() {
             return Err(argmin::core::Error::msg("interrupted"));
         }
+        self.2.fetch_add(1, Ordering::Relaxed);
         Ok(self.0.cost_at_stage(u, self.1))
     }
 }

@@ -50,6 +50,7 @@ pub struct HistoryPoint {
     pub restart: usize,
     pub iteration: u64,
     pub best_cost: f64,
+    /// Model evaluations of this restart so far (its swarm and polish).
     pub evaluations: usize,
 }
 
@@ -160,6 +161,13 @@ pub struct PeakComparison {
     /// or the model's peak when it lies inside).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub target_range_hz: Option<[f64; 2]>,
+    /// What the recording's line is: its own or a harmonic of a stronger line, and how far below
+    /// the spectrum's dominant line ([`crate::spectrum::harmonics`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measured_line: Option<crate::spectrum::harmonics::LineOrigin>,
+    /// The same for the model's line.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model_line: Option<crate::spectrum::harmonics::LineOrigin>,
 }
 
 /// One model of the hierarchy tried on the recording (speed against error at the level of the
@@ -403,6 +411,8 @@ mod tests {
                 measured_level: 1e-9,
                 model_level: 2e-9,
                 target_range_hz: None,
+                measured_line: None,
+                model_line: None,
             }],
             undetermined: vec![],
             correlation: vec![vec![f64::NAN]],

@@ -56,7 +56,10 @@ pub(super) struct SearchObserver {
     stage: SearchStage,
     restart: usize,
     reporting: Reporting,
+    /// The candidate's evaluations (all restarts), for the progress bar.
     evals: Arc<AtomicUsize>,
+    /// This restart's evaluations (swarm and polish), for the history.
+    run_evals: Arc<AtomicUsize>,
 }
 
 /// A point of the search space as the solvers' states hold it.
@@ -96,7 +99,7 @@ where
                 restart: self.restart,
                 iteration: state.get_iter(),
                 best_cost: state.get_best_cost(),
-                evaluations,
+                evaluations: self.run_evals.load(Ordering::Relaxed),
             });
         if let Some(pb) = &self.reporting.progress {
             pb.set_position(self.reporting.base + evaluations as u64);
@@ -407,11 +410,13 @@ pub(super) fn fit_candidate(
     if let Some(pb) = pb {
         pb.set_position(reporting.base + problem.evaluations.load(Ordering::Relaxed) as u64);
     }
-    let history = reporting
+    let mut history = reporting
         .history
         .lock()
         .unwrap_or_else(|e| e.into_inner())
         .clone();
+    // Restarts run in parallel and interleave their points: restart by restart, swarm then polish.
+    history.sort_by_key(|h| (h.restart, h.stage == SearchStage::Polish, h.iteration));
     Ok(CandidateFit {
         candidate,
         free,
@@ -448,79 +453,33 @@ pub(super) fn optimise(
     warm: Option<&[f64]>,
     log: Option<&Reporting>,
 ) -> Result<(Vec<f64>, u64, u64, f64)> {
-    let n = problem.free.len();
-    let fit_err = |e: argmin::core::Error| Error::Fit(e.to_string());
-    let evaluations = problem.evaluations.clone();
-    let observer = |stage: SearchStage, restart: usize| {
-        log.map(|reporting| SearchObserver {
-            stage,
-            restart,
-            reporting: reporting.clone(),
-            evals: evaluations.clone(),
-        })
-    };
+    use rayon::prelude::*;
     let restarts = fit.restarts.max(1);
+    if let Some(reporting) = log {
+        if restarts > 1 {
+            reporting.stage(format_args!("{restarts} restarts"));
+        } else {
+            reporting.stage(format_args!("swarm and polish"));
+        }
+    }
     // The warm point itself, at the polish's tolerance, is a candidate result: then a nested fit
     // cannot end above the smaller model's cost even when the swarm ranks points at a looser
     // tolerance (`[fit] swarm_rtol`) and leaves the warm particle's basin.
     let mut best: Option<(Vec<f64>, f64)> = warm.map(|w| (w.to_vec(), problem.cost_at(w)));
+    // The restarts are independent (each its own seed): they run in parallel, which keeps both
+    // cores busy during the polishes (Nelder–Mead evaluates one point at a time), and are then
+    // compared in restart order, so the result is the sequential one's.
+    let runs: Vec<Result<Option<Run>>> = (0..restarts)
+        .into_par_iter()
+        .map(|r| restart(problem, fit, seed, r, warm, log))
+        .collect();
     let (mut swarm_iters, mut polish_iters) = (0, 0);
-    for r in 0..restarts {
-        if let Some(reporting) = log {
-            if restarts > 1 {
-                reporting.stage(format_args!("swarm {}/{restarts}", r + 1));
-            } else {
-                reporting.stage(format_args!("swarm"));
-            }
-        }
-        let run_seed = seed ^ (r as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        let pso = ParticleSwarm::new((vec![0.0; n], vec![1.0; n]), fit.particles)
-            .with_rng_generator(rand::rngs::StdRng::seed_from_u64(run_seed));
-        let population = match warm {
-            Some(w) if r == 0 && fit.particles > 0 => {
-                Some(warm_population(problem, w, fit.particles, run_seed))
-            }
-            _ => None,
-        };
-        let mut ex =
-            Executor::new(Shared(problem.clone(), SearchStage::Swarm), pso).configure(|s| {
-                let s = s.max_iters(fit.swarm_iterations);
-                match population {
-                    Some(p) => s.population(p),
-                    None => s,
-                }
-            });
-        if let Some(o) = observer(SearchStage::Swarm, r) {
-            ex = ex.add_observer(o, ObserverMode::Always);
-        }
-        let res = match ex.run() {
-            Ok(res) => res,
-            Err(_) if interrupt::stop_requested() => break,
-            Err(e) => return Err(fit_err(e)),
-        };
-        let swarm_best = res
-            .state()
-            .get_best_param()
-            .map(|p| p.position.clone())
-            .ok_or_else(|| Error::Fit("particle swarm returned no particle".into()))?;
-        swarm_iters += res.state().get_iter();
-        if let Some(reporting) = log {
-            reporting.stage(format_args!("polish"));
-        }
-        let (u, iters, cost) = match polish(
-            problem,
-            &swarm_best,
-            0.05,
-            fit.polish_iterations,
-            observer(SearchStage::Polish, r),
-        ) {
-            Ok(p) => p,
-            Err(_) if interrupt::stop_requested() => break,
-            Err(e) => return Err(e),
-        };
-        polish_iters += iters;
-        if best.as_ref().is_none_or(|b| cost < b.1) {
-            best = Some((u, cost));
+    for run in runs {
+        let Some(run) = run? else { continue };
+        swarm_iters += run.swarm_iters;
+        polish_iters += run.polish_iters;
+        if best.as_ref().is_none_or(|b| run.cost < b.1) {
+            best = Some((run.u, run.cost));
         }
     }
     if interrupt::stop_requested()
@@ -528,7 +487,7 @@ pub(super) fn optimise(
             log.and_then(|r| r.best.lock().unwrap_or_else(|e| e.into_inner()).clone())
         && best.as_ref().is_none_or(|b| seen.1 < b.1)
     {
-        // Interrupted: the best point the observer saw in the unfinished run.
+        // Interrupted: the best point the observer saw in the unfinished runs.
         best = Some(seen);
     }
     let (u, cost) = best.ok_or_else(|| {
@@ -539,6 +498,90 @@ pub(super) fn optimise(
         }
     })?;
     Ok((u, swarm_iters, polish_iters, cost))
+}
+
+/// One restart's outcome.
+struct Run {
+    u: Vec<f64>,
+    cost: f64,
+    swarm_iters: u64,
+    polish_iters: u64,
+}
+
+/// Restart `r` of [`optimise`]: a particle swarm seeded with `seed ^ (r · 0x9E3779B97F4A7C15)` (its
+/// first particle at `warm` for restart 0), then a Nelder–Mead polish from its best particle.
+/// `None` when interrupted.
+fn restart(
+    problem: &Arc<SpectralProblem>,
+    fit: &job::FitSection,
+    seed: u64,
+    r: usize,
+    warm: Option<&[f64]>,
+    log: Option<&Reporting>,
+) -> Result<Option<Run>> {
+    let n = problem.free.len();
+    let fit_err = |e: argmin::core::Error| Error::Fit(e.to_string());
+    let run_evals = Arc::new(AtomicUsize::new(0));
+    let observer = |stage: SearchStage| {
+        log.map(|reporting| SearchObserver {
+            stage,
+            restart: r,
+            reporting: reporting.clone(),
+            evals: problem.evaluations.clone(),
+            run_evals: run_evals.clone(),
+        })
+    };
+    let run_seed = seed ^ (r as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    let pso = ParticleSwarm::new((vec![0.0; n], vec![1.0; n]), fit.particles)
+        .with_rng_generator(rand::rngs::StdRng::seed_from_u64(run_seed));
+    let population = match warm {
+        Some(w) if r == 0 && fit.particles > 0 => {
+            Some(warm_population(problem, w, fit.particles, run_seed))
+        }
+        _ => None,
+    };
+    let mut ex = Executor::new(
+        Shared(problem.clone(), SearchStage::Swarm, run_evals.clone()),
+        pso,
+    )
+    .configure(|s| {
+        let s = s.max_iters(fit.swarm_iterations);
+        match population {
+            Some(p) => s.population(p),
+            None => s,
+        }
+    });
+    if let Some(o) = observer(SearchStage::Swarm) {
+        ex = ex.add_observer(o, ObserverMode::Always);
+    }
+    let res = match ex.run() {
+        Ok(res) => res,
+        Err(_) if interrupt::stop_requested() => return Ok(None),
+        Err(e) => return Err(fit_err(e)),
+    };
+    let swarm_best = res
+        .state()
+        .get_best_param()
+        .map(|p| p.position.clone())
+        .ok_or_else(|| Error::Fit("particle swarm returned no particle".into()))?;
+    let swarm_iters = res.state().get_iter();
+    let (u, polish_iters, cost) = match polish(
+        problem,
+        &swarm_best,
+        0.05,
+        fit.polish_iterations,
+        observer(SearchStage::Polish),
+    ) {
+        Ok(p) => p,
+        Err(_) if interrupt::stop_requested() => return Ok(None),
+        Err(e) => return Err(e),
+    };
+    Ok(Some(Run {
+        u,
+        cost,
+        swarm_iters,
+        polish_iters,
+    }))
 }
 
 /// A swarm's first population with one particle at `warm` and the others drawn uniformly over
@@ -594,7 +637,10 @@ pub(super) fn polish(
     let nm = NelderMead::new(simplex)
         .with_sd_tolerance(1e-3)
         .map_err(fit_err)?;
-    let mut ex = Executor::new(Shared(problem.clone(), SearchStage::Polish), nm)
+    let run_evals = observer
+        .as_ref()
+        .map_or_else(|| Arc::new(AtomicUsize::new(0)), |o| o.run_evals.clone());
+    let mut ex = Executor::new(Shared(problem.clone(), SearchStage::Polish, run_evals), nm)
         .configure(|s| s.max_iters(iterations));
     if let Some(o) = observer {
         ex = ex.add_observer(o, ObserverMode::Always);

@@ -298,8 +298,8 @@ pub fn fit_figures(
     cost_figure(dir, &o.result.history)
 }
 
-/// Writes `cost.svg`: best cost against model evaluations, one series per restart (each restart's
-/// swarm starts anew, so its curve begins above the previous one's end).
+/// Writes `cost.svg`: best cost against the restart's own model evaluations, one series per restart
+/// (the restarts run in parallel, each from its own swarm).
 fn cost_figure(dir: &Path, history: &[HistoryPoint]) -> Result<()> {
     let restarts = history.iter().map(|h| h.restart + 1).max().unwrap_or(0);
     let series: Vec<Series> = (0..restarts.max(1))
@@ -320,7 +320,7 @@ fn cost_figure(dir: &Path, history: &[HistoryPoint]) -> Result<()> {
     line_chart(
         &dir.join("cost.svg"),
         "best cost against model evaluations",
-        "model evaluations",
+        "model evaluations of the restart",
         "best cost",
         &series,
         &ChartOpts {

@@ -258,6 +258,28 @@ struct PeakView {
     rel_diff: String,
     measured_level: String,
     model_level: String,
+    measured_line: String,
+    model_line: String,
+}
+
+/// A line's origin in words: its own, or a harmonic of a stronger line; and its distance below the
+/// spectrum's dominant line when that exceeds 100×.
+fn line_words(o: Option<crate::spectrum::harmonics::LineOrigin>) -> String {
+    let Some(o) = o else {
+        return "—".into();
+    };
+    let mut w = match o.harmonic_of {
+        Some(h) => format!("harmonic {} of {} Hz", h.order, num(h.freq_hz, 4)),
+        None => "its own line".into(),
+    };
+    if o.below_dominant > 100.0 {
+        w.push_str(&format!(
+            "; {}× below the dominant line ({} Hz)",
+            num(o.below_dominant, 3),
+            num(o.dominant_hz, 4)
+        ));
+    }
+    w
 }
 
 fn peak_rows(r: &FitResult) -> Vec<PeakView> {
@@ -274,6 +296,8 @@ fn peak_rows(r: &FitResult) -> Vec<PeakView> {
             rel_diff: pct(p.rel_diff),
             measured_level: num(p.measured_level, 3),
             model_level: num(p.model_level, 3),
+            measured_line: line_words(p.measured_line),
+            model_line: line_words(p.model_line),
         })
         .collect()
 }
@@ -754,6 +778,8 @@ mod tests {
                 measured_level: 1e-9,
                 model_level: 2e-9,
                 target_range_hz: None,
+                measured_line: None,
+                model_line: None,
             }],
             undetermined: vec![crate::model::ParamId::B],
             correlation: vec![vec![1.0, -0.9], vec![-0.9, 1.0]],

@@ -207,6 +207,16 @@ pub fn features(x: &[f64], fs_hz: f64, bands: &[BandSpec], max_fill: usize) -> R
     Ok(Features { bands: out, filled })
 }
 
+/// What the band's peak is against the band's whole spectrum ([`crate::spectrum::harmonics`]):
+/// a line of its own or a harmonic of a stronger line, and how far below the dominant line. Lines
+/// are looked for from 3 Welch bins up (below, the window's main lobe around 0 Hz). `None` without
+/// a peak or a spectrum (a target job's "measurement").
+pub fn line_origin(b: &BandFeatures) -> Option<crate::spectrum::harmonics::LineOrigin> {
+    let peak = b.peak?;
+    let df = b.full_freq_hz.get(1).copied()? - b.full_freq_hz[0];
+    crate::spectrum::harmonics::classify_line(&b.full_freq_hz, &b.full_psd, &peak, 3.0 * df)
+}
+
 /// Estimate of the measurement's white-noise floor (PSD units) in a band: the 10th percentile of
 /// the PSD over the upper half of the band. Tracking noise is white, the model has none; adding this
 /// floor to the model's PSD before comparing log-PSDs keeps the comparison like with like.

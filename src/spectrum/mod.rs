@@ -23,6 +23,7 @@
 
 pub mod error;
 pub mod features;
+pub mod harmonics;
 pub mod instfreq;
 pub mod peaks;
 pub mod resample;

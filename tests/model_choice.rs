@@ -1,0 +1,362 @@
+//! Which model does the fit choose, by the likelihood's AIC, on recordings whose true model is
+//! known? (issue 19, point 3: the confusion table.)
+//!
+//! Eight recordings the model made (rtol 1e-10) from the shipped sample's blade
+//! (`data/reversal/blade_true.toml`) with one thing changed per scene, written as DLTdv files
+//! through the sample's camera model with Gaussian tracking noise of 0.1 px per coordinate (as the
+//! sample: data/reversal/README.md) and 1 % of the frames dropped in runs of 1–3 (the job fills up
+//! to 5). Each is fitted with the main job's settings (`fits/reversal.toml`: bands, solver, swarm,
+//! 5 restarts, the three candidates, A, B, C, k1 and the shoulder's bounds) and Laplace intervals.
+//!
+//! The table goes to `reports/model_choice/table.md` (and `.csv`). It takes about 20 minutes on 2
+//! cores, so it is ignored by default:
+//! `cargo test --release --test model_choice -- --ignored --nocapture`.
+//!
+//! Asserted, as the issue states it: where the true model is in the candidate list and the chosen
+//! model's ln L differs from the true model's by more than the noise (|ΔAIC| > 2), the true model is
+//! chosen; where it is chosen, A, B, C, k1 (and k1c) are within 5 % of the truth.
+
+mod common;
+
+use rand::{Rng, SeedableRng};
+use rand_distr::{Distribution, Normal};
+use std::fmt::Write as _;
+use wiperlab::fit::job::LoadedJob;
+use wiperlab::fit::run_fit;
+use wiperlab::model::{BladeParams, FrictionLaw, Shoulder, StickForm};
+use wiperlab::simulate::SolverOptions;
+use wiperlab::simulate::blade::{ModelKind, default_window, simulate_model};
+
+/// One recording: what made it.
+struct Scene {
+    name: &'static str,
+    /// The model that made it, as the candidates are named.
+    truth_model: &'static str,
+    /// The simulated model (the shoulder comes from `shoulder`).
+    kind: ModelKind,
+    /// The sweep's angular frequency as a multiple of the sample's.
+    speed: f64,
+    /// Free neck stiffness, N·m/rad.
+    k1: f64,
+    /// Shoulder: (contact angle, rad; stiffness in contact, N·m/rad).
+    shoulder: Option<(f64, f64)>,
+}
+
+const SCENES: [Scene; 8] = [
+    Scene {
+        name: "no shoulder",
+        truth_model: "blade2dof",
+        kind: ModelKind::Blade2dof,
+        speed: 1.0,
+        k1: 0.029748408887917077,
+        shoulder: None,
+    },
+    Scene {
+        name: "no shoulder, 0.7x speed",
+        truth_model: "blade2dof",
+        kind: ModelKind::Blade2dof,
+        speed: 0.7,
+        k1: 0.029748408887917077,
+        shoulder: None,
+    },
+    // Free neck 4x softer than the sample's, touching at 0.06 rad (tests/shoulder_fit.rs's scene):
+    // measured, 2 switches, the neck enters contact once and stays.
+    Scene {
+        name: "soft neck on a shoulder at 0.06 rad",
+        truth_model: "blade2dof+shoulder",
+        kind: ModelKind::Blade2dof,
+        speed: 1.0,
+        k1: 0.0075,
+        shoulder: Some((0.06, 0.03)),
+    },
+    Scene {
+        name: "soft neck on a shoulder at 0.06 rad, 0.7x speed",
+        truth_model: "blade2dof+shoulder",
+        kind: ModelKind::Blade2dof,
+        speed: 0.7,
+        k1: 0.0075,
+        shoulder: Some((0.06, 0.03)),
+    },
+    // The issue's scene: a free neck a quarter of the sample's resting on the shoulder, contact
+    // stiffness 3.25x the free one (measured: 2 switches).
+    Scene {
+        name: "soft neck on a shoulder at 0.025 rad",
+        truth_model: "blade2dof+shoulder",
+        kind: ModelKind::Blade2dof,
+        speed: 1.0,
+        k1: 0.0075,
+        shoulder: Some((0.025, 0.024375)),
+    },
+    Scene {
+        name: "soft neck on a shoulder at 0.025 rad, 0.7x speed",
+        truth_model: "blade2dof+shoulder",
+        kind: ModelKind::Blade2dof,
+        speed: 0.7,
+        k1: 0.0075,
+        shoulder: Some((0.025, 0.024375)),
+    },
+    // The sample's neck with a shoulder near its largest |θ|: measured, 68 switches, crossed often.
+    Scene {
+        name: "sample neck, shoulder at 0.12 rad (crossed often)",
+        truth_model: "blade2dof+shoulder",
+        kind: ModelKind::Blade2dof,
+        speed: 1.0,
+        k1: 0.029748408887917077,
+        shoulder: Some((0.12, 0.09)),
+    },
+    // The head's motion alone: the 1-DOF head model, neck and lip locked to it. With the sample's
+    // blade it loses contact at the flip (N ≤ 0 at 1.824 s), so the table records that instead.
+    Scene {
+        name: "head-only motion",
+        truth_model: "head1dof",
+        kind: ModelKind::Head1dof,
+        speed: 1.0,
+        k1: 0.029748408887917077,
+        shoulder: None,
+    },
+];
+
+fn truth_params(s: &Scene) -> BladeParams {
+    let mut p = common::true_blade();
+    p.drive_omega_rad_per_s *= s.speed;
+    p.k1_nm_per_rad = s.k1;
+    p.shoulder = s.shoulder.map(|(theta, k1c)| Shoulder {
+        contact_angle_rad: theta,
+        k1_contact_nm_per_rad: k1c,
+    });
+    p
+}
+
+/// Writes the scene's recording (noise and drops) and job; returns the job's path and how many
+/// shoulder switches the recording has.
+fn write_scene(
+    dir: &std::path::Path,
+    i: usize,
+    s: &Scene,
+) -> Result<(std::path::PathBuf, usize), String> {
+    let truth = truth_params(s);
+    let (t0, t1) = default_window(&truth);
+    let times = common::frame_times(t0, t1, 1e4);
+    let sim = simulate_model(
+        s.kind,
+        &truth,
+        (t0, *times.last().unwrap()),
+        &times,
+        &SolverOptions {
+            rtol: 1e-10,
+            atol: 1e-12,
+            ..SolverOptions::default()
+        },
+        StickForm::Reduced,
+    )
+    .map_err(|e| format!("cannot be simulated: {e}"))?;
+    let mut rng = rand::rngs::StdRng::seed_from_u64(4000 + i as u64);
+    let noise = Normal::new(0.0, 0.1).unwrap();
+    let rec = dir.join(format!("scene{i}_xypts.csv"));
+    common::write_dltdv(&rec, &sim, &mut || noise.sample(&mut rng));
+    // Drops: 1 % of the frames, in runs of 1–3, written as DLTdv writes a lost point (NaN).
+    let text = std::fs::read_to_string(&rec).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let frames = lines.len() - 1;
+    let mut dropped = 0;
+    while dropped < frames / 100 {
+        let start = 1 + rng.random_range(10..frames - 10);
+        let len = rng.random_range(1..=3);
+        for line in lines.iter_mut().skip(start).take(len) {
+            *line = "NaN,NaN,NaN,NaN".into();
+        }
+        dropped += len;
+    }
+    std::fs::write(&rec, lines.join("\n") + "\n").unwrap();
+    // The job: the main job's, with this scene's drive in its blade and its own truth.
+    let mut blade = common::true_blade();
+    blade.drive_omega_rad_per_s = truth.drive_omega_rad_per_s;
+    std::fs::write(
+        dir.join(format!("blade{i}.toml")),
+        toml::to_string(&blade).unwrap(),
+    )
+    .unwrap();
+    let (a, b, c) = match truth.friction {
+        FrictionLaw::Exponential { a, b_s_per_m, c } => (a, b_s_per_m, c),
+        _ => panic!("the sample's friction law is exponential"),
+    };
+    let (theta, k1c) = s.shoulder.unwrap_or((f64::NAN, f64::NAN));
+    std::fs::write(
+        dir.join(format!("truth{i}.json")),
+        format!(
+            "{{\"A\": {a}, \"B\": {b}, \"C\": {c}, \"k1\": {}, \"k1c\": {}, \"theta_c\": {}}}",
+            s.k1,
+            if k1c.is_nan() {
+                "null".into()
+            } else {
+                k1c.to_string()
+            },
+            if theta.is_nan() {
+                "null".into()
+            } else {
+                theta.to_string()
+            },
+        ),
+    )
+    .unwrap();
+    let keys = if s.shoulder.is_some() {
+        "A = \"/A\", B = \"/B\", C = \"/C\", k1 = \"/k1\", k1c = \"/k1c\", theta_c = \"/theta_c\""
+    } else {
+        "A = \"/A\", B = \"/B\", C = \"/C\", k1 = \"/k1\""
+    };
+    let job = format!(
+        r#"name = "scene{i}"
+blade = "blade{i}.toml"
+{recording}{spectrum}[solver]
+rtol = 1e-8
+atol = 1e-10
+[fit]
+particles = 24
+swarm_iterations = 25
+polish_iterations = 60
+seed = 1
+restarts = 5
+swarm_rtol = 1e-6
+models = ["head1dof", "blade2dof", "blade2dof+shoulder"]
+[fit.uncertainty]
+method = "laplace"
+[fit.shoulder]
+k1c = [0.005, 0.15]
+theta_c = [0.02, 0.2]
+[fit.parameters]
+A = [0.2, 1.5]
+B = [10.0, 300.0]
+C = [0.1, 1.0]
+k1 = [0.005, 0.15]
+[truth]
+json = "truth{i}.json"
+keys = {{ {keys} }}
+"#,
+        recording = common::dltdv_recording(&format!("scene{i}_xypts.csv"), t0),
+        spectrum =
+            common::spectrum_bands(&[("low", [30.0, 300.0], 4096), ("high", [500.0, 5000.0], 512)]),
+    );
+    let path = dir.join(format!("scene{i}.toml"));
+    std::fs::write(&path, job).unwrap();
+    Ok((path, sim.switches.len()))
+}
+
+#[test]
+#[ignore = "about 20 minutes on 2 cores: cargo test --release --test model_choice -- --ignored"]
+fn likelihood_choice_confusion_table() {
+    let dir = std::env::temp_dir().join(format!("wiperlab_model_choice_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut md = String::from(
+        "| recording | shoulder switches | true model | chosen | ΔAIC of the true model | A | B | C | k1 | k1c | warnings |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    let mut csv = String::from(
+        "recording,switches,true_model,chosen_model,delta_aic_true,err_A,err_B,err_C,err_k1,err_k1c,wall_time_s\n",
+    );
+    let mut failures = Vec::new();
+    for (i, s) in SCENES.iter().enumerate() {
+        let fitted = write_scene(&dir, i, s).and_then(|(job, switches)| {
+            run_fit(&LoadedJob::load(&job).map_err(|e| e.to_string())?, false)
+                .map(|o| (o, switches))
+                .map_err(|e| format!("the fit failed: {e}"))
+        });
+        let (out, switches) = match fitted {
+            Ok(f) => f,
+            Err(e) => {
+                println!("{}: {e}", s.name);
+                let _ = writeln!(
+                    md,
+                    "| {} | — | {} | ({e}) | | | | | | | |",
+                    s.name, s.truth_model
+                );
+                failures.push(format!("{}: {e}", s.name));
+                continue;
+            }
+        };
+        let r = &out.result;
+        let chosen = r.model.to_string();
+        let true_trial = r
+            .model_trials
+            .iter()
+            .find(|t| t.model == s.truth_model)
+            .expect("the true model is a candidate");
+        let d_true = true_trial
+            .evidence
+            .as_ref()
+            .map_or(f64::NAN, |e| e.delta_aic);
+        let err = |name: &str| {
+            r.parameters
+                .iter()
+                .find(|p| p.name == name)
+                .and_then(|p| p.rel_error)
+        };
+        let pct = |e: Option<f64>| e.map_or("—".into(), |e| format!("{:+.2} %", 100.0 * e));
+        let absorbing: Vec<&String> = r
+            .warnings
+            .iter()
+            .filter(|w| w.contains("absorbs structure"))
+            .collect();
+        println!(
+            "{}: {switches} switches, true {}, chosen {chosen} (ΔAIC of the true model {d_true:+.2}), A {} B {} C {} k1 {} k1c {}, {:.0} s; {} absorbing warnings",
+            s.name,
+            s.truth_model,
+            pct(err("A")),
+            pct(err("B")),
+            pct(err("C")),
+            pct(err("k1")),
+            pct(err("k1c")),
+            r.wall_time_s,
+            absorbing.len()
+        );
+        for t in &r.model_trials {
+            println!("    {}: {}", t.model, t.reason);
+        }
+        let _ = writeln!(
+            md,
+            "| {} | {switches} | {} | {chosen} | {d_true:+.2} | {} | {} | {} | {} | {} | {} |",
+            s.name,
+            s.truth_model,
+            pct(err("A")),
+            pct(err("B")),
+            pct(err("C")),
+            pct(err("k1")),
+            pct(err("k1c")),
+            absorbing.len()
+        );
+        let num = |e: Option<f64>| e.map_or(String::new(), |e| format!("{e}"));
+        let _ = writeln!(
+            csv,
+            "\"{}\",{switches},{},{chosen},{d_true},{},{},{},{},{},{}",
+            s.name,
+            s.truth_model,
+            num(err("A")),
+            num(err("B")),
+            num(err("C")),
+            num(err("k1")),
+            num(err("k1c")),
+            r.wall_time_s
+        );
+        // The issue's criteria.
+        if chosen != s.truth_model && d_true.abs() > 2.0 {
+            failures.push(format!(
+                "{}: chose {chosen}, the true {} is {d_true:+.2} in AIC",
+                s.name, s.truth_model
+            ));
+        }
+        if chosen == s.truth_model {
+            for name in ["A", "B", "C", "k1", "k1c"] {
+                if let Some(e) = err(name)
+                    && e.abs() > 0.05
+                {
+                    failures.push(format!("{}: {name} off by {:+.2} %", s.name, 100.0 * e));
+                }
+            }
+        }
+    }
+    let out = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/model_choice");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("table.md"), &md).unwrap();
+    std::fs::write(out.join("table.csv"), &csv).unwrap();
+    println!("{md}");
+    std::fs::remove_dir_all(&dir).ok();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
