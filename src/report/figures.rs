@@ -260,15 +260,87 @@ pub fn fit_figures(
             },
         )?;
     }
-    // Friction law μ_d(v) fitted, and the truth when known.
-    let v: Vec<f64> = (0..=200).map(|i| i as f64 * 0.2 / 200.0).collect();
-    let mut series = vec![Series::line(
-        "fitted",
-        v.clone(),
-        v.iter()
-            .map(|x| o.best_params.friction.mu_slip(*x))
-            .collect(),
-    )];
+    friction_law_figure(dir, o)?;
+    if let Some(c) = freq_speed {
+        freq_vs_speed_figure(dir, c)?;
+    }
+    cost_figure(dir, &o.result.history)
+}
+
+/// The fastest slip speed the fitted model's lip tip reaches in the window, m/s (`|Δv3/Δt|` over
+/// the samples), or `None` without two finite samples.
+fn max_tip_speed(o: &FitOutcome) -> Option<f64> {
+    let sim = &o.best_sim;
+    let v = sim
+        .t_s
+        .windows(2)
+        .zip(sim.v3_m.windows(2))
+        .map(|(t, x)| ((x[1] - x[0]) / (t[1] - t[0])).abs())
+        .filter(|v| v.is_finite())
+        .fold(f64::NAN, f64::max);
+    (v.is_finite() && v > 0.0).then_some(v)
+}
+
+/// `μ_d(v) ± 1σ` of the seed's law at the fitted A, B, C by the delta method: `σ² = gᵀ Σ g` with
+/// `g = (e^(−Bv), −A v e^(−Bv), 1)` and `Σ` the fitted parameters' covariance (their 1σ and
+/// correlations from the result). `None` unless A, B and C were all fitted with finite 1σ and
+/// correlations.
+fn friction_sigma(o: &FitOutcome, v: &[f64]) -> Option<Vec<f64>> {
+    let r = &o.result;
+    let idx = |n: &str| r.parameters.iter().position(|p| p.name == n);
+    let ids = [idx("A")?, idx("B")?, idx("C")?];
+    let sd: Vec<f64> = ids.iter().map(|&i| r.parameters[i].std_error).collect();
+    let corr = |i: usize, j: usize| r.correlation.get(ids[i])?.get(ids[j]).copied();
+    let mut cov = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            cov[i][j] = sd[i] * sd[j] * corr(i, j).filter(|c| c.is_finite())?;
+        }
+    }
+    if sd.iter().any(|s| !s.is_finite()) {
+        return None;
+    }
+    let (a, b) = (r.parameters[ids[0]].value, r.parameters[ids[1]].value);
+    Some(delta_band(a, b, &cov, v))
+}
+
+/// `σ_μ(v) = √(gᵀ Σ g)`, `g = (e^(−Bv), −A v e^(−Bv), 1)`: the delta method's 1σ of
+/// `μ_d = A e^(−Bv) + C` for the covariance `cov` of (A, B, C).
+fn delta_band(a: f64, b: f64, cov: &[[f64; 3]; 3], v: &[f64]) -> Vec<f64> {
+    v.iter()
+        .map(|&x| {
+            let e = (-b * x).exp();
+            let g = [e, -a * x * e, 1.0];
+            let mut s2 = 0.0;
+            for i in 0..3 {
+                for j in 0..3 {
+                    s2 += g[i] * cov[i][j] * g[j];
+                }
+            }
+            s2.max(0.0).sqrt()
+        })
+        .collect()
+}
+
+/// Writes `friction_law.svg`: the fitted law over the slip speeds the model's tip reaches, with its
+/// ±1σ band (dashed) when A, B and C were fitted, and the truth when known.
+fn friction_law_figure(dir: &Path, o: &FitOutcome) -> Result<()> {
+    let v_max = max_tip_speed(o).map_or(0.2, |v| 1.05 * v);
+    let v: Vec<f64> = (0..=200).map(|i| i as f64 * v_max / 200.0).collect();
+    let mu: Vec<f64> = v
+        .iter()
+        .map(|x| o.best_params.friction.mu_slip(*x))
+        .collect();
+    let mut series = vec![Series::line("fitted", v.clone(), mu.clone())];
+    if let Some(sigma) = friction_sigma(o, &v) {
+        for (label, sign) in [("fitted + 1σ", 1.0), ("fitted − 1σ", -1.0)] {
+            series.push(Series::line(
+                label,
+                v.clone(),
+                mu.iter().zip(&sigma).map(|(m, s)| m + sign * s).collect(),
+            ));
+        }
+    }
     let truth = |n: &str| {
         o.result
             .parameters
@@ -286,16 +358,12 @@ pub fn fit_figures(
     }
     line_chart(
         &dir.join("friction_law.svg"),
-        "dynamic friction coefficient μ_d = A e^(−B|v|) + C (seed eq. 4)",
-        "slip speed |v̇3| [m/s]",
+        "dynamic friction coefficient μ_d = A e^(−B|v|) + C (seed eq. 4), ±1σ from the fit",
+        "slip speed |v̇3| [m/s] (up to the fastest the model's tip reaches)",
         "dynamic friction coefficient μ_d [-]",
         &series,
         &ChartOpts::default(),
-    )?;
-    if let Some(c) = freq_speed {
-        freq_vs_speed_figure(dir, c)?;
-    }
-    cost_figure(dir, &o.result.history)
+    )
 }
 
 /// Writes `cost.svg`: best cost against the restart's own model evaluations, one series per restart
@@ -561,4 +629,33 @@ pub fn fit_summary(r: &FitResult) -> String {
         );
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::delta_band;
+
+    #[test]
+    fn friction_band_by_the_delta_method() {
+        let (a, b, v) = (0.88, 70.0, [0.0, 0.01, 0.05]);
+        // Only C uncertain: a constant band of σ_C.
+        let c_only = [[0.0; 3], [0.0; 3], [0.0, 0.0, 0.0025]];
+        for s in delta_band(a, b, &c_only, &v) {
+            assert!((s - 0.05).abs() < 1e-15);
+        }
+        // Only A uncertain: σ_A e^(−Bv), which is σ_A at v = 0.
+        let a_only = [[1e-4, 0.0, 0.0], [0.0; 3], [0.0; 3]];
+        for (s, x) in delta_band(a, b, &a_only, &v).iter().zip(v) {
+            assert!((s - 1e-2 * (-b * x).exp()).abs() < 1e-15);
+        }
+        // A and C perfectly anti-correlated with equal σ: the band vanishes at v = 0 (μ(0) = A + C
+        // is fixed) and grows as e^(−Bv) decays: σ·(1 − e^(−Bv)).
+        let anti = [[1e-4, 0.0, -1e-4], [0.0; 3], [-1e-4, 0.0, 1e-4]];
+        for (s, x) in delta_band(a, b, &anti, &v).iter().zip(v) {
+            assert!(
+                (s - 1e-2 * (1.0 - (-b * x).exp())).abs() < 1e-12,
+                "{s} at {x}"
+            );
+        }
+    }
 }
