@@ -168,7 +168,7 @@ pub fn fit_figures(
                 Series::line("model", o.best_sim.t_s.clone(), demean(&model)),
             ]
         },
-        &ChartOpts::default(),
+        &residual_opts(t, &demean(&meas), &o.best_sim.t_s, &demean(&model)),
     )?;
     let head_meas = o
         .measured_trace
@@ -182,14 +182,18 @@ pub fn fit_figures(
         "t [s] (model clock)",
         "head y [mm]",
         &if targets_only {
-            vec![Series::line("model", o.best_sim.t_s.clone(), head_model)]
+            vec![Series::line(
+                "model",
+                o.best_sim.t_s.clone(),
+                head_model.clone(),
+            )]
         } else {
             vec![
-                Series::line("measured", t.clone(), head_meas),
-                Series::line("model", o.best_sim.t_s.clone(), head_model),
+                Series::line("measured", t.clone(), head_meas.clone()),
+                Series::line("model", o.best_sim.t_s.clone(), head_model.clone()),
             ]
         },
-        &ChartOpts::default(),
+        &residual_opts(t, &head_meas, &o.best_sim.t_s, &head_model),
     )?;
     for (d, m) in o.measured.bands.iter().zip(&o.model.bands) {
         // The cost adds the measurement's noise floor to the model PSD (src/fit/mod.rs cost_of);
@@ -265,6 +269,22 @@ pub fn fit_figures(
         freq_vs_speed_figure(dir, c)?;
     }
     cost_figure(dir, &o.result.history)
+}
+
+/// Chart options with a "measured − model" residual panel when both sides are sampled at the same
+/// times (the fit simulates at the recording's frames); none for a target job's empty measurement.
+fn residual_opts(t_meas: &[f64], meas: &[f64], t_model: &[f64], model: &[f64]) -> ChartOpts {
+    let same = !meas.is_empty() && t_meas.len() == t_model.len() && meas.len() == model.len();
+    ChartOpts {
+        residual: same.then(|| {
+            Series::line(
+                "residual: measured − model",
+                t_meas.to_vec(),
+                meas.iter().zip(model).map(|(d, m)| d - m).collect(),
+            )
+        }),
+        ..ChartOpts::default()
+    }
 }
 
 /// The fastest slip speed the fitted model's lip tip reaches in the window, m/s (`|Δv3/Δt|` over

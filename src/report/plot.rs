@@ -121,6 +121,10 @@ pub struct ChartOpts {
     pub markers: Vec<Marker>,
     /// Vertical dashed reference lines `(x, label)`, e.g. a target frequency.
     pub vlines: Vec<(f64, String)>,
+    /// A residual drawn in its own panel under the chart (a third of the height, linear y axis
+    /// fitted to it, the chart's x range), titled by its label: e.g. measured − model under a
+    /// trace overlay, where a match cannot be told from overplotting.
+    pub residual: Option<Series>,
 }
 
 fn draw_err(path: &Path, e: impl std::fmt::Display) -> Error {
@@ -361,9 +365,45 @@ pub fn line_chart(
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         root.fill(&WHITE).map_err(|e| draw_err(path, e))?;
         let (plot_root, _) = root.split_vertically(size.1 - legend.height);
-        draw_xy(&plot_root, plane, (title, x_label, y_label), series, opts)
-            .and_then(|_| root.present())
-            .map_err(|e| draw_err(path, e))?;
+        match &opts.residual {
+            None => draw_xy(&plot_root, plane, (title, x_label, y_label), series, opts),
+            Some(r) => {
+                let (top, bottom) = plot_root.split_vertically((size.1 - legend.height) * 2 / 3);
+                let (lo, hi) =
+                    r.x.iter()
+                        .zip(&r.y)
+                        .filter(|(x, y)| y.is_finite() && **x >= xlo && **x <= xhi)
+                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (_, y)| {
+                            (a.min(*y), b.max(*y))
+                        });
+                let (lo, hi) = if lo <= hi { (lo, hi) } else { (-1.0, 1.0) };
+                let lin = Axis { log: false };
+                let residual_plane = Plane {
+                    ax,
+                    ay: lin,
+                    bx,
+                    by: plane_range(lin, lo, hi, 0.05),
+                };
+                let plain = ChartOpts {
+                    log_y: false,
+                    markers: Vec::new(),
+                    vlines: Vec::new(),
+                    residual: None,
+                    ..opts.clone()
+                };
+                draw_xy(&top, plane, (title, x_label, y_label), series, opts).and_then(|_| {
+                    draw_xy(
+                        &bottom,
+                        residual_plane,
+                        (&r.label, x_label, y_label),
+                        std::slice::from_ref(r),
+                        &plain,
+                    )
+                })
+            }
+        }
+        .and_then(|_| root.present())
+        .map_err(|e| draw_err(path, e))?;
     }
     let svg =
         shown_at_figure_size(&svg, size).replace("</svg>", &legend.svg(size.1 - legend.height));
@@ -909,6 +949,40 @@ mod tests {
             assert!(s.contains(m), "{} lacks {m:?}", path.display());
         }
         s
+    }
+
+    #[test]
+    fn a_residual_gets_its_own_panel_with_its_own_scale() {
+        // Measured and model 1 mm sines a 1 % amplitude apart: overlaid they look the same; the
+        // residual panel's axis is fitted to the 0.01 mm difference.
+        let d = tmp_dir("residual");
+        let t: Vec<f64> = (0..400).map(|k| k as f64 * 1e-3).collect();
+        let meas: Vec<f64> = t.iter().map(|t| (50.0 * t).sin()).collect();
+        let model: Vec<f64> = meas.iter().map(|v| 0.99 * v).collect();
+        let residual: Vec<f64> = meas.iter().zip(&model).map(|(a, b)| a - b).collect();
+        let path = d.join("residual.svg");
+        line_chart(
+            &path,
+            "a trace",
+            "t [s]",
+            "x [mm]",
+            &[
+                Series::line("measured", t.clone(), meas),
+                Series::line("model", t.clone(), model),
+            ],
+            &ChartOpts {
+                residual: Some(Series::line("residual: measured − model", t, residual)),
+                ..ChartOpts::default()
+            },
+        )
+        .unwrap();
+        // Both panels' titles, and tick labels of the residual's ±0.01 scale.
+        let svg = assert_svg(&path, &["a trace", "residual: measured − model", "0.01"]);
+        // The legend still lists the two overlaid series only.
+        let legend = &svg[svg.find("class=\"legend\"").unwrap()..];
+        assert!(legend.contains("measured") && legend.contains("model"));
+        assert!(!legend.contains("residual"));
+        std::fs::remove_dir_all(&d).ok();
     }
 
     #[test]
