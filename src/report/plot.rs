@@ -365,49 +365,58 @@ pub fn line_chart(
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         root.fill(&WHITE).map_err(|e| draw_err(path, e))?;
         let (plot_root, _) = root.split_vertically(size.1 - legend.height);
-        match &opts.residual {
-            None => draw_xy(&plot_root, plane, (title, x_label, y_label), series, opts),
-            Some(r) => {
-                let (top, bottom) = plot_root.split_vertically((size.1 - legend.height) * 2 / 3);
-                let (lo, hi) =
-                    r.x.iter()
-                        .zip(&r.y)
-                        .filter(|(x, y)| y.is_finite() && **x >= xlo && **x <= xhi)
-                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (_, y)| {
-                            (a.min(*y), b.max(*y))
-                        });
-                let (lo, hi) = if lo <= hi { (lo, hi) } else { (-1.0, 1.0) };
-                let lin = Axis { log: false };
-                let residual_plane = Plane {
-                    ax,
-                    ay: lin,
-                    bx,
-                    by: plane_range(lin, lo, hi, 0.05),
-                };
-                let plain = ChartOpts {
-                    log_y: false,
-                    markers: Vec::new(),
-                    vlines: Vec::new(),
-                    residual: None,
-                    ..opts.clone()
-                };
-                draw_xy(&top, plane, (title, x_label, y_label), series, opts).and_then(|_| {
-                    draw_xy(
-                        &bottom,
-                        residual_plane,
-                        (&r.label, x_label, y_label),
-                        std::slice::from_ref(r),
-                        &plain,
-                    )
-                })
-            }
-        }
-        .and_then(|_| root.present())
-        .map_err(|e| draw_err(path, e))?;
+        draw_panels(&plot_root, plane, (title, x_label, y_label), series, opts)
+            .and_then(|_| root.present())
+            .map_err(|e| draw_err(path, e))?;
     }
     let svg =
         shown_at_figure_size(&svg, size).replace("</svg>", &legend.svg(size.1 - legend.height));
     write_svg(path, &svg)
+}
+
+/// The chart's panels on `root`: the series, and under them the residual panel when `opts` has one
+/// (a third of the height, a linear y axis fitted to the residual inside the chart's x range).
+fn draw_panels(
+    root: &DrawingArea<SVGBackend<'_>, Shift>,
+    plane: Plane,
+    labels: (&str, &str, &str),
+    series: &[Series],
+    opts: &ChartOpts,
+) -> std::result::Result<(), DrawingAreaErrorKind<std::io::Error>> {
+    let Some(r) = &opts.residual else {
+        return draw_xy(root, plane, labels, series, opts);
+    };
+    let (top, bottom) = root.split_vertically(root.dim_in_pixel().1 * 2 / 3);
+    let in_x = |x: f64| plane.ax.valid(x) && (plane.bx.0..=plane.bx.1).contains(&plane.ax.fwd(x));
+    let (lo, hi) =
+        r.x.iter()
+            .zip(&r.y)
+            .filter(|(x, y)| y.is_finite() && in_x(**x))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (_, y)| {
+                (a.min(*y), b.max(*y))
+            });
+    let (lo, hi) = if lo <= hi { (lo, hi) } else { (-1.0, 1.0) };
+    let lin = Axis { log: false };
+    let residual_plane = Plane {
+        ay: lin,
+        by: plane_range(lin, lo, hi, 0.05),
+        ..plane
+    };
+    let plain = ChartOpts {
+        log_y: false,
+        markers: Vec::new(),
+        vlines: Vec::new(),
+        residual: None,
+        ..opts.clone()
+    };
+    draw_xy(&top, plane, labels, series, opts)?;
+    draw_xy(
+        &bottom,
+        residual_plane,
+        (&r.label, labels.1, labels.2),
+        std::slice::from_ref(r),
+        &plain,
+    )
 }
 
 /// Internal drawing scale of [`line_chart`]: plotters' SVG backend writes whole-number
