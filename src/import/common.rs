@@ -264,7 +264,39 @@ pub struct RawTrace {
 /// for a file in a known physical unit; time not strictly increasing.
 pub fn calibrate(path: &Path, raw: RawTrace, spec: &ImportSpec) -> Result<(Trace, Vec<String>)> {
     let mut notes = raw.notes;
-    let t_s: Vec<f64> = match raw.time {
+    let t_s = time_base(path, raw.time, spec, &mut notes)?;
+    check_increasing(path, &t_s)?;
+    let scale = metres_per_unit(path, &raw.units, spec, &mut notes)?;
+    let [ox, oy] = spec.origin_px;
+    let y_down = spec.y_down.unwrap_or(raw.y_down_default);
+    let y_sign = if y_down { -1.0 } else { 1.0 };
+    if y_down {
+        notes.push("y: file y runs down, flipped to physical y up".into());
+    }
+    if ox != 0.0 || oy != 0.0 {
+        notes.push(format!("origin: ({ox}, {oy}) in file units subtracted"));
+    }
+    let n = t_s.len();
+    let mut points = Vec::with_capacity(raw.points.len());
+    for (name, x, y) in raw.points {
+        debug_assert!(x.len() == n && y.len() == n);
+        points.push(PointTrack {
+            name,
+            x_m: x.iter().map(|v| (v - ox) * scale).collect(),
+            y_m: y.iter().map(|v| y_sign * (v - oy) * scale).collect(),
+        });
+    }
+    Ok((Trace { t_s, points }, notes))
+}
+
+/// Times in seconds from the reader's axis (`t0_s` added; frames need `fps_hz`), noting the base.
+fn time_base(
+    path: &Path,
+    time: RawTime,
+    spec: &ImportSpec,
+    notes: &mut Vec<String>,
+) -> Result<Vec<f64>> {
+    Ok(match time {
         RawTime::Seconds(t) => {
             notes.push("time base: the file's time column (real frame times kept)".into());
             t.into_iter().map(|t| spec.t0_s + t).collect()
@@ -282,7 +314,11 @@ pub fn calibrate(path: &Path, raw: RawTrace, spec: &ImportSpec) -> Result<(Trace
             ));
             f.into_iter().map(|f| spec.t0_s + f / fps).collect()
         }
-    };
+    })
+}
+
+/// [`Error::Input`] at the first sample of `t_s` that is not after the previous one.
+fn check_increasing(path: &Path, t_s: &[f64]) -> Result<()> {
     if let Some(i) = t_s
         .windows(2)
         .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
@@ -297,8 +333,19 @@ pub fn calibrate(path: &Path, raw: RawTrace, spec: &ImportSpec) -> Result<(Trace
             ),
         ));
     }
+    Ok(())
+}
+
+/// Metres per file unit from the file's unit and the spec's `m_per_px`/`units_to_m`, noting the
+/// choice; errors name the missing or conflicting setting.
+fn metres_per_unit(
+    path: &Path,
+    units: &RawUnits,
+    spec: &ImportSpec,
+    notes: &mut Vec<String>,
+) -> Result<f64> {
     let m_per_px = spec.resolved_m_per_px()?;
-    let scale = match (&raw.units, m_per_px, spec.units_to_m) {
+    Ok(match (units, m_per_px, spec.units_to_m) {
         (_, Some(_), Some(_)) => {
             return Err(Error::Config(
                 "import: set either m_per_px (pixels) or units_to_m (calibrated units), not both"
@@ -346,27 +393,7 @@ pub fn calibrate(path: &Path, raw: RawTrace, spec: &ImportSpec) -> Result<(Trace
                  units_to_m (metres per calibrated unit, e.g. 0.01 for cm) or m_per_px",
             ));
         }
-    };
-    let [ox, oy] = spec.origin_px;
-    let y_down = spec.y_down.unwrap_or(raw.y_down_default);
-    let y_sign = if y_down { -1.0 } else { 1.0 };
-    if y_down {
-        notes.push("y: file y runs down, flipped to physical y up".into());
-    }
-    if ox != 0.0 || oy != 0.0 {
-        notes.push(format!("origin: ({ox}, {oy}) in file units subtracted"));
-    }
-    let n = t_s.len();
-    let mut points = Vec::with_capacity(raw.points.len());
-    for (name, x, y) in raw.points {
-        debug_assert!(x.len() == n && y.len() == n);
-        points.push(PointTrack {
-            name,
-            x_m: x.iter().map(|v| (v - ox) * scale).collect(),
-            y_m: y.iter().map(|v| y_sign * (v - oy) * scale).collect(),
-        });
-    }
-    Ok((Trace { t_s, points }, notes))
+    })
 }
 
 /// Sniff the delimiter of a header line: the first of TAB, `;`, `,` that occurs outside quotes,

@@ -25,6 +25,7 @@ use std::borrow::Cow;
 use std::path::Path;
 
 use crate::error::{Error, Result};
+use crate::import::common::unique_name;
 use crate::import::{Format, ImportSpec, parse_finite, quote_cell, read_text};
 use crate::trace::{PointTrack, Trace};
 
@@ -114,6 +115,19 @@ struct Columns {
     y: Option<usize>,
 }
 
+/// The table's layout: where the column row is, its delimiter and names, and each point's columns.
+struct Layout {
+    /// Index of the column row in the non-blank lines.
+    index: usize,
+    /// 1-based file line of the column row.
+    line: usize,
+    delim: char,
+    /// Column names ([`clean_name`]), trailing empty names removed.
+    header: Vec<String>,
+    /// `(point name, x column, y column)`.
+    columns: Vec<(String, usize, usize)>,
+}
+
 /// Read a Tracker export into a [`Trace`]: one point per track with x and y columns, named as
 /// described in the module docs, times from the `t` column. Uses `units_to_m`, `y_down`,
 /// `decimal_comma`, `t0_s` and, as a check only, `fps_hz` of `spec`; ignores `points`.
@@ -139,12 +153,27 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
         .map(|(i, l)| (i + 1, l.strip_suffix('\r').unwrap_or(l)))
         .filter(|(_, l)| !l.trim().is_empty())
         .collect();
+    let layout = layout(path, &lines, spec)?;
+    let (t_s, xs, ys) = read_rows(path, &lines[layout.index + 1..], &layout, spec)?;
+    check_fps(path, &t_s, spec)?;
+    let points = layout
+        .columns
+        .into_iter()
+        .zip(xs.into_iter().zip(ys))
+        .map(|((name, _, _), (x_m, y_m))| PointTrack { name, x_m, y_m })
+        .collect();
+    Ok(Trace { t_s, points })
+}
+
+/// Find the column row among the non-blank `lines`, read the track names above it and map the
+/// x/y columns to points.
+fn layout(path: &Path, lines: &[(usize, &str)], spec: &ImportSpec) -> Result<Layout> {
     let texts: Vec<&str> = lines
         .iter()
         .take(MAX_HEADER_LINES + 1)
         .map(|(_, l)| *l)
         .collect();
-    let Some((ci, delim)) = find_column_row(&texts) else {
+    let Some((index, delim)) = find_column_row(&texts) else {
         return Err(Error::input(
             path,
             "not a Tracker export: no column row starting with `t` (then x, y, ...; TAB, `;`, `,` \
@@ -158,11 +187,41 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
              re-export with a `;` or TAB delimiter",
         ));
     }
-    let (column_line, column_text) = lines[ci];
+    let (line, column_text) = lines[index];
+    let name_row = track_name_row(path, &lines[..index])?;
+    let mut header: Vec<String> = column_text.split(delim).map(clean_name).collect();
+    while header.last().is_some_and(|h| h.is_empty()) {
+        header.pop();
+    }
+    let col_track = column_tracks(name_row, delim, header.len());
+    let columns = point_columns(&header, &col_track);
+    if columns.is_empty() {
+        return Err(Error::parse(
+            path,
+            line,
+            0,
+            format!(
+                "expected a track with both an x and a y column; columns: {}",
+                header.join(", ")
+            ),
+        ));
+    }
+    Ok(Layout {
+        index,
+        line,
+        delim,
+        header,
+        columns,
+    })
+}
 
-    // Preamble: '#' lines are markers (#multi:), at most one other line = track names.
+/// The track-name row of the preamble: `#` lines are markers (`#multi:`), at most one other line.
+fn track_name_row<'a>(
+    path: &Path,
+    preamble: &[(usize, &'a str)],
+) -> Result<Option<(usize, &'a str)>> {
     let mut name_row: Option<(usize, &str)> = None;
-    for &(line, text) in &lines[..ci] {
+    for &(line, text) in preamble {
         if text.trim_start().starts_with('#') {
             continue;
         }
@@ -177,15 +236,16 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
         }
         name_row = Some((line, text));
     }
+    Ok(name_row)
+}
 
-    let mut header: Vec<String> = column_text.split(delim).map(clean_name).collect();
-    while header.last().is_some_and(|h| h.is_empty()) {
-        header.pop();
-    }
-    let ncols = header.len();
-
-    // Track name over each column: the last non-empty name at or left of it.
-    let col_track: Vec<Option<String>> = match name_row {
+/// Track name over each of `ncols` columns: the last non-empty name at or left of it.
+fn column_tracks(
+    name_row: Option<(usize, &str)>,
+    delim: char,
+    ncols: usize,
+) -> Vec<Option<String>> {
+    match name_row {
         None => vec![None; ncols],
         Some((_, text)) if !text.contains(delim) => vec![Some(text.trim().to_owned()); ncols],
         Some((_, text)) => {
@@ -200,10 +260,14 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
                 })
                 .collect()
         }
-    };
+    }
+}
 
+/// `(point name, x column, y column)` for every track with both an `x` and a `y` column, named
+/// after the track (`point` without one; `_2`, `_3` ... when taken).
+fn point_columns(header: &[String], col_track: &[Option<String>]) -> Vec<(String, usize, usize)> {
     let mut groups: Vec<Columns> = Vec::new();
-    for j in 1..ncols {
+    for j in 1..header.len() {
         let slot_is_x = match header[j].as_str() {
             "x" => true,
             "y" => false,
@@ -239,67 +303,34 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
             continue;
         };
         let base = g.base.clone().unwrap_or_else(|| "point".to_owned());
-        let mut name = base.clone();
-        let mut k = 1;
-        while columns.iter().any(|(n, _, _)| *n == name) {
-            k += 1;
-            name = format!("{base}_{k}");
-        }
-        columns.push((name, x, y));
+        let taken: Vec<String> = columns.iter().map(|c| c.0.clone()).collect();
+        columns.push((unique_name(&taken, &base), x, y));
     }
-    if columns.is_empty() {
-        return Err(Error::parse(
-            path,
-            column_line,
-            0,
-            format!(
-                "expected a track with both an x and a y column; columns: {}",
-                header.join(", ")
-            ),
-        ));
-    }
+    columns
+}
 
+/// Times (`t0_s` added) and each point's x, y in metres from the data rows after the column row.
+type Rows = (Vec<f64>, Vec<Vec<f64>>, Vec<Vec<f64>>);
+
+/// Parse the data `rows` (non-blank lines after the column row) of a table with `layout`.
+fn read_rows(
+    path: &Path,
+    rows: &[(usize, &str)],
+    layout: &Layout,
+    spec: &ImportSpec,
+) -> Result<Rows> {
+    let n = layout.columns.len();
+    let (mut t_s, mut xs, mut ys) = (Vec::new(), vec![Vec::new(); n], vec![Vec::new(); n]);
     let y_sign = if spec.y_down.unwrap_or(false) {
         -1.0
     } else {
         1.0
     };
     let scale = spec.units_to_m.unwrap_or(1.0);
-    let label = |j: usize| -> String {
-        match columns.iter().find(|(_, x, y)| *x == j || *y == j) {
-            Some((name, _, _)) => format!("{} (track {name})", header[j]),
-            None => header[j].clone(),
-        }
-    };
-    let mut t_s: Vec<f64> = Vec::new();
-    let mut xs: Vec<Vec<f64>> = vec![Vec::new(); columns.len()];
-    let mut ys: Vec<Vec<f64>> = vec![Vec::new(); columns.len()];
     let mut prev_t: Option<f64> = None;
-    for &(line, text) in &lines[ci + 1..] {
-        let fields: Vec<&str> = text.split(delim).collect();
-        if fields.len() < ncols || fields[ncols..].iter().any(|f| !f.trim().is_empty()) {
-            return Err(Error::parse(
-                path,
-                line,
-                0,
-                format!(
-                    "expected {ncols} fields like the column row (line {column_line}), found {}",
-                    fields.len()
-                ),
-            ));
-        }
-        let bad = |j: usize, what: &str| {
-            Error::parse(
-                path,
-                line,
-                j + 1,
-                format!(
-                    "field {}: expected {what}, found {}",
-                    label(j),
-                    quote_cell(fields[j].trim())
-                ),
-            )
-        };
+    for &(line, text) in rows {
+        let fields = row_fields(path, line, text, layout)?;
+        let bad = |j: usize, what: &str| bad_field(path, line, layout, &fields, j, what);
         let t = match parse_cell(fields[0], spec.decimal_comma) {
             Ok(Some(t)) => t,
             _ => return Err(bad(0, "a time in seconds")),
@@ -317,7 +348,7 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
         }
         prev_t = Some(t);
         t_s.push(spec.t0_s + t);
-        for (k, &(_, cx, cy)) in columns.iter().enumerate() {
+        for (k, &(_, cx, cy)) in layout.columns.iter().enumerate() {
             let x = parse_cell(fields[cx], spec.decimal_comma)
                 .map_err(|()| bad(cx, "a number or an empty cell"))?;
             let y = parse_cell(fields[cy], spec.decimal_comma)
@@ -329,34 +360,84 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
     if t_s.is_empty() {
         return Err(Error::input(
             path,
-            format!("no data rows after the column row (line {column_line})"),
+            format!("no data rows after the column row (line {})", layout.line),
         ));
     }
-    if let Some(fps) = spec.fps_hz {
-        let summary = super::describe(&Trace {
-            t_s: t_s.clone(),
-            points: Vec::new(),
-        });
-        let dt = summary.dt_median_s;
-        if dt.is_finite() && (dt * fps - 1.0).abs() > FPS_CHECK_REL_TOL {
-            return Err(Error::input(
-                path,
-                format!(
-                    "the t column's median step {dt} s ({:.4} fps) disagrees with fps_hz = {fps} \
-                     by more than {} % (fps_hz is only a check for Tracker files; remove it to \
-                     use the file's times)",
-                    1.0 / dt,
-                    FPS_CHECK_REL_TOL * 100.0
-                ),
-            ));
-        }
+    Ok((t_s, xs, ys))
+}
+
+/// A data row's fields: at least as many as the column row, any extra ones empty.
+fn row_fields<'a>(
+    path: &Path,
+    line: usize,
+    text: &'a str,
+    layout: &Layout,
+) -> Result<Vec<&'a str>> {
+    let ncols = layout.header.len();
+    let fields: Vec<&str> = text.split(layout.delim).collect();
+    if fields.len() < ncols || fields[ncols..].iter().any(|f| !f.trim().is_empty()) {
+        return Err(Error::parse(
+            path,
+            line,
+            0,
+            format!(
+                "expected {ncols} fields like the column row (line {}), found {}",
+                layout.line,
+                fields.len()
+            ),
+        ));
     }
-    let points = columns
-        .into_iter()
-        .zip(xs.into_iter().zip(ys))
-        .map(|((name, _, _), (x_m, y_m))| PointTrack { name, x_m, y_m })
-        .collect();
-    Ok(Trace { t_s, points })
+    Ok(fields)
+}
+
+/// The error for field `j` of a row: `field x (track head): expected <what>, found "..."`.
+fn bad_field(
+    path: &Path,
+    line: usize,
+    layout: &Layout,
+    fields: &[&str],
+    j: usize,
+    what: &str,
+) -> Error {
+    let label = match layout.columns.iter().find(|(_, x, y)| *x == j || *y == j) {
+        Some((name, _, _)) => format!("{} (track {name})", layout.header[j]),
+        None => layout.header[j].clone(),
+    };
+    Error::parse(
+        path,
+        line,
+        j + 1,
+        format!(
+            "field {label}: expected {what}, found {}",
+            quote_cell(fields[j].trim())
+        ),
+    )
+}
+
+/// With `fps_hz` set: [`Error::Input`] unless the median step of `t_s` is within
+/// [`FPS_CHECK_REL_TOL`] of 1/`fps_hz`.
+fn check_fps(path: &Path, t_s: &[f64], spec: &ImportSpec) -> Result<()> {
+    let Some(fps) = spec.fps_hz else {
+        return Ok(());
+    };
+    let summary = super::describe(&Trace {
+        t_s: t_s.to_vec(),
+        points: Vec::new(),
+    });
+    let dt = summary.dt_median_s;
+    if dt.is_finite() && (dt * fps - 1.0).abs() > FPS_CHECK_REL_TOL {
+        return Err(Error::input(
+            path,
+            format!(
+                "the t column's median step {dt} s ({:.4} fps) disagrees with fps_hz = {fps} \
+                 by more than {} % (fps_hz is only a check for Tracker files; remove it to \
+                 use the file's times)",
+                1.0 / dt,
+                FPS_CHECK_REL_TOL * 100.0
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Write `trace` as a Tracker "Export Data" text file (FORMATS.md §1 layout: `#multi:` when
