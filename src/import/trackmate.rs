@@ -27,6 +27,39 @@ use crate::import::common::{
 };
 use crate::import::sleap::MAX_SPAN_PER_ROW;
 
+/// Column indices of a spot table.
+struct SpotColumns {
+    track: usize,
+    x: usize,
+    y: usize,
+    frame: usize,
+    /// `POSITION_T`, if present.
+    t: Option<usize>,
+}
+
+/// Frame and track of every spot row.
+struct Spots {
+    /// `FRAME` of each row (a non-negative integer).
+    frames: Vec<f64>,
+    /// `TRACK_ID` of each row, `None` for a spot without a track.
+    track_of: Vec<Option<i64>>,
+    /// Rows without a track.
+    untracked: usize,
+}
+
+/// The frame range of the tracked spots: first and last `FRAME`, and the number of frames.
+struct FrameSpan {
+    first: f64,
+    last: f64,
+    n: usize,
+}
+
+/// Tracks in order of first appearance: id and `(x, y, line of the spot)` per frame.
+struct Tracks {
+    order: Vec<i64>,
+    pts: Vec<(Vec<f64>, Vec<f64>, Vec<usize>)>,
+}
+
 /// Read a TrackMate spot table (module docs) into a [`RawTrace`] in file units.
 ///
 /// # Errors
@@ -37,7 +70,62 @@ use crate::import::sleap::MAX_SPAN_PER_ROW;
 pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
     let (text, enc) = read_decoded(path)?;
     let lines = numbered_lines(&text);
-    // Header lines: the first, plus up to three more whose FRAME cell is not a number.
+    let n_header = header_count(path, &lines)?;
+    let (table, keys) = spot_table(path, &lines, n_header)?;
+    let cols = spot_columns(path, &table, &keys)?;
+    // The units row is the last header line when it has a parenthesised cell.
+    let units: Option<&Vec<String>> = table
+        .headers
+        .iter()
+        .skip(1)
+        .map(|h| &h.1)
+        .find(|cells| cells.iter().any(|c| c.starts_with('(')));
+    let unit_of = |j: usize| units.and_then(|u| u.get(j)).map(|s| s.trim().to_owned());
+
+    let xs = table.numbers(cols.x, false)?;
+    let ys = table.numbers(cols.y, false)?;
+    let spots = parse_spots(&table, &cols)?;
+    let tracked: Vec<usize> = (0..table.rows.len())
+        .filter(|&r| spots.track_of[r].is_some())
+        .collect();
+    let span = frame_span(path, &table, &spots, &tracked)?;
+    let tracks = assemble_tracks(&table, &cols, &spots, &tracked, &span, &xs, &ys)?;
+    let (first, last) = (span.first, span.last);
+    let mut notes = vec![format!(
+        "TrackMate ({} header line{}): {} spots in {} tracks, frames {first}–{last}, {} \
+         spots without a track skipped",
+        n_header,
+        if n_header == 1 {
+            ", ≤ 6 layout"
+        } else {
+            "s, ≥ 7 layout"
+        },
+        tracked.len(),
+        tracks.order.len(),
+        spots.untracked
+    )];
+    if enc == TextEncoding::Windows1252 {
+        notes.push("encoding: not UTF-8, decoded as Windows-1252 (Java platform charset)".into());
+    }
+    let t_unit = cols.t.and_then(&unit_of);
+    let time = time_base(path, spec, &table, &cols, t_unit, &spots, &span, &mut notes)?;
+    let points = tracks
+        .order
+        .iter()
+        .zip(tracks.pts)
+        .map(|(id, (x, y, _))| (format!("track{id}"), x, y))
+        .collect();
+    Ok(RawTrace {
+        time,
+        points,
+        units: coordinate_units(unit_of(cols.x)),
+        y_down_default: true,
+        notes,
+    })
+}
+
+/// How many header lines: the first, plus up to three more whose `FRAME` cell is not a number.
+fn header_count(path: &Path, lines: &[(usize, &str)]) -> Result<usize> {
     let nonblank: Vec<&str> = lines
         .iter()
         .map(|(_, l)| *l)
@@ -79,7 +167,16 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
         }
         n_header += 1;
     }
-    let mut table = Table::parse(path, &lines, n_header, ',')?;
+    Ok(n_header)
+}
+
+/// The spot table with the feature keys (upper case) as its column names, and the keys.
+fn spot_table<'a>(
+    path: &'a Path,
+    lines: &[(usize, &str)],
+    n_header: usize,
+) -> Result<(Table<'a>, Vec<String>)> {
+    let mut table = Table::parse(path, lines, n_header, ',')?;
     // The keys as the table split them (quotes honoured), so indices match the rows.
     let keys: Vec<String> = table.headers[0]
         .1
@@ -88,6 +185,11 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
         .collect();
     table.names = keys.clone();
     table.names.resize(table.rows[0].1.len(), String::new());
+    Ok((table, keys))
+}
+
+/// The `TRACK_ID`, `POSITION_X`, `POSITION_Y`, `FRAME` (required) and `POSITION_T` columns.
+fn spot_columns(path: &Path, table: &Table, keys: &[String]) -> Result<SpotColumns> {
     let hline = table.headers[0].0;
     let col = |key: &str| -> Result<usize> {
         keys.iter().position(|k| k == key).ok_or_else(|| {
@@ -99,33 +201,26 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
             )
         })
     };
-    let (ctrack, cx, cy, cframe) = (
-        col("TRACK_ID")?,
-        col("POSITION_X")?,
-        col("POSITION_Y")?,
-        col("FRAME")?,
-    );
-    let ct = keys.iter().position(|k| k == "POSITION_T");
-    // The units row is the last header line when it has a parenthesised cell.
-    let units: Option<&Vec<String>> = table
-        .headers
-        .iter()
-        .skip(1)
-        .map(|h| &h.1)
-        .find(|cells| cells.iter().any(|c| c.starts_with('(')));
-    let unit_of = |j: usize| units.and_then(|u| u.get(j)).map(|s| s.trim().to_owned());
+    Ok(SpotColumns {
+        track: col("TRACK_ID")?,
+        x: col("POSITION_X")?,
+        y: col("POSITION_Y")?,
+        frame: col("FRAME")?,
+        t: keys.iter().position(|k| k == "POSITION_T"),
+    })
+}
 
-    let xs = table.numbers(cx, false)?;
-    let ys = table.numbers(cy, false)?;
+/// Every row's frame and track id (`None`: empty, `ø` or `None` cell).
+fn parse_spots(table: &Table, cols: &SpotColumns) -> Result<Spots> {
     let mut frames = Vec::with_capacity(table.rows.len());
     let mut track_of = Vec::with_capacity(table.rows.len());
     let mut untracked = 0usize;
     for r in 0..table.rows.len() {
-        match parse_cell(&table.rows[r].1[cframe], false) {
+        match parse_cell(&table.rows[r].1[cols.frame], false) {
             Ok(Some(f)) if f >= 0.0 && f.fract() == 0.0 && f <= 1e8 => frames.push(f),
-            _ => return Err(table.bad_cell(r, cframe, "a non-negative integer frame")),
+            _ => return Err(table.bad_cell(r, cols.frame, "a non-negative integer frame")),
         }
-        let cell = table.rows[r].1[ctrack].trim();
+        let cell = table.rows[r].1[cols.track].trim();
         match parse_cell(cell, false) {
             Ok(Some(t)) if t.fract() == 0.0 => track_of.push(Some(t as i64)),
             Ok(None) => {
@@ -136,18 +231,31 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
                 untracked += 1;
                 track_of.push(None)
             }
-            _ => return Err(table.bad_cell(r, ctrack, "an integer track id or an empty cell")),
+            _ => {
+                return Err(table.bad_cell(r, cols.track, "an integer track id or an empty cell"));
+            }
         }
     }
-    let tracked: Vec<usize> = (0..table.rows.len())
-        .filter(|&r| track_of[r].is_some())
-        .collect();
+    Ok(Spots {
+        frames,
+        track_of,
+        untracked,
+    })
+}
+
+/// The frame range of the `tracked` rows, refused when empty, implausibly long for the row count,
+/// or too large to allocate for the number of tracks.
+fn frame_span(path: &Path, table: &Table, spots: &Spots, tracked: &[usize]) -> Result<FrameSpan> {
     if tracked.is_empty() {
         return Err(Error::input(
             path,
-            format!("no spot belongs to a track ({untracked} spots without TRACK_ID)"),
+            format!(
+                "no spot belongs to a track ({} spots without TRACK_ID)",
+                spots.untracked
+            ),
         ));
     }
+    let frames = &spots.frames;
     let first = tracked
         .iter()
         .map(|&r| frames[r])
@@ -168,29 +276,46 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
     }
     let n_tracks = tracked
         .iter()
-        .filter_map(|&r| track_of[r])
+        .filter_map(|&r| spots.track_of[r])
         .collect::<std::collections::BTreeSet<_>>()
         .len();
     crate::import::common::check_cells(path, n, n_tracks)?;
+    Ok(FrameSpan { first, last, n })
+}
+
+/// Place every tracked spot at its frame in its track; two spots of a track in one frame are an
+/// error.
+fn assemble_tracks(
+    table: &Table,
+    cols: &SpotColumns,
+    spots: &Spots,
+    tracked: &[usize],
+    span: &FrameSpan,
+    xs: &[f64],
+    ys: &[f64],
+) -> Result<Tracks> {
+    let n = span.n;
     let mut index: BTreeMap<i64, usize> = BTreeMap::new();
     let mut order: Vec<i64> = Vec::new();
     let mut pts: Vec<(Vec<f64>, Vec<f64>, Vec<usize>)> = Vec::new();
-    for &r in &tracked {
-        let Some(id) = track_of[r] else { continue };
+    for &r in tracked {
+        let Some(id) = spots.track_of[r] else {
+            continue;
+        };
         let i = *index.entry(id).or_insert_with(|| {
             order.push(id);
             pts.push((vec![f64::NAN; n], vec![f64::NAN; n], vec![0; n]));
             pts.len() - 1
         });
-        let k = (frames[r] - first) as usize;
+        let k = (spots.frames[r] - span.first) as usize;
         if pts[i].2[k] != 0 {
             return Err(table.bad_cell(
                 r,
-                cframe,
+                cols.frame,
                 &format!(
                     "one spot per track and frame (track {id} already has a spot in frame {} on \
                      line {}; split/merge tracks are not a single trajectory)",
-                    frames[r], pts[i].2[k]
+                    spots.frames[r], pts[i].2[k]
                 ),
             ));
         }
@@ -198,73 +323,68 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
         pts[i].0[k] = xs[r];
         pts[i].1[k] = ys[r];
     }
-    let mut notes = vec![format!(
-        "TrackMate ({} header line{}): {} spots in {} tracks, frames {first}–{last}, {untracked} \
-         spots without a track skipped",
-        n_header,
-        if n_header == 1 {
-            ", ≤ 6 layout"
-        } else {
-            "s, ≥ 7 layout"
-        },
-        tracked.len(),
-        order.len()
-    )];
-    if enc == TextEncoding::Windows1252 {
-        notes.push("encoding: not UTF-8, decoded as Windows-1252 (Java platform charset)".into());
+    Ok(Tracks { order, pts })
+}
+
+/// The time axis: frames when `fps_hz` is set, else seconds from the median `POSITION_T`/`FRAME`
+/// (which needs a time unit `t_unit` for `POSITION_T`); notes the derived frame interval.
+#[allow(clippy::too_many_arguments)]
+fn time_base(
+    path: &Path,
+    spec: &ImportSpec,
+    table: &Table,
+    cols: &SpotColumns,
+    t_unit: Option<String>,
+    spots: &Spots,
+    span: &FrameSpan,
+    notes: &mut Vec<String>,
+) -> Result<RawTime> {
+    let (first, n) = (span.first, span.n);
+    if spec.fps_hz.is_some() {
+        return Ok(RawTime::Frames((0..n).map(|k| first + k as f64).collect()));
     }
-    // Time base.
-    let time = if spec.fps_hz.is_some() {
-        RawTime::Frames((0..n).map(|k| first + k as f64).collect())
-    } else {
-        let t_unit = ct.and_then(&unit_of).and_then(|u| time_unit_s(&u));
-        let (Some(ct), Some(tu)) = (ct, t_unit) else {
-            return Err(Error::input(
-                path,
-                "the spot table has frame numbers but no calibrated time (no POSITION_T unit): \
-                 set the frame rate (fps_hz in the import spec, --fps on the command line)",
-            ));
-        };
-        let ts = table.numbers(ct, false)?;
-        let mut dts: Vec<f64> = (0..table.rows.len())
-            .filter(|&r| frames[r] > 0.0 && ts[r].is_finite())
-            .map(|r| ts[r] * tu / frames[r])
-            .collect();
-        dts.sort_by(f64::total_cmp);
-        let Some(&dt) = dts
-            .get(dts.len() / 2)
-            .filter(|d| d.is_finite() && **d > 0.0)
-        else {
-            return Err(Error::input(
-                path,
-                "cannot derive the frame interval from POSITION_T/FRAME: set fps_hz",
-            ));
-        };
-        notes.push(format!(
-            "frame interval {dt} s from POSITION_T/FRAME (median over spots)"
+    let t_unit = t_unit.and_then(|u| time_unit_s(&u));
+    let (Some(ct), Some(tu)) = (cols.t, t_unit) else {
+        return Err(Error::input(
+            path,
+            "the spot table has frame numbers but no calibrated time (no POSITION_T unit): \
+             set the frame rate (fps_hz in the import spec, --fps on the command line)",
         ));
-        RawTime::Seconds((0..n).map(|k| (first + k as f64) * dt).collect())
     };
-    let units = match unit_of(cx) {
+    let frames = &spots.frames;
+    let ts = table.numbers(ct, false)?;
+    let mut dts: Vec<f64> = (0..table.rows.len())
+        .filter(|&r| frames[r] > 0.0 && ts[r].is_finite())
+        .map(|r| ts[r] * tu / frames[r])
+        .collect();
+    dts.sort_by(f64::total_cmp);
+    let Some(&dt) = dts
+        .get(dts.len() / 2)
+        .filter(|d| d.is_finite() && **d > 0.0)
+    else {
+        return Err(Error::input(
+            path,
+            "cannot derive the frame interval from POSITION_T/FRAME: set fps_hz",
+        ));
+    };
+    notes.push(format!(
+        "frame interval {dt} s from POSITION_T/FRAME (median over spots)"
+    ));
+    Ok(RawTime::Seconds(
+        (0..n).map(|k| (first + k as f64) * dt).collect(),
+    ))
+}
+
+/// The coordinate unit from the unit row's `POSITION_X` cell.
+fn coordinate_units(unit: Option<String>) -> RawUnits {
+    match unit {
         Some(u) if u.to_ascii_lowercase().contains("pixel") => RawUnits::Pixels,
         Some(u) => match length_unit_m(&u) {
             Some(f) => RawUnits::Known(f, u),
             None => RawUnits::Unknown,
         },
         None => RawUnits::Unknown,
-    };
-    let points = order
-        .iter()
-        .zip(pts)
-        .map(|(id, (x, y, _))| (format!("track{id}"), x, y))
-        .collect();
-    Ok(RawTrace {
-        time,
-        points,
-        units,
-        y_down_default: true,
-        notes,
-    })
+    }
 }
 
 #[cfg(test)]
