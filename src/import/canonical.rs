@@ -14,6 +14,7 @@
 use std::path::Path;
 
 use crate::error::{Error, Result};
+use crate::import::common::{csv_header, open_csv};
 use crate::import::{csv_error, quote_cell, record_line};
 use crate::trace::{PointTrack, Trace};
 
@@ -119,41 +120,43 @@ pub fn trace_csv_bytes(path: &Path, trace: &Trace) -> Result<Vec<u8>> {
 ///   (`file:line:column: field head_x_m: expected a number or NaN, found "abc"`), a missing or
 ///   non-increasing time.
 pub fn read_trace_csv(path: &Path) -> Result<Trace> {
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, "open", e))?;
-    let mut reader = csv::ReaderBuilder::new()
-        .has_headers(false)
-        .flexible(true)
-        .from_reader(std::io::BufReader::new(file));
+    let mut reader = open_csv(path)?;
     let mut records = reader.records();
-    let header = match records.next() {
-        Some(r) => r.map_err(|e| csv_error(path, "read", e))?,
-        None => {
-            return Err(Error::input(
-                path,
-                "empty file: expected a header t_s,<name>_x_m,<name>_y_m,...",
-            ));
+    let (header_line, names) = csv_header(
+        path,
+        &mut records,
+        "empty file: expected a header t_s,<name>_x_m,<name>_y_m,...",
+    )?;
+    let mut points = header_points(path, header_line, &names)?;
+    let mut t_s: Vec<f64> = Vec::new();
+    for (row, record) in records.enumerate() {
+        let record = record.map_err(|e| csv_error(path, "read", e))?;
+        let line = record_line(path, &record, header_line + 1 + row, names.len())?;
+        let cell = |j: usize| row_cell(path, line, &record, &names, j);
+        let t = cell(0)?;
+        check_time(path, line, t, t_s.last().copied())?;
+        t_s.push(t);
+        for (k, p) in points.iter_mut().enumerate() {
+            p.x_m.push(cell(1 + 2 * k)?);
+            p.y_m.push(cell(2 + 2 * k)?);
         }
-    };
-    let header_line = header.position().map_or(1, |p| p.line() as usize);
-    let names: Vec<&str> = header
-        .iter()
-        .enumerate()
-        .map(|(i, h)| {
-            if i == 0 {
-                h.trim_start_matches('\u{feff}')
-            } else {
-                h
-            }
-        })
-        .collect();
-    if names.first().copied() != Some("t_s") {
+    }
+    if t_s.is_empty() {
+        return Err(Error::input(path, "no data rows after the header"));
+    }
+    Ok(Trace { t_s, points })
+}
+
+/// The empty points named by a header `t_s,<name>_x_m,<name>_y_m,...` (names unique).
+fn header_points(path: &Path, header_line: usize, names: &[String]) -> Result<Vec<PointTrack>> {
+    if names.first().map(String::as_str) != Some("t_s") {
         return Err(Error::parse(
             path,
             header_line,
             1,
             format!(
                 "expected the first column t_s, found {}",
-                quote_cell(names.first().copied().unwrap_or(""))
+                quote_cell(names.first().map_or("", String::as_str))
             ),
         ));
     }
@@ -173,7 +176,7 @@ pub fn read_trace_csv(path: &Path) -> Result<Trace> {
                 path,
                 header_line,
                 col,
-                format!("expected <name>_x_m, found {}", quote_cell(pair[0])),
+                format!("expected <name>_x_m, found {}", quote_cell(&pair[0])),
             ));
         };
         if pair[1].strip_suffix("_y_m") != Some(name) {
@@ -181,7 +184,7 @@ pub fn read_trace_csv(path: &Path) -> Result<Trace> {
                 path,
                 header_line,
                 col + 1,
-                format!("expected {name}_y_m, found {}", quote_cell(pair[1])),
+                format!("expected {name}_y_m, found {}", quote_cell(&pair[1])),
             ));
         }
         if points.iter().any(|p| p.name == name) {
@@ -198,64 +201,62 @@ pub fn read_trace_csv(path: &Path) -> Result<Trace> {
             y_m: Vec::new(),
         });
     }
+    Ok(points)
+}
 
-    let mut t_s: Vec<f64> = Vec::new();
-    for (row, record) in records.enumerate() {
-        let record = record.map_err(|e| csv_error(path, "read", e))?;
-        let line = record_line(path, &record, header_line + 1 + row, names.len())?;
-        let cell = |j: usize| -> Result<f64> {
-            let text = record.get(j).unwrap_or("").trim();
-            if text.is_empty() || text.eq_ignore_ascii_case("nan") {
-                return Ok(f64::NAN);
-            }
-            text.parse::<f64>()
-                .ok()
-                .filter(|v| !v.is_nan())
-                .ok_or_else(|| {
-                    Error::parse(
-                        path,
-                        line,
-                        j + 1,
-                        format!(
-                            "field {}: expected a number or NaN, found {}",
-                            names[j],
-                            quote_cell(text)
-                        ),
-                    )
-                })
-        };
-        let t = cell(0)?;
-        if !t.is_finite() {
-            return Err(Error::parse(
+/// Cell `j` of a data row: a number (infinities included), NaN when empty or `NaN`.
+fn row_cell(
+    path: &Path,
+    line: usize,
+    record: &csv::StringRecord,
+    names: &[String],
+    j: usize,
+) -> Result<f64> {
+    let text = record.get(j).unwrap_or("").trim();
+    if text.is_empty() || text.eq_ignore_ascii_case("nan") {
+        return Ok(f64::NAN);
+    }
+    text.parse::<f64>()
+        .ok()
+        .filter(|v| !v.is_nan())
+        .ok_or_else(|| {
+            Error::parse(
                 path,
                 line,
-                1,
-                format!("field t_s: expected a finite time, found {t}"),
-            ));
-        }
-        if let Some(&prev) = t_s.last()
-            && t <= prev
-        {
-            return Err(Error::parse(
-                path,
-                line,
-                1,
+                j + 1,
                 format!(
-                    "field t_s: time {t} s is not after the previous row's {prev} s (expected \
-                     strictly increasing times)"
+                    "field {}: expected a number or NaN, found {}",
+                    names[j],
+                    quote_cell(text)
                 ),
-            ));
-        }
-        t_s.push(t);
-        for (k, p) in points.iter_mut().enumerate() {
-            p.x_m.push(cell(1 + 2 * k)?);
-            p.y_m.push(cell(2 + 2 * k)?);
-        }
+            )
+        })
+}
+
+/// [`Error::Parse`] unless the time `t` of the row on `line` is finite and after `prev`.
+fn check_time(path: &Path, line: usize, t: f64, prev: Option<f64>) -> Result<()> {
+    if !t.is_finite() {
+        return Err(Error::parse(
+            path,
+            line,
+            1,
+            format!("field t_s: expected a finite time, found {t}"),
+        ));
     }
-    if t_s.is_empty() {
-        return Err(Error::input(path, "no data rows after the header"));
+    if let Some(prev) = prev
+        && t <= prev
+    {
+        return Err(Error::parse(
+            path,
+            line,
+            1,
+            format!(
+                "field t_s: time {t} s is not after the previous row's {prev} s (expected \
+                 strictly increasing times)"
+            ),
+        ));
     }
-    Ok(Trace { t_s, points })
+    Ok(())
 }
 
 #[cfg(test)]

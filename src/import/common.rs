@@ -222,6 +222,49 @@ pub fn check_cells(path: &Path, frames: usize, points: usize) -> Result<()> {
     Ok(())
 }
 
+/// A `csv` reader over the file at `path`: `,` delimited, RFC 4180 quotes, no header handling
+/// (the first record is the header, see [`csv_header`]), rows of any width (checked by the caller).
+///
+/// # Errors
+/// [`Error::Io`] if the file cannot be opened.
+pub(crate) fn open_csv(path: &Path) -> Result<csv::Reader<std::io::BufReader<std::fs::File>>> {
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, "open", e))?;
+    Ok(csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .from_reader(std::io::BufReader::new(file)))
+}
+
+/// The first record of `records` as a header: its 1-based line and its cells (untrimmed), a UTF-8
+/// BOM removed from the first cell (the `csv` reader keeps it).
+///
+/// # Errors
+/// [`Error::Input`] with the message `empty` when there is no record; the `csv` reader's errors
+/// ([`super::csv_error`]).
+pub(crate) fn csv_header(
+    path: &Path,
+    records: &mut impl Iterator<Item = csv::Result<csv::StringRecord>>,
+    empty: &str,
+) -> Result<(usize, Vec<String>)> {
+    let header = match records.next() {
+        Some(r) => r.map_err(|e| super::csv_error(path, "read", e))?,
+        None => return Err(Error::input(path, empty)),
+    };
+    let line = header.position().map_or(1, |p| p.line() as usize);
+    let names = header
+        .iter()
+        .enumerate()
+        .map(|(i, h)| {
+            if i == 0 {
+                h.trim_start_matches('\u{feff}').to_owned()
+            } else {
+                h.to_owned()
+            }
+        })
+        .collect();
+    Ok((line, names))
+}
+
 /// Time axis as a reader found it.
 #[derive(Debug, Clone, PartialEq)]
 pub enum RawTime {

@@ -16,6 +16,7 @@
 use std::path::Path;
 
 use crate::error::{Error, Result};
+use crate::import::common::{csv_header, open_csv};
 use crate::import::{Format, ImportSpec, csv_error, parse_finite, quote_cell, record_line};
 use crate::trace::{PointTrack, Trace};
 
@@ -70,6 +71,56 @@ struct PointColumns {
 /// * [`Error::Config`] — settings out of range ([`ImportSpec::validate`]).
 pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
     spec.validate(Format::Dltdv)?;
+    let (fps, scale) = required_settings(path, spec)?;
+    let mut reader = open_csv(path)?;
+    let mut records = reader.records();
+    let (header_line, names) = csv_header(
+        path,
+        &mut records,
+        "empty file: expected a DLTdv header line pt1_cam1_X,pt1_cam1_Y,...",
+    )?;
+    let names: Vec<String> = names.iter().map(|h| h.trim().to_owned()).collect();
+    let columns = camera_columns(path, header_line, &names, spec.camera)?;
+    let [ox, oy] = spec.origin_px;
+    let y_sign = if spec.y_down.unwrap_or(true) {
+        -1.0
+    } else {
+        1.0
+    };
+    let mut t_s = Vec::new();
+    let mut xs: Vec<Vec<f64>> = vec![Vec::new(); columns.len()];
+    let mut ys: Vec<Vec<f64>> = vec![Vec::new(); columns.len()];
+    let mut values = vec![f64::NAN; names.len()];
+    for (row, record) in records.enumerate() {
+        let record = record.map_err(|e| csv_error(path, "read", e))?;
+        let line = record_line(path, &record, header_line + 1 + row, names.len())?;
+        parse_row(path, line, &record, &names, &mut values)?;
+        for (k, &(_, cx, cy)) in columns.iter().enumerate() {
+            xs[k].push((values[cx] - ox) * scale);
+            ys[k].push(y_sign * (values[cy] - oy) * scale);
+        }
+        t_s.push(spec.t0_s + row as f64 / fps);
+    }
+    if t_s.is_empty() {
+        return Err(Error::input(
+            path,
+            "no data rows after the header (DLTdv writes one row per video frame)",
+        ));
+    }
+    let points = columns
+        .iter()
+        .zip(xs.into_iter().zip(ys))
+        .map(|(&(point, _, _), (x_m, y_m))| PointTrack {
+            name: format!("pt{point}"),
+            x_m,
+            y_m,
+        })
+        .collect();
+    Ok(Trace { t_s, points })
+}
+
+/// `fps_hz` and `m_per_px`, which a DLTdv file cannot do without.
+fn required_settings(path: &Path, spec: &ImportSpec) -> Result<(f64, f64)> {
     let fps = spec.fps_hz.ok_or_else(|| {
         Error::input(
             path,
@@ -83,47 +134,21 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
             "a DLTdv xypts file is in pixels: set m_per_px (metres per pixel) in the import spec",
         )
     })?;
-    let [ox, oy] = spec.origin_px;
-    let y_sign = if spec.y_down.unwrap_or(true) {
-        -1.0
-    } else {
-        1.0
-    };
+    Ok((fps, scale))
+}
 
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, "open", e))?;
-    let mut reader = csv::ReaderBuilder::new()
-        .has_headers(false)
-        .flexible(true)
-        .from_reader(std::io::BufReader::new(file));
-    let mut records = reader.records();
-
-    let header = match records.next() {
-        Some(r) => r.map_err(|e| csv_error(path, "read", e))?,
-        None => {
-            return Err(Error::input(
-                path,
-                "empty file: expected a DLTdv header line pt1_cam1_X,pt1_cam1_Y,...",
-            ));
-        }
-    };
-    let header_line = header.position().map_or(1, |p| p.line() as usize);
-    let names: Vec<String> = header
-        .iter()
-        .enumerate()
-        .map(|(i, h)| {
-            // The csv reader does not strip a BOM from the first field.
-            let h = if i == 0 {
-                h.trim_start_matches('\u{feff}')
-            } else {
-                h
-            };
-            h.trim().to_owned()
-        })
-        .collect();
+/// `(point, x column, y column)` of every point of `camera`, in order of first appearance; every
+/// header cell must be a DLTdv column name, each point needs one X and one Y column.
+fn camera_columns(
+    path: &Path,
+    header_line: usize,
+    names: &[String],
+    camera: usize,
+) -> Result<Vec<(usize, usize, usize)>> {
     let mut points: Vec<PointColumns> = Vec::new();
     let mut cameras: Vec<usize> = Vec::new();
     for (col, name) in names.iter().enumerate() {
-        let Some((point, camera, axis)) = parse_header_name(name) else {
+        let Some((point, cam, axis)) = parse_header_name(name) else {
             return Err(Error::parse(
                 path,
                 header_line,
@@ -134,10 +159,10 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
                 ),
             ));
         };
-        if !cameras.contains(&camera) {
-            cameras.push(camera);
+        if !cameras.contains(&cam) {
+            cameras.push(cam);
         }
-        if camera != spec.camera {
+        if cam != camera {
             continue;
         }
         let idx = match points.iter().position(|p| p.point == point) {
@@ -165,96 +190,79 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
         }
         *slot = Some(col);
     }
+    complete_columns(path, header_line, points, cameras, camera)
+}
+
+/// The points' column pairs, or the error for a camera without columns or a point without X or Y.
+fn complete_columns(
+    path: &Path,
+    header_line: usize,
+    points: Vec<PointColumns>,
+    mut cameras: Vec<usize>,
+    camera: usize,
+) -> Result<Vec<(usize, usize, usize)>> {
     if points.is_empty() {
         cameras.sort_unstable();
         let list: Vec<String> = cameras.iter().map(|c| format!("cam{c}")).collect();
         return Err(Error::input(
             path,
             format!(
-                "no columns for camera {} (camera = {}); cameras in the file: {}",
-                spec.camera,
-                spec.camera,
+                "no columns for camera {camera} (camera = {camera}); cameras in the file: {}",
                 list.join(", ")
             ),
         ));
     }
     let mut columns = Vec::with_capacity(points.len());
     for p in &points {
-        match (p.x, p.y) {
-            (Some(x), Some(y)) => columns.push((p.point, x, y)),
-            (None, _) => {
-                return Err(Error::parse(
-                    path,
-                    header_line,
-                    0,
-                    format!(
-                        "pt{}_cam{}_X is missing (expected an X and a Y column per point)",
-                        p.point, spec.camera
-                    ),
-                ));
+        let missing = match (p.x, p.y) {
+            (Some(x), Some(y)) => {
+                columns.push((p.point, x, y));
+                continue;
             }
-            (_, None) => {
-                return Err(Error::parse(
-                    path,
-                    header_line,
-                    0,
-                    format!(
-                        "pt{}_cam{}_Y is missing (expected an X and a Y column per point)",
-                        p.point, spec.camera
-                    ),
-                ));
-            }
-        }
-    }
-
-    let mut t_s = Vec::new();
-    let mut xs: Vec<Vec<f64>> = vec![Vec::new(); columns.len()];
-    let mut ys: Vec<Vec<f64>> = vec![Vec::new(); columns.len()];
-    let mut values = vec![f64::NAN; names.len()];
-    for (row, record) in records.enumerate() {
-        let record = record.map_err(|e| csv_error(path, "read", e))?;
-        let line = record_line(path, &record, header_line + 1 + row, names.len())?;
-        for (col, cell) in record.iter().enumerate() {
-            let cell = cell.trim();
-            values[col] = if cell.eq_ignore_ascii_case("nan") {
-                f64::NAN
-            } else {
-                parse_finite(cell).ok_or_else(|| {
-                    Error::parse(
-                        path,
-                        line,
-                        col + 1,
-                        format!(
-                            "field {}: expected a number or NaN, found {}",
-                            names[col],
-                            quote_cell(cell)
-                        ),
-                    )
-                })?
-            };
-        }
-        for (k, &(_, cx, cy)) in columns.iter().enumerate() {
-            xs[k].push((values[cx] - ox) * scale);
-            ys[k].push(y_sign * (values[cy] - oy) * scale);
-        }
-        t_s.push(spec.t0_s + row as f64 / fps);
-    }
-    if t_s.is_empty() {
-        return Err(Error::input(
+            (None, _) => "X",
+            (_, None) => "Y",
+        };
+        return Err(Error::parse(
             path,
-            "no data rows after the header (DLTdv writes one row per video frame)",
+            header_line,
+            0,
+            format!(
+                "pt{}_cam{camera}_{missing} is missing (expected an X and a Y column per point)",
+                p.point
+            ),
         ));
     }
-    let points = columns
-        .iter()
-        .zip(xs.into_iter().zip(ys))
-        .map(|(&(point, _, _), (x_m, y_m))| PointTrack {
-            name: format!("pt{point}"),
-            x_m,
-            y_m,
-        })
-        .collect();
-    Ok(Trace { t_s, points })
+    Ok(columns)
+}
+
+/// Parse every cell of a data row into `values`: a finite number, or NaN for the text `NaN`.
+fn parse_row(
+    path: &Path,
+    line: usize,
+    record: &csv::StringRecord,
+    names: &[String],
+    values: &mut [f64],
+) -> Result<()> {
+    for (col, cell) in record.iter().enumerate() {
+        let cell = cell.trim();
+        values[col] = if cell.eq_ignore_ascii_case("nan") {
+            f64::NAN
+        } else {
+            parse_finite(cell).ok_or_else(|| {
+                Error::parse(
+                    path,
+                    line,
+                    col + 1,
+                    format!(
+                        "field {}: expected a number or NaN, found {}",
+                        names[col],
+                        quote_cell(cell)
+                    ),
+                )
+            })?
+        };
+    }
+    Ok(())
 }
 
 /// Write `trace` as a DLTdv `xypts.csv` for one camera: the inverse of [`read`] with the same
