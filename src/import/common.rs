@@ -509,6 +509,14 @@ pub fn time_unit_s(unit: &str) -> Option<f64> {
     })
 }
 
+/// Seconds per unit of the time unit in a column name's parentheses (`Time (ms)` → 0.001), `None`
+/// without parentheses or for an unknown unit ([`time_unit_s`]).
+pub fn header_time_unit(name: &str) -> Option<f64> {
+    let open = name.find('(')?;
+    let close = name[open..].find(')')? + open;
+    time_unit_s(&name[open + 1..close])
+}
+
 /// A delimited table: header line(s) and data rows, each with its 1-based file line.
 #[derive(Debug, Clone)]
 pub struct Table<'a> {

@@ -27,8 +27,8 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Error, Result};
 use crate::import::ImportSpec;
 use crate::import::common::{
-    RawTime, RawTrace, RawUnits, Table, numbered_lines, read_decoded, sniff_delimiter, split_cells,
-    time_unit_s,
+    RawTime, RawTrace, RawUnits, Table, header_time_unit, numbered_lines, read_decoded,
+    sniff_delimiter, split_cells,
 };
 
 /// How many lines the header search looks at.
@@ -233,27 +233,7 @@ fn from_lines(
     }
     let dc = spec.decimal_comma;
     let idx = |name: &str| table.find(name).unwrap_or(0);
-    let time = if let Some(tc) = &map.time {
-        let factor = spec
-            .time_to_s
-            .or_else(|| {
-                let open = tc.find('(')?;
-                let close = tc[open..].find(')')? + open;
-                time_unit_s(&tc[open + 1..close])
-            })
-            .unwrap_or(1.0);
-        RawTime::Seconds(
-            table
-                .axis(idx(tc), dc, "a time")?
-                .into_iter()
-                .map(|t| t * factor)
-                .collect(),
-        )
-    } else if let Some(fc) = &map.frame {
-        RawTime::Frames(table.axis(idx(fc), dc, "a frame number")?)
-    } else {
-        RawTime::Frames((0..table.rows.len()).map(|r| r as f64).collect())
-    };
+    let time = time_axis(&table, map, spec)?;
     let mut points = Vec::new();
     for (name, cols) in &map.points {
         let x = table.numbers(idx(&cols[0]), dc)?;
@@ -273,6 +253,30 @@ fn from_lines(
             table.headers[0].0,
             table.rows.len()
         )],
+    })
+}
+
+/// The time axis: the `time` column × its factor (`time_to_s`, else a unit in the column name,
+/// else seconds), the `frame` column, or the row index.
+fn time_axis(table: &Table, map: &GenericColumns, spec: &ImportSpec) -> Result<RawTime> {
+    let dc = spec.decimal_comma;
+    let idx = |name: &str| table.find(name).unwrap_or(0);
+    Ok(if let Some(tc) = &map.time {
+        let factor = spec
+            .time_to_s
+            .or_else(|| header_time_unit(tc))
+            .unwrap_or(1.0);
+        RawTime::Seconds(
+            table
+                .axis(idx(tc), dc, "a time")?
+                .into_iter()
+                .map(|t| t * factor)
+                .collect(),
+        )
+    } else if let Some(fc) = &map.frame {
+        RawTime::Frames(table.axis(idx(fc), dc, "a frame number")?)
+    } else {
+        RawTime::Frames((0..table.rows.len()).map(|r| r as f64).collect())
     })
 }
 

@@ -24,17 +24,9 @@ use std::path::Path;
 use crate::error::{Error, Result};
 use crate::import::ImportSpec;
 use crate::import::common::{
-    RawTime, RawTrace, RawUnits, Table, numbered_lines, pair_xy, parse_cell, read_decoded,
-    sniff_delimiter, time_unit_s, unique_name,
+    RawTime, RawTrace, RawUnits, Table, TextEncoding, header_time_unit, numbered_lines, pair_xy,
+    parse_cell, read_decoded, sniff_delimiter, unique_name,
 };
-
-/// Seconds per time unit from a header like `Time (ms)`: `Some(unit)` when the parentheses hold a
-/// known unit.
-fn header_time_unit(name: &str) -> Option<f64> {
-    let open = name.find('(')?;
-    let close = name[open..].find(')')? + open;
-    time_unit_s(&name[open + 1..close])
-}
 
 /// Read a Kinovea trajectory CSV (module docs) into a [`RawTrace`] in file units.
 ///
@@ -53,47 +45,8 @@ pub fn read_csv(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
     let delim = sniff_delimiter(htext).unwrap_or(',');
     let table = Table::parse(path, &lines, 1, delim)?;
     let names = table.names();
-    if !names[0].starts_with("Time") {
-        return Err(Error::parse(
-            path,
-            hline,
-            1,
-            format!(
-                "expected the first column to be \"Time\", found {}",
-                super::quote_cell(&names[0])
-            ),
-        ));
-    }
-    let factor = match (header_time_unit(&names[0]), spec.time_to_s) {
-        (_, Some(f)) => f,
-        (Some(f), None) => f,
-        (None, None) => {
-            return Err(Error::input(
-                path,
-                "the Kinovea trajectory CSV does not state the unit of its Time column: set \
-                 time_to_s (1 for seconds, 0.001 for milliseconds)",
-            ));
-        }
-    };
-    // A cell that still holds a `,` after splitting was quoted (or the list separator is `;`):
-    // one number with a decimal comma. So commas are always decimal here.
-    let comma_ok = |_r: usize, _c: usize| true;
-    let mut time = Vec::with_capacity(table.rows.len());
-    for r in 0..table.rows.len() {
-        let cell = &table.rows[r].1[0];
-        let v = match parse_cell(cell, comma_ok(r, 0)) {
-            Ok(Some(v)) => v * factor,
-            _ => return Err(table.bad_cell(r, 0, "a time")),
-        };
-        if let Some(&p) = time.last().filter(|&&p| v <= p) {
-            return Err(table.bad_cell(
-                r,
-                0,
-                &format!("a time after the previous row's {p} s (strictly increasing)"),
-            ));
-        }
-        time.push(v);
-    }
+    let factor = csv_time_factor(path, hline, &names[0], spec)?;
+    let time = csv_time(&table, factor)?;
     let (pairs, single) = pair_xy(names, &[0]);
     if pairs.is_empty() {
         return Err(Error::parse(
@@ -108,16 +61,8 @@ pub fn read_csv(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
     }
     let mut points: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
     for (base, cx, cy) in pairs {
-        let col = |c: usize| -> Result<Vec<f64>> {
-            (0..table.rows.len())
-                .map(|r| match parse_cell(&table.rows[r].1[c], comma_ok(r, c)) {
-                    Ok(v) => Ok(v.unwrap_or(f64::NAN)),
-                    Err(()) => Err(table.bad_cell(r, c, "a number or an empty cell")),
-                })
-                .collect()
-        };
-        let x = col(cx)?;
-        let y = col(cy)?;
+        let x = csv_numbers(&table, cx)?;
+        let y = csv_numbers(&table, cy)?;
         let taken: Vec<String> = points.iter().map(|p| p.0.clone()).collect();
         points.push((unique_name(&taken, &base), x, y));
     }
@@ -131,9 +76,7 @@ pub fn read_csv(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
             cols.join(", ")
         ));
     }
-    if enc != super::common::TextEncoding::Utf8 {
-        notes.push("encoding: not UTF-8, decoded as Windows-1252".into());
-    }
+    push_encoding_note(enc, &mut notes);
     Ok(RawTrace {
         time: RawTime::Seconds(time),
         points,
@@ -141,6 +84,83 @@ pub fn read_csv(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
         y_down_default: false,
         notes,
     })
+}
+
+/// Seconds per unit of the trajectory CSV's first column `name` (which must start with `Time`):
+/// `time_to_s`, else the unit in the header (`Time (ms)`).
+fn csv_time_factor(path: &Path, hline: usize, name: &str, spec: &ImportSpec) -> Result<f64> {
+    if !name.starts_with("Time") {
+        return Err(Error::parse(
+            path,
+            hline,
+            1,
+            format!(
+                "expected the first column to be \"Time\", found {}",
+                super::quote_cell(name)
+            ),
+        ));
+    }
+    match (header_time_unit(name), spec.time_to_s) {
+        (_, Some(f)) => Ok(f),
+        (Some(f), None) => Ok(f),
+        (None, None) => Err(Error::input(
+            path,
+            "the Kinovea trajectory CSV does not state the unit of its Time column: set \
+             time_to_s (1 for seconds, 0.001 for milliseconds)",
+        )),
+    }
+}
+
+/// The trajectory CSV's first column × `factor`: seconds, strictly increasing. Commas are always
+/// decimal here: a cell that still holds a `,` after splitting was quoted (or `;` separated).
+fn csv_time(table: &Table, factor: f64) -> Result<Vec<f64>> {
+    let mut time: Vec<f64> = Vec::with_capacity(table.rows.len());
+    for r in 0..table.rows.len() {
+        let cell = &table.rows[r].1[0];
+        let v = match parse_cell(cell, true) {
+            Ok(Some(v)) => v * factor,
+            _ => return Err(table.bad_cell(r, 0, "a time")),
+        };
+        if let Some(&p) = time.last().filter(|&&p| v <= p) {
+            return Err(table.bad_cell(
+                r,
+                0,
+                &format!("a time after the previous row's {p} s (strictly increasing)"),
+            ));
+        }
+        time.push(v);
+    }
+    Ok(time)
+}
+
+/// Column `c` of a trajectory CSV (decimal comma), NaN where empty.
+fn csv_numbers(table: &Table, c: usize) -> Result<Vec<f64>> {
+    (0..table.rows.len())
+        .map(|r| match parse_cell(&table.rows[r].1[c], true) {
+            Ok(v) => Ok(v.unwrap_or(f64::NAN)),
+            Err(()) => Err(table.bad_cell(r, c, "a number or an empty cell")),
+        })
+        .collect()
+}
+
+/// Say so in `notes` when the file was not UTF-8.
+fn push_encoding_note(enc: TextEncoding, notes: &mut Vec<String>) {
+    if enc != TextEncoding::Utf8 {
+        notes.push("encoding: not UTF-8, decoded as Windows-1252".into());
+    }
+}
+
+/// A point of a [`RawTrace`]: name, x and y in file units.
+type Point = (String, Vec<f64>, Vec<f64>);
+
+/// One `# <name>` section of a trajectory TXT: its rows' times and coordinate columns.
+struct Section {
+    name: String,
+    /// Values per row (time + coordinates), fixed by the section's first row; 0 before it.
+    width: usize,
+    t: Vec<f64>,
+    /// x1, y1, x2, y2 ... columns.
+    xy: Vec<Vec<f64>>,
 }
 
 /// Read a Kinovea trajectory TXT (module docs) into a [`RawTrace`] in file units.
@@ -153,12 +173,6 @@ pub fn read_csv(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
 pub fn read_txt(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
     let (text, enc) = read_decoded(path)?;
     let factor = spec.time_to_s.unwrap_or(1.0);
-    struct Section {
-        name: String,
-        width: usize,
-        t: Vec<f64>,
-        xy: Vec<Vec<f64>>,
-    }
     let mut sections: Vec<Section> = Vec::new();
     for (line, l) in numbered_lines(&text) {
         let trimmed = l.trim();
@@ -185,87 +199,7 @@ pub fn read_txt(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
                 "data row before the first section: expected a `# <object name>` line",
             ));
         };
-        // Column numbers (1-based characters) of each token.
-        let mut tokens: Vec<(usize, &str)> = Vec::new();
-        let mut start = None;
-        for (ci, (bi, ch)) in l.char_indices().enumerate() {
-            if ch.is_whitespace() {
-                if let Some((c0, b0)) = start.take() {
-                    tokens.push((c0, &l[b0..bi]));
-                }
-            } else if start.is_none() {
-                start = Some((ci + 1, bi));
-            }
-        }
-        if let Some((c0, b0)) = start {
-            tokens.push((c0, &l[b0..]));
-        }
-        if tokens.len() < 3 || tokens.len().is_multiple_of(2) {
-            return Err(Error::parse(
-                path,
-                line,
-                0,
-                format!(
-                    "section {:?}: expected a time and x, y pairs (an odd number ≥ 3 of values), \
-                     found {} values",
-                    sec.name,
-                    tokens.len()
-                ),
-            ));
-        }
-        if sec.width == 0 {
-            sec.width = tokens.len();
-            sec.xy = vec![Vec::new(); tokens.len() - 1];
-        } else if tokens.len() != sec.width {
-            return Err(Error::parse(
-                path,
-                line,
-                0,
-                format!(
-                    "section {:?}: expected {} values like its first row, found {}",
-                    sec.name,
-                    sec.width,
-                    tokens.len()
-                ),
-            ));
-        }
-        let mut vals = Vec::with_capacity(tokens.len());
-        for (k, &(col, tok)) in tokens.iter().enumerate() {
-            match parse_cell(tok, true) {
-                Ok(Some(v)) => vals.push(v),
-                Ok(None) if k > 0 => vals.push(f64::NAN),
-                _ => {
-                    return Err(Error::parse(
-                        path,
-                        line,
-                        col,
-                        format!(
-                            "section {:?}: expected {}, found {}",
-                            sec.name,
-                            if k == 0 { "a time" } else { "a number" },
-                            super::quote_cell(tok)
-                        ),
-                    ));
-                }
-            }
-        }
-        let t = vals[0] * factor;
-        if let Some(&p) = sec.t.last().filter(|&&p| t <= p) {
-            return Err(Error::parse(
-                path,
-                line,
-                1,
-                format!(
-                    "section {:?}: time {t} s is not after the previous row's {p} s (expected \
-                     strictly increasing times)",
-                    sec.name
-                ),
-            ));
-        }
-        sec.t.push(t);
-        for (k, v) in vals[1..].iter().enumerate() {
-            sec.xy[k].push(*v);
-        }
+        push_txt_row(path, line, &tokens(l), factor, sec)?;
     }
     sections.retain(|s| !s.t.is_empty());
     if sections.is_empty() {
@@ -274,16 +208,136 @@ pub fn read_txt(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
             "no data rows: expected `# <object>` sections of `t x y` rows",
         ));
     }
-    // Union of all sections' times (exact values as written).
-    let mut time: Vec<f64> = sections.iter().flat_map(|s| s.t.iter().copied()).collect();
-    time.sort_by(f64::total_cmp);
-    time.dedup();
-    let mut points: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
+    let (time, points) = merge_sections(&sections);
     let lengths: Vec<String> = sections
         .iter()
         .map(|s| format!("{} {}", s.name, s.t.len()))
         .collect();
-    for s in &sections {
+    let mut notes = vec![format!(
+        "Kinovea trajectory TXT: {} sections (rows: {}); time axis = union of the sections' times \
+         ({} samples), NaN where a section has no row",
+        sections.len(),
+        lengths.join(", "),
+        time.len()
+    )];
+    push_encoding_note(enc, &mut notes);
+    Ok(RawTrace {
+        time: RawTime::Seconds(time),
+        points,
+        units: RawUnits::Unknown,
+        y_down_default: false,
+        notes,
+    })
+}
+
+/// The whitespace-separated tokens of `l`, each with its 1-based character column.
+fn tokens(l: &str) -> Vec<(usize, &str)> {
+    let mut tokens: Vec<(usize, &str)> = Vec::new();
+    let mut start = None;
+    for (ci, (bi, ch)) in l.char_indices().enumerate() {
+        if ch.is_whitespace() {
+            if let Some((c0, b0)) = start.take() {
+                tokens.push((c0, &l[b0..bi]));
+            }
+        } else if start.is_none() {
+            start = Some((ci + 1, bi));
+        }
+    }
+    if let Some((c0, b0)) = start {
+        tokens.push((c0, &l[b0..]));
+    }
+    tokens
+}
+
+/// Append the data row on `line` (its `tokens`: a time and x, y pairs) to `sec`.
+fn push_txt_row(
+    path: &Path,
+    line: usize,
+    tokens: &[(usize, &str)],
+    factor: f64,
+    sec: &mut Section,
+) -> Result<()> {
+    check_txt_width(path, line, tokens.len(), sec)?;
+    let mut vals = Vec::with_capacity(tokens.len());
+    for (k, &(col, tok)) in tokens.iter().enumerate() {
+        match parse_cell(tok, true) {
+            Ok(Some(v)) => vals.push(v),
+            Ok(None) if k > 0 => vals.push(f64::NAN),
+            _ => {
+                return Err(Error::parse(
+                    path,
+                    line,
+                    col,
+                    format!(
+                        "section {:?}: expected {}, found {}",
+                        sec.name,
+                        if k == 0 { "a time" } else { "a number" },
+                        super::quote_cell(tok)
+                    ),
+                ));
+            }
+        }
+    }
+    let t = vals[0] * factor;
+    if let Some(&p) = sec.t.last().filter(|&&p| t <= p) {
+        return Err(Error::parse(
+            path,
+            line,
+            1,
+            format!(
+                "section {:?}: time {t} s is not after the previous row's {p} s (expected \
+                 strictly increasing times)",
+                sec.name
+            ),
+        ));
+    }
+    sec.t.push(t);
+    for (k, v) in vals[1..].iter().enumerate() {
+        sec.xy[k].push(*v);
+    }
+    Ok(())
+}
+
+/// A row of `n` values must be a time and x, y pairs, as wide as the section's first row (whose
+/// width it sets).
+fn check_txt_width(path: &Path, line: usize, n: usize, sec: &mut Section) -> Result<()> {
+    if n < 3 || n.is_multiple_of(2) {
+        return Err(Error::parse(
+            path,
+            line,
+            0,
+            format!(
+                "section {:?}: expected a time and x, y pairs (an odd number ≥ 3 of values), \
+                 found {n} values",
+                sec.name
+            ),
+        ));
+    }
+    if sec.width == 0 {
+        sec.width = n;
+        sec.xy = vec![Vec::new(); n - 1];
+    } else if n != sec.width {
+        return Err(Error::parse(
+            path,
+            line,
+            0,
+            format!(
+                "section {:?}: expected {} values like its first row, found {n}",
+                sec.name, sec.width
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The union of all sections' times (exact values as written) and every section's points on it,
+/// NaN where a section has no row.
+fn merge_sections(sections: &[Section]) -> (Vec<f64>, Vec<Point>) {
+    let mut time: Vec<f64> = sections.iter().flat_map(|s| s.t.iter().copied()).collect();
+    time.sort_by(f64::total_cmp);
+    time.dedup();
+    let mut points: Vec<Point> = Vec::new();
+    for s in sections {
         let idx: Vec<usize> =
             s.t.iter()
                 .map(|t| time.binary_search_by(|u| u.total_cmp(t)).unwrap_or(0))
@@ -304,23 +358,7 @@ pub fn read_txt(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
             points.push((unique_name(&taken, &base), x, y));
         }
     }
-    let mut notes = vec![format!(
-        "Kinovea trajectory TXT: {} sections (rows: {}); time axis = union of the sections' times \
-         ({} samples), NaN where a section has no row",
-        sections.len(),
-        lengths.join(", "),
-        time.len()
-    )];
-    if enc != super::common::TextEncoding::Utf8 {
-        notes.push("encoding: not UTF-8, decoded as Windows-1252".into());
-    }
-    Ok(RawTrace {
-        time: RawTime::Seconds(time),
-        points,
-        units: RawUnits::Unknown,
-        y_down_default: false,
-        notes,
-    })
+    (time, points)
 }
 
 /// Read a Kinovea kinematics-dialog CSV (module docs) into a [`RawTrace`] in file units.
