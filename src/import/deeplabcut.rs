@@ -18,6 +18,14 @@ use crate::import::common::{RawTime, RawTrace, RawUnits, Table, numbered_lines, 
 /// DeepLabCut's default `pcutoff` (config.yaml), used when `min_likelihood` is not set.
 pub const DEFAULT_MIN_LIKELIHOOD: f64 = 0.6;
 
+/// One point's columns: `<bodypart>` or `<individual>/<bodypart>`, x, y and likelihood.
+struct Cols {
+    name: String,
+    x: Option<usize>,
+    y: Option<usize>,
+    l: Option<usize>,
+}
+
 /// Read a DeepLabCut CSV (module docs) into a [`RawTrace`] in pixels.
 ///
 /// # Errors
@@ -37,6 +45,44 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
     });
     let n_header = if multi { 4 } else { 3 };
     let table = Table::parse(path, &lines, n_header, ',')?;
+    let groups = column_groups(path, &table, multi)?;
+    let coords_line = table.headers[n_header - 1].0;
+    // The first column: 0-based frame index. Image paths mean labeled training data.
+    if table.rows[0].1[0].trim().parse::<f64>().is_err() {
+        return Err(table.bad_cell(
+            0,
+            0,
+            "a frame index (this looks like labeled training data with image paths, not a \
+             prediction time series)",
+        ));
+    }
+    let frames = table.axis(0, false, "a frame index")?;
+    let cutoff = spec.min_likelihood.unwrap_or(DEFAULT_MIN_LIKELIHOOD);
+    let mut points = Vec::new();
+    let mut below = 0usize;
+    for g in &groups {
+        let (x, y) = point_values(path, &table, coords_line, g, cutoff, &mut below)?;
+        points.push((g.name.clone(), x, y));
+    }
+    let notes = vec![format!(
+        "DeepLabCut {}: {below} point samples with likelihood < {cutoff} set to NaN",
+        if multi {
+            "multi-animal"
+        } else {
+            "single-animal"
+        }
+    )];
+    Ok(RawTrace {
+        time: RawTime::Frames(frames),
+        points,
+        units: RawUnits::Pixels,
+        y_down_default: true,
+        notes,
+    })
+}
+
+/// Check the header rows' first cells and group the columns by (individual, body part).
+fn column_groups(path: &Path, table: &Table, multi: bool) -> Result<Vec<Cols>> {
     let expect: &[&str] = if multi {
         &["scorer", "individuals", "bodyparts", "coords"]
     } else {
@@ -55,122 +101,109 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
             ));
         }
     }
-    let width = table.names().len();
     let row = |name: &str| -> &Vec<String> {
         let k = expect.iter().position(|w| *w == name).unwrap_or(0);
         &table.headers[k].1
     };
-    let (coords_line, coords) = (table.headers[n_header - 1].0, row("coords"));
-    let bodyparts = row("bodyparts");
+    let coords_line = table.headers[expect.len() - 1].0;
+    let (coords, bodyparts) = (row("coords"), row("bodyparts"));
     let individuals = if multi {
         Some(row("individuals"))
     } else {
         None
     };
-    // Group columns by (individual, bodypart).
-    struct Cols {
-        name: String,
-        x: Option<usize>,
-        y: Option<usize>,
-        l: Option<usize>,
-    }
     let mut groups: Vec<Cols> = Vec::new();
-    for j in 1..width {
+    for j in 1..table.names().len() {
         let bp = bodyparts.get(j).map_or("", |s| s.as_str());
         let name = match individuals {
             Some(ind) => format!("{}/{bp}", ind.get(j).map_or("", |s| s.as_str())),
             None => bp.to_owned(),
         };
-        let g = match groups.iter().position(|g| g.name == name) {
-            Some(i) => i,
-            None => {
-                groups.push(Cols {
-                    name,
-                    x: None,
-                    y: None,
-                    l: None,
-                });
-                groups.len() - 1
-            }
-        };
         let coord = coords.get(j).map_or("", |s| s.as_str());
-        let slot = match coord {
-            "x" => &mut groups[g].x,
-            "y" => &mut groups[g].y,
-            "likelihood" => &mut groups[g].l,
-            other => {
-                return Err(Error::parse(
-                    path,
-                    coords_line,
-                    j + 1,
-                    format!(
-                        "expected coords x, y or likelihood, found {}",
-                        super::quote_cell(other)
-                    ),
-                ));
-            }
-        };
-        if slot.is_some() {
+        assign_column(path, coords_line, &mut groups, name, coord, j)?;
+    }
+    Ok(groups)
+}
+
+/// Put column `j` (`coord` of point `name`) into its group, creating the group if new.
+fn assign_column(
+    path: &Path,
+    coords_line: usize,
+    groups: &mut Vec<Cols>,
+    name: String,
+    coord: &str,
+    j: usize,
+) -> Result<()> {
+    let g = match groups.iter().position(|g| g.name == name) {
+        Some(i) => i,
+        None => {
+            groups.push(Cols {
+                name,
+                x: None,
+                y: None,
+                l: None,
+            });
+            groups.len() - 1
+        }
+    };
+    let slot = match coord {
+        "x" => &mut groups[g].x,
+        "y" => &mut groups[g].y,
+        "likelihood" => &mut groups[g].l,
+        other => {
             return Err(Error::parse(
                 path,
                 coords_line,
                 j + 1,
-                format!("column {coord} of {:?} appears twice", groups[g].name),
+                format!(
+                    "expected coords x, y or likelihood, found {}",
+                    super::quote_cell(other)
+                ),
             ));
         }
-        *slot = Some(j);
-    }
-    // The first column: 0-based frame index. Image paths mean labeled training data.
-    if table.rows[0].1[0].trim().parse::<f64>().is_err() {
-        return Err(table.bad_cell(
-            0,
-            0,
-            "a frame index (this looks like labeled training data with image paths, not a \
-             prediction time series)",
+    };
+    if slot.is_some() {
+        return Err(Error::parse(
+            path,
+            coords_line,
+            j + 1,
+            format!("column {coord} of {:?} appears twice", groups[g].name),
         ));
     }
-    let frames = table.axis(0, false, "a frame index")?;
-    let cutoff = spec.min_likelihood.unwrap_or(DEFAULT_MIN_LIKELIHOOD);
-    let mut points = Vec::new();
-    let mut below = 0usize;
-    for g in &groups {
-        let (Some(cx), Some(cy)) = (g.x, g.y) else {
-            return Err(Error::parse(
-                path,
-                coords_line,
-                0,
-                format!("body part {:?}: expected an x and a y column", g.name),
-            ));
-        };
-        let mut x = table.numbers(cx, false)?;
-        let mut y = table.numbers(cy, false)?;
-        if let Some(cl) = g.l {
-            let l = table.numbers(cl, false)?;
-            for i in 0..l.len() {
-                if l[i] < cutoff && !(x[i].is_nan() && y[i].is_nan()) {
-                    x[i] = f64::NAN;
-                    y[i] = f64::NAN;
-                    below += 1;
-                }
+    *slot = Some(j);
+    Ok(())
+}
+
+/// A point's x and y, NaN where its likelihood is below `cutoff` (counted in `below`).
+fn point_values(
+    path: &Path,
+    table: &Table,
+    coords_line: usize,
+    g: &Cols,
+    cutoff: f64,
+    below: &mut usize,
+) -> Result<(Vec<f64>, Vec<f64>)> {
+    let (Some(cx), Some(cy)) = (g.x, g.y) else {
+        return Err(Error::parse(
+            path,
+            coords_line,
+            0,
+            format!("body part {:?}: expected an x and a y column", g.name),
+        ));
+    };
+    let mut x = table.numbers(cx, false)?;
+    let mut y = table.numbers(cy, false)?;
+    if let Some(cl) = g.l {
+        let l = table.numbers(cl, false)?;
+        for i in 0..l.len() {
+            if l[i] < cutoff && !(x[i].is_nan() && y[i].is_nan()) {
+                x[i] = f64::NAN;
+                y[i] = f64::NAN;
+                *below += 1;
             }
         }
-        points.push((g.name.clone(), x, y));
     }
-    let notes = vec![format!(
-        "DeepLabCut {}: {below} point samples with likelihood < {cutoff} set to NaN",
-        if multi {
-            "multi-animal"
-        } else {
-            "single-animal"
-        }
-    )];
-    Ok(RawTrace {
-        time: RawTime::Frames(frames),
-        points,
-        units: RawUnits::Pixels,
-        y_down_default: true,
-        notes,
-    })
+    Ok((x, y))
 }
 
 #[cfg(test)]

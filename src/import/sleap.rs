@@ -29,6 +29,21 @@ pub(crate) const MAX_SPAN_PER_ROW: usize = 1000;
 /// Largest frame index accepted (a frame axis longer than this is a corrupt file, not a video).
 const MAX_FRAME: f64 = 1e8;
 
+/// A node's columns: name, x, y and the optional score.
+type Node = (String, usize, usize, Option<usize>);
+
+/// Tracks assembled from the instance rows.
+struct Instances {
+    /// Track names in order of first appearance (empty = untracked).
+    order: Vec<String>,
+    /// Track → x, y per node over the frame axis.
+    tracks: BTreeMap<String, Vec<Xy>>,
+    /// Node samples set to NaN for a score below the cut-off.
+    below: usize,
+    /// Rows without any coordinate (empty frames).
+    padding: usize,
+}
+
 /// Read a SLEAP analysis CSV (module docs) into a [`RawTrace`] in pixels.
 ///
 /// # Errors
@@ -39,6 +54,60 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
     let (text, _) = read_decoded(path)?;
     let lines = numbered_lines(&text);
     let table = Table::parse(path, &lines, 1, ',')?;
+    let (ct, cf, nodes) = columns(path, &table)?;
+    let cutoff = spec.min_likelihood.unwrap_or(DEFAULT_MIN_LIKELIHOOD);
+    let frames = frame_indices(&table, cf)?;
+    let (first, last, n) = frame_span(path, &frames, table.rows.len())?;
+    let cols = node_values(&table, &nodes)?;
+    let n_tracks = table
+        .rows
+        .iter()
+        .map(|(_, c)| c[ct].trim())
+        .collect::<std::collections::BTreeSet<_>>()
+        .len();
+    crate::import::common::check_cells(path, n, n_tracks * nodes.len())?;
+    let frame_of: Vec<usize> = frames.iter().map(|f| (f - first) as usize).collect();
+    let mut inst = instances(&table, ct, &frames, &frame_of, &cols, n, cutoff)?;
+    let mut points = Vec::new();
+    for t in &inst.order {
+        if let Some(slots) = inst.tracks.remove(t) {
+            for ((node, ..), (x, y)) in nodes.iter().zip(slots) {
+                let name = if t.is_empty() {
+                    node.clone()
+                } else {
+                    format!("{t}/{node}")
+                };
+                points.push((name, x, y));
+            }
+        }
+    }
+    let has_scores = nodes.iter().any(|n| n.3.is_some());
+    let notes = vec![format!(
+        "SLEAP: {} instance rows, {} empty-frame rows, {} tracks, frames {first}–{last}; {}",
+        table.rows.len() - inst.padding,
+        inst.padding,
+        inst.order.len(),
+        if has_scores {
+            format!(
+                "{} node samples with score < {cutoff} set to NaN",
+                inst.below
+            )
+        } else {
+            "no score columns (no likelihood cut-off applied)".to_owned()
+        }
+    )];
+    Ok(RawTrace {
+        time: RawTime::Frames((0..n).map(|k| first + k as f64).collect()),
+        points,
+        units: RawUnits::Pixels,
+        y_down_default: true,
+        notes,
+    })
+}
+
+/// The `track` and `frame_idx` columns and the nodes: `<node>.x` with a matching `<node>.y` (and
+/// `<node>.score` if present).
+fn columns(path: &Path, table: &Table) -> Result<(usize, usize, Vec<Node>)> {
     let names = table.names();
     let hline = table.headers[0].0;
     let (Some(ct), Some(cf)) = (table.find("track"), table.find("frame_idx")) else {
@@ -52,8 +121,7 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
             ),
         ));
     };
-    // Nodes: <node>.x with a matching <node>.y.
-    let mut nodes: Vec<(String, usize, usize, Option<usize>)> = Vec::new();
+    let mut nodes: Vec<Node> = Vec::new();
     for (j, n) in names.iter().enumerate() {
         if let Some(node) = n.strip_suffix(".x") {
             let Some(cy) = table.find(&format!("{node}.y")) else {
@@ -78,8 +146,11 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
             ),
         ));
     }
-    let cutoff = spec.min_likelihood.unwrap_or(DEFAULT_MIN_LIKELIHOOD);
-    // Parse every row: frame, track, node values.
+    Ok((ct, cf, nodes))
+}
+
+/// Every row's `frame_idx`: a non-negative integer up to [`MAX_FRAME`].
+fn frame_indices(table: &Table, cf: usize) -> Result<Vec<f64>> {
     let mut frames = Vec::with_capacity(table.rows.len());
     for r in 0..table.rows.len() {
         match parse_cell(&table.rows[r].1[cf], false) {
@@ -87,52 +158,65 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
             _ => return Err(table.bad_cell(r, cf, "a non-negative integer frame index")),
         }
     }
+    Ok(frames)
+}
+
+/// First and last frame and the frame count, refused when implausibly many for `rows` rows.
+fn frame_span(path: &Path, frames: &[f64], rows: usize) -> Result<(f64, f64, usize)> {
     let first = frames.iter().copied().fold(f64::INFINITY, f64::min);
     let last = frames.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let n = (last - first) as usize + 1;
-    if n > MAX_SPAN_PER_ROW * table.rows.len() + 1_000_000 {
+    if n > MAX_SPAN_PER_ROW * rows + 1_000_000 {
         return Err(Error::input(
             path,
             format!(
-                "frame_idx runs from {first} to {last} but the file has only {} rows: expected a \
-                 frame range of at most {} × rows + 10⁶ (a corrupt frame index?)",
-                table.rows.len(),
-                MAX_SPAN_PER_ROW
+                "frame_idx runs from {first} to {last} but the file has only {rows} rows: expected \
+                 a frame range of at most {MAX_SPAN_PER_ROW} × rows + 10⁶ (a corrupt frame index?)"
             ),
         ));
     }
-    let cols: Vec<Vec<f64>> = {
-        let mut v = Vec::new();
-        for (_, cx, cy, cs) in &nodes {
-            v.push(table.numbers(*cx, false)?);
-            v.push(table.numbers(*cy, false)?);
-            v.push(match cs {
-                Some(c) => table.numbers(*c, false)?,
-                None => vec![f64::NAN; table.rows.len()],
-            });
-        }
-        v
+    Ok((first, last, n))
+}
+
+/// x, y and score columns of every node (three per node; scores NaN without a score column).
+fn node_values(table: &Table, nodes: &[Node]) -> Result<Vec<Vec<f64>>> {
+    let mut v = Vec::new();
+    for (_, cx, cy, cs) in nodes {
+        v.push(table.numbers(*cx, false)?);
+        v.push(table.numbers(*cy, false)?);
+        v.push(match cs {
+            Some(c) => table.numbers(*c, false)?,
+            None => vec![f64::NAN; table.rows.len()],
+        });
+    }
+    Ok(v)
+}
+
+/// Place every instance row at its frame (`frame_of`, 0-based on the `n`-frame axis) in its
+/// track; node samples scored below `cutoff` stay NaN; one instance per track and frame.
+fn instances(
+    table: &Table,
+    ct: usize,
+    frames: &[f64],
+    frame_of: &[usize],
+    cols: &[Vec<f64>],
+    n: usize,
+    cutoff: f64,
+) -> Result<Instances> {
+    let n_nodes = cols.len() / 3;
+    let mut inst = Instances {
+        order: Vec::new(),
+        tracks: BTreeMap::new(),
+        below: 0,
+        padding: 0,
     };
-    let n_tracks = table
-        .rows
-        .iter()
-        .map(|(_, c)| c[ct].trim())
-        .collect::<std::collections::BTreeSet<_>>()
-        .len();
-    crate::import::common::check_cells(path, n, n_tracks * nodes.len())?;
-    // track → (x, y per node), in order of first appearance.
-    let mut order: Vec<String> = Vec::new();
-    let mut tracks: BTreeMap<String, Vec<Xy>> = BTreeMap::new();
     let mut seen: BTreeMap<(String, usize), usize> = BTreeMap::new();
-    let mut below = 0usize;
-    let mut padding = 0usize;
     for r in 0..table.rows.len() {
-        let k = (frames[r] - first) as usize;
-        let any =
-            (0..nodes.len()).any(|i| !cols[3 * i][r].is_nan() || !cols[3 * i + 1][r].is_nan());
+        let k = frame_of[r];
+        let any = (0..n_nodes).any(|i| !cols[3 * i][r].is_nan() || !cols[3 * i + 1][r].is_nan());
         let track = table.rows[r].1[ct].trim().to_owned();
         if !any {
-            padding += 1;
+            inst.padding += 1;
             continue;
         }
         if let Some(prev) = seen.insert((track.clone(), k), table.rows[r].0) {
@@ -146,51 +230,21 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
                 ),
             ));
         }
-        let slots = tracks.entry(track.clone()).or_insert_with(|| {
-            order.push(track.clone());
-            vec![(vec![f64::NAN; n], vec![f64::NAN; n]); nodes.len()]
+        let slots = inst.tracks.entry(track.clone()).or_insert_with(|| {
+            inst.order.push(track.clone());
+            vec![(vec![f64::NAN; n], vec![f64::NAN; n]); n_nodes]
         });
         for (i, slot) in slots.iter_mut().enumerate() {
             let (x, y, s) = (cols[3 * i][r], cols[3 * i + 1][r], cols[3 * i + 2][r]);
             if s < cutoff && !(x.is_nan() && y.is_nan()) {
-                below += 1;
+                inst.below += 1;
                 continue;
             }
             slot.0[k] = x;
             slot.1[k] = y;
         }
     }
-    let mut points = Vec::new();
-    for t in &order {
-        if let Some(slots) = tracks.remove(t) {
-            for ((node, ..), (x, y)) in nodes.iter().zip(slots) {
-                let name = if t.is_empty() {
-                    node.clone()
-                } else {
-                    format!("{t}/{node}")
-                };
-                points.push((name, x, y));
-            }
-        }
-    }
-    let has_scores = nodes.iter().any(|n| n.3.is_some());
-    let notes = vec![format!(
-        "SLEAP: {} instance rows, {padding} empty-frame rows, {} tracks, frames {first}–{last}; {}",
-        table.rows.len() - padding,
-        order.len(),
-        if has_scores {
-            format!("{below} node samples with score < {cutoff} set to NaN")
-        } else {
-            "no score columns (no likelihood cut-off applied)".to_owned()
-        }
-    )];
-    Ok(RawTrace {
-        time: RawTime::Frames((0..n).map(|k| first + k as f64).collect()),
-        points,
-        units: RawUnits::Pixels,
-        y_down_default: true,
-        notes,
-    })
+    Ok(inst)
 }
 
 #[cfg(test)]
