@@ -21,6 +21,14 @@ use crate::import::common::{RawTime, RawTrace, RawUnits, numbered_lines, read_de
 /// Largest dense matrix accepted (rows × cols): 2·[`MAX_CELLS`](super::common::MAX_CELLS).
 const MAX_CELLS: usize = 2 * super::common::MAX_CELLS;
 
+/// The size line: its file line and the dense matrix's rows, columns and stored-entry count.
+struct Size {
+    line: usize,
+    rows: usize,
+    cols: usize,
+    nnz: usize,
+}
+
 /// Read a DLTdv sparse xypts file (module docs) into a [`RawTrace`] in pixels.
 ///
 /// # Errors
@@ -40,99 +48,12 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
             "expected a title line and a `rows<TAB>cols<TAB>nnz` line",
         ));
     }
-    let fields = |line: usize, l: &str, what: &str| -> Result<Vec<String>> {
-        let f: Vec<String> = l
-            .split(['\t', ' ', ','])
-            .filter(|s| !s.is_empty())
-            .map(str::to_owned)
-            .collect();
-        if f.len() != 3 {
-            return Err(Error::parse(
-                path,
-                line,
-                0,
-                format!(
-                    "expected {what} (three TAB-separated values), found {} values",
-                    f.len()
-                ),
-            ));
-        }
-        Ok(f)
-    };
-    let int = |line: usize, col: usize, s: &str, what: &str| -> Result<usize> {
-        s.trim().parse::<usize>().map_err(|_| {
-            Error::parse(
-                path,
-                line,
-                col,
-                format!(
-                    "expected {what} (an integer), found {}",
-                    super::quote_cell(s)
-                ),
-            )
-        })
-    };
-    let (sl, st) = lines[1];
-    let size = fields(sl, st, "rows, cols, nnz")?;
-    let rows = int(sl, 1, &size[0], "the row count")?;
-    let cols = int(sl, 2, &size[1], "the column count")?;
-    let nnz = int(sl, 3, &size[2], "the non-zero count")?;
-    let per_point = 2 * spec.n_cameras;
-    if rows == 0 || cols == 0 || cols % per_point != 0 || rows.saturating_mul(cols) > MAX_CELLS {
-        return Err(Error::parse(
-            path,
-            sl,
-            2,
-            format!(
-                "expected rows ≥ 1 and a column count that is a multiple of 2 × n_cameras = \
-                 {per_point} (≤ {MAX_CELLS} cells), found rows {rows}, cols {cols}"
-            ),
-        ));
-    }
-    let mut dense = vec![f64::NAN; rows * cols];
-    let mut count = 0usize;
-    for &(line, l) in &lines[2..] {
-        let f = fields(line, l, "a row, column, value triplet")?;
-        let r = int(line, 1, &f[0], "a row")?;
-        let c = int(line, 2, &f[1], "a column")?;
-        if r == 0 || r > rows || c == 0 || c > cols {
-            return Err(Error::parse(
-                path,
-                line,
-                1,
-                format!("expected row 1..={rows} and column 1..={cols}, found ({r}, {c})"),
-            ));
-        }
-        let v = match super::parse_finite(&f[2]) {
-            Some(v) => v,
-            None => {
-                return Err(Error::parse(
-                    path,
-                    line,
-                    3,
-                    format!("expected a number, found {}", super::quote_cell(&f[2])),
-                ));
-            }
-        };
-        let cell = &mut dense[(r - 1) * cols + (c - 1)];
-        if !cell.is_nan() {
-            return Err(Error::parse(
-                path,
-                line,
-                1,
-                format!("entry ({r}, {c}) appears twice"),
-            ));
-        }
-        *cell = if v == 0.0 { f64::NAN } else { v };
-        count += 1;
-    }
-    if count != nnz {
-        return Err(Error::input(
-            path,
-            format!("the size line (line {sl}) says {nnz} entries, the file has {count}"),
-        ));
-    }
-    let n_points = cols / per_point;
+    let size = size_line(path, lines[1], spec)?;
+    let dense = dense_matrix(path, &lines[2..], &size)?;
+    let Size {
+        rows, cols, nnz, ..
+    } = size;
+    let n_points = cols / (2 * spec.n_cameras);
     let cam = spec.camera - 1;
     let mut points = Vec::with_capacity(n_points);
     for i in 0..n_points {
@@ -152,6 +73,119 @@ pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
             spec.n_cameras, spec.camera
         )],
     })
+}
+
+/// The three values of a size or triplet line (`what` names it in the error).
+fn fields(path: &Path, line: usize, l: &str, what: &str) -> Result<Vec<String>> {
+    let f: Vec<String> = l
+        .split(['\t', ' ', ','])
+        .filter(|s| !s.is_empty())
+        .map(str::to_owned)
+        .collect();
+    if f.len() != 3 {
+        return Err(Error::parse(
+            path,
+            line,
+            0,
+            format!(
+                "expected {what} (three TAB-separated values), found {} values",
+                f.len()
+            ),
+        ));
+    }
+    Ok(f)
+}
+
+/// A non-negative integer in column `col` of `line`.
+fn int(path: &Path, line: usize, col: usize, s: &str, what: &str) -> Result<usize> {
+    s.trim().parse::<usize>().map_err(|_| {
+        Error::parse(
+            path,
+            line,
+            col,
+            format!(
+                "expected {what} (an integer), found {}",
+                super::quote_cell(s)
+            ),
+        )
+    })
+}
+
+/// Parse the size line `rows cols nnz`: rows ≥ 1, cols a positive multiple of 2·`n_cameras`, the
+/// matrix at most [`MAX_CELLS`].
+fn size_line(path: &Path, (sl, st): (usize, &str), spec: &ImportSpec) -> Result<Size> {
+    let size = fields(path, sl, st, "rows, cols, nnz")?;
+    let rows = int(path, sl, 1, &size[0], "the row count")?;
+    let cols = int(path, sl, 2, &size[1], "the column count")?;
+    let nnz = int(path, sl, 3, &size[2], "the non-zero count")?;
+    let per_point = 2 * spec.n_cameras;
+    if rows == 0 || cols == 0 || cols % per_point != 0 || rows.saturating_mul(cols) > MAX_CELLS {
+        return Err(Error::parse(
+            path,
+            sl,
+            2,
+            format!(
+                "expected rows ≥ 1 and a column count that is a multiple of 2 × n_cameras = \
+                 {per_point} (≤ {MAX_CELLS} cells), found rows {rows}, cols {cols}"
+            ),
+        ));
+    }
+    Ok(Size {
+        line: sl,
+        rows,
+        cols,
+        nnz,
+    })
+}
+
+/// The dense `rows × cols` matrix (row-major) from the triplet lines, NaN where absent or 0; the
+/// triplet count must match the size line's `nnz`.
+fn dense_matrix(path: &Path, triplets: &[(usize, &str)], size: &Size) -> Result<Vec<f64>> {
+    let (rows, cols) = (size.rows, size.cols);
+    let mut dense = vec![f64::NAN; rows * cols];
+    let mut count = 0usize;
+    for &(line, l) in triplets {
+        let f = fields(path, line, l, "a row, column, value triplet")?;
+        let r = int(path, line, 1, &f[0], "a row")?;
+        let c = int(path, line, 2, &f[1], "a column")?;
+        if r == 0 || r > rows || c == 0 || c > cols {
+            return Err(Error::parse(
+                path,
+                line,
+                1,
+                format!("expected row 1..={rows} and column 1..={cols}, found ({r}, {c})"),
+            ));
+        }
+        let Some(v) = super::parse_finite(&f[2]) else {
+            return Err(Error::parse(
+                path,
+                line,
+                3,
+                format!("expected a number, found {}", super::quote_cell(&f[2])),
+            ));
+        };
+        let cell = &mut dense[(r - 1) * cols + (c - 1)];
+        if !cell.is_nan() {
+            return Err(Error::parse(
+                path,
+                line,
+                1,
+                format!("entry ({r}, {c}) appears twice"),
+            ));
+        }
+        *cell = if v == 0.0 { f64::NAN } else { v };
+        count += 1;
+    }
+    if count != size.nnz {
+        return Err(Error::input(
+            path,
+            format!(
+                "the size line (line {}) says {} entries, the file has {count}",
+                size.line, size.nnz
+            ),
+        ));
+    }
+    Ok(dense)
 }
 
 /// Write `x`, `y` pixel tracks (frame 1 first, NaN = missing, one camera) as a DLTdv sparse
