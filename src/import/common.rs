@@ -9,41 +9,9 @@ use crate::error::{Error, Result};
 use crate::import::{ImportSpec, parse_finite};
 use crate::trace::{PointTrack, Trace};
 
-/// The Windows-1252 characters of bytes 0x80–0x9F; `None` = undefined in Windows-1252.
-const CP1252_HIGH: [Option<char>; 32] = [
-    Some('€'),
-    None,
-    Some('‚'),
-    Some('ƒ'),
-    Some('„'),
-    Some('…'),
-    Some('†'),
-    Some('‡'),
-    Some('ˆ'),
-    Some('‰'),
-    Some('Š'),
-    Some('‹'),
-    Some('Œ'),
-    None,
-    Some('Ž'),
-    None,
-    None,
-    Some('‘'),
-    Some('’'),
-    Some('“'),
-    Some('”'),
-    Some('•'),
-    Some('–'),
-    Some('—'),
-    Some('˜'),
-    Some('™'),
-    Some('š'),
-    Some('›'),
-    Some('œ'),
-    None,
-    Some('ž'),
-    Some('Ÿ'),
-];
+/// The bytes Windows-1252 leaves undefined. `encoding_rs` (WHATWG) decodes them as the C1
+/// controls U+0081 ...; a file holding one is refused instead (its encoding is ambiguous).
+const CP1252_UNDEFINED: [u8; 5] = [0x81, 0x8D, 0x8F, 0x90, 0x9D];
 
 /// Which character encoding a file was decoded from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -88,33 +56,25 @@ pub fn decode(path: &Path, bytes: &[u8]) -> Result<(String, TextEncoding)> {
             TextEncoding::Utf8,
         )),
         Err(utf8_err) => {
-            let mut out = String::with_capacity(bytes.len());
-            for (offset, &b) in bytes.iter().enumerate() {
-                match b {
-                    0x00..=0x7f => out.push(b as char),
-                    0x80..=0x9f => match CP1252_HIGH[usize::from(b - 0x80)] {
-                        Some(c) => out.push(c),
-                        None => {
-                            let (line, column) = locate(offset);
-                            let (l8, _) = locate(utf8_err.valid_up_to());
-                            return Err(Error::parse(
-                                path,
-                                line,
-                                column,
-                                format!(
-                                    "byte 0x{b:02X} at byte offset {offset}: the file is not UTF-8 \
-                                     (first invalid byte on line {l8}, offset {}) and this byte is \
-                                     undefined in Windows-1252/Latin-1; expected UTF-8 text — \
-                                     re-save the export as UTF-8",
-                                    utf8_err.valid_up_to()
-                                ),
-                            ));
-                        }
-                    },
-                    _ => out.push(char::from(b)),
-                }
+            if let Some(offset) = bytes.iter().position(|b| CP1252_UNDEFINED.contains(b)) {
+                let b = bytes[offset];
+                let (line, column) = locate(offset);
+                let (l8, _) = locate(utf8_err.valid_up_to());
+                return Err(Error::parse(
+                    path,
+                    line,
+                    column,
+                    format!(
+                        "byte 0x{b:02X} at byte offset {offset}: the file is not UTF-8 \
+                         (first invalid byte on line {l8}, offset {}) and this byte is \
+                         undefined in Windows-1252/Latin-1; expected UTF-8 text — \
+                         re-save the export as UTF-8",
+                        utf8_err.valid_up_to()
+                    ),
+                ));
             }
-            Ok((out, TextEncoding::Windows1252))
+            let (text, _) = encoding_rs::WINDOWS_1252.decode_without_bom_handling(bytes);
+            Ok((text.into_owned(), TextEncoding::Windows1252))
         }
     }
 }
@@ -745,6 +705,17 @@ mod tests {
         assert!(err.contains("byte offset 6"), "{err}");
         let err = decode(p, b"a\0b").unwrap_err().to_string();
         assert!(err.contains("NUL byte at byte offset 1"), "{err}");
+    }
+
+    #[test]
+    fn windows_1252_high_bytes() {
+        let p = Path::new("f.csv");
+        let (s, _) = decode(p, b"\x80\x82\x8e\x91\x9c\x9f\xa0\xf8\xff").unwrap();
+        assert_eq!(s, "€‚Ž‘œŸ\u{a0}øÿ");
+        for b in [0x81, 0x8d, 0x8f, 0x90, 0x9d] {
+            let err = decode(p, &[b'a', 0xf8, b]).unwrap_err().to_string();
+            assert!(err.starts_with("f.csv:1:3: byte 0x"), "{err}");
+        }
     }
 
     #[test]
