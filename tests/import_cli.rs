@@ -50,10 +50,30 @@ fn describe_prints_format_points_time_units_gaps() {
     assert!(out.contains("y: file y runs down"), "{out}");
 }
 
-/// Without a frame rate: exit code 2 and a message naming the file and the flag.
+/// Without a frame rate: converting is exit code 2 with a message naming the file and the flag;
+/// `--describe` counts in frames instead and says what a fit will need.
 #[test]
 fn missing_fps_is_exit_2_naming_the_setting() {
-    let f = TempFile::with("nofps_sleap.csv", "track,frame_idx,a.x,a.y\nm,0,1,2\n");
+    let f = TempFile::with(
+        "nofps_sleap.csv",
+        "track,frame_idx,a.x,a.y\nm,0,1,2\nm,1,1,3\n",
+    );
+    let out_csv = TempFile::path("nofps_sleap.trace.csv");
+    let o = wiperlab(&[
+        "import",
+        f.0.to_str().unwrap(),
+        "--m-per-px",
+        "1",
+        "-o",
+        out_csv.0.to_str().unwrap(),
+    ]);
+    let (out, err) = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{out}{err}");
+    assert!(
+        err.contains("nofps_sleap.csv") && err.contains("--fps"),
+        "{err}"
+    );
+    assert!(!out_csv.0.exists());
     let o = wiperlab(&[
         "import",
         f.0.to_str().unwrap(),
@@ -62,11 +82,9 @@ fn missing_fps_is_exit_2_naming_the_setting() {
         "1",
     ]);
     let (out, err) = text(&o);
-    assert_eq!(o.status.code(), Some(2), "{out}{err}");
-    assert!(
-        err.contains("nofps_sleap.csv") && err.contains("--fps"),
-        "{err}"
-    );
+    assert_eq!(o.status.code(), Some(0), "{out}{err}");
+    assert!(out.contains("2 frames, frame 0 … 1"), "{out}");
+    assert!(out.contains("a fit needs fps_hz (--fps)"), "{out}");
 }
 
 /// `--format` overrides detection: a Tracker-looking file read as generic fails for want of a

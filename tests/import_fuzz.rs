@@ -54,7 +54,7 @@ fn builtin_seed(format: Option<Format>) -> &'static str {
             "LABEL,ID,TRACK_ID,POSITION_X,POSITION_Y,POSITION_T,FRAME\nLabel,Spot ID,Track ID,X,Y,T,Frame\nLabel,Spot ID,Track ID,X,Y,T,Frame\n,,,(micron),(micron),(sec),\nID1,1,0,1.0,2.0,0.0,0\nID2,2,0,ø,3.0,0.5,1\nID3,3,,9,9,0.5,1\n"
         }
         Some(Format::Generic) => "Export v1\nunits mm\nt;x;y\n0;1,5;2\n0,1;;3\n",
-        None => "t_s,head_x_m,head_y_m\n0,1e-3,NaN\n0.001,2e-3,-1.5e-5\n",
+        Some(Format::Canonical) | None => "t_s,head_x_m,head_y_m\n0,1e-3,NaN\n0.001,2e-3,-1.5e-5\n",
     }
 }
 
@@ -85,7 +85,7 @@ fn spec_for(format: Format) -> ImportSpec {
         ..ImportSpec::default()
     };
     match format {
-        Format::Tracker => {}
+        Format::Tracker | Format::Canonical => {}
         Format::Dltdv | Format::DltdvSparse | Format::Deeplabcut | Format::Sleap => {
             s.fps_hz = Some(100.0);
             s.m_per_px = Some(1e-3);

@@ -18,11 +18,13 @@ pub(super) fn run(
         crate::io::refuse_overwriting_input(file, out)?;
     }
     let spec = import_spec(import)?;
-    let (trace, summary) = crate::import::read_trace_with_summary(file, &spec)?;
     if describe {
+        // Described without a calibration if need be: frames and pixels are said as such.
+        let (_, summary) = crate::import::describe_file(file, &spec)?;
         println!("{summary}");
         return Ok(());
     }
+    let (trace, summary) = crate::import::read_trace_with_summary(file, &spec)?;
     let out = output.unwrap_or_else(|| file.with_extension("trace.csv"));
     if out == Path::new("-") {
         // `-o -`: the CSV on stdout, the summary on stderr.
@@ -107,8 +109,5 @@ pub(super) fn import_spec(a: &ImportArgs) -> Result<ImportSpec> {
 }
 
 pub(super) fn read_any(file: &Path, a: &ImportArgs) -> Result<crate::trace::Trace> {
-    if a.format.as_deref() == Some("canonical") {
-        return crate::import::canonical::read_trace_csv(file);
-    }
     crate::import::read_trace(file, &import_spec(a)?)
 }

@@ -3,11 +3,12 @@
 //! Single-animal: three header rows `scorer,...` / `bodyparts,...` / `coords,x,y,likelihood,...`;
 //! multi-animal (maDLC): four, with `individuals,...` second. Then one row per frame, the first
 //! column the 0-based frame index (no time: `fps_hz` is required), x, y in pixels (image y down),
-//! likelihood in [0, 1]. Missing values (maDLC) are empty fields.
+//! likelihood in [0, 1] (anything else is an error at its cell). Missing values (maDLC) are empty
+//! fields.
 //!
 //! Points: `<bodypart>` (single animal) or `<individual>/<bodypart>` (multi-animal). A point whose
-//! likelihood is below [`ImportSpec::min_likelihood`] (default 0.6, DeepLabCut's `pcutoff`) becomes
-//! NaN in x and y — a gap, never a low-confidence position; the count is reported.
+//! likelihood is below [`ImportSpec::min_likelihood`] (default 0.6, DeepLabCut's `pcutoff`) or
+//! missing (`NaN`, empty) becomes NaN in x and y — a gap, never a low-confidence position; the count is reported.
 
 use std::path::Path;
 
@@ -174,7 +175,10 @@ fn assign_column(
     Ok(())
 }
 
-/// A point's x and y, NaN where its likelihood is below `cutoff` (counted in `below`).
+/// A point's x and y, NaN where its likelihood is below `cutoff` or missing (counted in `below`).
+///
+/// # Errors
+/// [`Error::Parse`] at a likelihood outside [0, 1] (DeepLabCut writes probabilities).
 fn point_values(
     path: &Path,
     table: &Table,
@@ -196,7 +200,13 @@ fn point_values(
     if let Some(cl) = g.l {
         let l = table.numbers(cl, false)?;
         for i in 0..l.len() {
-            if l[i] < cutoff && !(x[i].is_nan() && y[i].is_nan()) {
+            if l[i] < 0.0 || l[i] > 1.0 {
+                return Err(table.bad_cell(i, cl, "a likelihood in [0, 1]"));
+            }
+            // A missing (NaN) likelihood is not a confident detection: a gap, as below the cut-off.
+            let confident = l[i] >= cutoff; // false for NaN
+            let tracked = !(x[i].is_nan() && y[i].is_nan());
+            if !confident && tracked {
                 x[i] = f64::NAN;
                 y[i] = f64::NAN;
                 *below += 1;
@@ -227,6 +237,20 @@ mod tests {
         assert!(raw.points[0].1[1].is_nan(), "likelihood 0.1 < 0.6 → gap");
         assert!(raw.points[1].2[0].is_nan());
         assert!(raw.notes[0].contains("1 point samples"), "{:?}", raw.notes);
+    }
+
+    /// A `nan` likelihood (a frame DeepLabCut did not score) is a gap, like one below the cut-off;
+    /// a likelihood above 1 is no probability: an error at its cell (line 5, column 4).
+    #[test]
+    fn missing_likelihood_is_a_gap_and_one_above_1_an_error() {
+        let head = "scorer,s,s,s\nbodyparts,h,h,h\ncoords,x,y,likelihood\n";
+        let f = TempFile::new("dlc_nan.csv", &format!("{head}0,1,2,0.9\n1,1,2,nan\n"));
+        let raw = read(&f.0, &ImportSpec::default()).unwrap();
+        assert_eq!(raw.points[0].1[0], 1.0);
+        assert!(raw.points[0].1[1].is_nan(), "NaN likelihood → gap");
+        let f = TempFile::new("dlc_17.csv", &format!("{head}0,1,2,0.9\n1,1,2,1.7\n"));
+        let err = read(&f.0, &ImportSpec::default()).unwrap_err().to_string();
+        assert!(err.contains(":5:4:") && err.contains("[0, 1]"), "{err}");
     }
 
     #[test]

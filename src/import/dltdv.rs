@@ -124,14 +124,15 @@ fn required_settings(path: &Path, spec: &ImportSpec) -> Result<(f64, f64)> {
     let fps = spec.fps_hz.ok_or_else(|| {
         Error::input(
             path,
-            "a DLTdv xypts file has no time column: set fps_hz (camera frames per second) in the \
-             import spec",
+            "a DLTdv xypts file has no time column: set the camera's frame rate (--fps on the \
+             command line, fps_hz in an import spec or job)",
         )
     })?;
     let scale = spec.m_per_px.ok_or_else(|| {
         Error::input(
             path,
-            "a DLTdv xypts file is in pixels: set m_per_px (metres per pixel) in the import spec",
+            "a DLTdv xypts file is in pixels: set the scale (--m-per-px or --scale-points-px with \
+             --scale-distance-m on the command line, m_per_px in an import spec or job)",
         )
     })?;
     Ok((fps, scale))

@@ -99,11 +99,14 @@ pub enum Format {
     Trackmate,
     /// Any delimited table with the columns mapped in [`ImportSpec::generic`].
     Generic,
+    /// wiperlab's own canonical trace CSV (`t_s,<name>_x_m,<name>_y_m,...`, seconds and metres,
+    /// y up), as `wiperlab import` writes it. Reader: [`canonical::read_trace_csv`].
+    Canonical,
 }
 
 impl Format {
     /// Every format, in the order `--format` lists them.
-    pub const ALL: [Format; 10] = [
+    pub const ALL: [Format; 11] = [
         Format::Dltdv,
         Format::DltdvSparse,
         Format::Tracker,
@@ -114,6 +117,7 @@ impl Format {
         Format::Sleap,
         Format::Trackmate,
         Format::Generic,
+        Format::Canonical,
     ];
 
     /// The kebab-case name (`"kinovea-csv"`).
@@ -129,6 +133,7 @@ impl Format {
             Format::Sleap => "sleap",
             Format::Trackmate => "trackmate",
             Format::Generic => "generic",
+            Format::Canonical => "canonical",
         }
     }
 
@@ -159,6 +164,7 @@ impl Format {
     ///   `"Time"`; kinematics CSV starts with `Time (ms)`.
     /// * DeepLabCut: first line starts with `scorer`; SLEAP: the header has `frame_idx` and a
     ///   `.x` column; TrackMate: first field `Label`/`LABEL` and a `POSITION_X` column.
+    /// * Canonical trace CSV: the first field is `t_s` and the next one ends in `_x_m`.
     /// * [`Format::Generic`] is never detected: it needs [`ImportSpec::generic`].
     ///
     /// # Errors
@@ -185,7 +191,8 @@ impl Format {
                      xypts header (pt1_cam1_X,...), a DLTdv sparse file, a Tracker export (column \
                      row `t x y ...`), a Kinovea export, a DeepLabCut CSV (`scorer,...`), a SLEAP \
                      analysis CSV (`track,frame_idx,...`) or a TrackMate spot table \
-                     (`LABEL,...,POSITION_X,...`); for any other table set format = \"generic\" \
+                     (`LABEL,...,POSITION_X,...`) or a canonical trace CSV (`t_s,head_x_m,...`); \
+                     for any other table set format = \"generic\" \
                      and map its columns ([generic] in the import spec)"
                 ),
             )
@@ -220,6 +227,14 @@ impl Format {
         }
         if first.starts_with("Time (ms)") {
             return Some(Format::KinoveaKinematics);
+        }
+        if f0 == "t_s"
+            && first
+                .split(',')
+                .nth(1)
+                .is_some_and(|c| c.trim().ends_with("_x_m"))
+        {
+            return Some(Format::Canonical);
         }
         if f0 == "scorer" {
             return Some(Format::Deeplabcut);
@@ -463,6 +478,22 @@ impl ImportSpec {
                     return not_for("decimal_comma", "DLTdv always writes a decimal point");
                 }
             }
+            Format::Canonical => {
+                for (field, set) in [
+                    ("fps_hz", self.fps_hz.is_some()),
+                    ("m_per_px", self.m_per_px.is_some()),
+                    ("units_to_m", self.units_to_m.is_some()),
+                    ("scale_points_px", self.scale_points_px.is_some()),
+                    ("time_to_s", self.time_to_s.is_some()),
+                ] {
+                    if set {
+                        return not_for(
+                            field,
+                            "a canonical trace is in seconds and metres already",
+                        );
+                    }
+                }
+            }
             Format::Tracker => {
                 if self.m_per_px.is_some() {
                     return not_for(
@@ -551,6 +582,23 @@ pub fn read_trace(path: &Path, spec: &ImportSpec) -> Result<Trace> {
 /// # Errors
 /// As [`read_trace`].
 pub fn read_trace_with_summary(path: &Path, spec: &ImportSpec) -> Result<(Trace, ImportSummary)> {
+    read_with(path, spec, false)
+}
+
+/// Describe a file even when the settings lack its calibration: where a frame rate is missing for
+/// a file with frame numbers only, times are frame numbers (a stand-in of 1 frame/s); where a scale
+/// is missing for a file in pixels or an unstated unit, positions stay in file units (a stand-in
+/// of 1 m per unit). [`ImportSummary::uncalibrated`] says which stand-ins were used, so a caller
+/// can print frames and pixels as such and say what a fit still needs.
+///
+/// # Errors
+/// As [`read_trace`], except the missing frame rate and scale.
+pub fn describe_file(path: &Path, spec: &ImportSpec) -> Result<(Trace, ImportSummary)> {
+    read_with(path, spec, true)
+}
+
+/// [`read_trace_with_summary`] (`stand_in` false) or [`describe_file`] (true).
+fn read_with(path: &Path, spec: &ImportSpec, stand_in: bool) -> Result<(Trace, ImportSummary)> {
     let format = match spec.format {
         Some(f) => f,
         None if spec.generic.is_some() => Format::Generic,
@@ -571,53 +619,160 @@ pub fn read_trace_with_summary(path: &Path, spec: &ImportSpec) -> Result<(Trace,
             spec.scale_distance_m.unwrap_or(f64::NAN)
         ));
     }
-    let spec = &resolved;
-    let raw = match format {
-        Format::Dltdv => {
-            notes.push(format!(
-                "time base: (frame − 1) / {} fps; units: pixels × {:e} m/px, image y down flipped \
-                 unless y_down = false",
-                spec.fps_hz.unwrap_or(f64::NAN),
-                spec.m_per_px.unwrap_or(f64::NAN)
-            ));
-            dltdv::read(path, spec)?
-        }
-        Format::Tracker => {
-            notes.push(format!(
-                "time base: the file's t column (real frame times kept); units: calibrated × {} m",
-                spec.units_to_m.unwrap_or(1.0)
-            ));
-            tracker::read(path, spec)?
-        }
-        other => {
-            let raw = match other {
-                Format::DltdvSparse => dltdv_sparse::read(path, spec)?,
-                Format::KinoveaCsv => kinovea::read_csv(path, spec)?,
-                Format::KinoveaTxt => kinovea::read_txt(path, spec)?,
-                Format::KinoveaKinematics => kinovea::read_kinematics(path, spec)?,
-                Format::Deeplabcut => deeplabcut::read(path, spec)?,
-                Format::Sleap => sleap::read(path, spec)?,
-                Format::Trackmate => trackmate::read(path, spec)?,
-                Format::Generic => generic::read(path, spec)?,
-                Format::Dltdv | Format::Tracker => unreachable!("handled above"),
-            };
-            let (trace, n) = common::calibrate(path, raw, spec)?;
-            notes.extend(n);
-            trace
-        }
-    };
-    let mut trace = assign_roles(path, raw, &spec.points)?;
-    if let Some(note) = rotate_to_sweep(path, &mut trace, spec)? {
+    let (raw, uncalibrated) = read_format(path, format, &resolved, stand_in, &mut notes)?;
+    let mut trace = assign_roles(path, raw, &resolved.points)?;
+    if let Some(note) = rotate_to_sweep(path, &mut trace, &resolved)? {
         notes.push(note);
     }
     // The readers guarantee this; checked once more because t0_s is added to every time.
     trace
         .check()
         .map_err(|m| Error::input(path, format!("imported trace is inconsistent: {m}")))?;
+    check_plausible(path, &trace, uncalibrated)?;
     let mut summary = describe(&trace);
     summary.format = Some(format);
     summary.notes = notes;
+    summary.uncalibrated = uncalibrated;
     Ok((trace, summary))
+}
+
+/// Largest plausible |position| of a trace, m (or file units in an uncalibrated description): a
+/// wiper sweep spans well under 1 m and image coordinates stay below 1e5 pixels even when a scale
+/// of 1 keeps them as they are, so 1e6 only catches overflowed cells such as `1e308` and unit
+/// mix-ups of that size.
+pub const MAX_POSITION_M: f64 = 1e6;
+
+/// At least two frames, and every tracked position within [`MAX_POSITION_M`].
+///
+/// # Errors
+/// [`Error::Input`] naming the point, the coordinate, the frame and its time.
+fn check_plausible(path: &Path, trace: &Trace, unc: Uncalibrated) -> Result<()> {
+    let n = trace.t_s.len();
+    if n < 2 {
+        return Err(Error::input(
+            path,
+            format!("{n} frame(s): a trace needs at least 2 frames (a time step and a spectrum)"),
+        ));
+    }
+    let (limit, unit) = (
+        MAX_POSITION_M,
+        if unc.file_units { "file units" } else { "m" },
+    );
+    for p in &trace.points {
+        for (axis, v) in [("x", &p.x_m), ("y", &p.y_m)] {
+            if let Some(k) = v.iter().position(|c| c.abs() > limit) {
+                return Err(Error::input(
+                    path,
+                    format!(
+                        "point {}: {axis} = {:e} {unit} at frame {} (t = {} s) is beyond ±{limit:e} \
+                         {unit}: not a tracked position (an overflowed cell or a wrong unit?)",
+                        p.name,
+                        v[k],
+                        k + 1,
+                        trace.t_s[k]
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The format's reader and the calibration, with stand-ins for a missing frame rate and scale
+/// when `stand_in` (see [`describe_file`]); notes go to `notes`.
+fn read_format(
+    path: &Path,
+    format: Format,
+    spec: &ImportSpec,
+    stand_in: bool,
+    notes: &mut Vec<String>,
+) -> Result<(Trace, Uncalibrated)> {
+    let mut spec = spec.clone();
+    let mut unc = Uncalibrated::default();
+    let trace = match format {
+        Format::Dltdv => {
+            if stand_in {
+                // A DLTdv xypts file is always frame-indexed and in pixels.
+                unc.frames = spec.fps_hz.is_none();
+                unc.file_units = spec.m_per_px.is_none();
+                stand_ins(&mut spec, unc, notes);
+            }
+            if unc == Uncalibrated::default() {
+                notes.push(format!(
+                    "time base: (frame − 1) / {} fps; units: pixels × {:e} m/px, image y down \
+                     flipped unless y_down = false",
+                    spec.fps_hz.unwrap_or(f64::NAN),
+                    spec.m_per_px.unwrap_or(f64::NAN)
+                ));
+            }
+            dltdv::read(path, &spec)?
+        }
+        Format::Tracker => {
+            notes.push(format!(
+                "time base: the file's t column (real frame times kept); units: calibrated × {} m",
+                spec.units_to_m.unwrap_or(1.0)
+            ));
+            tracker::read(path, &spec)?
+        }
+        Format::Canonical => {
+            notes.push("canonical trace: times in s, positions in m, y up, as written".into());
+            canonical::read_trace_csv(path)?
+        }
+        other => {
+            let raw = read_raw(path, other, &spec)?;
+            if stand_in {
+                unc.frames =
+                    matches!(raw.time, common::RawTime::Frames(_)) && spec.fps_hz.is_none();
+                unc.file_units = !matches!(raw.units, common::RawUnits::Known(..))
+                    && spec.m_per_px.is_none()
+                    && spec.units_to_m.is_none();
+                stand_ins(&mut spec, unc, notes);
+            }
+            let (trace, n) = common::calibrate(path, raw, &spec)?;
+            notes.extend(n);
+            trace
+        }
+    };
+    Ok((trace, unc))
+}
+
+/// Sets the stand-in frame rate (1 frame/s) and scale (1 m per file unit) that `unc` calls for,
+/// and says so in `notes`.
+fn stand_ins(spec: &mut ImportSpec, unc: Uncalibrated, notes: &mut Vec<String>) {
+    if unc.frames {
+        spec.fps_hz = Some(1.0);
+        notes.push(
+            "no frame rate given: times are frame numbers (1 frame/s stands in below); a fit \
+             needs fps_hz (--fps)"
+                .into(),
+        );
+    }
+    if unc.file_units {
+        spec.m_per_px = Some(1.0);
+        notes.push(
+            "no scale given: positions are in file units (1 m per unit stands in below); a fit \
+             needs m_per_px (--m-per-px), scale_points_px + scale_distance_m, or units_to_m"
+                .into(),
+        );
+    }
+}
+
+/// The reader of a format that returns file units ([`common::RawTrace`]); DLTdv and Tracker
+/// calibrate in their own readers.
+fn read_raw(path: &Path, format: Format, spec: &ImportSpec) -> Result<common::RawTrace> {
+    match format {
+        Format::DltdvSparse => dltdv_sparse::read(path, spec),
+        Format::KinoveaCsv => kinovea::read_csv(path, spec),
+        Format::KinoveaTxt => kinovea::read_txt(path, spec),
+        Format::KinoveaKinematics => kinovea::read_kinematics(path, spec),
+        Format::Deeplabcut => deeplabcut::read(path, spec),
+        Format::Sleap => sleap::read(path, spec),
+        Format::Trackmate => trackmate::read(path, spec),
+        Format::Generic => generic::read(path, spec),
+        Format::Dltdv | Format::Tracker | Format::Canonical => {
+            unreachable!("DLTdv, Tracker and canonical traces are calibrated by their readers")
+        }
+    }
 }
 
 /// Principal-axis angle (radians, in (−π/2, π/2]) of the finite `(x, y)` samples: the direction of
@@ -793,6 +948,21 @@ pub struct ImportSummary {
     /// What the import did: time base, units and scale, y flip, rotation, encoding, thresholds,
     /// skipped rows (empty from [`describe`]).
     pub notes: Vec<String>,
+    /// The calibration a description stood in for because the settings lack it (all false from
+    /// [`read_trace_with_summary`]; see [`describe_file`]).
+    pub uncalibrated: Uncalibrated,
+}
+
+/// What [`describe_file`] stood in for when the settings lack a calibration: the trace's numbers
+/// are then not in seconds and metres, and a fit still needs the missing settings.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct Uncalibrated {
+    /// The file has frame numbers but no frame rate was given: times are frame numbers from 0
+    /// (plus `t0_s`), steps in frames.
+    pub frames: bool,
+    /// The file is in pixels (or a unit it does not state) and no scale was given: positions are
+    /// in the file's own units (origin and y flip applied).
+    pub file_units: bool,
 }
 
 impl ImportSummary {
@@ -841,6 +1011,7 @@ pub fn describe(trace: &Trace) -> ImportSummary {
             .map(|p| fillable_samples(p, FILL_MAX_SAMPLES))
             .collect(),
         notes: Vec::new(),
+        uncalibrated: Uncalibrated::default(),
     }
 }
 
@@ -901,17 +1072,31 @@ impl fmt::Display for ImportSummary {
         if let Some(format) = self.format {
             write!(f, "{format}: ")?;
         }
-        writeln!(
-            f,
-            "{} frames, t = {} … {} s, dt median {} s ({:.6} fps), min {} s, max {} s",
-            self.n_frames,
-            self.t_first_s,
-            self.t_last_s,
-            self.dt_median_s,
-            self.fps_median_hz(),
-            self.dt_min_s,
-            self.dt_max_s
-        )?;
+        if self.uncalibrated.frames {
+            writeln!(
+                f,
+                "{} frames, frame {} … {} (no frame rate: times in frames), step median {}, min \
+                 {}, max {} frames",
+                self.n_frames,
+                self.t_first_s,
+                self.t_last_s,
+                self.dt_median_s,
+                self.dt_min_s,
+                self.dt_max_s
+            )?;
+        } else {
+            writeln!(
+                f,
+                "{} frames, t = {} … {} s, dt median {} s ({:.6} fps), min {} s, max {} s",
+                self.n_frames,
+                self.t_first_s,
+                self.t_last_s,
+                self.dt_median_s,
+                self.fps_median_hz(),
+                self.dt_min_s,
+                self.dt_max_s
+            )?;
+        }
         for (i, (name, nan)) in self.points.iter().enumerate() {
             let pct = if self.n_frames > 0 {
                 100.0 * *nan as f64 / self.n_frames as f64
