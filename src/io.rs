@@ -27,6 +27,62 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     Ok(())
 }
 
+/// True when `name` can be used as a file or directory name beside another file: not empty, not
+/// `.` or `..`, no `/` or `\\`, no leading `.`.
+pub fn is_plain_stem(name: &str) -> bool {
+    !name.is_empty() && !name.contains(['/', '\\']) && !name.starts_with('.')
+}
+
+/// Checks, before long work starts, that a file can later be written at `path`: it is not a
+/// directory and its directory exists and takes a new file (a temporary one is created and
+/// removed).
+///
+/// # Errors
+/// [`Error::Io`] naming `path` (a directory there) or its directory.
+pub fn check_writable_file(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        return Err(Error::io(
+            path,
+            "cannot write a file over this directory",
+            std::io::Error::from(std::io::ErrorKind::IsADirectory),
+        ));
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    tempfile::NamedTempFile::new_in(dir)
+        .map(drop)
+        .map_err(|e| Error::io(dir, "cannot write files in", e))
+}
+
+/// Checks, before long work starts, that `dir` exists as a writable directory or can be created:
+/// its nearest existing ancestor is a directory that takes a new file. Creates nothing.
+///
+/// # Errors
+/// [`Error::Io`] naming `dir` when a file is in the way, or the ancestor that cannot be written.
+pub fn check_creatable_dir(dir: &Path) -> Result<()> {
+    let mut at = dir;
+    loop {
+        if at.exists() {
+            if !at.is_dir() {
+                return Err(Error::io(
+                    dir,
+                    "cannot create this directory: a file is in the way",
+                    std::io::Error::from(std::io::ErrorKind::NotADirectory),
+                ));
+            }
+            return tempfile::NamedTempFile::new_in(at)
+                .map(drop)
+                .map_err(|e| Error::io(at, "cannot write files in", e));
+        }
+        match at.parent() {
+            Some(p) if !p.as_os_str().is_empty() => at = p,
+            _ => at = Path::new("."),
+        }
+    }
+}
+
 /// Creates `dir` and its parents if missing.
 ///
 /// # Errors

@@ -229,12 +229,7 @@ fn line_column(text: &str, offset: usize) -> (usize, usize) {
 
 /// A campaign name is used as a directory name beside the campaign file: a plain file stem.
 fn check_plain_name(path: &Path, name: &str) -> Result<()> {
-    let plain = !name.is_empty()
-        && name != "."
-        && name != ".."
-        && !name.contains(['/', '\\'])
-        && !name.starts_with('.');
-    if plain {
+    if crate::io::is_plain_stem(name) {
         Ok(())
     } else {
         Err(Error::input(

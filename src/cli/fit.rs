@@ -97,6 +97,10 @@ fn fit_and_write(
     job: &LoadedJob,
     progress: bool,
 ) -> Result<(crate::fit::FitResult, PathBuf, PathBuf)> {
+    // Outputs that cannot be written are found now, not after the whole fit.
+    crate::io::check_writable_file(&result_path(job))?;
+    crate::io::check_writable_file(&interrupted_path(job))?;
+    crate::io::check_creatable_dir(&report_dir(job))?;
     crate::fit::interrupt::install_signal_handler()?;
     let mut outcome = match crate::fit::run_fit(job, progress) {
         Err(_) if crate::fit::interrupt::stop_requested() => {

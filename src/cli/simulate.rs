@@ -48,8 +48,21 @@ pub(super) fn run(a: SimulateArgs) -> Result<()> {
         }
         None => default_window(&p),
     };
+    if !(win.0.is_finite() && win.1.is_finite() && win.0 < win.1) {
+        return Err(Error::Config(format!(
+            "--window {},{}: expected T0 < T1, both finite, in s",
+            win.0, win.1
+        )));
+    }
     if !(a.fps > 0.0 && a.fps.is_finite()) {
         return Err(Error::Config(format!("--fps must be > 0 (got {})", a.fps)));
+    }
+    for (flag, v) in [("--rtol", a.rtol), ("--atol", a.atol)] {
+        if !(v > 0.0 && v.is_finite()) {
+            return Err(Error::Config(format!(
+                "{flag} {v}: expected a positive, finite tolerance"
+            )));
+        }
     }
     let n = ((win.1 - win.0) * a.fps).floor() as usize + 1;
     let times: Vec<f64> = (0..n).map(|k| win.0 + k as f64 / a.fps).collect();

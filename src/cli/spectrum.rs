@@ -48,7 +48,7 @@ pub(super) fn run(a: SpectrumArgs) -> Result<()> {
     let nperseg = a
         .nperseg
         .unwrap_or_else(|| crate::spectrum::default_nperseg(n));
-    check_settings(nperseg, n, fs, &a.band)?;
+    check_settings(&a.file, nperseg, n, fs, &a.band)?;
     let mut bands: Vec<BandSpec> = a
         .band
         .iter()
@@ -69,7 +69,9 @@ pub(super) fn run(a: SpectrumArgs) -> Result<()> {
         b.scaling = a.welch.scaling;
         b.average = a.welch.average;
     }
-    let cfg = bands[0].welch_config()?;
+    let cfg = bands[0]
+        .welch_config()
+        .map_err(|e| crate::Error::Config(format!("Welch settings (--noverlap, --nfft): {e}")))?;
 
     let dir = a
         .out_dir
@@ -111,7 +113,19 @@ pub(super) fn run(a: SpectrumArgs) -> Result<()> {
 
 /// Checks the segment length and the bands against the record before any spectrum is computed:
 /// 8 ≤ nperseg ≤ samples, and every band ordered inside (0, Nyquist].
-fn check_settings(nperseg: usize, n: usize, fs_hz: f64, bands: &[BandArg]) -> Result<()> {
+fn check_settings(
+    file: &Path,
+    nperseg: usize,
+    n: usize,
+    fs_hz: f64,
+    bands: &[BandArg],
+) -> Result<()> {
+    if n < 8 {
+        return Err(crate::Error::input(
+            file,
+            format!("{n} frames: one Welch segment needs at least 8"),
+        ));
+    }
     if !(8..=n).contains(&nperseg) {
         return Err(crate::Error::Config(format!(
             "--nperseg {nperseg}: expected 8 <= nperseg <= the record's {n} samples"

@@ -444,11 +444,13 @@ impl LoadedJob {
             spans: &spans,
             job: &job,
         };
+        check.name(&name)?;
         let free = check.parameters(&blade, &blade_path)?;
         check.fit_settings()?;
         check.source()?;
+        check.recording_import(dir, &blade)?;
         check.more_recordings()?;
-        job.solver.validate()?;
+        check.solver()?;
         check.bands()?;
         let truth = read_truth(dir, job.truth.as_ref())?;
         Ok(LoadedJob {
@@ -464,6 +466,17 @@ impl LoadedJob {
             free,
             truth,
         })
+    }
+}
+
+impl LoadedJob {
+    /// [`Error::Parse`] in the job file at the value at `key_path`, for checks that need the
+    /// recording (the job's text is read again for its spans).
+    pub fn error_at(&self, key_path: &[Key], message: impl Into<String>) -> Error {
+        match read_text(&self.path) {
+            Ok(text) => Spans::new(&text).error(&self.path, key_path, message),
+            Err(e) => e,
+        }
     }
 }
 
@@ -536,6 +549,64 @@ impl Check<'_> {
         Ok(free)
     }
 
+    /// The job's name names its outputs (`<name>.result.toml`, `reports/<name>/`): a plain file
+    /// stem, so they stay where the docs say.
+    fn name(&self, name: &str) -> Result<()> {
+        if crate::io::is_plain_stem(name) {
+            return Ok(());
+        }
+        Err(self.error(
+            &[Key::Name("name")],
+            format!(
+                "name = {name:?} must be a plain file stem (no '/', '\\' or leading '.'): it names \
+                 the outputs <name>.result.toml and reports/<name>/"
+            ),
+        ))
+    }
+
+    /// `[solver]` tolerances, at the `[solver]` table.
+    fn solver(&self) -> Result<()> {
+        self.job
+            .solver
+            .validate()
+            .map_err(|e| self.error(&[Key::Name("solver")], format!("[solver] {e}")))
+    }
+
+    /// The recording's import settings (at `[recording.import]`), with `t0_s` inside the blade's
+    /// drive period 2π/ω: frame 1 must fall on the first period of the model's clock.
+    fn recording_import(&self, dir: &Path, blade: &BladeParams) -> Result<()> {
+        let Some(r) = &self.job.recording else {
+            return Ok(());
+        };
+        let at = [Key::Name("recording"), Key::Name("import")];
+        let format = match r.import.format {
+            Some(f) => f,
+            None if r.import.generic.is_some() => crate::import::Format::Generic,
+            None => crate::import::Format::detect(&dir.join(&r.file))?,
+        };
+        r.import.validate(format).map_err(|e| match e {
+            Error::Config(m) => self.error(&at, format!("[recording.import] {m}")),
+            other => other,
+        })?;
+        let period_s = std::f64::consts::TAU / blade.drive_omega_rad_per_s;
+        let t0 = r.import.t0_s;
+        if !(0.0..period_s).contains(&t0) {
+            return Err(self.error(
+                &[
+                    Key::Name("recording"),
+                    Key::Name("import"),
+                    Key::Name("t0_s"),
+                ],
+                format!(
+                    "[recording.import] t0_s = {t0} s must lie in the blade's drive period [0, \
+                     {period_s:.4}) s (2π/ω, ω = {} rad/s): it places frame 1 on the drive's clock",
+                    blade.drive_omega_rad_per_s
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// Optimiser settings, candidate models and shoulder bounds.
     fn fit_settings(&self) -> Result<()> {
         let fit = &self.job.fit;
@@ -543,6 +614,12 @@ impl Check<'_> {
             return Err(self.error(
                 &[Key::Name("fit"), Key::Name("particles")],
                 "[fit] particles must be >= 2",
+            ));
+        }
+        if fit.restarts < 1 {
+            return Err(self.error(
+                &[Key::Name("fit"), Key::Name("restarts")],
+                "[fit] restarts must be >= 1 (independent swarm + polish runs, the best kept)",
             ));
         }
         for (i, m) in fit.models.iter().enumerate() {
@@ -661,7 +738,7 @@ impl Check<'_> {
                 return Err(self.error(
                     &[Key::Name("spectrum"), Key::Name("bands"), Key::Index(i)],
                     format!(
-                        "[spectrum] band '{}': need 0 <= lower < upper and nperseg >= 8 (got {:?}, nperseg {})",
+                        "[spectrum] band '{}': need range_hz = [lower, upper] with 0 <= lower < upper and nperseg >= 8 (got {:?}, nperseg {})",
                         b.name, b.range_hz, b.nperseg
                     ),
                 ));

@@ -95,6 +95,41 @@ pub(super) fn necklip_view(
     Ok((measured, floors, mask))
 }
 
+/// Every band of the job fits the recording at `path` (`n` frames at `fs_hz`): its segment is no
+/// longer than the record and its upper edge lies below Nyquist. Checked before any FFT plan is
+/// made or any simulation runs.
+fn check_bands(job: &LoadedJob, path: &std::path::Path, n: usize, fs_hz: f64) -> Result<()> {
+    use job::Key;
+    let nyquist = 0.5 * fs_hz;
+    for (i, b) in job.job.spectrum.bands.iter().enumerate() {
+        let at = [Key::Name("spectrum"), Key::Name("bands"), Key::Index(i)];
+        if b.nperseg > n {
+            return Err(job.error_at(
+                &at,
+                format!(
+                    "[spectrum] band '{}': nperseg = {} is longer than the recording {} ({n} frames)",
+                    b.name,
+                    b.nperseg,
+                    path.display()
+                ),
+            ));
+        }
+        if b.range_hz[1] > nyquist {
+            return Err(job.error_at(
+                &at,
+                format!(
+                    "[spectrum] band '{}': range_hz upper edge {} Hz is above the Nyquist frequency \
+                     {nyquist} Hz of the recording {} ({fs_hz} frames/s)",
+                    b.name,
+                    b.range_hz[1],
+                    path.display()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Reads the recording and its features.
 pub(super) fn measure_recording(
     job: &LoadedJob,
@@ -103,6 +138,7 @@ pub(super) fn measure_recording(
 ) -> Result<Measurement> {
     let trace = crate::import::read_trace(path, spec)?;
     let fs_hz = sampling_rate(&trace, spec.fps_hz)?;
+    check_bands(job, path, trace.t_s.len(), fs_hz)?;
     let signal = job.job.spectrum.signal;
     let x = signal.extract(&trace)?;
     let measured = features(
