@@ -14,6 +14,7 @@ mod bench;
 mod campaign;
 mod fit;
 mod import;
+mod init;
 mod modes;
 mod simulate;
 mod spectrum;
@@ -123,6 +124,18 @@ pub enum Command {
         #[arg(long)]
         describe: bool,
         /// Output CSV (default: <file stem>.trace.csv beside the input; `-`: stdout).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// Write a commented fit-job template for a recording: format detected, points listed, what a
+    /// fit still needs marked MISSING and guesses marked CHECK.
+    Init {
+        /// The tracking export the job fits.
+        recording: PathBuf,
+        #[command(flatten)]
+        import: ImportArgs,
+        /// Job file to write (default: <recording stem>.job.toml beside the recording; never
+        /// overwrites a file).
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -258,6 +271,11 @@ pub fn run(cli: Cli) -> Result<()> {
             describe,
             output,
         } => import::run(&file, &import, describe, output),
+        Command::Init {
+            recording,
+            import,
+            output,
+        } => init::run(&recording, &import, output),
         Command::Spectrum {
             file,
             import,

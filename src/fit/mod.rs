@@ -23,6 +23,7 @@ mod problem;
 pub mod result;
 mod search;
 mod select;
+pub mod template;
 mod uncertainty;
 
 pub use candidate::{Candidate, NECK_BAND_MIN_HZ, smallest_capable_model};

@@ -1,0 +1,178 @@
+//! `wiperlab init RECORDING`: the job template it writes for the shipped sample recording, run as
+//! a user runs it, and what the job loader makes of it once the MISSING lines are filled in.
+//!
+//! The reference settings come from the shipped main job `fits/reversal.toml` (the sample's
+//! frame rate 10,000 frames/s, 1.5e-5 m/px, points pt1 = head and pt2 = tip, and the default
+//! bands, which the template's band rule reproduces at 10,000 frames/s).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use wiperlab::fit::job::LoadedJob;
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn wiperlab(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_wiperlab"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("cannot start the wiperlab binary")
+}
+
+/// A fresh temp dir holding a copy of the sample recording; removed on drop.
+struct Scratch(PathBuf);
+
+impl Scratch {
+    fn new(name: &str) -> Scratch {
+        let d = std::env::temp_dir().join(format!("wiperlab_init_{}_{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).expect("create temp dir");
+        std::fs::copy(
+            root().join("data/reversal/wiper_reversal_sample_xypts.csv"),
+            d.join("rec_xypts.csv"),
+        )
+        .expect("copy the sample");
+        Scratch(d)
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn text(o: &Output) -> String {
+    format!(
+        "stdout:\n{}\nstderr:\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+#[test]
+fn without_settings_the_template_marks_what_a_fit_needs() {
+    let s = Scratch::new("bare");
+    let o = wiperlab(&s.0, &["init", "rec_xypts.csv"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let job = s.0.join("rec_xypts.job.toml");
+    let t = std::fs::read_to_string(&job).expect("the template");
+    // Detected format and the file's points.
+    assert!(t.contains("format = \"dltdv\""), "{t}");
+    assert!(t.contains("points: pt1, pt2"), "{t}");
+    // Blade, frame rate and scale are missing; the roles are guessed.
+    for missing in ["# blade = ", "# fps_hz = ", "# m_per_px = "] {
+        let at = t
+            .find(missing)
+            .unwrap_or_else(|| panic!("no {missing:?} in\n{t}"));
+        let before = &t[..at];
+        assert!(before.contains("MISSING"), "{missing} not marked MISSING");
+    }
+    assert!(
+        t.contains("head = \"pt1\"") && t.contains("tip = \"pt2\""),
+        "{t}"
+    );
+    assert!(t.contains("CHECK: guessed"), "{t}");
+    // As written, the job does not run: the loader names the missing blade.
+    let e = LoadedJob::load(&job).expect_err("a job without a blade");
+    assert!(e.to_string().contains("blade"), "{e}");
+    // `init` never overwrites a job: exit 2, the file unchanged.
+    std::fs::write(&job, "# mine\n").expect("write");
+    let o = wiperlab(&s.0, &["init", "rec_xypts.csv"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("never overwrites"), "{}", text(&o));
+    assert_eq!(std::fs::read_to_string(&job).expect("read"), "# mine\n");
+}
+
+#[test]
+fn with_the_sample_settings_the_filled_in_template_loads_like_the_main_job() {
+    let s = Scratch::new("calibrated");
+    std::fs::create_dir_all(s.0.join("jobs")).expect("mkdir");
+    let o = wiperlab(
+        &s.0,
+        &[
+            "init",
+            "rec_xypts.csv",
+            "--fps",
+            "10000",
+            "--m-per-px",
+            "1.5e-5",
+            "--origin-px",
+            "200,300",
+            "--head",
+            "pt1",
+            "--tip",
+            "pt2",
+            "-o",
+            "jobs/sample.toml",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let job = s.0.join("jobs/sample.toml");
+    let t = std::fs::read_to_string(&job).expect("the template");
+    assert!(!t.contains("CHECK: guessed"), "roles were given: {t}");
+    // The job lives elsewhere than the recording: the recording's path is absolute.
+    let rec = s.0.canonicalize().expect("canon").join("rec_xypts.csv");
+    assert!(t.contains(&format!("file = \"{}\"", rec.display())), "{t}");
+    // Fill in the one MISSING line (the blade) as a user would.
+    let blade = root().join("data/reversal/blade.toml");
+    let filled = t.replace(
+        "# blade = \"blade.toml\"",
+        &format!("blade = \"{}\"", blade.display()),
+    );
+    std::fs::write(&job, &filled).expect("write the filled job");
+    let loaded = LoadedJob::load(&job).unwrap_or_else(|e| panic!("{e}\n{filled}"));
+    let main = LoadedJob::load(&root().join("fits/reversal.toml")).expect("the main job");
+    let imp = &loaded.job.recording.as_ref().expect("recording").import;
+    let main_imp = &main.job.recording.as_ref().expect("recording").import;
+    assert_eq!(imp.fps_hz, main_imp.fps_hz);
+    assert_eq!(imp.m_per_px, main_imp.m_per_px);
+    assert_eq!(imp.origin_px, main_imp.origin_px);
+    assert_eq!(imp.points, main_imp.points);
+    assert_eq!(loaded.job.spectrum.signal, main.job.spectrum.signal);
+    let bands = |j: &LoadedJob| -> Vec<(String, [f64; 2], usize)> {
+        j.job
+            .spectrum
+            .bands
+            .iter()
+            .map(|b| (b.name.clone(), b.range_hz, b.nperseg))
+            .collect()
+    };
+    assert_eq!(bands(&loaded), bands(&main));
+    assert_eq!(
+        loaded.free.iter().map(|f| f.0).collect::<Vec<_>>(),
+        main.free.iter().map(|f| f.0).collect::<Vec<_>>()
+    );
+}
+
+#[test]
+fn describe_needs_no_calibration_and_says_what_a_fit_needs() {
+    let s = Scratch::new("describe");
+    let o = wiperlab(&s.0, &["import", "rec_xypts.csv", "--describe"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    // 18,869 frames: the sample's row count (data/reversal/README.md), frames 0 … 18868.
+    assert!(out.contains("18869 frames, frame 0 … 18868"), "{out}");
+    assert!(out.contains("times in frames"), "{out}");
+    assert!(out.contains("a fit needs fps_hz (--fps)"), "{out}");
+    assert!(out.contains("a fit needs m_per_px (--m-per-px)"), "{out}");
+    // With the settings, the same file is described in seconds (frame 18869 at 1.8868 s).
+    let o = wiperlab(
+        &s.0,
+        &[
+            "import",
+            "rec_xypts.csv",
+            "--describe",
+            "--fps",
+            "10000",
+            "--m-per-px",
+            "1.5e-5",
+        ],
+    );
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("t = 0 … 1.8868 s"), "{out}");
+    assert!(!out.contains("a fit needs"), "{out}");
+}
