@@ -408,3 +408,55 @@ fn import_to_stdout_with_dash() {
     assert!(!std::path::Path::new("-").exists());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `--quiet` (global, any position) silences the import's notes on stderr; the file is written.
+#[test]
+fn quiet_import_writes_without_notes() {
+    let out = TempFile::path("quiet.trace.csv");
+    let o = wiperlab(&[
+        "--quiet",
+        "import",
+        "data/reversal/wiper_reversal_sample_xypts.csv",
+        "--fps",
+        "10000",
+        "--m-per-px",
+        "1.5e-5",
+        "-o",
+        out.0.to_str().unwrap(),
+    ]);
+    let (stdout, err) = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{stdout}{err}");
+    assert!(err.is_empty(), "{err}");
+    assert!(out.0.exists());
+}
+
+/// A reader that stops early (`wiperlab modes ... | head -1`, here 800 slip speeds: about 120 kB
+/// of table, more than a pipe buffers) ends the command quietly: no panic about a broken pipe.
+#[test]
+fn a_closed_stdout_ends_quietly() {
+    use std::io::{BufRead, BufReader};
+    // 0.2 mm/s … 0.16 m/s, below the sample drive's peak head speed aω = 0.1665 m/s.
+    let speeds: Vec<String> = (1..=800)
+        .map(|i| format!("{:.4}", 0.0002 * i as f64))
+        .collect();
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_wiperlab"))
+        .args([
+            "modes",
+            "data/reversal/blade_true.toml",
+            "--speeds",
+            &speeds.join(","),
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("start wiperlab");
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().expect("stdout"))
+        .read_line(&mut first)
+        .expect("read one line");
+    // The pipe's read end is dropped here, long before the table is written out.
+    let o = child.wait_with_output().expect("wait");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!first.is_empty());
+    assert!(!err.contains("panicked"), "{err}");
+}

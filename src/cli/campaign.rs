@@ -20,9 +20,6 @@ pub enum CampaignCommand {
         /// Recordings fitted at once (each fit also uses the thread pool). Default: 1.
         #[arg(long, default_value_t = 1)]
         jobs: usize,
-        /// No per-recording lines on stderr.
-        #[arg(long)]
-        quiet: bool,
     },
     /// Fit one recording (what each Slurm array task runs).
     Task {
@@ -72,11 +69,9 @@ pub struct SlurmArgs {
 pub fn run(cmd: CampaignCommand) -> Result<()> {
     match cmd {
         CampaignCommand::List { campaign } => list(&Campaign::load(&campaign)?),
-        CampaignCommand::Run {
-            campaign,
-            jobs,
-            quiet,
-        } => run_all(&Campaign::load(&campaign)?, jobs, quiet),
+        CampaignCommand::Run { campaign, jobs } => {
+            run_all(&Campaign::load(&campaign)?, jobs, super::quiet())
+        }
         CampaignCommand::Task { campaign, index } => {
             let c = Campaign::load(&campaign)?;
             let entry = c.entries.get(index).ok_or_else(|| {

@@ -31,11 +31,11 @@ pub(super) fn run(
         let bytes = crate::import::canonical::trace_csv_bytes(&out, &trace)?;
         std::io::Write::write_all(&mut std::io::stdout().lock(), &bytes)
             .map_err(|e| Error::io(Path::new("<stdout>"), "cannot write", e))?;
-        eprintln!("{summary}");
+        super::esay!("{summary}");
         return Ok(());
     }
     crate::import::canonical::write_trace_csv(&out, &trace)?;
-    eprintln!("{summary}");
+    super::esay!("{summary}");
     println!("wrote {}", out.display());
     Ok(())
 }

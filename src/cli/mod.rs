@@ -10,6 +10,24 @@ use crate::simulate::blade::ModelKind;
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 
+/// Set once by [`run`] from `--quiet`.
+static QUIET: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// True when `--quiet` was given.
+fn quiet() -> bool {
+    QUIET.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// `eprintln!` for status messages on stderr, silent under `--quiet`.
+macro_rules! esay {
+    ($($arg:tt)*) => {
+        if !$crate::cli::quiet() {
+            eprintln!($($arg)*);
+        }
+    };
+}
+use esay;
+
 mod bench;
 mod campaign;
 mod fit;
@@ -28,6 +46,11 @@ pub use spectrum::BandArg;
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
+    /// No progress (on any command): no progress bar or progress lines of a fit, no per-recording
+    /// lines of a campaign run, no import notes on stderr. Results, errors and warnings still
+    /// appear.
+    #[arg(long, short, global = true)]
+    pub quiet: bool,
 }
 
 /// Welch settings of `spectrum`, named and defaulted as `scipy.signal.welch`.
@@ -208,9 +231,6 @@ pub enum Command {
         /// Print the result as one JSON object on stdout.
         #[arg(long)]
         json: bool,
-        /// No progress bar.
-        #[arg(long)]
-        quiet: bool,
     },
     /// Write the report page reports/<job>/index.html from fits/<job>.result.toml (with --refit:
     /// fit first; without a result and without --refit: exit 2).
@@ -219,9 +239,6 @@ pub enum Command {
         /// Run the fit again even if the result file exists.
         #[arg(long)]
         refit: bool,
-        /// No progress bar when fitting.
-        #[arg(long)]
-        quiet: bool,
     },
     /// Campaigns: one fit job over many recordings, locally or as a Slurm job array.
     Campaign {
@@ -264,6 +281,7 @@ fn stem(p: &Path) -> String {
 
 /// Runs the parsed command.
 pub fn run(cli: Cli) -> Result<()> {
+    QUIET.store(cli.quiet, std::sync::atomic::Ordering::Relaxed);
     match cli.command {
         Command::Import {
             file,
@@ -333,7 +351,7 @@ pub fn run(cli: Cli) -> Result<()> {
             speeds,
             json,
         } => modes::run(&blade, speeds.as_deref(), json),
-        Command::Fit { job, json, quiet } => fit::fit(&job, json, quiet),
-        Command::Report { job, refit, quiet } => fit::report(&job, refit, quiet),
+        Command::Fit { job, json } => fit::fit(&job, json, cli.quiet),
+        Command::Report { job, refit } => fit::report(&job, refit, cli.quiet),
     }
 }
