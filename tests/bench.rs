@@ -75,3 +75,21 @@ fn quick_bench_runs_every_method_and_writes_reports() {
     assert_eq!(csv.lines().count(), rows.len() + 1);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `wiperlab bench` runs from any working directory: its default blades are the source tree's
+/// (here run from the system temp dir, outputs to a temp dir).
+#[test]
+fn bench_runs_from_anywhere() {
+    let cwd = std::env::temp_dir();
+    let out = cwd.join(format!("wiperlab_bench_anywhere_{}", std::process::id()));
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_wiperlab"))
+        .args(["bench", "--quick", "--out-dir", out.to_str().unwrap()])
+        .current_dir(&cwd)
+        .output()
+        .expect("start wiperlab");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["work_precision.csv", "spectra_vs_rtol.csv"] {
+        assert!(out.join(f).exists(), "{f} not written");
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}

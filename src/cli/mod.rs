@@ -259,16 +259,14 @@ pub enum Command {
         #[arg(long)]
         quick: bool,
         /// Blade parameter TOMLs, comma-separated: the first is used for the work–precision problems,
-        /// all of them for the spectra-against-tolerance study.
-        #[arg(
-            long,
-            value_delimiter = ',',
-            default_value = "data/reversal/blade_true.toml,data/reversal/blade.toml"
-        )]
-        blade: Vec<PathBuf>,
-        /// Output directory.
-        #[arg(long, default_value = "reports/bench")]
-        out_dir: PathBuf,
+        /// all of them for the spectra-against-tolerance study. Default: the source tree's
+        /// data/reversal/blade_true.toml and blade.toml, wherever the command runs.
+        #[arg(long, value_delimiter = ',')]
+        blade: Option<Vec<PathBuf>>,
+        /// Output directory. Default: the source tree's reports/bench (the committed benchmark),
+        /// wherever the command runs.
+        #[arg(long)]
+        out_dir: Option<PathBuf>,
     },
 }
 
@@ -334,7 +332,17 @@ pub fn run(cli: Cli) -> Result<()> {
             quick,
             blade,
             out_dir,
-        } => bench::run(quick, &blade, &out_dir),
+        } => {
+            // The bench's defaults are the source tree's files, not the working directory's.
+            let tree = Path::new(env!("CARGO_MANIFEST_DIR"));
+            let blade = blade.unwrap_or_else(|| {
+                ["blade_true.toml", "blade.toml"]
+                    .map(|f| tree.join("data/reversal").join(f))
+                    .to_vec()
+            });
+            let out_dir = out_dir.unwrap_or_else(|| tree.join("reports/bench"));
+            bench::run(quick, &blade, &out_dir)
+        }
         Command::Campaign { action } => campaign::run(action),
         Command::Completions { shell } => {
             use clap::CommandFactory;
