@@ -202,6 +202,22 @@ fn main_job_end_to_end() {
         .unwrap_or_else(|| panic!("no JSON object on stdout:\n{out}"));
     let r: serde_json::Value = serde_json::from_str(json_line).expect("stdout is JSON");
     assert_eq!(r["job"], "reversal");
+    // The result's warnings (here the harmonic ones) are printed once each on stderr.
+    let warned: Vec<String> = stderr(&o)
+        .lines()
+        .filter_map(|l| l.strip_prefix("warning: ").map(str::to_string))
+        .collect();
+    let in_result: Vec<String> = r["warnings"]
+        .as_array()
+        .expect("warnings array")
+        .iter()
+        .map(|w| w.as_str().expect("a string").to_string())
+        .collect();
+    assert!(
+        !in_result.is_empty(),
+        "the main job warns about its harmonic lines"
+    );
+    assert_eq!(warned, in_result);
 
     // Peaks: the fitted model's within 2 % of the recording's (the requirement).
     let peaks = r["peaks"].as_array().expect("peaks array");

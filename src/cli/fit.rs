@@ -8,6 +8,10 @@ use std::path::{Path, PathBuf};
 pub(super) fn fit(job: &Path, json: bool, quiet: bool) -> Result<()> {
     let loaded = LoadedJob::load(job)?;
     let (result, result_path, report_dir) = fit_and_write(&loaded, !quiet && !json)?;
+    // Each warning once, on stderr (also in the result file and on the report page).
+    for w in &result.warnings {
+        eprintln!("warning: {w}");
+    }
     if json {
         println!(
             "{}",
