@@ -100,6 +100,10 @@ pub fn numbered_lines(text: &str) -> Vec<(usize, &str)> {
 /// Split one line on `delim`, honouring RFC 4180 double quotes (`"a,b"`, `""` for a quote). Quoted
 /// cells are returned unquoted; the bool says whether the cell was quoted. An unterminated quote
 /// runs to the end of the line.
+///
+/// Hand-written rather than the `csv` crate (which reads the plain CSV formats: canonical, DLTdv):
+/// these readers split single lines already chosen by a header search, with a space delimiter
+/// that `csv` cannot take, and need whether a cell was quoted (Kinovea) to tell text from numbers.
 pub fn split_record(line: &str, delim: char) -> Vec<(String, bool)> {
     let mut out = Vec::new();
     let mut cell = String::new();

@@ -57,6 +57,8 @@ pub(crate) fn clean_name(s: &str) -> String {
     out.trim().to_owned()
 }
 
+/// Tracker's own sniffing, not `common::sniff_delimiter`: Tracker never quotes cells, so a quote
+/// in a track name must not hide a delimiter (and no crate sniffs a delimiter from one line).
 fn sniff_delimiter(line: &str) -> Option<char> {
     DELIMITERS.into_iter().find(|d| line.contains(*d))
 }
@@ -92,6 +94,8 @@ pub(crate) fn find_column_row(lines: &[&str]) -> Option<(usize, char)> {
 }
 
 /// A cell: `Ok(None)` when empty or `NaN` (missing), `Ok(Some(v))` for a finite number.
+/// Tracker's own, not `common::parse_cell`: that one also reads TrackMate's `ø` as missing, which in
+/// a Tracker export is a bad cell.
 fn parse_cell(cell: &str, decimal_comma: bool) -> std::result::Result<Option<f64>, ()> {
     let cell = cell.trim();
     if cell.is_empty() || cell.eq_ignore_ascii_case("nan") {
