@@ -102,8 +102,8 @@ pub fn numbered_lines(text: &str) -> Vec<(usize, &str)> {
 /// runs to the end of the line.
 ///
 /// Hand-written rather than the `csv` crate (which reads the plain CSV formats: canonical, DLTdv):
-/// these readers split single lines already chosen by a header search, with a space delimiter
-/// that `csv` cannot take, and need whether a cell was quoted (Kinovea) to tell text from numbers.
+/// these readers split single lines already chosen by a header search (preambles, unit rows and
+/// footers of free-form exports), some with a space delimiter that `csv` cannot take.
 pub fn split_record(line: &str, delim: char) -> Vec<(String, bool)> {
     let mut out = Vec::new();
     let mut cell = String::new();
