@@ -2,7 +2,7 @@
 //! [`super::plot`]).
 
 use super::plot::{ChartOpts, Marker, Series, heatmap, line_chart};
-use crate::fit::features::{Features, noise_floor};
+use crate::fit::features::{BandFeatures, Features, noise_floor};
 use crate::fit::instfreq::FreqSpeedComparison;
 use crate::fit::result::HistoryPoint;
 use crate::fit::{FitOutcome, FitResult};
@@ -138,6 +138,46 @@ pub fn fit_figures(
 ) -> Result<()> {
     // A target job has no recorded points: its figures show the model against the target lines.
     let targets_only = o.measured_trace.points.is_empty();
+    trace_figures(dir, o, targets_only)?;
+    for (d, m) in o.measured.bands.iter().zip(&o.model.bands) {
+        band_psd_figure(dir, o, d, m, targets_only)?;
+    }
+    friction_law_figure(dir, o)?;
+    if let Some(c) = freq_speed {
+        freq_vs_speed_figure(dir, c)?;
+    }
+    cost_figure(dir, &o.result.history)
+}
+
+/// A signal in mm with its mean over the finite samples removed, so measured (camera frame) and
+/// model (model frame) share an axis.
+fn demean(x: &[f64]) -> Vec<f64> {
+    let f: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();
+    let m = f.iter().sum::<f64>() / f.len().max(1) as f64;
+    x.iter().map(|v| (v - m) * 1e3).collect::<Vec<f64>>()
+}
+
+/// The "model" series alone for a target job, else "measured" then "model".
+fn measured_and_model(
+    targets_only: bool,
+    t_meas: &[f64],
+    meas: Vec<f64>,
+    t_model: &[f64],
+    model: Vec<f64>,
+) -> Vec<Series> {
+    if targets_only {
+        vec![Series::line("model", t_model.to_vec(), model)]
+    } else {
+        vec![
+            Series::line("measured", t_meas.to_vec(), meas),
+            Series::line("model", t_model.to_vec(), model),
+        ]
+    }
+}
+
+/// `traces_tip.svg` and `traces_head.svg`: the measured and fitted-model traces, means removed,
+/// with their residual panels.
+fn trace_figures(dir: &Path, o: &FitOutcome, targets_only: bool) -> Result<()> {
     let meas = if targets_only {
         Vec::new()
     } else {
@@ -145,30 +185,14 @@ pub fn fit_figures(
     };
     let model = o.signal.extract(&o.best_sim.to_trace())?;
     let t = &o.measured_trace.t_s;
-    // Remove each signal's mean so measured (camera frame) and model (model frame) share an axis.
-    let demean = |x: &[f64]| {
-        let f: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();
-        let m = f.iter().sum::<f64>() / f.len().max(1) as f64;
-        x.iter().map(|v| (v - m) * 1e3).collect::<Vec<f64>>()
-    };
+    let t_model = &o.best_sim.t_s;
     line_chart(
         &dir.join("traces_tip.svg"),
         "tip x − head x: measured and fitted model (means removed)",
         "t [s] (model clock)",
         "tip − head [mm]",
-        &if targets_only {
-            vec![Series::line(
-                "model",
-                o.best_sim.t_s.clone(),
-                demean(&model),
-            )]
-        } else {
-            vec![
-                Series::line("measured", t.clone(), demean(&meas)),
-                Series::line("model", o.best_sim.t_s.clone(), demean(&model)),
-            ]
-        },
-        &residual_opts(t, &demean(&meas), &o.best_sim.t_s, &demean(&model)),
+        &measured_and_model(targets_only, t, demean(&meas), t_model, demean(&model)),
+        &residual_opts(t, &demean(&meas), t_model, &demean(&model)),
     )?;
     let head_meas = o
         .measured_trace
@@ -181,94 +205,105 @@ pub fn fit_figures(
         "head y: measured and fitted model (means removed)",
         "t [s] (model clock)",
         "head y [mm]",
+        &measured_and_model(
+            targets_only,
+            t,
+            head_meas.clone(),
+            t_model,
+            head_model.clone(),
+        ),
+        &residual_opts(t, &head_meas, t_model, &head_model),
+    )
+}
+
+/// The peak markers of one band's PSD figure: the measured peak (or, for a target job, the
+/// target line at the model peak's level), then the model peak.
+fn band_psd_markers(
+    o: &FitOutcome,
+    d: &BandFeatures,
+    m: &BandFeatures,
+    targets_only: bool,
+) -> Vec<Marker> {
+    let mut markers = Vec::new();
+    if let Some(p) = d.peak.filter(|_| !targets_only) {
+        markers.push(Marker {
+            x: p.freq_hz,
+            y: p.level,
+            label: format!("measured {:.2} Hz", p.freq_hz),
+        });
+    }
+    if let (true, Some(pk), Some(pm)) = (
+        targets_only,
+        o.result.peaks.iter().find(|p| p.band == d.spec.name),
+        m.peak,
+    ) {
+        markers.push(Marker {
+            x: pk.measured_hz,
+            y: pm.level,
+            label: match pk.target_range_hz {
+                Some(r) => format!("target {:.0}–{:.0} Hz", r[0], r[1]),
+                None => format!("target {:.2} Hz", pk.measured_hz),
+            },
+        });
+    }
+    if let Some(p) = m.peak {
+        markers.push(Marker {
+            x: p.freq_hz,
+            y: p.level,
+            label: format!("model {:.2} Hz", p.freq_hz),
+        });
+    }
+    markers
+}
+
+/// `psd_<band>.svg`: one band's measured and model PSDs (and the model plus the measured noise
+/// floor) on a log axis, peaks marked; the model alone against the target for a target job.
+fn band_psd_figure(
+    dir: &Path,
+    o: &FitOutcome,
+    d: &BandFeatures,
+    m: &BandFeatures,
+    targets_only: bool,
+) -> Result<()> {
+    // The cost adds the measurement's noise floor to the model PSD (src/fit/mod.rs cost_of);
+    // without it the model's deep stick–slip troughs look like misfits they are not.
+    let floor = noise_floor(d);
+    let markers = band_psd_markers(o, d, m, targets_only);
+    line_chart(
+        &dir.join(format!("psd_{}.svg", d.spec.name)),
+        &format!(
+            "Welch PSD, {} band (nperseg {}): {}",
+            d.spec.name,
+            d.spec.nperseg,
+            if targets_only {
+                "model against the target"
+            } else {
+                "measured, model, model + noise floor"
+            }
+        ),
+        "frequency [Hz]",
+        "PSD [m²/Hz]",
         &if targets_only {
-            vec![Series::line(
-                "model",
-                o.best_sim.t_s.clone(),
-                head_model.clone(),
-            )]
+            vec![Series::line("model", m.freq_hz.clone(), m.psd.clone())]
         } else {
             vec![
-                Series::line("measured", t.clone(), head_meas.clone()),
-                Series::line("model", o.best_sim.t_s.clone(), head_model.clone()),
+                Series::line("measured", d.freq_hz.clone(), d.psd.clone()),
+                Series::line("model", m.freq_hz.clone(), m.psd.clone()),
+                Series::line(
+                    format!(
+                        "model + measured noise floor {floor:.2e} m²/Hz (as the cost compares)"
+                    ),
+                    m.freq_hz.clone(),
+                    m.psd.iter().map(|p| p + floor).collect(),
+                ),
             ]
         },
-        &residual_opts(t, &head_meas, &o.best_sim.t_s, &head_model),
-    )?;
-    for (d, m) in o.measured.bands.iter().zip(&o.model.bands) {
-        // The cost adds the measurement's noise floor to the model PSD (src/fit/mod.rs cost_of);
-        // without it the model's deep stick–slip troughs look like misfits they are not.
-        let floor = noise_floor(d);
-        let mut markers = Vec::new();
-        if let Some(p) = d.peak.filter(|_| !targets_only) {
-            markers.push(Marker {
-                x: p.freq_hz,
-                y: p.level,
-                label: format!("measured {:.2} Hz", p.freq_hz),
-            });
-        }
-        if let (true, Some(pk), Some(pm)) = (
-            targets_only,
-            o.result.peaks.iter().find(|p| p.band == d.spec.name),
-            m.peak,
-        ) {
-            markers.push(Marker {
-                x: pk.measured_hz,
-                y: pm.level,
-                label: match pk.target_range_hz {
-                    Some(r) => format!("target {:.0}–{:.0} Hz", r[0], r[1]),
-                    None => format!("target {:.2} Hz", pk.measured_hz),
-                },
-            });
-        }
-        if let Some(p) = m.peak {
-            markers.push(Marker {
-                x: p.freq_hz,
-                y: p.level,
-                label: format!("model {:.2} Hz", p.freq_hz),
-            });
-        }
-        line_chart(
-            &dir.join(format!("psd_{}.svg", d.spec.name)),
-            &format!(
-                "Welch PSD, {} band (nperseg {}): {}",
-                d.spec.name,
-                d.spec.nperseg,
-                if targets_only {
-                    "model against the target"
-                } else {
-                    "measured, model, model + noise floor"
-                }
-            ),
-            "frequency [Hz]",
-            "PSD [m²/Hz]",
-            &if targets_only {
-                vec![Series::line("model", m.freq_hz.clone(), m.psd.clone())]
-            } else {
-                vec![
-                    Series::line("measured", d.freq_hz.clone(), d.psd.clone()),
-                    Series::line("model", m.freq_hz.clone(), m.psd.clone()),
-                    Series::line(
-                        format!(
-                            "model + measured noise floor {floor:.2e} m²/Hz (as the cost compares)"
-                        ),
-                        m.freq_hz.clone(),
-                        m.psd.iter().map(|p| p + floor).collect(),
-                    ),
-                ]
-            },
-            &ChartOpts {
-                log_y: true,
-                markers,
-                ..ChartOpts::default()
-            },
-        )?;
-    }
-    friction_law_figure(dir, o)?;
-    if let Some(c) = freq_speed {
-        freq_vs_speed_figure(dir, c)?;
-    }
-    cost_figure(dir, &o.result.history)
+        &ChartOpts {
+            log_y: true,
+            markers,
+            ..ChartOpts::default()
+        },
+    )
 }
 
 /// Chart options with a "measured − model" residual panel when both sides are sampled at the same
