@@ -291,6 +291,27 @@ pub fn line_chart(
     series: &[Series],
     opts: &ChartOpts,
 ) -> Result<()> {
+    check_ranges(path, opts)?;
+    let plane = chart_plane(path, title, series, opts)?;
+    let size = (FIGURE_SIZE.0 * SCALE, FIGURE_SIZE.1 * SCALE);
+    let legend = Legend::of(series);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| draw_err(path, e))?;
+        let (plot_root, _) = root.split_vertically(size.1 - legend.height);
+        draw_panels(&plot_root, plane, (title, x_label, y_label), series, opts)
+            .and_then(|_| root.present())
+            .map_err(|e| draw_err(path, e))?;
+    }
+    let svg =
+        shown_at_figure_size(&svg, size).replace("</svg>", &legend.svg(size.1 - legend.height));
+    write_svg(path, &svg)
+}
+
+/// Errors ([`Error::Config`], naming the path) unless `opts`' explicit `x_range` and `y_range`
+/// are finite, increasing and, on a log axis, positive.
+fn check_ranges(path: &Path, opts: &ChartOpts) -> Result<()> {
     let ax = Axis { log: opts.log_x };
     let ay = Axis { log: opts.log_y };
     for (name, r, axis) in [("x_range", opts.x_range, ax), ("y_range", opts.y_range, ay)] {
@@ -308,6 +329,15 @@ pub fn line_chart(
             )));
         }
     }
+    Ok(())
+}
+
+/// The plotting plane of [`line_chart`]: the given ranges, else the valid points' x extent and the
+/// padded y extent of the points and markers inside it. [`Error::Numerics`] (naming the path and
+/// title) when there is no valid point.
+fn chart_plane(path: &Path, title: &str, series: &[Series], opts: &ChartOpts) -> Result<Plane> {
+    let ax = Axis { log: opts.log_x };
+    let ay = Axis { log: opts.log_y };
     let no_data = || {
         Error::Numerics(format!(
             "{}: nothing to plot in \"{title}\": no finite (x, y) point{}",
@@ -356,22 +386,7 @@ pub fn line_chart(
             plane_range(ay, lo, hi, 0.05)
         }
     };
-    let plane = Plane { ax, ay, bx, by };
-
-    let size = (FIGURE_SIZE.0 * SCALE, FIGURE_SIZE.1 * SCALE);
-    let legend = Legend::of(series);
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| draw_err(path, e))?;
-        let (plot_root, _) = root.split_vertically(size.1 - legend.height);
-        draw_panels(&plot_root, plane, (title, x_label, y_label), series, opts)
-            .and_then(|_| root.present())
-            .map_err(|e| draw_err(path, e))?;
-    }
-    let svg =
-        shown_at_figure_size(&svg, size).replace("</svg>", &legend.svg(size.1 - legend.height));
-    write_svg(path, &svg)
+    Ok(Plane { ax, ay, bx, by })
 }
 
 /// The chart's panels on `root`: the series, and under them the residual panel when `opts` has one
@@ -525,6 +540,12 @@ impl Legend {
     }
 }
 
+/// What plotters' drawing calls return.
+type DrawResult = std::result::Result<(), DrawingAreaErrorKind<std::io::Error>>;
+
+/// The chart [`draw_xy`] draws into: plane coordinates on tick axes.
+type XyChart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<TickAxis, TickAxis>>;
+
 /// Draws the axes, series, reference lines and markers of [`line_chart`] on `root`.
 fn draw_xy(
     root: &DrawingArea<SVGBackend<'_>, Shift>,
@@ -532,7 +553,7 @@ fn draw_xy(
     (title, x_label, y_label): (&str, &str, &str),
     series: &[Series],
     opts: &ChartOpts,
-) -> std::result::Result<(), DrawingAreaErrorKind<std::io::Error>> {
+) -> DrawResult {
     let Plane { ax, ay, bx, by } = plane;
     let xt = ax.ticks(bx.0, bx.1, 10);
     let yt = ay.ticks(by.0, by.1, 6);
@@ -562,36 +583,48 @@ fn draw_xy(
         .draw()?;
 
     for (i, s) in series.iter().enumerate() {
-        let colour = series_colour(i);
-        let line_style = colour.stroke_width(px(2));
-        let lines = if s.style == SeriesStyle::Points {
-            Vec::new()
-        } else {
-            plane.polylines(s)
-        };
-        let pts: Vec<(f64, f64)> = if s.style == SeriesStyle::Line {
-            Vec::new()
-        } else {
-            s.x.iter()
-                .zip(&s.y)
-                .filter_map(|(&x, &y)| plane.point(x, y))
-                .collect()
-        };
-        // One plotters series per data series, so the legend has one entry even when the data
-        // breaks into pieces (or has none to show).
-        let elems: Vec<DynElement<'static, SVGBackend<'_>, (f64, f64)>> = lines
-            .into_iter()
-            .map(|l| PathElement::new(l, line_style).into_dyn())
-            .chain(
-                pts.into_iter()
-                    .map(|p| Circle::new(p, px(3), colour.filled()).into_dyn()),
-            )
-            .collect();
-        chart.draw_series(elems)?;
+        draw_one_series(&mut chart, plane, i, s)?;
     }
+    draw_vlines(&mut chart, plane, &opts.vlines)?;
+    draw_markers(&mut chart, plane, &opts.markers)
+}
 
+/// Series number `i` in its colour: its clipped polylines and/or a circle per visible point, as
+/// one plotters series (so the legend has one entry even when the data breaks into pieces or has
+/// none to show).
+fn draw_one_series(chart: &mut XyChart<'_, '_>, plane: Plane, i: usize, s: &Series) -> DrawResult {
+    let colour = series_colour(i);
+    let line_style = colour.stroke_width(px(2));
+    let lines = if s.style == SeriesStyle::Points {
+        Vec::new()
+    } else {
+        plane.polylines(s)
+    };
+    let pts: Vec<(f64, f64)> = if s.style == SeriesStyle::Line {
+        Vec::new()
+    } else {
+        s.x.iter()
+            .zip(&s.y)
+            .filter_map(|(&x, &y)| plane.point(x, y))
+            .collect()
+    };
+    let elems: Vec<DynElement<'static, SVGBackend<'_>, (f64, f64)>> = lines
+        .into_iter()
+        .map(|l| PathElement::new(l, line_style).into_dyn())
+        .chain(
+            pts.into_iter()
+                .map(|p| Circle::new(p, px(3), colour.filled()).into_dyn()),
+        )
+        .collect();
+    chart.draw_series(elems)?;
+    Ok(())
+}
+
+/// The vertical dashed reference lines inside the x range, each labelled at its top.
+fn draw_vlines(chart: &mut XyChart<'_, '_>, plane: Plane, vlines: &[(f64, String)]) -> DrawResult {
+    let Plane { ax, bx, by, .. } = plane;
     let grey = RGBColor(90, 90, 90);
-    for (x, label) in &opts.vlines {
+    for (x, label) in vlines {
         if !ax.valid(*x) {
             continue;
         }
@@ -614,7 +647,12 @@ fn draw_xy(
                 ),
         ))?;
     }
-    for (i, m) in opts.markers.iter().enumerate() {
+    Ok(())
+}
+
+/// The visible markers as open circles with their labels.
+fn draw_markers(chart: &mut XyChart<'_, '_>, plane: Plane, markers: &[Marker]) -> DrawResult {
+    for (i, m) in markers.iter().enumerate() {
         let Some(p) = plane.point(m.x, m.y) else {
             continue;
         };
@@ -632,7 +670,6 @@ fn draw_xy(
                 ),
         ))?;
     }
-
     Ok(())
 }
 
@@ -720,78 +757,9 @@ pub fn heatmap(
     log_z: bool,
 ) -> Result<()> {
     let bad = |m: String| Error::Numerics(format!("{}: heatmap \"{title}\": {m}", path.display()));
-    if x.is_empty() || y.is_empty() {
-        return Err(bad(format!(
-            "expected non-empty axes, got {} x and {} y values",
-            x.len(),
-            y.len()
-        )));
-    }
-    if z.len() != x.len() {
-        return Err(bad(format!(
-            "z has {} rows, expected one per x value ({})",
-            z.len(),
-            x.len()
-        )));
-    }
-    if let Some(i) = z.iter().position(|r| r.len() != y.len()) {
-        return Err(bad(format!(
-            "z row {i} has {} values, expected one per y value ({})",
-            z[i].len(),
-            y.len()
-        )));
-    }
-    for (name, a) in [("x", x), ("y", y)] {
-        if a.iter().any(|v| !v.is_finite()) || a.windows(2).any(|w| w[1] <= w[0]) {
-            return Err(bad(format!(
-                "{name} must be finite and strictly increasing"
-            )));
-        }
-    }
-    // Colour values: log10 z for a log scale; missing cells are NaN.
-    let zt: Vec<Vec<f64>> = z
-        .iter()
-        .map(|r| {
-            r.iter()
-                .map(|&v| match (v.is_finite(), log_z) {
-                    (false, _) => f64::NAN,
-                    (true, true) if v <= 0.0 => f64::NAN,
-                    (true, true) => v.log10(),
-                    (true, false) => v,
-                })
-                .collect()
-        })
-        .collect();
-    let bx = x.len().div_ceil(HEATMAP_MAX_CELLS.0);
-    let by = y.len().div_ceil(HEATMAP_MAX_CELLS.1);
-    let (xe, ye) = (edges(x), edges(y));
-    let (xe, ye, zd) = if bx > 1 || by > 1 {
-        (
-            block_edges(&xe, bx),
-            block_edges(&ye, by),
-            decimate(&zt, bx, by),
-        )
-    } else {
-        (xe, ye, zt)
-    };
-    let (zmin, zmax) = zd
-        .iter()
-        .flatten()
-        .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
-    if zmin > zmax {
-        return Err(bad(format!(
-            "no finite{} z value",
-            if log_z { " positive" } else { "" }
-        )));
-    }
-    let zr = if zmax > zmin {
-        (zmin, zmax)
-    } else {
-        (zmin - 0.5, zmax + 0.5)
-    };
+    check_heatmap_shape(x, y, z).map_err(bad)?;
+    let (xe, ye, zd) = heatmap_cells(x, y, colour_values(z, log_z));
+    let zr = colour_range(&zd, log_z).map_err(bad)?;
 
     let mut svg = String::new();
     let image = {
@@ -811,6 +779,95 @@ pub fn heatmap(
         .ok_or_else(|| bad("unexpected SVG from plotters (no background)".into()))?;
     svg.insert_str(at, &format!("\n{image}"));
     write_svg(path, &svg)
+}
+
+/// Why `x`, `y`, `z` are not a [`heatmap`]'s input: empty axes, `z` not `x.len()` rows of
+/// `y.len()` values, or an axis not finite and strictly increasing.
+fn check_heatmap_shape(x: &[f64], y: &[f64], z: &[Vec<f64>]) -> std::result::Result<(), String> {
+    if x.is_empty() || y.is_empty() {
+        return Err(format!(
+            "expected non-empty axes, got {} x and {} y values",
+            x.len(),
+            y.len()
+        ));
+    }
+    if z.len() != x.len() {
+        return Err(format!(
+            "z has {} rows, expected one per x value ({})",
+            z.len(),
+            x.len()
+        ));
+    }
+    if let Some(i) = z.iter().position(|r| r.len() != y.len()) {
+        return Err(format!(
+            "z row {i} has {} values, expected one per y value ({})",
+            z[i].len(),
+            y.len()
+        ));
+    }
+    for (name, a) in [("x", x), ("y", y)] {
+        if a.iter().any(|v| !v.is_finite()) || a.windows(2).any(|w| w[1] <= w[0]) {
+            return Err(format!("{name} must be finite and strictly increasing"));
+        }
+    }
+    Ok(())
+}
+
+/// Colour values: log10 z for a log scale; missing cells (not finite, or non-positive with
+/// `log_z`) are NaN.
+fn colour_values(z: &[Vec<f64>], log_z: bool) -> Vec<Vec<f64>> {
+    z.iter()
+        .map(|r| {
+            r.iter()
+                .map(|&v| match (v.is_finite(), log_z) {
+                    (false, _) => f64::NAN,
+                    (true, true) if v <= 0.0 => f64::NAN,
+                    (true, true) => v.log10(),
+                    (true, false) => v,
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Cell edges along x and y and the cell values, decimated by block maxima to at most
+/// [`HEATMAP_MAX_CELLS`].
+fn heatmap_cells(x: &[f64], y: &[f64], zt: Vec<Vec<f64>>) -> (Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
+    let bx = x.len().div_ceil(HEATMAP_MAX_CELLS.0);
+    let by = y.len().div_ceil(HEATMAP_MAX_CELLS.1);
+    let (xe, ye) = (edges(x), edges(y));
+    if bx > 1 || by > 1 {
+        (
+            block_edges(&xe, bx),
+            block_edges(&ye, by),
+            decimate(&zt, bx, by),
+        )
+    } else {
+        (xe, ye, zt)
+    }
+}
+
+/// The colour bar's range: the finite cells' extent, widened by ±0.5 when flat; an error message
+/// when no cell is finite.
+fn colour_range(zd: &[Vec<f64>], log_z: bool) -> std::result::Result<(f64, f64), String> {
+    let (zmin, zmax) = zd
+        .iter()
+        .flatten()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    if zmin > zmax {
+        return Err(format!(
+            "no finite{} z value",
+            if log_z { " positive" } else { "" }
+        ));
+    }
+    Ok(if zmax > zmin {
+        (zmin, zmax)
+    } else {
+        (zmin - 0.5, zmax + 0.5)
+    })
 }
 
 /// Pixel rectangle `(x0, y0, width, height)` of the plotting area.
