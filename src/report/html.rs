@@ -28,7 +28,7 @@ use crate::fit::result::{FitResult, sha256_file};
 use crate::simulate::blade::ModelKind;
 use crate::{Error, Result};
 use serde::Serialize;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// File name of the page inside the report directory.
 pub const INDEX: &str = "index.html";
@@ -628,61 +628,8 @@ pub fn render_html(
 pub fn write_report(r: &FitResult, paths: &ReportPaths) -> Result<ReportSummary> {
     let dir = &paths.dir;
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "cannot create directory", e))?;
-    let mut present: Vec<String> = std::fs::read_dir(dir)
-        .map_err(|e| Error::io(dir, "cannot list", e))?
-        .filter_map(|d| d.ok())
-        .filter(|d| d.path().is_file())
-        .filter_map(|d| d.file_name().into_string().ok())
-        .filter(|n| n.ends_with(".svg"))
-        .collect();
-    present.sort();
-    let mut figures = Vec::new();
-    let mut missing = Vec::new();
-    for (file, caption) in fit_figure_list(r) {
-        if let Some(i) = present.iter().position(|p| *p == file) {
-            present.remove(i);
-            figures.push(Figure { file, caption });
-        } else {
-            missing.push(file);
-        }
-    }
-    for (file, caption) in OPTIONAL_FIGURES {
-        if let Some(i) = present.iter().position(|p| p == file) {
-            present.remove(i);
-            figures.push(Figure {
-                file: file.to_string(),
-                caption: caption.to_string(),
-            });
-        }
-    }
-    for file in present {
-        figures.push(Figure {
-            caption: format!("figure {file}"),
-            file,
-        });
-    }
-
-    let mut warnings = r.warnings.clone();
-    for p in &r.parameters {
-        if !p.determined && !warnings.iter().any(|w| w.contains(p.name.name())) {
-            warnings.push(format!(
-                "the data leave {} undetermined (1σ {} over a search range [{}, {}]); read its \
-                 value with care and see the correlations",
-                p.name,
-                num(p.std_error, 3),
-                num(p.lower, 4),
-                num(p.upper, 4)
-            ));
-        }
-    }
-    if r.failed_evaluations > 0 {
-        warnings.push(format!(
-            "{} of {} model evaluations failed and were given the failure cost; first: {}",
-            r.failed_evaluations,
-            r.model_evaluations,
-            r.first_failure.as_deref().unwrap_or("(not recorded)")
-        ));
-    }
+    let (figures, missing) = report_figures(r, dir)?;
+    let mut warnings = result_warnings(r);
     if !missing.is_empty() {
         warnings.push(format!(
             "figures missing from {}: {} (run `wiperlab report --refit` to redraw them)",
@@ -720,6 +667,72 @@ pub fn write_report(r: &FitResult, paths: &ReportPaths) -> Result<ReportSummary>
         missing_figures: missing,
         warnings,
     })
+}
+
+/// The SVGs in `dir` as the page lists them (the fit's own in [`fit_figure_list`] order, then
+/// [`OPTIONAL_FIGURES`], then the rest by name), and the fit figures missing from it.
+fn report_figures(r: &FitResult, dir: &Path) -> Result<(Vec<Figure>, Vec<String>)> {
+    let mut present: Vec<String> = std::fs::read_dir(dir)
+        .map_err(|e| Error::io(dir, "cannot list", e))?
+        .filter_map(|d| d.ok())
+        .filter(|d| d.path().is_file())
+        .filter_map(|d| d.file_name().into_string().ok())
+        .filter(|n| n.ends_with(".svg"))
+        .collect();
+    present.sort();
+    let mut figures = Vec::new();
+    let mut missing = Vec::new();
+    for (file, caption) in fit_figure_list(r) {
+        if let Some(i) = present.iter().position(|p| *p == file) {
+            present.remove(i);
+            figures.push(Figure { file, caption });
+        } else {
+            missing.push(file);
+        }
+    }
+    for (file, caption) in OPTIONAL_FIGURES {
+        if let Some(i) = present.iter().position(|p| p == file) {
+            present.remove(i);
+            figures.push(Figure {
+                file: file.to_string(),
+                caption: caption.to_string(),
+            });
+        }
+    }
+    for file in present {
+        figures.push(Figure {
+            caption: format!("figure {file}"),
+            file,
+        });
+    }
+    Ok((figures, missing))
+}
+
+/// The result's own warnings, one per undetermined parameter they do not already name, and one
+/// for failed model evaluations.
+fn result_warnings(r: &FitResult) -> Vec<String> {
+    let mut warnings = r.warnings.clone();
+    for p in &r.parameters {
+        if !p.determined && !warnings.iter().any(|w| w.contains(p.name.name())) {
+            warnings.push(format!(
+                "the data leave {} undetermined (1σ {} over a search range [{}, {}]); read its \
+                 value with care and see the correlations",
+                p.name,
+                num(p.std_error, 3),
+                num(p.lower, 4),
+                num(p.upper, 4)
+            ));
+        }
+    }
+    if r.failed_evaluations > 0 {
+        warnings.push(format!(
+            "{} of {} model evaluations failed and were given the failure cost; first: {}",
+            r.failed_evaluations,
+            r.model_evaluations,
+            r.first_failure.as_deref().unwrap_or("(not recorded)")
+        ));
+    }
+    warnings
 }
 
 #[cfg(test)]
