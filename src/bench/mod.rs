@@ -270,8 +270,14 @@ pub fn run_bench(opts: &BenchOptions) -> Result<Vec<BenchRow>> {
 
     // Event location order: fixed steps on the undamped Coulomb belt (physics.md §3.1).
     rows.extend(event_order_rows()?);
+    bench_belt(quick, &mut rows)?;
+    bench_blade_burst(opts, &mut rows)?;
+    bench_blade_window(opts, &mut rows)?;
+    Ok(rows)
+}
 
-    // Belt.
+/// The `belt` problem: Leine's belt from stick at x = 0 over 30 s, all three methods.
+fn bench_belt(quick: bool, rows: &mut Vec<BenchRow>) -> Result<()> {
     let belt = leine_belt();
     let samples: Vec<f64> = (0..=3000).map(|i| i as f64 * 0.01).collect();
     let steps: Vec<f64> = if quick {
@@ -300,10 +306,14 @@ pub fn run_bench(opts: &BenchOptions) -> Result<Vec<BenchRow>> {
         &steps,
         &eps,
         quick,
-        &mut rows,
-    )?;
+        rows,
+    )
+}
 
-    // Blade burst.
+/// The `blade-burst` problem: 20 ms of stick–slip from the blade's first stick onset, all three
+/// methods, then event-driven with a Baumgarte-stabilised stick.
+fn bench_blade_burst(opts: &BenchOptions, rows: &mut Vec<BenchRow>) -> Result<()> {
+    let quick = opts.quick;
     let blade = Blade::new(opts.blade, StickForm::Reduced);
     let (ta, ya, anchor) = blade_burst_start(&opts.blade)?;
     let tb = ta + 0.02;
@@ -334,7 +344,7 @@ pub fn run_bench(opts: &BenchOptions) -> Result<Vec<BenchRow>> {
         &steps,
         &eps,
         quick,
-        &mut rows,
+        rows,
     )?;
     let baum = Blade::new(opts.blade, StickForm::Baumgarte { omega_b_per_s: 1e4 });
     let reference = event_driven(&blade, ta, tb, ya, mode, &ed_opts(1e-13), &samples)?;
@@ -353,8 +363,13 @@ pub fn run_bench(opts: &BenchOptions) -> Result<Vec<BenchRow>> {
             r,
         ));
     }
+    Ok(())
+}
 
-    // Whole window, event-driven: cost.
+/// The `blade-window` problem: the whole default reversal window, event-driven only (its cost).
+fn bench_blade_window(opts: &BenchOptions, rows: &mut Vec<BenchRow>) -> Result<()> {
+    let quick = opts.quick;
+    let blade = Blade::new(opts.blade, StickForm::Reduced);
     let (w0, w1) = default_window(&opts.blade);
     let y0 = blade
         .slip_equilibrium(w0)
@@ -380,7 +395,7 @@ pub fn run_bench(opts: &BenchOptions) -> Result<Vec<BenchRow>> {
             r,
         ));
     }
-    Ok(rows)
+    Ok(())
 }
 
 /// Transition-time error of the undamped Coulomb belt's first stick onset against the closed form
@@ -446,7 +461,27 @@ pub fn write_reports(dir: &Path, rows: &[BenchRow]) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "create directory", e))?;
     let path = dir.join("work_precision.csv");
     write_csv_rows(&path, rows)?;
+    work_precision_figures(dir, rows)?;
+    event_order_figure(dir, rows)
+}
 
+/// Log–log axes of the work–precision figures.
+fn log_log() -> ChartOpts {
+    ChartOpts {
+        log_x: true,
+        log_y: true,
+        ..Default::default()
+    }
+}
+
+/// One line-and-points series per (problem, method) in first-seen order, event-order rows left
+/// out: `y_of` against `x_of` over the rows whose `y_of` is finite (floored at 1e-16 for the log
+/// axis); methods with no such row are dropped.
+fn work_precision_series(
+    rows: &[BenchRow],
+    x_of: &dyn Fn(&BenchRow) -> f64,
+    y_of: &dyn Fn(&BenchRow) -> f64,
+) -> Vec<Series> {
     let mut keys: Vec<(String, String)> = Vec::new();
     for r in rows {
         let key = (r.problem.clone(), r.method.clone());
@@ -454,29 +489,28 @@ pub fn write_reports(dir: &Path, rows: &[BenchRow]) -> Result<()> {
             keys.push(key);
         }
     }
-    let series =
-        |x_of: &dyn Fn(&BenchRow) -> f64, y_of: &dyn Fn(&BenchRow) -> f64| -> Vec<Series> {
-            keys.iter()
-                .map(|(p, m)| {
-                    let sel: Vec<&BenchRow> = rows
-                        .iter()
-                        .filter(|r| &r.problem == p && &r.method == m && y_of(r).is_finite())
-                        .collect();
-                    let mut s = Series::line(
-                        format!("{p}: {m}"),
-                        sel.iter().map(|r| x_of(r)).collect(),
-                        sel.iter().map(|r| y_of(r).max(1e-16)).collect(),
-                    );
-                    s.style = crate::report::plot::SeriesStyle::LinePoints;
-                    s
-                })
-                .filter(|s| !s.x.is_empty())
-                .collect()
-        };
-    let log = ChartOpts {
-        log_x: true,
-        log_y: true,
-        ..Default::default()
+    keys.iter()
+        .map(|(p, m)| {
+            let sel: Vec<&BenchRow> = rows
+                .iter()
+                .filter(|r| &r.problem == p && &r.method == m && y_of(r).is_finite())
+                .collect();
+            let mut s = Series::line(
+                format!("{p}: {m}"),
+                sel.iter().map(|r| x_of(r)).collect(),
+                sel.iter().map(|r| y_of(r).max(1e-16)).collect(),
+            );
+            s.style = crate::report::plot::SeriesStyle::LinePoints;
+            s
+        })
+        .filter(|s| !s.x.is_empty())
+        .collect()
+}
+
+/// `work_precision.svg`, `work_precision_rhs.svg` and `work_precision_trace.svg`.
+fn work_precision_figures(dir: &Path, rows: &[BenchRow]) -> Result<()> {
+    let series = |x_of: &dyn Fn(&BenchRow) -> f64, y_of: &dyn Fn(&BenchRow) -> f64| {
+        work_precision_series(rows, x_of, y_of)
     };
     line_chart(
         &dir.join("work_precision.svg"),
@@ -484,7 +518,7 @@ pub fn write_reports(dir: &Path, rows: &[BenchRow]) -> Result<()> {
         "wall time per run (s)",
         "max transition-time error (s)",
         &series(&|r| r.wall_s, &|r| r.transition_err_s),
-        &log,
+        &log_log(),
     )?;
     line_chart(
         &dir.join("work_precision_rhs.svg"),
@@ -492,7 +526,7 @@ pub fn write_reports(dir: &Path, rows: &[BenchRow]) -> Result<()> {
         "RHS evaluations (incl. event functions; Moreau-Jean: contact solves)",
         "max transition-time error (s)",
         &series(&|r| r.rhs_evals as f64, &|r| r.transition_err_s),
-        &log,
+        &log_log(),
     )?;
     line_chart(
         &dir.join("work_precision_trace.svg"),
@@ -500,29 +534,34 @@ pub fn write_reports(dir: &Path, rows: &[BenchRow]) -> Result<()> {
         "wall time per run (s)",
         "max error of x (belt) / lip-tip v3 (blade) (m)",
         &series(&|r| r.wall_s, &|r| r.trace_err_m),
-        &log,
-    )?;
+        &log_log(),
+    )
+}
+
+/// `event_order.svg`: the `coulomb-fixed-step` rows' stick-onset error against the step, with an
+/// h⁵ line through the smallest step; nothing when there are no such rows.
+fn event_order_figure(dir: &Path, rows: &[BenchRow]) -> Result<()> {
     let order: Vec<&BenchRow> = rows
         .iter()
         .filter(|r| r.problem == "coulomb-fixed-step")
         .collect();
-    if !order.is_empty() {
-        let x: Vec<f64> = order.iter().map(|r| r.setting).collect();
-        let y: Vec<f64> = order.iter().map(|r| r.transition_err_s).collect();
-        let (x0, y0) = (x[x.len() - 1], y[y.len() - 1]);
-        let slope: Vec<f64> = x.iter().map(|h| y0 * (h / x0).powi(5)).collect();
-        let mut s = Series::line("DOPRI5 + event location on CONTD5", x.clone(), y);
-        s.style = crate::report::plot::SeriesStyle::LinePoints;
-        line_chart(
-            &dir.join("event_order.svg"),
-            "Stick-onset time error vs fixed step (undamped Coulomb belt, closed form)",
-            "step h (s)",
-            "|t_onset - closed form| (s)",
-            &[s, Series::line("slope 5 (h^5)", x, slope)],
-            &log,
-        )?;
+    if order.is_empty() {
+        return Ok(());
     }
-    Ok(())
+    let x: Vec<f64> = order.iter().map(|r| r.setting).collect();
+    let y: Vec<f64> = order.iter().map(|r| r.transition_err_s).collect();
+    let (x0, y0) = (x[x.len() - 1], y[y.len() - 1]);
+    let slope: Vec<f64> = x.iter().map(|h| y0 * (h / x0).powi(5)).collect();
+    let mut s = Series::line("DOPRI5 + event location on CONTD5", x.clone(), y);
+    s.style = crate::report::plot::SeriesStyle::LinePoints;
+    line_chart(
+        &dir.join("event_order.svg"),
+        "Stick-onset time error vs fixed step (undamped Coulomb belt, closed form)",
+        "step h (s)",
+        "|t_onset - closed form| (s)",
+        &[s, Series::line("slope 5 (h^5)", x, slope)],
+        &log_log(),
+    )
 }
 
 /// Spectral peaks of the blade at one tolerance.
@@ -595,91 +634,122 @@ pub fn write_spectra(
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "create directory", e))?;
     let path = dir.join("spectra_vs_rtol.csv");
     write_csv_rows(&path, rows)?;
-    let mut names: Vec<&str> = Vec::new();
-    for r in rows {
-        if !names.contains(&r.blade.as_str()) {
-            names.push(&r.blade);
-        }
-    }
     let mut series = Vec::new();
     let mut rtols: Vec<f64> = rows.iter().map(|r| r.rtol).collect();
     rtols.sort_by(f64::total_cmp);
     rtols.dedup();
     // For each rtol: is it, and every tighter one, within `rel` for every blade and band?
     let mut ok_all = vec![true; rtols.len()];
-    for name in &names {
-        let sel: Vec<&SpectrumRow> = rows.iter().filter(|r| r.blade == *name).collect();
+    for name in blade_names(rows) {
+        let sel: Vec<&SpectrumRow> = rows.iter().filter(|r| r.blade == name).collect();
         let Some(conv) = sel.iter().min_by(|a, b| a.rtol.total_cmp(&b.rtol)) else {
             continue;
-        };
-        // A band without a peak (NaN: e.g. a mode at the band's edge) agrees with a run that has
-        // none either, and disagrees completely with one that has.
-        let rel_dev = |f: f64, f_conv: f64| match (f.is_nan(), f_conv.is_nan()) {
-            (true, true) => 0.0,
-            (false, false) => ((f - f_conv) / f_conv).abs(),
-            _ => f64::INFINITY,
-        };
-        let dev = |r: &SpectrumRow| {
-            [
-                rel_dev(r.low_peak_hz, conv.low_peak_hz),
-                rel_dev(r.high_peak_hz, conv.high_peak_hz),
-            ]
         };
         let n_conv = conv.transitions as f64;
         for (k, rt) in rtols.iter().enumerate() {
             let within = sel.iter().filter(|r| r.rtol == *rt).all(|r| {
-                dev(r).iter().all(|d| *d <= rel)
+                peak_devs(r, conv).iter().all(|d| *d <= rel)
                     && (r.transitions as f64 - n_conv).abs() <= max_count_change * n_conv
             });
             ok_all[k] &= within;
         }
-        let others: Vec<&&SpectrumRow> = sel.iter().filter(|r| r.rtol > conv.rtol).collect();
-        for (i, band) in ["low band peak", "high band peak"].iter().enumerate() {
-            // No peak at the tightest tolerance: nothing to draw a deviation from.
-            if [conv.low_peak_hz, conv.high_peak_hz][i].is_nan() {
-                continue;
-            }
-            // Runs that lost the peak (infinite deviation) are left out of the plot.
-            let pts: Vec<(f64, f64)> = others
-                .iter()
-                .map(|r| (r.rtol, dev(r)[i]))
-                .filter(|(_, d)| d.is_finite())
-                .collect();
-            if pts.is_empty() {
-                continue;
-            }
-            let mut s = Series::line(
-                format!("{name}: {band}"),
-                pts.iter().map(|p| p.0).collect(),
-                pts.iter().map(|p| p.1.max(1e-9)).collect(),
-            );
-            s.style = crate::report::plot::SeriesStyle::LinePoints;
-            series.push(s);
+        series.extend(deviation_series(name, &sel, conv));
+    }
+    spectra_figure(dir, &rtols, rel, series)?;
+    Ok(loosest_passing(&rtols, &ok_all))
+}
+
+/// The distinct blade names of `rows`, in first-seen order.
+fn blade_names(rows: &[SpectrumRow]) -> Vec<&str> {
+    let mut names: Vec<&str> = Vec::new();
+    for r in rows {
+        if !names.contains(&r.blade.as_str()) {
+            names.push(&r.blade);
         }
     }
-    let loose: Vec<f64> = rtols.iter().copied().skip(1).collect();
-    if !loose.is_empty() {
-        series.push(Series::line(
-            format!("{} % limit", rel * 100.0),
-            loose.clone(),
-            vec![rel; loose.len()],
-        ));
-        line_chart(
-            &dir.join("spectra_vs_rtol.svg"),
-            &format!(
-                "Fit spectral peaks vs rtol (relative to rtol {:e}; floor 1e-9 = identical)",
-                rtols[0]
-            ),
-            "rtol",
-            "|peak - converged| / converged",
-            &series,
-            &ChartOpts {
-                log_x: true,
-                log_y: true,
-                ..Default::default()
-            },
-        )?;
+    names
+}
+
+/// Relative deviation of a peak frequency `f` from the converged `f_conv`. A band without a peak
+/// (NaN: e.g. a mode at the band's edge) agrees with a run that has none either (0), and
+/// disagrees completely with one that has (infinite).
+fn rel_dev(f: f64, f_conv: f64) -> f64 {
+    match (f.is_nan(), f_conv.is_nan()) {
+        (true, true) => 0.0,
+        (false, false) => ((f - f_conv) / f_conv).abs(),
+        _ => f64::INFINITY,
     }
+}
+
+/// [`rel_dev`] of the low and high band peaks of `r` against the converged run `conv`.
+fn peak_devs(r: &SpectrumRow, conv: &SpectrumRow) -> [f64; 2] {
+    [
+        rel_dev(r.low_peak_hz, conv.low_peak_hz),
+        rel_dev(r.high_peak_hz, conv.high_peak_hz),
+    ]
+}
+
+/// One blade's deviation series against rtol, one per band that has a peak at the tightest
+/// tolerance, over the looser runs that kept the peak (floored at 1e-9 for the log axis).
+fn deviation_series(name: &str, sel: &[&SpectrumRow], conv: &SpectrumRow) -> Vec<Series> {
+    let mut series = Vec::new();
+    let others: Vec<&&SpectrumRow> = sel.iter().filter(|r| r.rtol > conv.rtol).collect();
+    for (i, band) in ["low band peak", "high band peak"].iter().enumerate() {
+        // No peak at the tightest tolerance: nothing to draw a deviation from.
+        if [conv.low_peak_hz, conv.high_peak_hz][i].is_nan() {
+            continue;
+        }
+        // Runs that lost the peak (infinite deviation) are left out of the plot.
+        let pts: Vec<(f64, f64)> = others
+            .iter()
+            .map(|r| (r.rtol, peak_devs(r, conv)[i]))
+            .filter(|(_, d)| d.is_finite())
+            .collect();
+        if pts.is_empty() {
+            continue;
+        }
+        let mut s = Series::line(
+            format!("{name}: {band}"),
+            pts.iter().map(|p| p.0).collect(),
+            pts.iter().map(|p| p.1.max(1e-9)).collect(),
+        );
+        s.style = crate::report::plot::SeriesStyle::LinePoints;
+        series.push(s);
+    }
+    series
+}
+
+/// `spectra_vs_rtol.svg`: the deviation `series` plus the `rel` limit line over the looser
+/// tolerances (`rtols` ascending); nothing when there is only one tolerance.
+fn spectra_figure(dir: &Path, rtols: &[f64], rel: f64, mut series: Vec<Series>) -> Result<()> {
+    let loose: Vec<f64> = rtols.iter().copied().skip(1).collect();
+    if loose.is_empty() {
+        return Ok(());
+    }
+    series.push(Series::line(
+        format!("{} % limit", rel * 100.0),
+        loose.clone(),
+        vec![rel; loose.len()],
+    ));
+    line_chart(
+        &dir.join("spectra_vs_rtol.svg"),
+        &format!(
+            "Fit spectral peaks vs rtol (relative to rtol {:e}; floor 1e-9 = identical)",
+            rtols[0]
+        ),
+        "rtol",
+        "|peak - converged| / converged",
+        &series,
+        &ChartOpts {
+            log_x: true,
+            log_y: true,
+            ..Default::default()
+        },
+    )
+}
+
+/// The loosest of `rtols` (ascending) that passes with every tighter one passing too.
+fn loosest_passing(rtols: &[f64], ok_all: &[bool]) -> Option<f64> {
     let mut best = None;
     for (k, rt) in rtols.iter().enumerate() {
         if ok_all[k] {
@@ -688,5 +758,5 @@ pub fn write_spectra(
             break;
         }
     }
-    Ok(best)
+    best
 }
