@@ -5,13 +5,31 @@ use crate::model::BladeParams;
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};
 
-/// Runs the study, writes its CSVs and figures under `out_dir`, and prints both tables.
-pub(super) fn run(quick: bool, blade: &[PathBuf], out_dir: &Path) -> Result<()> {
+/// Runs the study, writes its CSVs and figures under `out_dir`, and prints both tables. The
+/// defaults are the source tree's blades and `reports/bench`, wherever the command runs; a blade
+/// inside the source tree is labelled by its path relative to it.
+pub(super) fn run(
+    quick: bool,
+    blade: Option<Vec<PathBuf>>,
+    out_dir: Option<PathBuf>,
+) -> Result<()> {
+    let tree = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let blade = blade.unwrap_or_else(|| {
+        ["blade_true.toml", "blade.toml"]
+            .map(|f| tree.join("data/reversal").join(f))
+            .to_vec()
+    });
+    let out_dir = &out_dir.unwrap_or_else(|| tree.join("reports/bench"));
     let mut blades = Vec::new();
-    for path in blade {
+    for path in &blade {
         let params: BladeParams = parse_toml(path, &read_text(path)?)?;
         params.validate().map_err(|m| Error::input(path, m))?;
-        blades.push((path.display().to_string(), params));
+        let label = path
+            .strip_prefix(tree)
+            .unwrap_or(path)
+            .display()
+            .to_string();
+        blades.push((label, params));
     }
     let Some((_, params)) = blades.first() else {
         return Err(Error::Config(

@@ -332,17 +332,7 @@ pub fn run(cli: Cli) -> Result<()> {
             quick,
             blade,
             out_dir,
-        } => {
-            // The bench's defaults are the source tree's files, not the working directory's.
-            let tree = Path::new(env!("CARGO_MANIFEST_DIR"));
-            let blade = blade.unwrap_or_else(|| {
-                ["blade_true.toml", "blade.toml"]
-                    .map(|f| tree.join("data/reversal").join(f))
-                    .to_vec()
-            });
-            let out_dir = out_dir.unwrap_or_else(|| tree.join("reports/bench"));
-            bench::run(quick, &blade, &out_dir)
-        }
+        } => bench::run(quick, blade, out_dir),
         Command::Campaign { action } => campaign::run(action),
         Command::Completions { shell } => {
             use clap::CommandFactory;
