@@ -62,25 +62,28 @@ pub fn check_writable_file(path: &Path) -> Result<()> {
 /// # Errors
 /// [`Error::Io`] naming `dir` when a file is in the way, or the ancestor that cannot be written.
 pub fn check_creatable_dir(dir: &Path) -> Result<()> {
-    let mut at = dir;
-    loop {
-        if at.exists() {
-            if !at.is_dir() {
-                return Err(Error::io(
-                    dir,
-                    "cannot create this directory: a file is in the way",
-                    std::io::Error::from(std::io::ErrorKind::NotADirectory),
-                ));
-            }
-            return tempfile::NamedTempFile::new_in(at)
-                .map(drop)
-                .map_err(|e| Error::io(at, "cannot write files in", e));
-        }
-        match at.parent() {
-            Some(p) if !p.as_os_str().is_empty() => at = p,
-            _ => at = Path::new("."),
-        }
+    let nearest = dir
+        .ancestors()
+        .filter(|a| !a.as_os_str().is_empty())
+        .chain([Path::new(".")])
+        .find(|a| a.exists());
+    let Some(at) = nearest else {
+        return Err(Error::io(
+            dir,
+            "cannot create this directory: no part of its path exists",
+            std::io::Error::from(std::io::ErrorKind::NotFound),
+        ));
+    };
+    if !at.is_dir() {
+        return Err(Error::io(
+            dir,
+            "cannot create this directory: a file is in the way",
+            std::io::Error::from(std::io::ErrorKind::NotADirectory),
+        ));
     }
+    tempfile::NamedTempFile::new_in(at)
+        .map(drop)
+        .map_err(|e| Error::io(at, "cannot write files in", e))
 }
 
 /// Creates `dir` and its parents if missing.
@@ -138,6 +141,22 @@ mod tests {
         let via_dot = dir.path().join(".").join("a.csv");
         assert!(refuse_overwriting_input(&a, &via_dot).is_err());
         assert!(refuse_overwriting_input(&a, &dir.path().join("b.csv")).is_ok());
+    }
+
+    #[test]
+    fn a_directory_to_create_is_checked_without_creating_it() {
+        let base = std::env::temp_dir().join(format!("wiperlab_io_dir_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&base);
+        std::fs::create_dir_all(&base).unwrap();
+        let deep = base.join("a/b/c");
+        check_creatable_dir(&deep).unwrap();
+        assert!(!base.join("a").exists(), "the check creates nothing");
+        std::fs::write(base.join("file"), "x").unwrap();
+        let err = check_creatable_dir(&base.join("file/sub")).unwrap_err();
+        assert!(err.to_string().contains("a file is in the way"), "{err}");
+        let err = check_writable_file(&base).unwrap_err();
+        assert!(err.to_string().contains("over this directory"), "{err}");
+        std::fs::remove_dir_all(&base).unwrap();
     }
 
     #[test]
