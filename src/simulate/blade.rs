@@ -179,22 +179,7 @@ pub fn simulate_necklip(
             Phase::SlipNeg
         }
     };
-    let mut sim = BladeSimulation {
-        t_s: sample_times.to_vec(),
-        v_m: sample_times
-            .iter()
-            .map(|&t| model.blade.drive(t).0)
-            .collect(),
-        u_m: vec![f64::NAN; n],
-        v3_m: vec![f64::NAN; n],
-        theta_rad: vec![f64::NAN; n],
-        phi_rad: vec![f64::NAN; n],
-        phase: vec![drive_dir(window.0); n],
-        transitions: Vec::new(),
-        switches: Vec::new(),
-        stats: Stats::default(),
-        reach_m: reach,
-    };
+    let mut sim = unsimulated(&model.blade, sample_times, drive_dir(window.0), reach);
     for (i, &(a0, b)) in segments.iter().enumerate() {
         let mut a = a0;
         let fail = |e: ModelFault| -> Error {
@@ -211,30 +196,10 @@ pub fn simulate_necklip(
                 Mode::new(drive_dir(a), 0.0),
             )
         } else {
-            // The first sample (up to 10 ms into the segment) where the tracks give a state the
-            // model can start from: right after the flip slip can be Painlevé-singular with the
-            // head height prescribed, and static friction may not yet hold the tip.
-            let dt = sample_times.get(1).map_or(1e-4, |t1| t1 - sample_times[0]);
-            let limit = (a + START_SEARCH_S).min(b);
-            let mut ts = a;
-            loop {
-                let attempt = model
-                    .state_from_tracks(ts)
-                    .and_then(|(y, dir)| start_from_tracks(&model, ts, y, dir));
-                match attempt {
-                    Ok(s) => {
-                        a = ts;
-                        break s;
-                    }
-                    Err(e) if ts + dt > limit => {
-                        return Err(fail(ModelFault::NoConsistentStart {
-                            search_s: START_SEARCH_S,
-                            last: Box::new(e),
-                        }));
-                    }
-                    Err(_) => ts += dt,
-                }
-            }
+            let (start, t_start) =
+                first_consistent_start(&model, (a, b), sample_times).map_err(fail)?;
+            a = t_start;
+            start
         };
         let lo = sample_times.partition_point(|&t| t < a);
         let hi = sample_times.partition_point(|&t| t <= b);
@@ -260,6 +225,57 @@ pub fn simulate_necklip(
         sim.stats.event_evals += run.stats.event_evals;
     }
     Ok(sim)
+}
+
+/// A simulation of the neck/lip model before any segment ran: the drive `v` at every sample, NaN
+/// positions and angles, every sample in `phase`.
+fn unsimulated(blade: &Blade, sample_times: &[f64], phase: Phase, reach_m: f64) -> BladeSimulation {
+    let n = sample_times.len();
+    BladeSimulation {
+        t_s: sample_times.to_vec(),
+        v_m: sample_times.iter().map(|&t| blade.drive(t).0).collect(),
+        u_m: vec![f64::NAN; n],
+        v3_m: vec![f64::NAN; n],
+        theta_rad: vec![f64::NAN; n],
+        phi_rad: vec![f64::NAN; n],
+        phase: vec![phase; n],
+        transitions: Vec::new(),
+        switches: Vec::new(),
+        stats: Stats::default(),
+        reach_m,
+    }
+}
+
+/// The first sample (up to [`START_SEARCH_S`] into the segment `(a, b)`) where the tracks give a
+/// state the neck/lip model can start from, and its time: right after the flip slip can be
+/// Painlevé-singular with the head height prescribed, and static friction may not yet hold the tip.
+///
+/// # Errors
+/// [`ModelFault::NoConsistentStart`] with the last attempt's fault when no sample in the search
+/// span gives a start.
+fn first_consistent_start(
+    model: &crate::model::necklip::NeckLip,
+    (a, b): (f64, f64),
+    sample_times: &[f64],
+) -> std::result::Result<(([f64; 4], Mode), f64), ModelFault> {
+    let dt = sample_times.get(1).map_or(1e-4, |t1| t1 - sample_times[0]);
+    let limit = (a + START_SEARCH_S).min(b);
+    let mut ts = a;
+    loop {
+        let attempt = model
+            .state_from_tracks(ts)
+            .and_then(|(y, dir)| start_from_tracks(model, ts, y, dir));
+        match attempt {
+            Ok(s) => return Ok((s, ts)),
+            Err(e) if ts + dt > limit => {
+                return Err(ModelFault::NoConsistentStart {
+                    search_s: START_SEARCH_S,
+                    last: Box::new(e),
+                });
+            }
+            Err(_) => ts += dt,
+        }
+    }
 }
 
 /// The mode a neck/lip segment starts in from the tracks, and its state: stick when the tip's speed
