@@ -579,11 +579,7 @@ impl Check<'_> {
             return Ok(());
         };
         let at = [Key::Name("recording"), Key::Name("import")];
-        let format = match r.import.format {
-            Some(f) => f,
-            None if r.import.generic.is_some() => crate::import::Format::Generic,
-            None => crate::import::Format::detect(&dir.join(&r.file))?,
-        };
+        let format = r.import.resolve_format(&dir.join(&r.file))?;
         r.import.validate(format).map_err(|e| match e {
             Error::Config(m) => self.error(&at, format!("[recording.import] {m}")),
             other => other,

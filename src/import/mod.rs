@@ -529,6 +529,19 @@ impl ImportSpec {
         Ok(())
     }
 
+    /// The format a file at `path` is read as: `format` when set, generic with a `[generic]`
+    /// mapping, else [`Format::detect`] on the file's content.
+    ///
+    /// # Errors
+    /// As [`Format::detect`].
+    pub fn resolve_format(&self, path: &Path) -> Result<Format> {
+        match self.format {
+            Some(f) => Ok(f),
+            None if self.generic.is_some() => Ok(Format::Generic),
+            None => Format::detect(path),
+        }
+    }
+
     /// The image scale in m/px: `m_per_px`, or `scale_distance_m` / |p2 − p1| from
     /// `scale_points_px`, or `None` if neither is set.
     ///
@@ -599,11 +612,7 @@ pub fn describe_file(path: &Path, spec: &ImportSpec) -> Result<(Trace, ImportSum
 
 /// [`read_trace_with_summary`] (`stand_in` false) or [`describe_file`] (true).
 fn read_with(path: &Path, spec: &ImportSpec, stand_in: bool) -> Result<(Trace, ImportSummary)> {
-    let format = match spec.format {
-        Some(f) => f,
-        None if spec.generic.is_some() => Format::Generic,
-        None => Format::detect(path)?,
-    };
+    let format = spec.resolve_format(path)?;
     spec.validate(format)?;
     // The two-point scale becomes m_per_px for every reader.
     let mut resolved = spec.clone();
@@ -654,10 +663,8 @@ fn check_plausible(path: &Path, trace: &Trace, unc: Uncalibrated) -> Result<()> 
             format!("{n} frame(s): a trace needs at least 2 frames (a time step and a spectrum)"),
         ));
     }
-    let (limit, unit) = (
-        MAX_POSITION_M,
-        if unc.file_units { "file units" } else { "m" },
-    );
+    let limit = MAX_POSITION_M;
+    let unit = if unc.file_units { "file units" } else { "m" };
     for p in &trace.points {
         for (axis, v) in [("x", &p.x_m), ("y", &p.y_m)] {
             if let Some(k) = v.iter().position(|c| c.abs() > limit) {
