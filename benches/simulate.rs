@@ -6,8 +6,9 @@ use std::hint::black_box;
 use std::sync::atomic::AtomicUsize;
 use std::sync::{Arc, Mutex};
 use wiperlab::fit::SpectralProblem;
+use wiperlab::fit::evidence::RecordingLikelihood;
 use wiperlab::fit::features::{SignalKind, default_bands, features};
-use wiperlab::fit::job::Weights;
+use wiperlab::fit::job::{Objective, Weights};
 use wiperlab::model::{Blade, BladeParams, StickForm};
 use wiperlab::simulate::blade::{default_window, simulate_blade};
 use wiperlab::simulate::hybrid::{Mode, Phase, SolverOptions, StickSlipModel};
@@ -93,7 +94,7 @@ fn cost(c: &mut Criterion) {
         .expect("signal");
     let bands = default_bands();
     let measured = features(&x, fs, &bands, 5).expect("features");
-    let problem = SpectralProblem {
+    let mut problem = SpectralProblem {
         model: wiperlab::simulate::blade::ModelKind::Blade2dof,
         head: None,
         targets: None,
@@ -113,12 +114,16 @@ fn cost(c: &mut Criterion) {
         window,
         solver,
         swarm_solver: solver,
+        objective: Objective::Likelihood,
         weights: Weights::default(),
-        likelihood: Err("the bench times the cost only".into()),
+        likelihood: Err("built below".into()),
         evaluations: Arc::new(AtomicUsize::new(0)),
         failures: std::sync::Arc::new(AtomicUsize::new(0)),
         first_failure: Mutex::new(None),
     };
+    problem.likelihood = Ok(Arc::new(
+        RecordingLikelihood::new(&problem, &x, false).expect("likelihood"),
+    ));
     let mut g = c.benchmark_group("fit");
     g.sample_size(10);
     g.bench_function("SpectralProblem::cost_at (rtol 1e-8)", |b| {

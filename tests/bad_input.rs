@@ -752,6 +752,21 @@ fn fit_cases() -> Vec<Case> {
             &["$D/job.toml:", "restarts"],
         ),
         case(
+            "fit: weights without the features objective",
+            j(&[(
+                "[fit.uncertainty]",
+                "[fit.weights]\npeak = 2.0\n[fit.uncertainty]",
+            )]),
+            fit,
+            &["$D/job.toml:", "weights", "objective = \"features\""],
+        ),
+        case(
+            "fit: unknown objective",
+            j(&[("restarts = 5", "restarts = 5\nobjective = \"chi2\"")]),
+            fit,
+            &["$D/job.toml:", "chi2", "likelihood", "features"],
+        ),
+        case(
             "fit: negative iterations",
             j(&[("polish_iterations = 60", "polish_iterations = -3")]),
             fit,

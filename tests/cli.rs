@@ -272,11 +272,6 @@ fn main_job_end_to_end() {
             t["reason"]
         );
     }
-    let head = trials
-        .iter()
-        .find(|t| t["model"] == "head1dof")
-        .expect("head1dof trial");
-    assert!(num(head, "/cost") > 10.0 * num(&r, "/cost"), "{head}");
     // The shoulder candidate contains blade2dof (k1_contact = k1) and starts one particle at its
     // optimum, bitwise the same parameters, which it keeps if no restart ends lower
     // (src/fit/mod.rs, fit_candidate `nested`). There |θ| stays below 0.15 rad, under θ_c's upper
@@ -300,10 +295,25 @@ fn main_job_end_to_end() {
     let lnl = |m: &str| num(&evidence(m), "/log_likelihood_nats");
     let (full, shoulder, head1) = (lnl("blade2dof"), lnl("blade2dof+shoulder"), lnl("head1dof"));
     println!("ln L: blade2dof {full:.3}, +shoulder {shoulder:.3}, head1dof {head1:.3} nats");
-    assert!((shoulder - full).abs() <= 1e-9 * full.abs(), "{trials:?}");
-    assert!((num(&evidence("blade2dof+shoulder"), "/delta_aic") - 4.0).abs() < 1e-6);
+    // The search minimises the NLL above the saturated model's (src/fit/evidence.rs,
+    // `excess_nll`), which differs from −ln L by a constant of the recording: cost differences
+    // between candidates are their ln L differences.
+    for m in ["head1dof", "blade2dof+shoulder"] {
+        let d_cost = cost_of(m) - cost_of("blade2dof");
+        let d_lnl = full - lnl(m);
+        assert!(
+            (d_cost - d_lnl).abs() < 1e-6 * (1.0 + d_lnl.abs()),
+            "{m}: Δcost {d_cost} against Δln L {d_lnl}"
+        );
+    }
+    // Nested: the shoulder cannot be less likely than blade2dof (its warm start is blade2dof's
+    // optimum). The sample has no shoulder, so what it gains is noise: Wilks' statistic below the
+    // χ²(2) 95 % point 5.991 (closed form −2 ln 0.05), and its AIC above blade2dof's.
+    let lrt = num(&evidence("blade2dof+shoulder"), "/lrt/statistic");
+    assert!(shoulder >= full - 1e-9 * full.abs(), "{trials:?}");
+    assert!((0.0..5.991).contains(&lrt), "{trials:?}");
     assert!(
-        num(&evidence("blade2dof+shoulder"), "/lrt/statistic").abs() < 1e-6,
+        num(&evidence("blade2dof+shoulder"), "/delta_aic") > 0.0,
         "{trials:?}"
     );
     assert!(full - head1 > 100.0, "{trials:?}");

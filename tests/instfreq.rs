@@ -494,7 +494,10 @@ fn fit_job_with_freq_speed_and_trace_terms_runs_and_reports_them() {
         .replace("name = \"reversal\"", "name = \"instfreq_terms\"")
         .replace("particles = 24", "particles = 2")
         .replace("swarm_iterations = 25", "swarm_iterations = 1")
-        .replace("polish_iterations = 60", "polish_iterations = 1")
+        .replace(
+            "polish_iterations = 60",
+            "polish_iterations = 1\nobjective = \"features\"",
+        )
         + "\n[fit.weights]\nfreq_speed = 1.0\ntrace = 1.0\n";
     let path =
         std::env::temp_dir().join(format!("wiperlab_instfreq_job_{}.toml", std::process::id()));

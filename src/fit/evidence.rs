@@ -50,6 +50,9 @@ pub struct RecordingLikelihood {
     pub sigma_m: f64,
     /// Whether the time-domain term is part of the likelihood.
     pub time_domain: bool,
+    /// The bands' NLL of the saturated model (every expected ordinate equal to the measured one),
+    /// nats: the lowest value each band's term can take.
+    saturated_spectral_nats: f64,
 }
 
 /// A fit's negative log-likelihood, by term.
@@ -112,11 +115,16 @@ impl RecordingLikelihood {
                 })
             })
             .collect::<Result<Vec<_>>>()?;
+        let saturated_spectral_nats = bands
+            .iter()
+            .map(|b| b.lik.nll(&b.measured, &b.measured))
+            .sum::<std::result::Result<f64, _>>()?;
         Ok(RecordingLikelihood {
             bands,
             measured_x,
             sigma_m,
             time_domain,
+            saturated_spectral_nats,
         })
     }
 
@@ -142,12 +150,42 @@ impl RecordingLikelihood {
         Ok(x)
     }
 
+    /// The measured signal the likelihood reads, m (NaN where missing or masked).
+    pub fn measured_signal(&self) -> &[f64] {
+        &self.measured_x
+    }
+
     /// The NLL of a simulation, by term.
     ///
     /// # Errors
     /// The features' errors, and [`likelihood::LikelihoodError`] for a non-positive ordinate or
     /// too few residuals.
     pub fn nll(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<NllParts> {
+        Ok(self.terms(problem, sim)?.0)
+    }
+
+    /// What the search minimises with `[fit] objective = "likelihood"`: the NLL above the saturated
+    /// model's, nats (half the deviance; McCullagh & Nelder 1989, *Generalized Linear Models*,
+    /// §2.3). Per band `Σ_k α(ln(S_k/P̂_k) + P̂_k/S_k − 1)/φ ≥ 0`, the Whittle NLL minus its value
+    /// at `S = P̂`; with the time-domain term, `(n_eff/n)·Σe²/(2σ²) ≥ 0`, that term minus its
+    /// normalisation `(n_eff/2)·ln(2πσ²)`. It differs from [`RecordingLikelihood::nll`]'s total by
+    /// a constant of the recording (while the residuals' `n_eff` stays put), so its minimum is the
+    /// maximum-likelihood estimate and differences between parameter sets are log-likelihood
+    /// ratios.
+    ///
+    /// # Errors
+    /// Those of [`RecordingLikelihood::nll`].
+    pub fn excess_nll(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<f64> {
+        let (parts, time_n_eff) = self.terms(problem, sim)?;
+        let spectral = parts.spectral_nats.iter().sum::<f64>() - self.saturated_spectral_nats;
+        let time = parts.time_nats.map_or(0.0, |t| {
+            t - 0.5 * time_n_eff * (std::f64::consts::TAU * self.sigma_m * self.sigma_m).ln()
+        });
+        Ok(spectral + time)
+    }
+
+    /// The NLL by term and the residuals' effective sample size.
+    fn terms(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<(NllParts, f64)> {
         let psd = self.model_psd(problem, sim)?;
         let mut spectral_nats = Vec::with_capacity(self.bands.len());
         let mut n_effective = 0.0;
@@ -164,13 +202,16 @@ impl RecordingLikelihood {
         } else {
             None
         };
-        Ok(NllParts {
-            spectral_nats,
-            time_nats,
-            residual_rms_m,
-            residual_rho: size.rho,
-            n_effective,
-        })
+        Ok((
+            NllParts {
+                spectral_nats,
+                time_nats,
+                residual_rms_m,
+                residual_rho: size.rho,
+                n_effective,
+            },
+            size.n_eff,
+        ))
     }
 
     /// What one simulation contributes to the Gauss–Newton Fisher information: the log expected

@@ -199,6 +199,12 @@ pub struct FitSection {
     /// `[solver]` tolerance throughout.
     #[serde(default)]
     pub swarm_rtol: Option<f64>,
+    /// What the search minimises (default: the recording's likelihood; a target job always uses
+    /// its targets' cost).
+    #[serde(default = "d_objective")]
+    pub objective: Objective,
+    /// Weights of the `features` objective (refused with the `likelihood` objective, which has no
+    /// weights).
     #[serde(default)]
     pub weights: Weights,
     /// Models of the hierarchy to fit and compare ([`Candidate`]), e.g. `["head1dof",
@@ -225,6 +231,25 @@ pub struct FitSection {
 pub struct LikelihoodSection {
     /// Add the Gaussian likelihood of the signal's time-domain residuals to the Welch spectra's.
     pub time_domain: bool,
+}
+
+crate::names::named_enum! {
+    /// What the fit's search minimises (docs/fit.md, "How it works").
+    pub enum Objective: "objective" {
+        /// The recording's negative log-likelihood in nats above the saturated model's
+        /// ([`crate::fit::evidence::RecordingLikelihood::excess_nll`]): the Whittle NLL of every
+        /// band's Welch ordinates, plus the time-domain term with `[fit.likelihood] time_domain`.
+        /// Model choice, intervals and the search then read one quantity.
+        Likelihood => "likelihood",
+        /// The weighted feature cost ([`crate::fit::SpectralProblem::cost_of`]): squared log
+        /// errors of each band's peak frequency (1 % scale), level (factor-2 scale) and shape, with
+        /// `[fit.weights]` and their optional frequency-against-speed and trace terms.
+        Features => "features",
+    }
+}
+
+fn d_objective() -> Objective {
+    Objective::Likelihood
 }
 
 crate::names::named_enum! {
@@ -641,6 +666,13 @@ impl Check<'_> {
                     ));
                 }
             }
+        }
+        if fit.objective == Objective::Likelihood && fit.weights != Weights::default() {
+            return Err(self.error(
+                &[Key::Name("fit"), Key::Name("weights")],
+                "[fit.weights] weigh the feature cost: set [fit] objective = \"features\" to use \
+                 them (the default objective, \"likelihood\", has no weights)",
+            ));
         }
         if let Some(r) = fit.swarm_rtol
             && !(r.is_finite() && r > 0.0 && r < 1.0)

@@ -3,7 +3,7 @@
 
 use super::features::{BandSpec, Features, SignalKind, features};
 use super::instfreq;
-use super::job::Weights;
+use super::job::{Objective, Weights};
 use super::result::SearchStage;
 use crate::model::BladeParams;
 use crate::model::ParamId;
@@ -93,6 +93,8 @@ pub struct SpectralProblem {
     pub solver: SolverOptions,
     /// The solver of the particle-swarm stage (`[fit] swarm_rtol`; else `solver`).
     pub swarm_solver: SolverOptions,
+    /// What [`SpectralProblem::total_cost`] is: the likelihood or the weighted features.
+    pub objective: Objective,
     pub weights: Weights,
     /// Optional frequency-against-speed and trace-error terms (`None` when their weights are 0).
     pub time_targets: Option<instfreq::TimeTargets>,
@@ -199,8 +201,37 @@ impl SpectralProblem {
         total
     }
 
-    /// Spectral cost of a simulation plus the optional time-domain terms ([`instfreq::TimeTargets`]).
+    /// The cost of a simulation: for a target job its [`target_cost`]; with the likelihood
+    /// objective the recording's NLL above the saturated model's, nats
+    /// ([`super::evidence::RecordingLikelihood::excess_nll`]); with the features objective the
+    /// weighted feature cost ([`SpectralProblem::cost_of`]) plus the optional time-domain terms
+    /// ([`instfreq::TimeTargets`]).
+    ///
+    /// # Errors
+    /// The simulation's features' errors, and [`Error::Config`] when the likelihood objective has
+    /// no likelihood (e.g. a median-averaged band, whose ordinates are not χ²).
     pub fn total_cost(&self, sim: &BladeSimulation) -> Result<f64> {
+        self.stage_cost(sim, SearchStage::Polish)
+    }
+
+    /// The cost a search `stage` ranks a simulation by: [`SpectralProblem::total_cost`], except
+    /// that with the likelihood objective the particle swarm ranks by the feature cost
+    /// ([`SpectralProblem::cost_of`], default weights). Its 1 %-scale peak-frequency term funnels the
+    /// swarm into the lines' basin; the Whittle likelihood is flat along valleys a short recording
+    /// leaves open (docs/fit.md, "How it works"), where the polish then finds its minimum.
+    fn stage_cost(&self, sim: &BladeSimulation, stage: SearchStage) -> Result<f64> {
+        if self.objective == Objective::Likelihood
+            && self.targets.is_none()
+            && stage == SearchStage::Polish
+        {
+            let lik = self.likelihood.as_ref().map_err(|why| {
+                Error::Config(format!(
+                    "[fit] objective = \"likelihood\" needs the recording's likelihood: {why}; \
+                     set objective = \"features\""
+                ))
+            })?;
+            return lik.excess_nll(self, sim);
+        }
         let spectral = self.cost_of(&self.model_features(sim)?);
         Ok(match &self.time_targets {
             Some(t) => spectral + t.cost(sim)?,
@@ -231,7 +262,7 @@ impl SpectralProblem {
         self.evaluations.fetch_add(1, Ordering::Relaxed);
         let c = match self
             .simulate_with(&p, solver)
-            .and_then(|s| self.total_cost(&s))
+            .and_then(|s| self.stage_cost(&s, stage))
         {
             Ok(c) => c,
             Err(e) => {

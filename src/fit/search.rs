@@ -280,6 +280,7 @@ pub(super) fn build_problem(
                 },
                 None => job.job.solver,
             },
+            objective: fit.objective,
             weights: fit.weights,
             likelihood: Err("not built yet".into()),
             evaluations: evaluations.clone(),

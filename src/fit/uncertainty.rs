@@ -1,5 +1,6 @@
 //! Uncertainty stage: bootstrap intervals and identifiability warnings for the chosen model.
 
+use super::evidence::RecordingLikelihood;
 use super::features::{features, noise_floor};
 use super::job::{self, UncertaintyMethod};
 use super::problem::{FreeParam, SpectralProblem};
@@ -56,8 +57,8 @@ pub(super) fn intervals(
 /// estimate. A parameter the likelihood does not inform (`σ_u = ∞`) gets its search range.
 ///
 /// Asymptotically (many effectively independent bins, a smooth likelihood) this is the
-/// maximum-likelihood estimate's interval (Pawitan 2001, *In All Likelihood*, §9.4); the fit's
-/// estimate is the spectral cost's minimum, not the likelihood's, and its coverage is measured in
+/// maximum-likelihood estimate's interval (Pawitan 2001, *In All Likelihood*, §9.4), which the
+/// fit's estimate is with the default `[fit] objective = "likelihood"`; its coverage is measured in
 /// docs/fit.md, "Uncertainty".
 pub fn laplace_intervals(free: &[FreeParam], best_u: &[f64], sigma_u: &[f64]) -> Vec<Interval> {
     free.iter()
@@ -238,11 +239,21 @@ impl ReplicateSource {
             window: problem.window,
             solver: problem.solver,
             swarm_solver: problem.swarm_solver,
+            objective: problem.objective,
             weights: problem.weights,
-            likelihood: Err("a bootstrap replicate".into()),
+            likelihood: Err("not built yet".into()),
             evaluations: problem.evaluations.clone(),
             failures: problem.failures.clone(),
             first_failure: Mutex::new(None),
+        })
+        .map(|mut rep| {
+            // The replicate's own likelihood: its measured ordinates and noise, the recording's
+            // terms.
+            let time_domain = problem.likelihood.as_ref().is_ok_and(|l| l.time_domain);
+            rep.likelihood = RecordingLikelihood::new(&rep, &x, time_domain)
+                .map(Arc::new)
+                .map_err(|e| e.to_string());
+            rep
         })
     }
 }

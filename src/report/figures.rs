@@ -4,7 +4,8 @@
 use super::plot::{ChartOpts, Marker, Series, heatmap, line_chart};
 use crate::fit::features::{BandFeatures, Features, noise_floor};
 use crate::fit::instfreq::FreqSpeedComparison;
-use crate::fit::result::HistoryPoint;
+use crate::fit::job::Objective;
+use crate::fit::result::{HistoryPoint, SearchStage};
 use crate::fit::{FitOutcome, FitResult};
 use crate::model::FrictionLaw;
 use crate::simulate::blade::BladeSimulation;
@@ -146,7 +147,12 @@ pub fn fit_figures(
     if let Some(c) = freq_speed {
         freq_vs_speed_figure(dir, c)?;
     }
-    cost_figure(dir, &o.result.history)
+    let objective = o
+        .result
+        .fit_settings
+        .as_ref()
+        .map_or(Objective::Features, |f| f.objective);
+    cost_figure(dir, &o.result.history, objective)
 }
 
 /// A signal in mm with its mean over the finite samples removed, so measured (camera frame) and
@@ -422,29 +428,49 @@ fn friction_law_figure(dir: &Path, o: &FitOutcome) -> Result<()> {
 }
 
 /// Writes `cost.svg`: best cost against the restart's own model evaluations, one series per restart
-/// (the restarts run in parallel, each from its own swarm).
-fn cost_figure(dir: &Path, history: &[HistoryPoint]) -> Result<()> {
+/// and stage (the restarts run in parallel, each from its own swarm). With the likelihood
+/// objective the swarm ranks by the feature cost and the polish by the NLL above the saturated
+/// model (nats), so the two stages are separate series and the axis names both.
+fn cost_figure(dir: &Path, history: &[HistoryPoint], objective: Objective) -> Result<()> {
     let restarts = history.iter().map(|h| h.restart + 1).max().unwrap_or(0);
+    let split = objective == Objective::Likelihood;
+    let stages: &[Option<SearchStage>] = if split {
+        &[Some(SearchStage::Swarm), Some(SearchStage::Polish)]
+    } else {
+        &[None]
+    };
     let series: Vec<Series> = (0..restarts.max(1))
-        .map(|r| {
+        .flat_map(|r| stages.iter().map(move |st| (r, *st)))
+        .map(|(r, st)| {
             let (it, c): (Vec<f64>, Vec<f64>) = history
                 .iter()
-                .filter(|h| h.restart == r)
+                .filter(|h| h.restart == r && st.is_none_or(|s| h.stage == s))
                 .map(|h| (h.evaluations as f64, h.best_cost))
                 .unzip();
+            let what = match st {
+                Some(SearchStage::Swarm) => "swarm, feature cost",
+                Some(SearchStage::Polish) => "Nelder–Mead, nats",
+                None => "swarm, then Nelder–Mead",
+            };
             let label = if restarts > 1 {
-                format!("restart {} (swarm, then Nelder–Mead)", r + 1)
+                format!("restart {} ({what})", r + 1)
             } else {
-                "best cost (swarm, then Nelder–Mead)".into()
+                format!("best cost ({what})")
             };
             Series::line(label, it, c)
         })
+        .filter(|s| !s.x.is_empty())
         .collect();
+    let y_label = if split {
+        "best cost (swarm: feature cost; polish: NLL above saturated, nats)"
+    } else {
+        "best cost"
+    };
     line_chart(
         &dir.join("cost.svg"),
         "best cost against model evaluations",
         "model evaluations of the restart",
-        "best cost",
+        y_label,
         &series,
         &ChartOpts {
             log_y: true,
