@@ -4,7 +4,7 @@ use crate::fit::job::{parse_toml, read_text};
 use crate::model::{BladeParams, StickForm};
 use crate::names::named_enum;
 use crate::simulate::SolverOptions;
-use crate::simulate::blade::{ModelKind, default_window, simulate_model};
+use crate::simulate::blade::{ModelKind, contact_forces, default_window, simulate_model};
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -79,12 +79,13 @@ pub(super) fn run(a: SimulateArgs) -> Result<()> {
     };
     let t = std::time::Instant::now();
     let sim = simulate_model(a.model, &p, win, &times, &opts, form)?;
+    let forces = contact_forces(a.model, &p, form, &sim)?;
     let wall = t.elapsed().as_secs_f64();
     let dir = a
         .out_dir
         .unwrap_or_else(|| Path::new("reports/simulate").join(super::stem(&a.params)));
     crate::io::create_dir(&dir)?;
-    crate::report::figures::write_simulation(&dir, &sim)?;
+    crate::report::figures::write_simulation(&dir, &sim, &forces)?;
     println!(
         "simulated {:.4}..{:.4} s in {wall:.3} s: {} transitions, {} steps ({} rejected), {} RHS evaluations; outputs in {}",
         win.0,

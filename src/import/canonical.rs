@@ -1,12 +1,14 @@
 //! The canonical trace CSV: what wiperlab writes after an import and reads back bit for bit.
 //!
 //! ```text
-//! t_s,head_x_m,head_y_m,tip_x_m,tip_y_m[,<other>_x_m,<other>_y_m ...]
+//! t_s,head_x_m,head_y_m,tip_x_m,tip_y_m[,<other>_x_m,<other>_y_m ...][,<extra> ...]
 //! 0,3.061379e-6,-1.904484e-4,-1.401455e-3,-5.999148e-3
 //! ```
 //! * Comma delimited, `.` decimal, LF line ends, one header line, one row per sample.
 //! * `t_s` in seconds, positions in metres, physical y up (the [`Trace`] conventions).
-//! * Columns: `head` and `tip` first when present, then the other points in trace order.
+//! * Columns: `head` and `tip` first when present, then the other points in trace order, then
+//!   optional extra columns ([`ExtraColumn`], e.g. the model state `wiperlab simulate` writes) whose
+//!   names do not end in `_x_m` or `_y_m`; a reader of the trace skips them.
 //! * Numbers: Rust's shortest representation that parses back to the same `f64` (plain decimal for
 //!   1e-4 ≤ |v| < 1e15, otherwise `1.5e-5` style); missing = `NaN`.
 //! * Names containing `,` or `"` are quoted per RFC 4180 (the `csv` crate).
@@ -28,6 +30,43 @@ fn format_f64(v: f64) -> String {
     } else {
         format!("{v:e}")
     }
+}
+
+/// A column after the points: numbers (written as the positions are) or labels. Its name must not
+/// end in `_x_m` or `_y_m` (those name points).
+#[derive(Debug, Clone, Copy)]
+pub enum ExtraColumn<'a> {
+    /// A numeric column: name (with its unit, e.g. `theta_rad`) and one value per sample.
+    Numbers(&'a str, &'a [f64]),
+    /// A text column: name and one label per sample (no `,` or `"` needed, but quoted if present).
+    Labels(&'a str, &'a [&'a str]),
+}
+
+impl ExtraColumn<'_> {
+    fn name(&self) -> &str {
+        match self {
+            ExtraColumn::Numbers(n, _) | ExtraColumn::Labels(n, _) => n,
+        }
+    }
+
+    fn len(&self) -> usize {
+        match self {
+            ExtraColumn::Numbers(_, v) => v.len(),
+            ExtraColumn::Labels(_, v) => v.len(),
+        }
+    }
+
+    fn cell(&self, k: usize) -> String {
+        match self {
+            ExtraColumn::Numbers(_, v) => format_f64(v[k]),
+            ExtraColumn::Labels(_, v) => v[k].to_owned(),
+        }
+    }
+}
+
+/// Whether `name` would be read as a point column.
+fn is_point_column(name: &str) -> bool {
+    name.ends_with("_x_m") || name.ends_with("_y_m")
 }
 
 /// The column order of the canonical CSV: indices into `trace.points`, `head` and `tip` first.
@@ -62,6 +101,49 @@ pub fn write_trace_csv(path: &Path, trace: &Trace) -> Result<()> {
 /// # Errors
 /// As [`write_trace_csv`], without the file's.
 pub fn trace_csv_bytes(path: &Path, trace: &Trace) -> Result<Vec<u8>> {
+    trace_csv_bytes_with(path, trace, &[])
+}
+
+/// Write `trace` followed by the columns `extra` (module docs) to `path`, replacing an existing
+/// file. Reading the file back gives `trace`; the extra columns are skipped.
+///
+/// # Errors
+/// As [`write_trace_csv`]; [`Error::Input`] naming `path` too when an extra column's length is not
+/// the trace's, its name is empty, `t_s`, a point column's (`_x_m`, `_y_m`) or repeated.
+pub fn write_trace_csv_with(path: &Path, trace: &Trace, extra: &[ExtraColumn]) -> Result<()> {
+    let bytes = trace_csv_bytes_with(path, trace, extra)?;
+    crate::io::write_atomic(path, &bytes)
+}
+
+/// Checks the extra columns against `trace` ([`write_trace_csv_with`]).
+fn check_extra(path: &Path, trace: &Trace, extra: &[ExtraColumn]) -> Result<()> {
+    for (i, c) in extra.iter().enumerate() {
+        let name = c.name();
+        let bad = if name.is_empty() || name == "t_s" || is_point_column(name) {
+            Some("a name that is not empty, t_s or a point's (_x_m, _y_m)".to_owned())
+        } else if extra[..i].iter().any(|d| d.name() == name) {
+            Some("a name of its own (it repeats)".to_owned())
+        } else if c.len() != trace.t_s.len() {
+            Some(format!("{} values (it has {})", trace.t_s.len(), c.len()))
+        } else {
+            None
+        };
+        if let Some(expected) = bad {
+            return Err(Error::input(
+                path,
+                format!("cannot write trace: extra column {name:?}: expected {expected}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// [`trace_csv_bytes`] followed by the columns `extra`.
+///
+/// # Errors
+/// As [`write_trace_csv_with`], without the file's.
+pub fn trace_csv_bytes_with(path: &Path, trace: &Trace, extra: &[ExtraColumn]) -> Result<Vec<u8>> {
+    check_extra(path, trace, extra)?;
     trace
         .check()
         .map_err(|m| Error::input(path, format!("cannot write trace: {m}")))?;
@@ -89,6 +171,7 @@ pub fn trace_csv_bytes(path: &Path, trace: &Trace) -> Result<Vec<u8>> {
         header.push(format!("{name}_x_m"));
         header.push(format!("{name}_y_m"));
     }
+    header.extend(extra.iter().map(|c| c.name().to_owned()));
     w.write_record(&header)
         .map_err(|e| csv_error(path, "write", e))?;
     let mut row: Vec<String> = Vec::with_capacity(header.len());
@@ -100,6 +183,7 @@ pub fn trace_csv_bytes(path: &Path, trace: &Trace) -> Result<Vec<u8>> {
             row.push(format_f64(p.x_m[k]));
             row.push(format_f64(p.y_m[k]));
         }
+        row.extend(extra.iter().map(|c| c.cell(k)));
         w.write_record(&row)
             .map_err(|e| csv_error(path, "write", e))?;
     }
@@ -110,16 +194,26 @@ pub fn trace_csv_bytes(path: &Path, trace: &Trace) -> Result<Vec<u8>> {
 /// Read a canonical trace CSV (module docs) written by [`write_trace_csv`] or by hand.
 ///
 /// Cells `NaN` (any case) or empty are missing values. Returns the points in column order; time
-/// must be finite and strictly increasing.
+/// must be finite and strictly increasing. Extra columns after the points are skipped
+/// ([`read_trace_csv_with_extras`] names them).
 ///
 /// # Errors
 /// * [`Error::Io`] — cannot open/read `path`;
 /// * [`Error::Input`] — empty file or no data rows;
-/// * [`Error::Parse`] — header not `t_s` followed by `<name>_x_m,<name>_y_m` pairs (line 1 and the
-///   column), a row with a different field count (line, column 0), a non-number cell
+/// * [`Error::Parse`] — header not `t_s` followed by `<name>_x_m,<name>_y_m` pairs and then
+///   columns not named like points (line 1 and the column), a row with a different field count
+///   (line, column 0), a non-number cell
 ///   (`file:line:column: field head_x_m: expected a number or NaN, found "abc"`), a missing or
 ///   non-increasing time.
 pub fn read_trace_csv(path: &Path) -> Result<Trace> {
+    read_trace_csv_with_extras(path).map(|(trace, _)| trace)
+}
+
+/// [`read_trace_csv`] and the names of the extra columns it skipped, in file order.
+///
+/// # Errors
+/// As [`read_trace_csv`].
+pub fn read_trace_csv_with_extras(path: &Path) -> Result<(Trace, Vec<String>)> {
     let mut reader = open_csv(path)?;
     let mut records = reader.records();
     let (header_line, names) = csv_header(
@@ -128,6 +222,7 @@ pub fn read_trace_csv(path: &Path) -> Result<Trace> {
         "empty file: expected a header t_s,<name>_x_m,<name>_y_m,...",
     )?;
     let mut points = header_points(path, header_line, &names)?;
+    let extras = names[1 + 2 * points.len()..].to_vec();
     let mut t_s: Vec<f64> = Vec::new();
     for (row, record) in records.enumerate() {
         let record = record.map_err(|e| csv_error(path, "read", e))?;
@@ -144,10 +239,12 @@ pub fn read_trace_csv(path: &Path) -> Result<Trace> {
     if t_s.is_empty() {
         return Err(Error::input(path, "no data rows after the header"));
     }
-    Ok(Trace { t_s, points })
+    Ok((Trace { t_s, points }, extras))
 }
 
-/// The empty points named by a header `t_s,<name>_x_m,<name>_y_m,...` (names unique).
+/// The empty points named by a header `t_s,<name>_x_m,<name>_y_m,...[,<extra>...]` (names unique);
+/// the points end at the first column not named `<name>_x_m` or `<name>_y_m`, and no such column
+/// may follow.
 fn header_points(path: &Path, header_line: usize, names: &[String]) -> Result<Vec<PointTrack>> {
     if names.first().map(String::as_str) != Some("t_s") {
         return Err(Error::parse(
@@ -160,16 +257,25 @@ fn header_points(path: &Path, header_line: usize, names: &[String]) -> Result<Ve
             ),
         ));
     }
-    if names.len().is_multiple_of(2) {
+    let n_point_cols = names[1..].iter().take_while(|n| is_point_column(n)).count();
+    if let Some(k) = names[1 + n_point_cols..]
+        .iter()
+        .position(|n| is_point_column(n))
+    {
+        let col = 2 + n_point_cols + k;
         return Err(Error::parse(
             path,
             header_line,
-            names.len(),
-            "expected t_s followed by pairs <name>_x_m,<name>_y_m: odd number of position columns",
+            col,
+            format!(
+                "point column {} after the other columns: expected every <name>_x_m,<name>_y_m \
+                 pair right after t_s",
+                quote_cell(&names[col - 1])
+            ),
         ));
     }
     let mut points: Vec<PointTrack> = Vec::new();
-    for (k, pair) in names[1..].chunks(2).enumerate() {
+    for (k, pair) in names[1..=n_point_cols].chunks(2).enumerate() {
         let col = 2 + 2 * k;
         let Some(name) = pair[0].strip_suffix("_x_m").filter(|n| !n.is_empty()) else {
             return Err(Error::parse(
@@ -179,12 +285,15 @@ fn header_points(path: &Path, header_line: usize, names: &[String]) -> Result<Ve
                 format!("expected <name>_x_m, found {}", quote_cell(&pair[0])),
             ));
         };
-        if pair[1].strip_suffix("_y_m") != Some(name) {
+        if pair.get(1).and_then(|c| c.strip_suffix("_y_m")) != Some(name) {
             return Err(Error::parse(
                 path,
                 header_line,
                 col + 1,
-                format!("expected {name}_y_m, found {}", quote_cell(&pair[1])),
+                format!(
+                    "expected {name}_y_m, found {}",
+                    quote_cell(names.get(col).map_or("", String::as_str))
+                ),
             ));
         }
         if points.iter().any(|p| p.name == name) {

@@ -723,7 +723,14 @@ fn read_format(
         }
         Format::Canonical => {
             notes.push("canonical trace: times in s, positions in m, y up, as written".into());
-            canonical::read_trace_csv(path)?
+            let (trace, extras) = canonical::read_trace_csv_with_extras(path)?;
+            if !extras.is_empty() {
+                notes.push(format!(
+                    "columns after the points skipped (not tracked points): {}",
+                    extras.join(", ")
+                ));
+            }
+            trace
         }
         other => {
             let raw = read_raw(path, other, &spec)?;

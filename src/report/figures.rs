@@ -8,7 +8,7 @@ use crate::fit::job::Objective;
 use crate::fit::result::{HistoryPoint, SearchStage};
 use crate::fit::{FitOutcome, FitResult};
 use crate::model::FrictionLaw;
-use crate::simulate::blade::BladeSimulation;
+use crate::simulate::blade::{BladeSimulation, ContactForces};
 use crate::spectrum::Spectrogram;
 use crate::spectrum::instfreq::FreqSpeedPoint;
 use crate::{Error, Result};
@@ -84,9 +84,10 @@ pub fn spectrum_figures(
     Ok(())
 }
 
-/// Writes a simulation: canonical trace CSV, transitions CSV, and SVGs of the tip and head motion.
-pub fn write_simulation(dir: &Path, sim: &BladeSimulation) -> Result<()> {
-    crate::import::canonical::write_trace_csv(&dir.join("trace.csv"), &sim.to_trace())?;
+/// Writes a simulation: the trace CSV with the model state ([`write_simulation_trace`]), the
+/// transitions CSV, and SVGs of the tip and head motion.
+pub fn write_simulation(dir: &Path, sim: &BladeSimulation, forces: &ContactForces) -> Result<()> {
+    write_simulation_trace(&dir.join("trace.csv"), sim, forces)?;
     let tpath = dir.join("transitions.csv");
     let mut s = String::from("t_s,from,to\n");
     for t in &sim.transitions {
@@ -127,6 +128,36 @@ pub fn write_simulation(dir: &Path, sim: &BladeSimulation) -> Result<()> {
             sim.u_m.iter().map(|u| u * 1e3).collect(),
         )],
         &ChartOpts::default(),
+    )
+}
+
+/// Simulate's `trace.csv`: the canonical trace of the model (head at (v, −u), tip at (v3, −(l1+l2)),
+/// so `tip_x_m` is v3) followed by the model's state and contact: `theta_rad`, `phi_rad`,
+/// `theta_dot_rad_per_s`, `phi_dot_rad_per_s`, `v3_dot_m_per_s`, `normal_force_n`,
+/// `friction_force_n` (along +x, on the tip) and `phase` (`slip+`, `slip-`, `stick`).
+///
+/// # Errors
+/// As [`crate::import::canonical::write_trace_csv_with`].
+pub fn write_simulation_trace(
+    path: &Path,
+    sim: &BladeSimulation,
+    forces: &ContactForces,
+) -> Result<()> {
+    use crate::import::canonical::{ExtraColumn, write_trace_csv_with};
+    let phase: Vec<&str> = sim.phase.iter().map(|p| p.label()).collect();
+    write_trace_csv_with(
+        path,
+        &sim.to_trace(),
+        &[
+            ExtraColumn::Numbers("theta_rad", &sim.theta_rad),
+            ExtraColumn::Numbers("phi_rad", &sim.phi_rad),
+            ExtraColumn::Numbers("theta_dot_rad_per_s", &sim.theta_dot_rad_per_s),
+            ExtraColumn::Numbers("phi_dot_rad_per_s", &sim.phi_dot_rad_per_s),
+            ExtraColumn::Numbers("v3_dot_m_per_s", &sim.v3_dot_m_per_s),
+            ExtraColumn::Numbers("normal_force_n", &forces.normal_n),
+            ExtraColumn::Numbers("friction_force_n", &forces.friction_n),
+            ExtraColumn::Labels("phase", &phase),
+        ],
     )
 }
 

@@ -1,6 +1,8 @@
 //! Simulating the blade over a drive window, sampled at given (camera) times.
 
-use super::hybrid::{Mode, ModelFault, Phase, SolverOptions, Stats, Switch, Transition, integrate};
+use super::hybrid::{
+    Mode, ModelFault, Phase, SolverOptions, Stats, StickSlipModel, Switch, Transition, integrate,
+};
 use crate::model::blade::{Blade, BladeParams, LockedBlade, StickForm};
 use crate::trace::{PointTrack, Trace};
 use crate::{Error, Result};
@@ -20,9 +22,20 @@ pub struct BladeSimulation {
     pub u_m: Vec<f64>,
     /// Lip-tip horizontal position v3, m.
     pub v3_m: Vec<f64>,
+    /// Neck angle θ from the vertical, rad.
     pub theta_rad: Vec<f64>,
+    /// Lip angle φ from the vertical, rad.
     pub phi_rad: Vec<f64>,
+    /// Neck rate θ̇, rad/s.
+    pub theta_dot_rad_per_s: Vec<f64>,
+    /// Lip rate φ̇, rad/s.
+    pub phi_dot_rad_per_s: Vec<f64>,
+    /// Lip-tip horizontal velocity v̇3 (the slip velocity; 0 in stick), m/s.
+    pub v3_dot_m_per_s: Vec<f64>,
     pub phase: Vec<Phase>,
+    /// The mode at each sample: the phase with its stick anchor and shoulder region, what
+    /// [`contact_forces`] needs to evaluate the model there.
+    pub modes: Vec<Mode>,
     pub transitions: Vec<Transition>,
     /// Crossings of the shoulder-contact angle (empty without a shoulder).
     pub switches: Vec<Switch>,
@@ -32,6 +45,37 @@ pub struct BladeSimulation {
 }
 
 impl BladeSimulation {
+    /// Fills sample `j` from the state `y` (layout `[θ, φ, θ̇, φ̇]`) in `mode`: positions from
+    /// `blade`'s kinematics, the slip velocity from `model`.
+    fn observe<M: StickSlipModel<4>>(
+        &mut self,
+        j: usize,
+        model: &M,
+        blade: &Blade,
+        y: &[f64; 4],
+        mode: &Mode,
+    ) {
+        let t = self.t_s[j];
+        self.u_m[j] = blade.head_drop(y);
+        self.v3_m[j] = blade.tip_position(t, y);
+        self.theta_rad[j] = y[0];
+        self.phi_rad[j] = y[1];
+        self.theta_dot_rad_per_s[j] = y[2];
+        self.phi_dot_rad_per_s[j] = y[3];
+        self.v3_dot_m_per_s[j] = model.slip_velocity(t, y);
+        self.modes[j] = *mode;
+    }
+
+    /// The state `[θ, φ, θ̇, φ̇]` at sample `j`.
+    fn state(&self, j: usize) -> [f64; 4] {
+        [
+            self.theta_rad[j],
+            self.phi_rad[j],
+            self.theta_dot_rad_per_s[j],
+            self.phi_dot_rad_per_s[j],
+        ]
+    }
+
     /// The simulation as a canonical trace: point `head` at (v, −u), point `tip` at (v3, −(l1+l2)),
     /// in the model's frame (origin at the upright head position, y up).
     pub fn to_trace(&self) -> Trace {
@@ -52,6 +96,56 @@ impl BladeSimulation {
             ],
         }
     }
+}
+
+/// The contact forces of a simulation at its samples, N (the length of its `t_s`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactForces {
+    /// Normal force N of the glass on the lip tip (seed eq. 3), N.
+    pub normal_n: Vec<f64>,
+    /// Friction force f of the glass on the lip tip along +x, N: `−sign(v̇3)·μ_d(|v̇3|)·N` in slip
+    /// (seed eq. 4), the force that holds the tip in stick, `|f| ≤ μ_s·N` (seed eq. 5).
+    pub friction_n: Vec<f64>,
+}
+
+/// The contact forces of `sim`, a simulation of model `kind` with `params` and `stick_form`, at its
+/// samples: the model's own right-hand side evaluated in each sample's mode (what the integrator
+/// used there). Separate from the simulation so that a fit's runs do not pay for them.
+///
+/// # Errors
+/// [`Error::Config`] for the neck/lip model (its prescribed head is not kept);
+/// [`Error::Simulation`] naming the time and state if the right-hand side fails at a sample.
+pub fn contact_forces(
+    kind: ModelKind,
+    params: &BladeParams,
+    stick_form: StickForm,
+    sim: &BladeSimulation,
+) -> Result<ContactForces> {
+    match kind {
+        ModelKind::Blade2dof => forces_of(&Blade::new(*params, stick_form), sim),
+        ModelKind::Head1dof => forces_of(&LockedBlade::new(*params), sim),
+        ModelKind::Necklip => Err(Error::Config(
+            "contact forces of the neck/lip model need its prescribed head: not available".into(),
+        )),
+    }
+}
+
+fn forces_of<M: StickSlipModel<4>>(model: &M, sim: &BladeSimulation) -> Result<ContactForces> {
+    let n = sim.t_s.len();
+    let mut out = ContactForces {
+        normal_n: Vec::with_capacity(n),
+        friction_n: Vec::with_capacity(n),
+    };
+    let mut dy = [0.0; 4];
+    for (j, (&t, mode)) in sim.t_s.iter().zip(&sim.modes).enumerate() {
+        let y = sim.state(j);
+        let c = model
+            .rhs(mode, t, &y, &mut dy)
+            .map_err(|e| super::error::SimulationError::new(t, e, model.describe(t, &y)))?;
+        out.normal_n.push(c.normal);
+        out.friction_n.push(c.friction);
+    }
+    Ok(out)
 }
 
 /// The default reversal window `[π/2, 3π/2]/ω`: from the fastest forward point of the drive
@@ -204,12 +298,8 @@ pub fn simulate_necklip(
         let lo = sample_times.partition_point(|&t| t < a);
         let hi = sample_times.partition_point(|&t| t <= b);
         let run = integrate(&model, a, y0, mode0, b, &sample_times[lo..hi], opts)?;
-        for (j, y) in (lo..hi).zip(&run.y) {
-            let t = sample_times[j];
-            sim.u_m[j] = model.blade.head_drop(y);
-            sim.v3_m[j] = model.blade.tip_position(t, y);
-            sim.theta_rad[j] = y[0];
-            sim.phi_rad[j] = y[1];
+        for (k, j) in (lo..hi).enumerate() {
+            sim.observe(j, &model, &model.blade, &run.y[k], &run.modes[k]);
         }
         sim.phase[lo..hi].copy_from_slice(&run.phase);
         let last = run.phase.last().copied().unwrap_or(mode0.phase);
@@ -227,8 +317,8 @@ pub fn simulate_necklip(
     Ok(sim)
 }
 
-/// A simulation of the neck/lip model before any segment ran: the drive `v` at every sample, NaN
-/// positions and angles, every sample in `phase`.
+/// A simulation before any sample was observed: the drive `v` at every sample, NaN positions,
+/// angles, rates and forces, every sample in `phase`.
 fn unsimulated(blade: &Blade, sample_times: &[f64], phase: Phase, reach_m: f64) -> BladeSimulation {
     let n = sample_times.len();
     BladeSimulation {
@@ -238,7 +328,11 @@ fn unsimulated(blade: &Blade, sample_times: &[f64], phase: Phase, reach_m: f64) 
         v3_m: vec![f64::NAN; n],
         theta_rad: vec![f64::NAN; n],
         phi_rad: vec![f64::NAN; n],
+        theta_dot_rad_per_s: vec![f64::NAN; n],
+        phi_dot_rad_per_s: vec![f64::NAN; n],
+        v3_dot_m_per_s: vec![f64::NAN; n],
         phase: vec![phase; n],
+        modes: vec![Mode::new(phase, 0.0); n],
         transitions: Vec::new(),
         switches: Vec::new(),
         stats: Stats::default(),
@@ -353,26 +447,13 @@ fn run_to_simulation<M: crate::simulate::hybrid::StickSlipModel<4>>(
         Phase::SlipNeg
     };
     let run = integrate(model, t0, y0, Mode::new(s0, 0.0), t1, sample_times, opts)?;
-    let n = run.t_s.len();
-    let mut sim = BladeSimulation {
-        t_s: run.t_s,
-        v_m: Vec::with_capacity(n),
-        u_m: Vec::with_capacity(n),
-        v3_m: Vec::with_capacity(n),
-        theta_rad: Vec::with_capacity(n),
-        phi_rad: Vec::with_capacity(n),
-        phase: run.phase,
-        transitions: run.transitions,
-        switches: run.switches,
-        stats: run.stats,
-        reach_m: params.l1_m + params.l2_m,
-    };
-    for (t, y) in sim.t_s.iter().zip(&run.y) {
-        sim.v_m.push(blade.drive(*t).0);
-        sim.u_m.push(blade.head_drop(y));
-        sim.v3_m.push(blade.tip_position(*t, y));
-        sim.theta_rad.push(y[0]);
-        sim.phi_rad.push(y[1]);
+    let mut sim = unsimulated(blade, &run.t_s, s0, params.l1_m + params.l2_m);
+    for (j, (y, mode)) in run.y.iter().zip(&run.modes).enumerate() {
+        sim.observe(j, model, blade, y, mode);
     }
+    sim.phase = run.phase;
+    sim.transitions = run.transitions;
+    sim.switches = run.switches;
+    sim.stats = run.stats;
     Ok(sim)
 }

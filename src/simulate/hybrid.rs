@@ -122,6 +122,9 @@ pub struct Run<const N: usize> {
     pub t_s: Vec<f64>,
     pub y: Vec<[f64; N]>,
     pub phase: Vec<Phase>,
+    /// The mode at each requested time: its phase with the stick anchor and the switching region,
+    /// what [`StickSlipModel::rhs`] needs to give the contact forces there.
+    pub modes: Vec<Mode>,
     pub transitions: Vec<Transition>,
     /// State just after each transition (consistent with the new phase).
     pub transition_states: Vec<[f64; N]>,
@@ -421,6 +424,14 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
     /// # Errors
     /// The model's fault when the state cannot be completed (see [`StickSlipModel::complete`]).
     pub fn state_at(&mut self, t: f64) -> Result<([f64; N], Phase)> {
+        self.state_and_mode_at(t).map(|(y, mode)| (y, mode.phase))
+    }
+
+    /// [`HybridSolver::state_at`] with the whole mode there (phase, stick anchor, region).
+    ///
+    /// # Errors
+    /// As [`HybridSolver::state_at`].
+    pub fn state_and_mode_at(&mut self, t: f64) -> Result<([f64; N], Mode)> {
         while self.segments.len() > 1 && self.segments[0].t1 < t {
             self.segments.remove(0);
         }
@@ -437,7 +448,7 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
         self.model
             .complete(&mode, t, &mut y)
             .map_err(|e| self.fail(t, &y, e.into()))?;
-        Ok((y, mode.phase))
+        Ok((y, mode))
     }
 
     fn fail(&self, t: f64, y: &[f64; N], cause: StopCause) -> Error {
@@ -794,6 +805,7 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
         t_s: Vec::with_capacity(out_times.len()),
         y: Vec::with_capacity(out_times.len()),
         phase: Vec::with_capacity(out_times.len()),
+        modes: Vec::with_capacity(out_times.len()),
         transitions: Vec::new(),
         transition_states: Vec::new(),
         switches: Vec::new(),
@@ -808,16 +820,18 @@ pub fn integrate<M: StickSlipModel<N>, const N: usize>(
         run.t_s.push(out_times[next_out]);
         run.y.push(y_start);
         run.phase.push(mode_start.phase);
+        run.modes.push(mode_start);
         next_out += 1;
     }
     loop {
         let reason = solver.step()?;
         while next_out < out_times.len() && out_times[next_out] <= solver.settled_s() {
             let to = out_times[next_out];
-            let (yo, phase) = solver.state_at(to)?;
+            let (yo, mode) = solver.state_and_mode_at(to)?;
             run.t_s.push(to);
             run.y.push(yo);
-            run.phase.push(phase);
+            run.phase.push(mode.phase);
+            run.modes.push(mode);
             next_out += 1;
         }
         if let StopReason::StopTime { .. } = reason {
