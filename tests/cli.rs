@@ -603,12 +603,20 @@ fn simulate_writes_outputs() {
     let (header, rows) = csv_rows(&dir.join("trace.csv"));
     assert!(header.starts_with("t_s,head_x_m,"), "{header}");
     let ncol = header.split(',').count();
+    // The last column is the phase label; tests/sim_trace.rs checks the model columns' physics.
+    assert!(header.ends_with(",friction_force_n,phase"), "{header}");
     // 0.02 s at the default 10 kHz: 201 samples.
     assert!(rows.len() > 100 && rows.len() <= 201, "{} rows", rows.len());
     for r in &rows {
         assert_eq!(r.len(), ncol, "{r:?}");
         assert!(
-            r.iter().all(|c| c.parse::<f64>().is_ok_and(f64::is_finite)),
+            r[..ncol - 1]
+                .iter()
+                .all(|c| c.parse::<f64>().is_ok_and(f64::is_finite)),
+            "{r:?}"
+        );
+        assert!(
+            ["slip+", "slip-", "stick"].contains(&r[ncol - 1].as_str()),
             "{r:?}"
         );
     }

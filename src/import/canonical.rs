@@ -285,15 +285,23 @@ fn header_points(path: &Path, header_line: usize, names: &[String]) -> Result<Ve
                 format!("expected <name>_x_m, found {}", quote_cell(&pair[0])),
             ));
         };
-        if pair.get(1).and_then(|c| c.strip_suffix("_y_m")) != Some(name) {
+        let Some(y_col) = pair.get(1) else {
+            return Err(Error::parse(
+                path,
+                header_line,
+                col,
+                format!(
+                    "expected t_s followed by pairs <name>_x_m,<name>_y_m: no {name}_y_m after \
+                     {name}_x_m"
+                ),
+            ));
+        };
+        if y_col.strip_suffix("_y_m") != Some(name) {
             return Err(Error::parse(
                 path,
                 header_line,
                 col + 1,
-                format!(
-                    "expected {name}_y_m, found {}",
-                    quote_cell(names.get(col).map_or("", String::as_str))
-                ),
+                format!("expected {name}_y_m, found {}", quote_cell(y_col)),
             ));
         }
         if points.iter().any(|p| p.name == name) {
@@ -447,6 +455,54 @@ mod tests {
         }
     }
 
+    /// Extra columns after the points: written as the positions are (numbers) or as given
+    /// (labels), skipped and named when read back; names that would read as points are refused.
+    #[test]
+    fn extra_columns_are_written_after_the_points_and_skipped_on_reading() {
+        let trace = Trace {
+            t_s: vec![0.0, 0.5],
+            points: vec![PointTrack {
+                name: "head".into(),
+                x_m: vec![1.0, 2.0],
+                y_m: vec![3.0, f64::NAN],
+            }],
+        };
+        let f = temp_path("extra");
+        let theta = [0.1 + 0.2, -1.5e-5];
+        let phase = ["stick", "slip+"];
+        let extra = [
+            ExtraColumn::Numbers("theta_rad", &theta),
+            ExtraColumn::Labels("phase", &phase),
+        ];
+        write_trace_csv_with(&f.0, &trace, &extra).unwrap();
+        let text = std::fs::read_to_string(&f.0).unwrap();
+        assert_eq!(
+            text,
+            "t_s,head_x_m,head_y_m,theta_rad,phase\n0,1,3,0.30000000000000004,stick\n0.5,2,NaN,-1.5e-5,slip+\n"
+        );
+        let (back, extras) = read_trace_csv_with_extras(&f.0).unwrap();
+        assert_eq!(extras, ["theta_rad", "phase"]);
+        assert_eq!(back.points.len(), 1);
+        assert_eq!(back.points[0].x_m, [1.0, 2.0]);
+        for (name, len) in [
+            ("tip_y_m", 2),
+            ("t_s", 2),
+            ("", 2),
+            ("theta_rad", 2),
+            ("ok", 1),
+        ] {
+            let v = vec![0.0; len];
+            let cols = [
+                ExtraColumn::Numbers("theta_rad", &theta),
+                ExtraColumn::Numbers(name, &v),
+            ];
+            let msg = write_trace_csv_with(&f.0, &trace, &cols)
+                .unwrap_err()
+                .to_string();
+            assert!(msg.contains("extra column"), "{name:?}: {msg}");
+        }
+    }
+
     #[test]
     fn write_rejects_broken_traces() {
         let f = temp_path("broken");
@@ -472,6 +528,14 @@ mod tests {
             ),
             ("t_s,a_x_m,b_y_m\n0,1,2\n", ":1:3: expected a_y_m"),
             ("t_s,a_x_m\n0,1\n", ":1:2: expected t_s followed by pairs"),
+            (
+                "t_s,a_x_m,theta_rad\n0,1,2\n",
+                ":1:2: expected t_s followed by pairs <name>_x_m,<name>_y_m: no a_y_m",
+            ),
+            (
+                "t_s,a_x_m,a_y_m,phase,b_x_m,b_y_m\n0,1,2,stick,3,4\n",
+                ":1:5: point column \"b_x_m\" after the other columns",
+            ),
             (
                 "t_s,a_x_m,a_y_m\n0,1,2\n1,x,2\n",
                 ":3:2: field a_x_m: expected a number or NaN, found \"x\"",
