@@ -178,6 +178,11 @@ pub enum Command {
         /// Band LO:HI in Hz to pick a peak in (repeatable); default: the whole spectrum above 2 bins.
         #[arg(long)]
         band: Vec<BandArg>,
+        /// Signal to analyse (repeatable): <point>_x, <point>_y, the difference of two points
+        /// <a>-<b>_x, <a>-<b>_y (e.g. wstL-shdL_y), or tip_rel_x, tip_rel_y (tip − head); default:
+        /// every point's x and y, and tip_rel_x when there are a head and a tip.
+        #[arg(long)]
+        signal: Vec<String>,
         /// Directory for the SVG figures (default: reports/spectrum/<file stem>).
         #[arg(long)]
         out_dir: Option<PathBuf>,
@@ -298,6 +303,7 @@ pub fn run(cli: Cli) -> Result<()> {
             nperseg,
             welch,
             band,
+            signal,
             out_dir,
             max_fill,
         } => spectrum::run(spectrum::SpectrumArgs {
@@ -306,6 +312,7 @@ pub fn run(cli: Cli) -> Result<()> {
             nperseg,
             welch,
             band,
+            signal,
             out_dir,
             max_fill,
         }),

@@ -3,6 +3,7 @@
 use super::ImportArgs;
 use crate::Result;
 use crate::spectrum::features::{BandSpec, features};
+use crate::spectrum::signal::SignalExpr;
 use std::path::{Path, PathBuf};
 
 /// A `--band LO:HI` in Hz, as given.
@@ -34,6 +35,7 @@ pub(super) struct SpectrumArgs {
     pub nperseg: Option<usize>,
     pub welch: super::WelchArgs,
     pub band: Vec<BandArg>,
+    pub signal: Vec<String>,
     pub out_dir: Option<PathBuf>,
     pub max_fill: usize,
 }
@@ -42,7 +44,7 @@ pub(super) struct SpectrumArgs {
 /// peaks.json.
 pub(super) fn run(a: SpectrumArgs) -> Result<()> {
     let trace = super::import::read_any(&a.file, &a.import)?;
-    let uniform = crate::spectrum::uniform_signals(&trace)?;
+    let uniform = crate::spectrum::uniform_signals_for(&trace, &signals(&trace, &a.signal)?)?;
     let fs = uniform.fs_hz;
     let n = uniform.signals.first().map(|s| s.1.len()).unwrap_or(0);
     let nperseg = a
@@ -109,6 +111,20 @@ pub(super) fn run(a: SpectrumArgs) -> Result<()> {
     println!("figures in {}", dir.display());
     println!("psd.csv and peaks.json in {}", dir.display());
     Ok(())
+}
+
+/// The `--signal`s resolved against the trace's points, or the default signals when none is given.
+fn signals(trace: &crate::trace::Trace, given: &[String]) -> Result<Vec<SignalExpr>> {
+    if given.is_empty() {
+        return Ok(SignalExpr::defaults(trace));
+    }
+    given
+        .iter()
+        .map(|s| {
+            SignalExpr::resolve(s, trace)
+                .map_err(|e| crate::Error::Config(format!("--signal {s}: {e}")))
+        })
+        .collect()
 }
 
 /// Checks the segment length and the bands against the record before any spectrum is computed:

@@ -9,6 +9,7 @@
 //! * [`welch`](mod@welch): [`WelchConfig`], [`WelchPlan`] (plan once, process many), [`welch()`],
 //!   NaN-aware [`welch_gappy`].
 //! * [`resample`]: [`resample_uniform`] for jittered frame times, [`median_rate_hz`].
+//! * [`signal`]: signals named by text (`<point>_y`, `<a>-<b>_x`), [`signal::SignalExpr`].
 //! * [`peaks`]: [`find_peak`], [`top_peaks`]: largest local maximum with parabolic interpolation of
 //!   the log PSD (J.O. Smith, SASP).
 //! * [`stft`]: [`spectrogram()`] and its [`Spectrogram::ridge`].
@@ -27,6 +28,7 @@ pub mod harmonics;
 pub mod instfreq;
 pub mod peaks;
 pub mod resample;
+pub mod signal;
 pub mod stats;
 pub mod stft;
 pub mod welch;
@@ -34,7 +36,9 @@ pub mod window;
 
 pub use error::SpectrumError;
 pub use peaks::{Peak, find_peak, parabolic_vertex, top_peaks};
-pub use resample::{UniformSignals, median_rate_hz, resample_uniform, uniform_signals};
+pub use resample::{
+    UniformSignals, median_rate_hz, resample_uniform, uniform_signals, uniform_signals_for,
+};
 pub use stft::{Spectrogram, spectrogram};
 pub use welch::{
     Average, Detrend, GapReport, Psd, Scaling, WelchConfig, WelchPlan, default_nperseg,

@@ -139,18 +139,31 @@ pub struct UniformSignals {
     /// False when the frame times were uniform already (within 1e-6 of a step) and the samples
     /// are the trace's own; true when they were linearly interpolated onto the grid.
     pub resampled: bool,
-    /// `(<point>_x | <point>_y | tip_rel_x, samples)`, in m, NaN where missing.
+    /// `(name, samples)` per signal (`<point>_x`, `<point>_y`, `tip_rel_x`, `<a>-<b>_y`, ...), in m,
+    /// NaN where missing.
     pub signals: Vec<(String, Vec<f64>)>,
 }
 
 /// Every tracked coordinate of `trace` (and the tip relative to the head, when both are tracked)
-/// on a uniform grid at the median frame rate. Frame-indexed files (t = frame/fps) are uniform
-/// already: resampling them would only smear each NaN over its neighbours through the rounding of
-/// the grid, so their samples are taken as they are.
+/// on a uniform grid at the median frame rate ([`uniform_signals_for`] with
+/// [`SignalExpr::defaults`](super::signal::SignalExpr::defaults)).
 ///
 /// # Errors
 /// As [`resample_uniform`].
 pub fn uniform_signals(trace: &crate::trace::Trace) -> Result<UniformSignals> {
+    uniform_signals_for(trace, &super::signal::SignalExpr::defaults(trace))
+}
+
+/// The signals `exprs` of `trace` on a uniform grid at the median frame rate. Frame-indexed files
+/// (t = frame/fps) are uniform already: resampling them would only smear each NaN over its
+/// neighbours through the rounding of the grid, so their samples are taken as they are.
+///
+/// # Errors
+/// As [`resample_uniform`].
+pub fn uniform_signals_for(
+    trace: &crate::trace::Trace,
+    exprs: &[super::signal::SignalExpr],
+) -> Result<UniformSignals> {
     let fs = median_rate_hz(&trace.t_s);
     let t0 = trace.t_s.first().copied().unwrap_or(0.0);
     let already_uniform = trace
@@ -165,12 +178,8 @@ pub fn uniform_signals(trace: &crate::trace::Trace) -> Result<UniformSignals> {
         Ok(resample_uniform(&trace.t_s, x, fs)?.1)
     };
     let mut signals = Vec::new();
-    for p in &trace.points {
-        signals.push((format!("{}_x", p.name), uniform(&p.x_m)?));
-        signals.push((format!("{}_y", p.name), uniform(&p.y_m)?));
-    }
-    if let Ok(x) = super::features::SignalKind::TipRelX.extract(trace) {
-        signals.push(("tip_rel_x".into(), uniform(&x)?));
+    for e in exprs {
+        signals.push((e.name.clone(), uniform(&e.extract(trace))?));
     }
     Ok(UniformSignals {
         fs_hz: fs,
