@@ -188,10 +188,8 @@ fn signal_label(s: SignalKind) -> &'static str {
     match s {
         SignalKind::TipRelX => "lip tip x − head x (horizontal, relative to the head)",
         SignalKind::TipRelY => "lip tip y − head y (vertical, relative to the head)",
-        SignalKind::HeadX => "head x (horizontal)",
         SignalKind::HeadY => "head y (vertical)",
         SignalKind::TipX => "lip tip x (horizontal)",
-        SignalKind::TipY => "lip tip y (vertical)",
     }
 }
 

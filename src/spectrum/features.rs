@@ -99,7 +99,9 @@ pub fn default_bands() -> Vec<BandSpec> {
 crate::names::named_enum! {
     /// Which scalar signal of a trace a fit compares: a coordinate of the model's points `head` and
     /// `tip` (a recording's points are mapped to them in `[recording.import.points]`), or their
-    /// difference. `spectrum` takes any point's (`crate::spectrum::signal`).
+    /// difference. `spectrum` takes any point's (`crate::spectrum::signal`). Not offered: `head_x`,
+    /// the drive the model prescribes, and `tip_y`, the glass the model holds the tip on — the
+    /// model has no dynamics of its own in either.
     #[derive(Default)]
     pub enum SignalKind: "signal" {
         /// Lip tip relative to head, horizontal: `tip_x − head_x` (v3 − v), m.
@@ -107,14 +109,10 @@ crate::names::named_enum! {
         TipRelX => "tip_rel_x",
         /// Lip tip relative to head, vertical: `tip_y − head_y` (u − (l1 + l2) in the model), m.
         TipRelY => "tip_rel_y",
-        /// Head horizontal position `head_x` (the drive v in the model), m.
-        HeadX => "head_x",
         /// Head vertical position `head_y` (= −u), m.
         HeadY => "head_y",
         /// Lip tip horizontal position (v3), m.
         TipX => "tip_x",
-        /// Lip tip vertical position (constant −(l1 + l2) in the model: the tip stays on the glass), m.
-        TipY => "tip_y",
     }
 }
 
@@ -136,10 +134,8 @@ impl SignalKind {
         Ok(match self {
             SignalKind::TipRelX => diff(&need("tip")?.x_m, &need("head")?.x_m),
             SignalKind::TipRelY => diff(&need("tip")?.y_m, &need("head")?.y_m),
-            SignalKind::HeadX => need("head")?.x_m.clone(),
             SignalKind::HeadY => need("head")?.y_m.clone(),
             SignalKind::TipX => need("tip")?.x_m.clone(),
-            SignalKind::TipY => need("tip")?.y_m.clone(),
         })
     }
 
@@ -148,10 +144,8 @@ impl SignalKind {
         match self {
             SignalKind::TipRelX => "tip x − head x (m)",
             SignalKind::TipRelY => "tip y − head y (m)",
-            SignalKind::HeadX => "head x (m)",
             SignalKind::HeadY => "head y (m)",
             SignalKind::TipX => "tip x (m)",
-            SignalKind::TipY => "tip y (m)",
         }
     }
 }
