@@ -680,6 +680,18 @@ fn fit_cases() -> Vec<Case> {
             &["$D/job.toml:", "'k1'", "lower < upper"],
         ),
         case(
+            "fit: a freed head mass that may be zero",
+            j(&[("C = [0.1, 1.0]", "C = [0.1, 1.0]\nhead_mass = [0.0, 0.2]")]),
+            fit,
+            &["$D/job.toml:", "'head_mass'", "> 0"],
+        ),
+        case(
+            "fit: lip mass freed beside the k1 it holds",
+            j(&[("C = [0.1, 1.0]", "C = [0.1, 1.0]\nlip_mass = [1e-4, 1e-3]")]),
+            fit,
+            &["$D/job.toml:", "'lip_mass'", "'k1'"],
+        ),
+        case(
             "fit: job name that climbs out of the directory",
             j(&[("name = \"reversal\"", "name = \"../../escape\"")]),
             fit,

@@ -30,6 +30,7 @@ use esay;
 
 mod bench;
 mod campaign;
+mod explore;
 mod fit;
 mod import;
 mod init;
@@ -237,6 +238,23 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Sample a job's freed parameters (seeded Sobol points over [fit.parameters]) and map where
+    /// they take the model's lines: explore.csv (parameters, each band's line, prominence and
+    /// failure cause), the one-at-a-time sensitivity around the job's start (sensitivity.csv, .md)
+    /// and the reachability map (reachability.svg).
+    Explore {
+        job: PathBuf,
+        /// Number of samples (1 to 65536).
+        #[arg(long, default_value_t = crate::fit::explore::DEFAULT_SAMPLES)]
+        samples: usize,
+        /// Scramble seed of the Sobol sequence (same seed, same samples).
+        #[arg(long, default_value_t = 1)]
+        seed: u32,
+        /// Output directory (default: reports/explore/<job name>/); an exploration already there
+        /// is replaced, with a note on stderr.
+        #[arg(short = 'o', long = "out-dir")]
+        out_dir: Option<PathBuf>,
+    },
     /// Write the report page reports/<job>/index.html from fits/<job>.result.toml (with --refit:
     /// fit first; without a result and without --refit: exit 2).
     Report {
@@ -357,6 +375,12 @@ pub fn run(cli: Cli) -> Result<()> {
             json,
         } => modes::run(&blade, speeds.as_deref(), json),
         Command::Fit { job, json } => fit::fit(&job, json, cli.quiet),
+        Command::Explore {
+            job,
+            samples,
+            seed,
+            out_dir,
+        } => explore::run(&job, samples, seed, out_dir),
         Command::Report { job, refit } => fit::report(&job, refit, cli.quiet),
     }
 }

@@ -555,11 +555,26 @@ impl Check<'_> {
                     ),
                 ));
             }
-            if lo < 0.0 {
+            if lo < 0.0 || (id.strictly_positive() && lo <= 0.0) {
                 return Err(self.error(
                     &at,
                     format!(
-                        "[fit.parameters]: '{id}' is a physical magnitude; its lower bound must be >= 0 (got {lo})"
+                        "[fit.parameters]: '{id}' ({}) is a physical magnitude; its lower bound must be {} (got {lo})",
+                        id.meaning(),
+                        if id.strictly_positive() { "> 0" } else { ">= 0" }
+                    ),
+                ));
+            }
+            if let Some(other) = id
+                .holds()
+                .iter()
+                .find(|o| self.job.fit.parameters.contains_key(o))
+            {
+                return Err(self.error(
+                    &at,
+                    format!(
+                        "[fit.parameters]: '{id}' moves '{other}' to hold the blade's measured frequencies ({}); free one of them",
+                        id.meaning()
                     ),
                 ));
             }

@@ -12,6 +12,7 @@
 
 mod candidate;
 pub mod evidence;
+pub mod explore;
 /// The spectral features the fit compares (they belong to the spectrum stage).
 pub use crate::spectrum::features;
 pub mod instfreq;

@@ -21,6 +21,8 @@ named_enum! {
         C2 => "c2",
         /// Preload compression h_d, m.
         Hd => "hd",
+        /// Head mass M, kg, with the head's natural frequency held (k0 follows).
+        HeadMass => "head_mass",
         /// Head spring k0, N/m.
         K0 => "k0",
         /// Neck stiffness k1, N·m/rad.
@@ -29,6 +31,10 @@ named_enum! {
         K1c => "k1c",
         /// Lip stiffness k2, N·m/rad.
         K2 => "k2",
+        /// Lip length l2, m, the lip scaled as a rod of the same mass (d2 and J2 follow).
+        L2 => "l2",
+        /// Lip mass m2, kg, with the head's and the free neck's natural frequencies held.
+        LipMass => "lip_mass",
         /// Shoulder contact angle, rad.
         ThetaC => "theta_c",
     }
@@ -45,12 +51,19 @@ impl ParamId {
             ParamId::C1 => "neck damper c1, N·m·s/rad",
             ParamId::C2 => "lip damper c2, N·m·s/rad",
             ParamId::Hd => "preload compression h_d, m",
+            ParamId::HeadMass => {
+                "head mass M, kg (k0 follows: the head's natural frequency is held)"
+            }
             ParamId::K0 => "head spring k0, N/m",
             ParamId::K1 => "neck stiffness k1, N·m/rad",
             ParamId::K1c => {
                 "neck stiffness touching the shoulder, N·m/rad (needs a [shoulder] in the blade)"
             }
             ParamId::K2 => "lip stiffness k2, N·m/rad",
+            ParamId::L2 => "lip length l2, m (its centre of mass and inertia scale with it)",
+            ParamId::LipMass => {
+                "lip mass m2, kg (its inertia scales with it; k0 and k1 follow: head and free neck frequencies held)"
+            }
             ParamId::ThetaC => "shoulder contact angle, rad (needs a [shoulder] in the blade)",
         }
     }
@@ -58,6 +71,28 @@ impl ParamId {
     /// Whether the parameter belongs to the shoulder contact ([`super::Shoulder`]).
     pub fn is_shoulder(self) -> bool {
         matches!(self, ParamId::K1c | ParamId::ThetaC)
+    }
+
+    /// Whether the parameter is a mass or a length of the blade (set by [`ParamId::set`] with what
+    /// a measurement of the blade fixes held; see there).
+    pub fn is_geometry(self) -> bool {
+        matches!(self, ParamId::HeadMass | ParamId::L2 | ParamId::LipMass)
+    }
+
+    /// Whether the parameter must be strictly positive (a mass, a length, a spring the model divides
+    /// by or the preload), not merely non-negative.
+    pub fn strictly_positive(self) -> bool {
+        self.is_geometry() || matches!(self, ParamId::K0 | ParamId::K1 | ParamId::Hd)
+    }
+
+    /// The freed parameters that `self` moves when set ([`ParamId::set`]), and that a job therefore
+    /// cannot free beside it: the lip mass holds the head's and the free neck's frequencies through
+    /// k0 and k1.
+    pub fn holds(self) -> &'static [ParamId] {
+        match self {
+            ParamId::LipMass => &[ParamId::K0, ParamId::K1],
+            _ => &[],
+        }
     }
 
     /// The parameter's value in `p`: `None` when `p` has no such parameter (a shoulder parameter
@@ -75,15 +110,27 @@ impl ParamId {
             ParamId::C1 => p.c1_nms_per_rad,
             ParamId::C2 => p.c2_nms_per_rad,
             ParamId::Hd => p.hd_m,
+            ParamId::HeadMass => p.head_mass_kg,
             ParamId::K0 => p.k0_n_per_m,
             ParamId::K1 => p.k1_nm_per_rad,
             ParamId::K1c => p.shoulder?.k1_contact_nm_per_rad,
             ParamId::K2 => p.k2_nm_per_rad,
+            ParamId::L2 => p.l2_m,
+            ParamId::LipMass => p.lip_mass_kg,
             ParamId::ThetaC => p.shoulder?.contact_angle_rad,
         })
     }
 
     /// Sets the parameter in `p` to `v`; false (and `p` unchanged) when `p` has no such parameter.
+    ///
+    /// A geometry parameter keeps what a measurement of the real blade fixes (the seed measured the
+    /// head's and the free neck's frequencies, not the masses behind them):
+    /// - `head_mass`: k0 = M_t (2π f_head)² with f_head = [`BladeParams::head_freq_hz`] before the
+    ///   change (M_t = M + m1 + m2);
+    /// - `lip_mass`: the lip's inertia J2 scales with m2 (the same shape), and k0 and k1 follow so
+    ///   that f_head and the free neck's [`BladeParams::neck_freq_hz`] stay;
+    /// - `l2`: the lip's centre of mass d2 scales with l2 and J2 with l2² (the same rod, longer);
+    ///   its mass stays.
     pub fn set(self, p: &mut BladeParams, v: f64) -> bool {
         let slot: &mut f64 = match self {
             ParamId::A | ParamId::B | ParamId::C => match &mut p.friction {
@@ -106,9 +153,40 @@ impl ParamId {
                 None => return false,
             },
             ParamId::K2 => &mut p.k2_nm_per_rad,
+            ParamId::HeadMass | ParamId::L2 | ParamId::LipMass => {
+                set_geometry(self, p, v);
+                return true;
+            }
         };
         *slot = v;
         true
+    }
+}
+
+/// [`ParamId::set`] for the geometry parameters ([`ParamId::is_geometry`]).
+fn set_geometry(id: ParamId, p: &mut BladeParams, v: f64) {
+    let (f_head_hz, f_neck_hz) = (p.head_freq_hz(), p.neck_freq_hz());
+    let ratio = |old: f64| if old > 0.0 { v / old } else { 1.0 };
+    match id {
+        ParamId::HeadMass => p.head_mass_kg = v,
+        ParamId::L2 => {
+            let r = ratio(p.l2_m);
+            p.lip_com_m *= r;
+            p.lip_inertia_kg_m2 *= r * r;
+            p.l2_m = v;
+        }
+        _ => {
+            p.lip_inertia_kg_m2 *= ratio(p.lip_mass_kg);
+            p.lip_mass_kg = v;
+        }
+    }
+    let m = p.mass_coefficients();
+    let w = |f_hz: f64| (std::f64::consts::TAU * f_hz).powi(2);
+    if id != ParamId::L2 {
+        p.k0_n_per_m = m.mt * w(f_head_hz);
+    }
+    if id == ParamId::LipMass {
+        p.k1_nm_per_rad = m.mth * w(f_neck_hz);
     }
 }
 
@@ -121,5 +199,55 @@ mod tests {
         let mut sorted = ParamId::NAMES.to_vec();
         sorted.sort_unstable();
         assert_eq!(sorted, ParamId::NAMES);
+    }
+
+    fn experiment_blade() -> BladeParams {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/data/paper/seed_experiment_blade.toml"
+        );
+        toml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+    }
+
+    /// The geometry parameters hold what they say, checked against the closed forms
+    /// f_head = √(k0/M_t)/2π and f_neck = √(k1/m_θ)/2π (with m_θ = J1 + m1 d1² + m2 l1²) and a uniform
+    /// rod's d2 = l2/2, J2 = m2 l2²/12 (the experiment blade's lip is one).
+    #[test]
+    fn geometry_parameters_hold_the_measured_frequencies() {
+        let base = experiment_blade();
+        let (f_head, f_neck) = (base.head_freq_hz(), base.neck_freq_hz());
+        assert!((f_head - 20.0).abs() < 1e-9 && (f_neck - 195.0).abs() < 1e-9);
+        let mut p = base;
+        assert!(ParamId::HeadMass.set(&mut p, 0.005));
+        let mt = 0.005 + p.neck_mass_kg + p.lip_mass_kg;
+        assert!((p.k0_n_per_m - mt * (std::f64::consts::TAU * 20.0).powi(2)).abs() < 1e-9);
+        assert_eq!(p.k1_nm_per_rad, base.k1_nm_per_rad);
+        let mut p = base;
+        assert!(ParamId::LipMass.set(&mut p, 2.0 * base.lip_mass_kg));
+        let l1 = p.l1_m;
+        let mth =
+            p.neck_inertia_kg_m2 + p.neck_mass_kg * p.neck_com_m.powi(2) + p.lip_mass_kg * l1 * l1;
+        let w_neck = (std::f64::consts::TAU * 195.0).powi(2);
+        assert!((p.k1_nm_per_rad / (mth * w_neck) - 1.0).abs() < 1e-12);
+        assert!((p.head_freq_hz() - 20.0).abs() < 1e-9);
+        assert!(
+            (p.lip_inertia_kg_m2 / (p.lip_mass_kg * p.l2_m.powi(2) / 12.0) - 1.0).abs() < 1e-12
+        );
+        let mut p = base;
+        assert!(ParamId::L2.set(&mut p, 0.006));
+        assert!((p.lip_com_m - 0.003).abs() < 1e-15);
+        assert!(
+            (p.lip_inertia_kg_m2 / (p.lip_mass_kg * 0.006f64.powi(2) / 12.0) - 1.0).abs() < 1e-12
+        );
+        assert_eq!(
+            (p.k0_n_per_m, p.k1_nm_per_rad),
+            (base.k0_n_per_m, base.k1_nm_per_rad)
+        );
+        for id in [ParamId::HeadMass, ParamId::L2, ParamId::LipMass] {
+            let v = id.get(&base).unwrap();
+            let mut p = base;
+            id.set(&mut p, 0.5 * v);
+            assert_eq!(id.get(&p), Some(0.5 * v), "{id}");
+        }
     }
 }

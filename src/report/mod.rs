@@ -6,6 +6,7 @@
 //! * [`campaign`]: a campaign's report page, `<campaign dir>/<name>/report/index.html`.
 
 pub mod campaign;
+pub mod explore;
 pub mod figures;
 pub mod html;
 pub mod plot;

@@ -15,7 +15,10 @@
 //! The report stage computes nothing: pass it spectra and traces computed upstream.
 
 mod png;
+mod scatter;
 mod ticks;
+
+pub use scatter::{Category, Panel, Target, scatter_panels};
 
 use std::path::Path;
 
