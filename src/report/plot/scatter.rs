@@ -123,13 +123,12 @@ fn z_range(points: &[(f64, f64, f64)]) -> Option<(f64, f64)> {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
             (a.min(v), b.max(v))
         });
-    (lo <= hi).then(|| {
-        if hi > lo {
-            (lo, hi)
-        } else {
-            (lo - 0.5, hi + 0.5)
-        }
-    })
+    let widened = if hi > lo {
+        (lo, hi)
+    } else {
+        (lo - 0.5, hi + 0.5)
+    };
+    (lo <= hi).then_some(widened)
 }
 
 /// One panel: axes, coloured points, categories, targets, and its colour bar.
