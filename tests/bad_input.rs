@@ -686,6 +686,18 @@ fn fit_cases() -> Vec<Case> {
             &["$D/job.toml:", "'head_mass'", "> 0"],
         ),
         case(
+            "explore: a freed head mass that may be zero",
+            j(&[("C = [0.1, 1.0]", "C = [0.1, 1.0]\nhead_mass = [0.0, 0.2]")]),
+            &["explore", "$D/job.toml", "-o", "$D/out"],
+            &["$D/job.toml:", "'head_mass'", "> 0"],
+        ),
+        case(
+            "explore: no samples",
+            j(&[]),
+            &["explore", "$D/job.toml", "--samples", "0", "-o", "$D/out"],
+            &["--samples 0"],
+        ),
+        case(
             "fit: lip mass freed beside the k1 it holds",
             j(&[("C = [0.1, 1.0]", "C = [0.1, 1.0]\nlip_mass = [1e-4, 1e-3]")]),
             fit,
