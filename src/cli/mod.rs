@@ -6,6 +6,7 @@
 #![allow(rustdoc::invalid_html_tags)]
 
 use crate::Result;
+use crate::simulate::Method;
 use crate::simulate::blade::ModelKind;
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -207,6 +208,9 @@ pub enum Command {
         rtol: f64,
         #[arg(long, default_value_t = 1e-12)]
         atol: f64,
+        /// Integrator of the smooth phases: dopri5 or dop853.
+        #[arg(long, value_enum, default_value_t = Method::Dopri5)]
+        method: Method,
         /// Stick-phase form: reduced (drift-free) or baumgarte.
         #[arg(long, value_enum, default_value_t = StickChoice::Reduced)]
         stick: StickChoice,
@@ -340,6 +344,7 @@ pub fn run(cli: Cli) -> Result<()> {
             fps,
             rtol,
             atol,
+            method,
             stick,
             model,
             out_dir,
@@ -349,6 +354,7 @@ pub fn run(cli: Cli) -> Result<()> {
             fps,
             rtol,
             atol,
+            method,
             stick,
             model,
             out_dir,

@@ -3,8 +3,8 @@
 use crate::fit::job::{parse_toml, read_text};
 use crate::model::{BladeParams, StickForm};
 use crate::names::named_enum;
-use crate::simulate::SolverOptions;
 use crate::simulate::blade::{ModelKind, contact_forces, default_window, simulate_model};
+use crate::simulate::{Method, SolverOptions};
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -29,6 +29,7 @@ pub(super) struct SimulateArgs {
     pub fps: f64,
     pub rtol: f64,
     pub atol: f64,
+    pub method: Method,
     pub stick: StickChoice,
     pub model: ModelKind,
     pub out_dir: Option<PathBuf>,
@@ -75,6 +76,7 @@ pub(super) fn run(a: SimulateArgs) -> Result<()> {
     let opts = SolverOptions {
         rtol: a.rtol,
         atol: a.atol,
+        method: a.method,
         ..SolverOptions::default()
     };
     let t = std::time::Instant::now();
@@ -87,9 +89,10 @@ pub(super) fn run(a: SimulateArgs) -> Result<()> {
     crate::io::create_dir(&dir)?;
     crate::report::figures::write_simulation(&dir, &sim, &forces)?;
     println!(
-        "simulated {:.4}..{:.4} s in {wall:.3} s: {} transitions, {} steps ({} rejected), {} RHS evaluations; outputs in {}",
+        "simulated {:.4}..{:.4} s with {} in {wall:.3} s: {} transitions, {} steps ({} rejected), {} RHS evaluations; outputs in {}",
         win.0,
         win.1,
+        a.method,
         sim.transitions.len(),
         sim.stats.steps,
         sim.stats.rejected,

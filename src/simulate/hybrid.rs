@@ -1,7 +1,7 @@
 //! Event-driven integration of a one-contact stick–slip system.
 //!
-//! Each smooth phase (slip+, slip−, stick) is integrated with DOPRI5 ([`super::rk`]). Transitions are
-//! zeros of smooth event functions located on the step's continuous extension by the Illinois method to
+//! Each smooth phase (slip+, slip−, stick) is integrated with DOPRI5 or DOP853 ([`super::method`],
+//! [`SolverOptions::method`]). Transitions are zeros of smooth event functions located on the step's continuous extension by the Illinois method to
 //! a bracket of a few ulps (physics.md §1.5–1.6, "how the transition time is located exactly"):
 //!
 //! | phase   | event function            | becomes zero when                      | next phase            |
@@ -23,7 +23,7 @@
 //! sub-interval is searched for a positive maximum (a departure and a return within one sub-step).
 
 use super::error::{SimulationError, StopCause};
-use super::rk;
+use super::method::{Dense, Method, Outcome, Step};
 use crate::{Error, Result};
 
 use serde::Serialize;
@@ -48,6 +48,8 @@ pub struct SolverOptions {
     pub max_steps: usize,
     /// Largest number of transitions before giving up (accumulation guard).
     pub max_transitions: usize,
+    /// The Runge–Kutta pair of the smooth phases (`"dopri5"` or `"dop853"`).
+    pub method: Method,
 }
 
 impl Default for SolverOptions {
@@ -59,6 +61,7 @@ impl Default for SolverOptions {
             event_samples: 3,
             max_steps: 20_000_000,
             max_transitions: 1_000_000,
+            method: Method::Dopri5,
         }
     }
 }
@@ -313,7 +316,7 @@ pub enum StopReason {
 /// `y1` is the step's exact end state when it ended without an event at `t1`.
 struct Segment<const N: usize> {
     t1: f64,
-    dense: rk::Dense<N>,
+    dense: Dense<N>,
     y1: Option<[f64; N]>,
     mode: Mode,
 }
@@ -334,11 +337,13 @@ pub struct HybridSolver<'m, M: StickSlipModel<N>, const N: usize> {
     h: f64,
     /// Set after an event: the next step starts a phase (derivative and event values anew).
     phase_start: bool,
+    /// The last attempt was rejected (the next accepted step does not grow the step size).
+    rejected_last: bool,
     f: [f64; N],
     g_prev: [f64; N_EVENTS],
     /// The previous accepted step of this phase: its continuous extension and its last interior
     /// event sample, so that a minimum of the samples at a step boundary is searched too.
-    prev: Option<(rk::Dense<N>, f64, [f64; N_EVENTS])>,
+    prev: Option<(Dense<N>, f64, [f64; N_EVENTS])>,
     settled: f64,
     segments: Vec<Segment<N>>,
     quick_transitions: usize,
@@ -393,6 +398,7 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
             mode,
             h: (1e-6 * span).min(opts.h_max),
             phase_start: true,
+            rejected_last: false,
             f: [0.0; N],
             g_prev: [NO_EVENT; N_EVENTS],
             prev: None,
@@ -519,9 +525,9 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
         Ok(())
     }
 
-    /// One DOPRI5 attempt of size `h` (cut to the stop time): the accepted attempt and whether it
+    /// One attempt of size `h` (cut to the stop time): the accepted attempt and whether it
     /// is the last step, or `None` after a rejection (the step size is reduced).
-    fn attempt(&mut self) -> Result<Option<(rk::Attempt<N>, bool)>> {
+    fn attempt(&mut self) -> Result<Option<(Step<N>, bool)>> {
         self.h = self.h.min(self.opts.h_max);
         let last = self.t + self.h >= self.t_end;
         if last {
@@ -538,9 +544,13 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
             ));
         }
         let (model, mode) = (self.model, self.mode);
-        let mut rhs =
-            |tt: f64, yy: &[f64; N], dy: &mut [f64; N]| model.rhs(&mode, tt, yy, dy).map(|_| ());
-        let attempt = rk::attempt(
+        let mut evals = 0;
+        let mut rhs = |tt: f64, yy: &[f64; N], dy: &mut [f64; N]| {
+            evals += 1;
+            model.rhs(&mode, tt, yy, dy).map(|_| ())
+        };
+        let method = self.opts.method;
+        let outcome = method.attempt(
             &mut rhs,
             self.t,
             &self.y,
@@ -549,20 +559,22 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
             self.opts.rtol,
             self.opts.atol,
         );
-        self.stats.rhs_evals += 6;
-        match attempt {
+        self.stats.rhs_evals += evals;
+        match outcome {
             // The right-hand side failed inside the step, or the error estimate or state is not
             // finite (e.g. near a singular constraint): shrink, so the collapse check ends the run.
             Err(_) => {}
-            Ok(a) if !a.err.is_finite() || !a.y_new.iter().all(|v| v.is_finite()) => {}
-            Ok(a) if a.err > 1.0 => {
+            Ok(Outcome::Rejected { err }) if !err.is_finite() => {}
+            Ok(Outcome::Rejected { err }) => {
                 self.stats.rejected += 1;
-                self.h = rk::next_step(self.h, a.err).min(self.h * 0.9);
+                self.rejected_last = true;
+                self.h = method.next_step(self.h, err).min(self.h * 0.9);
                 return Ok(None);
             }
-            Ok(a) => return Ok(Some((a, last))),
+            Ok(Outcome::Accepted(a)) => return Ok(Some((a, last))),
         }
         self.stats.rejected += 1;
+        self.rejected_last = true;
         self.h *= 0.25;
         Ok(None)
     }
@@ -570,7 +582,7 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
     /// The earliest event in the accepted step `a` ending at `t_new`: its function and its time.
     /// The event function is sampled at `event_samples` interior points and the end; a crossing
     /// is refined by the Illinois method, a dip between samples found by golden-section search.
-    fn locate(&mut self, a: &rk::Attempt<N>, t_new: f64) -> Result<Option<(usize, f64)>> {
+    fn locate(&mut self, a: &Step<N>, t_new: f64) -> Result<Option<(usize, f64)>> {
         let (model, mode, t, h) = (self.model, self.mode, self.t, self.h);
         let m = self.opts.event_samples;
         let mut found: Option<(usize, f64)> = None;
@@ -656,7 +668,7 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
     }
 
     /// Takes the accepted step without an event.
-    fn accept(&mut self, a: rk::Attempt<N>, t_new: f64) -> StopReason {
+    fn accept(&mut self, a: Step<N>, t_new: f64) -> StopReason {
         self.segments.push(Segment {
             t1: t_new,
             dense: a.dense,
@@ -668,7 +680,11 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
         self.t = t_new;
         self.y = a.y_new;
         self.f = a.f_new;
-        self.h = rk::next_step(self.h, a.err);
+        self.h = self
+            .opts
+            .method
+            .next_step_after(self.h, a.err, self.rejected_last);
+        self.rejected_last = false;
         if self.t >= self.t_end {
             self.settled = self.t_end;
             StopReason::StopTime { t_s: self.t }
@@ -679,13 +695,7 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
 
     /// Ends the step at event `k` located at `te` (possibly in the previous step: a dip at the
     /// boundary), and starts the phase that follows it.
-    fn handle_event(
-        &mut self,
-        a: &rk::Attempt<N>,
-        k: usize,
-        te: f64,
-        t_new: f64,
-    ) -> Result<StopReason> {
+    fn handle_event(&mut self, a: &Step<N>, k: usize, te: f64, t_new: f64) -> Result<StopReason> {
         let t_start = self.t;
         let mut ye = if te >= t_new {
             a.y_new
