@@ -3,17 +3,20 @@
 
 use wiperlab::model::benchmarks::{CoulombBelt, seed_law_belt};
 use wiperlab::model::{Blade, BladeParams, StickForm};
+use wiperlab::simulate::Method;
 use wiperlab::simulate::blade::default_window;
 use wiperlab::simulate::hybrid::{
     Contact, Mode, ModelFault, Phase, SolverOptions, StickSlipModel, integrate,
 };
 
-/// Fixed steps of size `h`: tolerances so loose that every step is accepted, `h_max = h`.
-fn fixed_step(h: f64) -> SolverOptions {
+/// Fixed steps of size `h` with `method`: tolerances so loose that every step is accepted,
+/// `h_max = h`.
+fn fixed_step(h: f64, method: Method) -> SolverOptions {
     SolverOptions {
         rtol: 1e6,
         atol: 1e6,
         h_max: h,
+        method,
         ..Default::default()
     }
 }
@@ -48,7 +51,7 @@ fn transition_time_error_falls_at_integrator_order() {
     let hs = [0.04, 0.02, 0.01, 0.005];
     let errs: Vec<f64> = hs
         .iter()
-        .map(|&h| onset_error(&fixed_step(h)).abs())
+        .map(|&h| onset_error(&fixed_step(h, Method::Dopri5)).abs())
         .collect();
     for w in 0..hs.len() - 1 {
         let order = (errs[w] / errs[w + 1]).log2();
@@ -67,16 +70,45 @@ fn transition_time_error_falls_at_integrator_order() {
         );
     }
     assert!((errs[2] / errs[3]).log2() > 4.5);
-    // With adaptive steps the error follows the tolerance.
-    for (rtol, bound) in [(1e-6, 1e-5), (1e-9, 1e-8), (1e-12, 1e-11)] {
-        let e = onset_error(&SolverOptions {
-            rtol,
-            atol: rtol * 1e-2,
-            ..Default::default()
-        })
-        .abs();
-        eprintln!("rtol {rtol:e}: onset error {e:.3e}");
-        assert!(e < bound, "rtol {rtol}: {e}");
+    // With adaptive steps the error follows the tolerance, with either method.
+    for method in Method::ALL.iter().copied() {
+        for (rtol, bound) in [(1e-6, 1e-5), (1e-9, 1e-8), (1e-12, 1e-11)] {
+            let e = onset_error(&SolverOptions {
+                rtol,
+                atol: rtol * 1e-2,
+                method,
+                ..Default::default()
+            })
+            .abs();
+            eprintln!("{method} rtol {rtol:e}: onset error {e:.3e}");
+            assert!(e < bound, "{method} rtol {rtol}: {e}");
+        }
+    }
+}
+
+/// DOP853's continuous extension is 7th-order (Hairer–Nørsett–Wanner §II.10), i.e. its local error
+/// is O(h⁸), the order of the steps' global error: the slip→stick time located on it converges at
+/// order ≈ 8 with fixed steps (asserted within [7, 9] for h from T/5 to T/20; smaller steps reach
+/// rounding).
+#[test]
+fn dop853_transition_time_error_falls_at_order_eight() {
+    let hs = [0.2, 0.1, 0.05];
+    let errs: Vec<f64> = hs
+        .iter()
+        .map(|&h| onset_error(&fixed_step(h, Method::Dop853)).abs())
+        .collect();
+    for w in 0..hs.len() - 1 {
+        let order = (errs[w] / errs[w + 1]).log2();
+        eprintln!(
+            "h = {}: err {:.3e}, observed order {order:.2}",
+            hs[w], errs[w]
+        );
+        assert!(
+            order > 7.0 && order < 9.0,
+            "order {order} between h = {} and {}",
+            hs[w],
+            hs[w + 1]
+        );
     }
 }
 
@@ -129,14 +161,12 @@ fn dip_across_zero_within_one_step_is_not_missed() {
     // step, and in one quarter-step sub-interval (event_samples = 3), so neither end nor sample of the
     // step sees a negative value. Steps start at 2e-6 s and grow tenfold up to 0.25 s, so their
     // boundaries fall near 0.222 + 0.25 i: the third dip's sampled minimum is a step boundary.
-    for (t1, t2) in [(0.61, 0.62), (0.5001, 0.5102), (0.7, 0.7005)] {
+    for (t1, t2, method) in [(0.61, 0.62), (0.5001, 0.5102), (0.7, 0.7005)]
+        .into_iter()
+        .flat_map(|(a, b)| Method::ALL.iter().map(move |&m| (a, b, m)))
+    {
         let dip = Dip { t1, t2 };
-        let opts = SolverOptions {
-            rtol: 1e6,
-            atol: 1e6,
-            h_max: 0.25,
-            ..Default::default()
-        };
+        let opts = fixed_step(0.25, method);
         let mode = Mode {
             phase: Phase::SlipPos,
             anchor: 0.0,
@@ -144,12 +174,15 @@ fn dip_across_zero_within_one_step_is_not_missed() {
         };
         let run = integrate(&dip, 0.0, [t1 * t2], mode, 2.0, &[], &opts).unwrap();
         let times: Vec<(f64, Phase)> = run.transitions.iter().map(|tr| (tr.t_s, tr.to)).collect();
-        eprintln!("dip ({t1}, {t2}): {times:?}, {} steps", run.stats.steps);
+        eprintln!(
+            "{method} dip ({t1}, {t2}): {times:?}, {} steps",
+            run.stats.steps
+        );
         assert_eq!(run.transitions.len(), 2, "{times:?}");
         assert_eq!(run.transitions[0].to, Phase::SlipNeg);
         assert_eq!(run.transitions[1].to, Phase::SlipPos);
-        // The velocity is a quadratic, integrated exactly by DOPRI5 and its continuous extension, so
-        // the times are exact up to rounding (the analytic roots t1, t2).
+        // The velocity is a quadratic, integrated exactly by either method and its continuous
+        // extension, so the times are exact up to rounding (the analytic roots t1, t2).
         assert!((run.transitions[0].t_s - t1).abs() < 1e-12);
         assert!((run.transitions[1].t_s - t2).abs() < 1e-12);
     }
@@ -192,8 +225,9 @@ fn tangential_departures_take_the_consistent_direction() {
     }
     assert!(slip_samples > 10_000);
 
-    // The blade (default sample parameters): over the reversal window, every slip phase moves the
-    // tip in its own direction (v̇3 sampled at 100 kHz, allowing 1e-9 m/s of rounding).
+    // The blade (default sample parameters), with either method: over the reversal window, every
+    // slip phase moves the tip in its own direction (v̇3 sampled at 100 kHz, allowing 1e-9 m/s of
+    // rounding).
     let text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/data/reversal/blade_true.toml"
@@ -210,26 +244,35 @@ fn tangential_departures_take_the_consistent_direction() {
         anchor: 0.0,
         region: 0,
     };
-    let run = integrate(&blade, t0, y0, mode, t1, &times, &SolverOptions::default()).unwrap();
-    let departures = run
-        .transitions
-        .iter()
-        .filter(|tr| tr.from == Phase::Stick)
-        .count();
-    eprintln!(
-        "blade: {} transitions, {departures} departures",
-        run.transitions.len()
-    );
-    assert!(departures >= 3, "{departures} departures");
-    let mut checked = 0;
-    for ((t, y), ph) in run.t_s.iter().zip(&run.y).zip(&run.phase) {
-        if let Some(s) = ph.slip_dir() {
-            let v = blade.tip_velocity(*t, y);
-            assert!(s * v >= -1e-9, "t = {t}: {ph} with tip velocity {v}");
-            checked += 1;
+    for method in Method::ALL.iter().copied() {
+        let opts = SolverOptions {
+            method,
+            ..SolverOptions::default()
+        };
+        let run = integrate(&blade, t0, y0, mode, t1, &times, &opts).unwrap();
+        let departures = run
+            .transitions
+            .iter()
+            .filter(|tr| tr.from == Phase::Stick)
+            .count();
+        eprintln!(
+            "blade ({method}): {} transitions, {departures} departures",
+            run.transitions.len()
+        );
+        assert!(departures >= 3, "{departures} departures");
+        let mut checked = 0;
+        for ((t, y), ph) in run.t_s.iter().zip(&run.y).zip(&run.phase) {
+            if let Some(s) = ph.slip_dir() {
+                let v = blade.tip_velocity(*t, y);
+                assert!(
+                    s * v >= -1e-9,
+                    "{method} t = {t}: {ph} with tip velocity {v}"
+                );
+                checked += 1;
+            }
         }
+        assert!(checked > n / 10, "{method}: {checked} slip samples");
     }
-    assert!(checked > n / 10, "{checked} slip samples");
 }
 
 /// The step API: on the Coulomb belt (physics.md §3.1) started in stick, the first event is the

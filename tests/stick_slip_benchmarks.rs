@@ -18,8 +18,8 @@ use wiperlab::model::benchmarks::{
     CoulombBelt, DAMPED_COULOMB_REFERENCE, LEINE_REFERENCE, SEED_LAW_REFERENCE,
     damped_coulomb_belt, leine_belt, seed_law_belt,
 };
-use wiperlab::simulate::SolverOptions;
 use wiperlab::simulate::belt::limit_cycle;
+use wiperlab::simulate::{Method, SolverOptions};
 
 fn tight() -> SolverOptions {
     SolverOptions {
@@ -27,6 +27,11 @@ fn tight() -> SolverOptions {
         atol: 1e-14,
         ..Default::default()
     }
+}
+
+/// [`tight`] with `method`.
+fn tight_with(method: Method) -> SolverOptions {
+    SolverOptions { method, ..tight() }
 }
 
 /// Required relative accuracy of t_slip, t_stick and T at tight tolerance (issue 5).
@@ -170,8 +175,21 @@ fn damped_coulomb_reference(
     None
 }
 
+/// The limit cycle against `reference`, with each integrator ([`Method::ALL`]).
 fn check_cycle(name: &str, belt: &Belt, reference: Reference, t_end: f64) {
-    let cyc = limit_cycle(belt, 0.0, t_end, &tight())
+    for &method in Method::ALL {
+        check_cycle_with(
+            &format!("{name} ({method})"),
+            belt,
+            reference,
+            t_end,
+            method,
+        );
+    }
+}
+
+fn check_cycle_with(name: &str, belt: &Belt, reference: Reference, t_end: f64, method: Method) {
+    let cyc = limit_cycle(belt, 0.0, t_end, &tight_with(method))
         .unwrap()
         .expect("stick-slip cycle");
     let period = reference.t_slip + reference.t_stick;
