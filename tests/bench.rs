@@ -1,6 +1,6 @@
 //! `wiperlab bench --quick` through the library: every method runs on every problem, the
-//! event-driven errors fall with the tolerance, Moreau–Jean converges at first order, and the CSV and
-//! figures are written. (Timings are not asserted: speed is measured by the bench, not by tests.)
+//! event-driven errors (DOPRI5 and DOP853) fall with the tolerance, Moreau–Jean converges at first
+//! order, and the CSV and figures are written. (Timings are not asserted: speed is measured by the bench, not by tests.)
 
 use wiperlab::bench::{BenchOptions, run_bench, spectra_vs_rtol, write_reports, write_spectra};
 use wiperlab::model::BladeParams;
@@ -20,7 +20,12 @@ fn quick_bench_runs_every_method_and_writes_reports() {
             .collect()
     };
     for problem in ["belt", "blade-burst"] {
-        for method in ["event-driven DOPRI5", "Moreau-Jean", "smoothed tanh"] {
+        for method in [
+            "event-driven DOPRI5",
+            "event-driven DOP853",
+            "Moreau-Jean",
+            "smoothed tanh",
+        ] {
             let s = sel(problem, method);
             assert!(!s.is_empty(), "{problem}/{method} missing");
             for r in &s {
@@ -28,19 +33,21 @@ fn quick_bench_runs_every_method_and_writes_reports() {
                 assert!(r.rhs_evals > 0 && r.transition_err_s.is_finite());
             }
         }
-        // Event-driven: the tightest setting is far more accurate than the loosest, and for these
-        // two problems reaches 1e-9 s.
-        let ed: Vec<_> = sel(problem, "event-driven DOPRI5")
-            .into_iter()
-            .filter(|r| r.method == "event-driven DOPRI5")
-            .collect();
-        let (first, last) = (ed.first().unwrap(), ed.last().unwrap());
-        assert!(
-            last.transition_err_s < 1e-9,
-            "{problem}: {}",
-            last.transition_err_s
-        );
-        assert!(last.transition_err_s < 1e-3 * first.transition_err_s);
+        // Event-driven, with either integrator: the tightest setting is far more accurate than the
+        // loosest, and for these two problems reaches 1e-9 s.
+        for method in ["event-driven DOPRI5", "event-driven DOP853"] {
+            let ed: Vec<_> = sel(problem, method)
+                .into_iter()
+                .filter(|r| r.method == method)
+                .collect();
+            let (first, last) = (ed.first().unwrap(), ed.last().unwrap());
+            assert!(
+                last.transition_err_s < 1e-9,
+                "{problem} {method}: {}",
+                last.transition_err_s
+            );
+            assert!(last.transition_err_s < 1e-3 * first.transition_err_s);
+        }
     }
     // Moreau–Jean on the belt: first order (error ÷ 10 per step ÷ 10, within 2×).
     let mj = sel("belt", "Moreau-Jean");

@@ -20,6 +20,7 @@
 use crate::model::benchmarks::{CoulombBelt, leine_belt};
 use crate::model::{Blade, BladeParams, StickForm};
 use crate::report::plot::{ChartOpts, Series, line_chart};
+use crate::simulate::Method;
 use crate::simulate::blade::default_window;
 use crate::simulate::hybrid::{Mode, Phase, SolverOptions, StickSlipModel, integrate};
 use crate::simulate::timestep::{NonsmoothModel, Trajectory, moreau_jean, smoothed};
@@ -178,7 +179,20 @@ fn ed_opts(rtol: f64) -> SolverOptions {
     }
 }
 
-/// Runs the three methods on one problem.
+/// [`ed_opts`] with `method`.
+fn ed_opts_with(rtol: f64, method: Method) -> SolverOptions {
+    SolverOptions {
+        method,
+        ..ed_opts(rtol)
+    }
+}
+
+/// The bench's name of the event-driven method with `method` ("event-driven DOPRI5", ...).
+fn ed_label(method: Method) -> String {
+    format!("event-driven {}", method.name().to_uppercase())
+}
+
+/// Runs the three methods on one problem (the event-driven one with each [`Method`]).
 #[allow(clippy::too_many_arguments)]
 fn compare<M, const N: usize>(
     problem: &str,
@@ -198,20 +212,16 @@ where
 {
     let min_s = if quick { 0.05 } else { 0.2 };
     let reference = event_driven(model, t0, t1, y0, mode0, &ed_opts(1e-13), samples)?;
-    for rtol in rtols(quick) {
-        let r = event_driven(model, t0, t1, y0, mode0, &ed_opts(rtol), samples).map(|_| {
-            timed(min_s, || {
-                event_driven(model, t0, t1, y0, mode0, &ed_opts(rtol), samples).unwrap()
-            })
-        });
-        rows.push(row(
-            problem,
-            "event-driven DOPRI5",
-            "rtol",
-            rtol,
-            &reference,
-            r,
-        ));
+    for &method in Method::ALL {
+        for rtol in rtols(quick) {
+            let o = ed_opts_with(rtol, method);
+            let r = event_driven(model, t0, t1, y0, mode0, &o, samples).map(|_| {
+                timed(min_s, || {
+                    event_driven(model, t0, t1, y0, mode0, &o, samples).unwrap()
+                })
+            });
+            rows.push(row(problem, &ed_label(method), "rtol", rtol, &reference, r));
+        }
     }
     for &h in steps_s {
         let r = moreau_jean(model, t0, t1, y0, h, samples).map(|_| {
@@ -366,7 +376,8 @@ fn bench_blade_burst(opts: &BenchOptions, rows: &mut Vec<BenchRow>) -> Result<()
     Ok(())
 }
 
-/// The `blade-window` problem: the whole default reversal window, event-driven only (its cost).
+/// The `blade-window` problem: the whole default reversal window, event-driven only (its cost),
+/// with each [`Method`].
 fn bench_blade_window(opts: &BenchOptions, rows: &mut Vec<BenchRow>) -> Result<()> {
     let quick = opts.quick;
     let blade = Blade::new(opts.blade, StickForm::Reduced);
@@ -380,20 +391,23 @@ fn bench_blade_window(opts: &BenchOptions, rows: &mut Vec<BenchRow>) -> Result<(
         region: 0,
     };
     let reference = event_driven(&blade, w0, w1, y0, slip, &ed_opts(1e-13), &[])?;
-    for rtol in rtols(quick) {
-        let r = event_driven(&blade, w0, w1, y0, slip, &ed_opts(rtol), &[]).map(|_| {
-            timed(if quick { 0.1 } else { 0.5 }, || {
-                event_driven(&blade, w0, w1, y0, slip, &ed_opts(rtol), &[]).unwrap()
-            })
-        });
-        rows.push(row(
-            "blade-window",
-            "event-driven DOPRI5",
-            "rtol",
-            rtol,
-            &reference,
-            r,
-        ));
+    for &method in Method::ALL {
+        for rtol in rtols(quick) {
+            let o = ed_opts_with(rtol, method);
+            let r = event_driven(&blade, w0, w1, y0, slip, &o, &[]).map(|_| {
+                timed(if quick { 0.1 } else { 0.5 }, || {
+                    event_driven(&blade, w0, w1, y0, slip, &o, &[]).unwrap()
+                })
+            });
+            rows.push(row(
+                "blade-window",
+                &ed_label(method),
+                "rtol",
+                rtol,
+                &reference,
+                r,
+            ));
+        }
     }
     Ok(())
 }
