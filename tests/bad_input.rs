@@ -809,6 +809,18 @@ fn fit_cases() -> Vec<Case> {
             &["$D/job.toml", "rtol"],
         ),
         case(
+            "fit: unknown solver method",
+            j(&[("atol = 1e-10", "atol = 1e-10\nmethod = \"rk4\"")]),
+            fit,
+            &["$D/job.toml:", "rk4", "dop853"],
+        ),
+        case(
+            "simulate: unknown --method",
+            vec![],
+            &["simulate", BLADE, "--method", "rk4"],
+            &["--method", "dop853"],
+        ),
+        case(
             "fit: swarm tolerance out of range",
             j(&[("swarm_rtol = 1e-6", "swarm_rtol = 0.0")]),
             fit,
