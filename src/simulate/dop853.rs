@@ -11,6 +11,9 @@
 //! dense output ([`Trial::finish`]): 15 per accepted step, 11 per rejected one. The state is a
 //! fixed-size array `[f64; N]`, so nothing is allocated.
 
+// The coefficients keep every digit `dop853.f` prints, so they can be checked against it.
+#![allow(clippy::excessive_precision)]
+
 /// Number of stages including the end point's derivative and the three dense-output stages.
 const STAGES: usize = 16;
 
