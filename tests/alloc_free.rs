@@ -8,6 +8,7 @@ use wiperlab::model::benchmarks::leine_belt;
 use wiperlab::model::{Blade, BladeParams, StickForm};
 use wiperlab::simulate::blade::default_window;
 use wiperlab::simulate::hybrid::{Mode, Phase, SolverOptions, StickSlipModel, integrate};
+use wiperlab::simulate::method::{Method, Outcome};
 use wiperlab::simulate::rk;
 use wiperlab::simulate::timestep::NonsmoothModel;
 
@@ -106,6 +107,14 @@ fn right_hand_sides_allocate_nothing() {
         rhs(t0, &y, &mut f0).unwrap();
         let a = rk::attempt(&mut rhs, t0, &y, &f0, 1e-5, 1e-8, 1e-10).unwrap();
         sink += a.dense.eval(t0 + 5e-6)[0];
+        // One DOP853 step (12 stages and the 3 of its dense output), through the method layer.
+        match Method::Dop853
+            .attempt(&mut rhs, t0, &y, &f0, 1e-5, 1e-8, 1e-10)
+            .unwrap()
+        {
+            Outcome::Accepted(step) => sink += step.dense.eval(t0 + 5e-6)[0],
+            Outcome::Rejected { err } => panic!("the DOP853 step was rejected (err {err})"),
+        }
         // The comparison methods' right-hand sides.
         let mut yy = y;
         reduced.moreau_step(t0, 1e-6, &mut yy).unwrap();
