@@ -355,38 +355,9 @@ pub(super) fn fit_candidate(
     reporting.stage(format_args!("swarm"));
     let (main, free) = build_problem(job, meas, candidate)?;
     let problem = Arc::new(main);
-    let warm: Option<Vec<f64>> = nested.map(|smaller| {
-        let params = smaller.problem.params_at(&smaller.best_u);
-        free.iter()
-            .map(|fp| {
-                let source = if fp.name == ParamId::K1c {
-                    ParamId::K1
-                } else {
-                    fp.name
-                };
-                // The smaller model's own coordinate where the scales agree: then the values are
-                // bitwise the same (a value → u → value round trip through ln/exp can move them by
-                // an ulp, and on this chaotic cost surface one ulp of k1 moved the main job's cost by
-                // 0.4 %).
-                if let Some(i) = smaller.free.iter().position(|f| {
-                    f.name == source
-                        && f.lower == fp.lower
-                        && f.upper == fp.upper
-                        && f.log == fp.log
-                }) {
-                    return smaller.best_u[i];
-                }
-                let v = match fp.name {
-                    ParamId::K1c => params.k1_nm_per_rad,
-                    ParamId::ThetaC => fp.upper,
-                    id => id.get(&params).unwrap_or(fp.lower),
-                };
-                fp.u_of(v)
-            })
-            .collect()
-    });
+    let warm = nested.map_or_else(Vec::new, |smaller| nested_warm_points(smaller, &free));
     let (best_u, swarm_iters, polish_iters, cost) =
-        optimise(&problem, fit, fit.seed, warm.as_deref(), Some(&reporting))?;
+        optimise(&problem, fit, fit.seed, &warm, Some(&reporting))?;
 
     // The likelihood at the optimum → NLL for model choice, and the inverse Fisher information →
     // standard errors, correlations, identifiability; the cost's curvature where there is no
@@ -434,6 +405,67 @@ pub(super) fn fit_candidate(
     })
 }
 
+/// Where a nested candidate (`X+shoulder`) starts: `X`'s optimum with k1_contact = k1, so that
+/// the shoulder changes no moment. The first point has θ_c on its upper bound and the smaller
+/// model's own normalised coordinates (bitwise its parameters and, while the neck stays below θ_c,
+/// its simulation); it is also the point [`optimise`] keeps if no restart ends below it. The
+/// others put θ_c at the median and the 90th percentile of |θ| in the smaller model's simulation
+/// (inside the contact-angle bounds): the same motion, but a polish from there feels k1_contact at
+/// once, while from the first it must first bring θ_c into the range the neck visits. On the
+/// confusion table's often-crossed shoulder (docs/fit.md) the search from the first point alone
+/// never left blade2dof's optimum.
+fn nested_warm_points(smaller: &CandidateFit, free: &[FreeParam]) -> Vec<Vec<f64>> {
+    let params = smaller.problem.params_at(&smaller.best_u);
+    let first: Vec<f64> = free
+        .iter()
+        .map(|fp| {
+            let source = if fp.name == ParamId::K1c {
+                ParamId::K1
+            } else {
+                fp.name
+            };
+            // The smaller model's own coordinate where the scales agree: then the values are
+            // bitwise the same (a value → u → value round trip through ln/exp can move them by
+            // an ulp, and on this chaotic cost surface one ulp of k1 moved the main job's cost by
+            // 0.4 %).
+            if let Some(i) = smaller.free.iter().position(|f| {
+                f.name == source && f.lower == fp.lower && f.upper == fp.upper && f.log == fp.log
+            }) {
+                return smaller.best_u[i];
+            }
+            let v = match fp.name {
+                ParamId::K1c => params.k1_nm_per_rad,
+                ParamId::ThetaC => fp.upper,
+                id => id.get(&params).unwrap_or(fp.lower),
+            };
+            fp.u_of(v)
+        })
+        .collect();
+    let mut points = vec![first.clone()];
+    let (Some(i), Ok(sim)) = (
+        free.iter().position(|fp| fp.name == ParamId::ThetaC),
+        smaller.problem.simulate(&params),
+    ) else {
+        return points;
+    };
+    let mut abs_theta: Vec<f64> = sim
+        .theta_rad
+        .iter()
+        .filter(|t| t.is_finite())
+        .map(|t| t.abs())
+        .collect();
+    if abs_theta.is_empty() {
+        return points;
+    }
+    abs_theta.sort_by(f64::total_cmp);
+    for q in [0.5, 0.9] {
+        let mut p = first.clone();
+        p[i] = free[i].u_of(crate::spectrum::stats::quantile_sorted(&abs_theta, q));
+        points.push(p);
+    }
+    points
+}
+
 /// The estimator: `restarts` independent runs of a particle swarm over `[0, 1]^n` (`particles`,
 /// `swarm_iterations`; 0 iterations skips it and starts from the problem's centre), each followed by
 /// a Nelder–Mead polish from its best particle; the run with the lowest cost is kept. Restart `r`
@@ -443,15 +475,15 @@ pub(super) fn fit_candidate(
 /// parameters move, so one swarm can settle in a nearby minimum. On the shipped recording, single
 /// swarms of 24 particles × 25 iterations ended in the truth's basin (cost 0.25) for some seeds and
 /// at 0.30 to 19.7 for others (docs/fit.md, "Restarts"; the seed-by-seed costs: CHANGELOG.md).
-/// `warm`: a point that one particle of the first swarm starts at (the others at random); it is
-/// also returned itself if no restart ends below its cost.
+/// `warm`: points that one particle of restart `r`'s swarm starts at (`warm[r]`; the others at
+/// random); the first is also returned itself if no restart ends below its cost.
 /// Returns `(best_u, swarm iterations, polish iterations, best cost)`, the iterations summed over
 /// the restarts.
 pub(super) fn optimise(
     problem: &Arc<SpectralProblem>,
     fit: &job::FitSection,
     seed: u64,
-    warm: Option<&[f64]>,
+    warm: &[Vec<f64>],
     log: Option<&Reporting>,
 ) -> Result<(Vec<f64>, u64, u64, f64)> {
     use rayon::prelude::*;
@@ -466,13 +498,13 @@ pub(super) fn optimise(
     // The warm point itself, at the polish's tolerance, is a candidate result: then a nested fit
     // cannot end above the smaller model's cost even when the swarm ranks points at a looser
     // tolerance (`[fit] swarm_rtol`) and leaves the warm particle's basin.
-    let mut best: Option<(Vec<f64>, f64)> = warm.map(|w| (w.to_vec(), problem.cost_at(w)));
+    let mut best: Option<(Vec<f64>, f64)> = warm.first().map(|w| (w.clone(), problem.cost_at(w)));
     // The restarts are independent (each its own seed): they run in parallel, which keeps both
     // cores busy during the polishes (Nelder–Mead evaluates one point at a time), and are then
     // compared in restart order, so the result is the sequential one's.
     let runs: Vec<Result<Option<Run>>> = (0..restarts)
         .into_par_iter()
-        .map(|r| restart(problem, fit, seed, r, warm, log))
+        .map(|r| restart(problem, fit, seed, r, warm.get(r).map(Vec::as_slice), log))
         .collect();
     let (mut swarm_iters, mut polish_iters) = (0, 0);
     for run in runs {
@@ -510,7 +542,7 @@ struct Run {
 }
 
 /// Restart `r` of [`optimise`]: a particle swarm seeded with `seed ^ (r · 0x9E3779B97F4A7C15)` (its
-/// first particle at `warm` for restart 0), then a Nelder–Mead polish from its best particle.
+/// first particle at `warm`), then a Nelder–Mead polish from its best particle.
 /// `None` when interrupted.
 fn restart(
     problem: &Arc<SpectralProblem>,
@@ -536,9 +568,7 @@ fn restart(
     let pso = ParticleSwarm::new((vec![0.0; n], vec![1.0; n]), fit.particles)
         .with_rng_generator(rand::rngs::StdRng::seed_from_u64(run_seed));
     let population = match warm {
-        Some(w) if r == 0 && fit.particles > 0 => {
-            Some(warm_population(problem, w, fit.particles, run_seed))
-        }
+        Some(w) if fit.particles > 0 => Some(warm_population(problem, w, fit.particles, run_seed)),
         _ => None,
     };
     let mut ex = Executor::new(

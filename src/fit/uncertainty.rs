@@ -132,7 +132,7 @@ pub fn bootstrap_intervals(
             }
             let rep = Arc::new(rep);
             let u = if settings.full_refit {
-                optimise(&rep, fit, fit.seed.wrapping_add(1 + r as u64), None, None)?.0
+                optimise(&rep, fit, fit.seed.wrapping_add(1 + r as u64), &[], None)?.0
             } else {
                 polish(&rep, best_u, 0.05, settings.polish_iterations, None)?.0
             };
