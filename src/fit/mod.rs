@@ -451,8 +451,12 @@ mod tests {
                 .collect::<Vec<_>>()
                 .join("\n")
         };
-        let with = strip(&text).replace("restarts = 5", "restarts = 5\nswarm_rtol = 1e-5");
-        let without = strip(&text);
+        // The feature objective, so that both stages read the same cost and only the tolerance
+        // differs; the default (likelihood) objective is checked at the end.
+        let features =
+            strip(&text).replace("restarts = 5", "restarts = 5\nobjective = \"features\"");
+        let with = features.replace("restarts = 5", "restarts = 5\nswarm_rtol = 1e-5");
+        let without = features.clone();
         let load = |name: &str, t: &str| {
             let path = dir.join(name);
             std::fs::write(&path, t).unwrap();
@@ -491,6 +495,19 @@ mod tests {
         .unwrap();
         assert_eq!(q.swarm_solver.rtol, q.solver.rtol);
         assert_eq!(q.cost_at(&u), q.cost_at_stage(&u, SearchStage::Swarm));
+        // With the likelihood objective the swarm ranks by the same feature cost, and the polish by
+        // the NLL above the saturated model, which is never negative.
+        let l = problem_for(
+            &load("likelihood.toml", &strip(&text)),
+            "blade2dof".parse().unwrap(),
+        )
+        .unwrap();
+        assert_eq!(
+            l.cost_at_stage(&u, SearchStage::Swarm),
+            q.cost_at_stage(&u, SearchStage::Swarm)
+        );
+        let nll = l.cost_at(&u);
+        assert!(nll >= 0.0 && nll != q.cost_at(&u), "{nll}");
         std::fs::remove_dir_all(&dir).ok();
     }
 }
