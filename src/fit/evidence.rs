@@ -161,7 +161,7 @@ impl RecordingLikelihood {
     /// The features' errors, and [`likelihood::LikelihoodError`] for a non-positive ordinate or
     /// too few residuals.
     pub fn nll(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<NllParts> {
-        Ok(self.terms(problem, sim)?.0)
+        self.terms(problem, sim)
     }
 
     /// What the search minimises with `[fit] objective = "likelihood"`: the NLL above the saturated
@@ -176,25 +176,49 @@ impl RecordingLikelihood {
     /// # Errors
     /// Those of [`RecordingLikelihood::nll`].
     pub fn excess_nll(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<f64> {
-        let (parts, time_n_eff) = self.terms(problem, sim)?;
-        let spectral = parts.spectral_nats.iter().sum::<f64>() - self.saturated_spectral_nats;
-        let time = parts.time_nats.map_or(0.0, |t| {
-            t - 0.5 * time_n_eff * (std::f64::consts::TAU * self.sigma_m * self.sigma_m).ln()
-        });
-        Ok(spectral + time)
+        // The fit's cost: the residuals are only formed when the time-domain term needs them.
+        let (spectral_nats, _) = self.spectral_terms(problem, sim)?;
+        let mut excess = spectral_nats.iter().sum::<f64>() - self.saturated_spectral_nats;
+        if self.time_domain {
+            let (e, size) = self.residuals(problem, sim)?;
+            let nll = likelihood::gaussian_nll(&e, self.sigma_m, size.n_eff)?;
+            excess +=
+                nll - 0.5 * size.n_eff * (std::f64::consts::TAU * self.sigma_m * self.sigma_m).ln();
+        }
+        Ok(excess)
     }
 
-    /// The NLL by term and the residuals' effective sample size.
-    fn terms(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<(NllParts, f64)> {
+    /// The Whittle NLL of every band, nats, and the bands' effectively independent bins.
+    fn spectral_terms(
+        &self,
+        problem: &SpectralProblem,
+        sim: &BladeSimulation,
+    ) -> Result<(Vec<f64>, f64)> {
         let psd = self.model_psd(problem, sim)?;
         let mut spectral_nats = Vec::with_capacity(self.bands.len());
-        let mut n_effective = 0.0;
+        let mut effective_bins = 0.0;
         for (b, s) in self.bands.iter().zip(&psd) {
             spectral_nats.push(b.lik.nll(&b.measured, s)?);
-            n_effective += b.lik.effective_bins();
+            effective_bins += b.lik.effective_bins();
         }
+        Ok((spectral_nats, effective_bins))
+    }
+
+    /// The de-meaned time-domain residuals and their AR(1) effective sample size.
+    fn residuals(
+        &self,
+        problem: &SpectralProblem,
+        sim: &BladeSimulation,
+    ) -> Result<(Vec<f64>, likelihood::SampleSize)> {
         let e = likelihood::demeaned_residuals(&self.measured_x, &self.model_x(problem, sim)?)?;
         let size = likelihood::effective_sample_size(&e)?;
+        Ok((e, size))
+    }
+
+    /// The NLL by term.
+    fn terms(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<NllParts> {
+        let (spectral_nats, mut n_effective) = self.spectral_terms(problem, sim)?;
+        let (e, size) = self.residuals(problem, sim)?;
         let residual_rms_m = (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt();
         let time_nats = if self.time_domain {
             n_effective += size.n_eff;
@@ -202,16 +226,13 @@ impl RecordingLikelihood {
         } else {
             None
         };
-        Ok((
-            NllParts {
-                spectral_nats,
-                time_nats,
-                residual_rms_m,
-                residual_rho: size.rho,
-                n_effective,
-            },
-            size.n_eff,
-        ))
+        Ok(NllParts {
+            spectral_nats,
+            time_nats,
+            residual_rms_m,
+            residual_rho: size.rho,
+            n_effective,
+        })
     }
 
     /// What one simulation contributes to the Gauss–Newton Fisher information: the log expected
