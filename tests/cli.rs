@@ -272,9 +272,9 @@ fn main_job_end_to_end() {
             t["reason"]
         );
     }
-    // The shoulder candidate contains blade2dof (k1_contact = k1) and starts one particle at its
-    // optimum, bitwise the same parameters, which it keeps if no restart ends lower
-    // (src/fit/mod.rs, fit_candidate `nested`). There |θ| stays below 0.15 rad, under θ_c's upper
+    // The shoulder candidate contains blade2dof (k1_contact = k1) and starts its search at its
+    // optimum, bitwise the same parameters, which it keeps if no polish or restart ends lower
+    // (src/fit/search.rs, `nested_warm_points` and `nested_search`). There |θ| stays below 0.15 rad, under θ_c's upper
     // bound 0.2, so the shoulder's simulation is bitwise blade2dof's: it cannot end above it.
     let cost_of = |m: &str| {
         num(

@@ -216,6 +216,11 @@ pub struct FitSection {
     /// Bounds of the shoulder-contact parameters freed by the `+shoulder` candidates.
     #[serde(default)]
     pub shoulder: Option<ShoulderBounds>,
+    /// How a `+shoulder` candidate is searched once the same model without shoulder is fitted
+    /// (default `adaptive`: a local search from that fit first, the restarts' global search only
+    /// when the local one finds the likelihood worth it).
+    #[serde(default = "d_nested_search")]
+    pub nested_search: NestedSearch,
     /// Confidence intervals: Laplace (from the likelihood's Fisher information) or parametric
     /// bootstrap (see [`crate::fit::bootstrap_intervals`]).
     #[serde(default)]
@@ -246,6 +251,25 @@ crate::names::named_enum! {
         /// `[fit.weights]` and their optional frequency-against-speed and trace terms.
         Features => "features",
     }
+}
+
+crate::names::named_enum! {
+    /// How a nested candidate (`X+shoulder`, fitted after `X`) is searched (docs/fit.md, "Which
+    /// model the scene needs").
+    pub enum NestedSearch: "nested search" {
+        /// Nelder–Mead polishes from `X`'s optimum (θ_c at its bound, the median and the 90th
+        /// percentile of |θ|) first; the global search (`restarts` swarms) follows only when they
+        /// lower the recording's NLL by more than
+        /// [`crate::fit::NESTED_GLOBAL_GAIN_NATS`]. With the features objective, or a target job
+        /// (no likelihood), always the global search.
+        Adaptive => "adaptive",
+        /// Always the global search, warm-started from `X`'s optimum.
+        Global => "global",
+    }
+}
+
+fn d_nested_search() -> NestedSearch {
+    NestedSearch::Adaptive
 }
 
 fn d_objective() -> Objective {

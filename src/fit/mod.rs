@@ -34,7 +34,7 @@ pub use result::{
     FitResult, FittedParam, HistoryPoint, Interval, IntervalMethod, ModelTrial, PeakComparison,
     RatioTest, SearchStage, SpreadSource, TrialEvidence,
 };
-pub use search::problem_for;
+pub use search::{NESTED_GLOBAL_GAIN_NATS, problem_for};
 pub use select::aic;
 pub use uncertainty::{bootstrap_intervals, identifiability_warnings, laplace_intervals};
 

@@ -239,6 +239,15 @@ impl SpectralProblem {
         })
     }
 
+    /// True when the polish's cost is the recording's NLL in nats (the likelihood objective, a
+    /// recording with a likelihood, not a target job): cost differences are then log-likelihood
+    /// ratios.
+    pub fn cost_is_nll(&self) -> bool {
+        self.objective == Objective::Likelihood
+            && self.targets.is_none()
+            && self.likelihood.is_ok()
+    }
+
     /// Cost at normalised coordinates, with a quadratic penalty outside the box.
     pub fn cost_at(&self, u: &[f64]) -> f64 {
         self.cost_at_stage(u, SearchStage::Polish)

@@ -94,7 +94,10 @@ pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) ->
             model_evaluations: f.problem.evaluations.load(Ordering::Relaxed),
             failed_evaluations: super::failures(&f.problem).0,
             chosen: i == chosen,
-            reason: scored.reason(fits, i, bands, listed),
+            reason: match &f.search_note {
+                Some(note) => format!("{}; {note}", scored.reason(fits, i, bands, listed)),
+                None => scored.reason(fits, i, bands, listed),
+            },
             evidence: scored.trial_evidence(fits, i),
         })
         .collect();
