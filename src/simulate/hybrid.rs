@@ -156,12 +156,24 @@ fn event_values<M: StickSlipModel<N>, const N: usize>(
     model.complete(mode, t, &mut yc)?;
     let mut dy = [0.0; N];
     let c = model.rhs(mode, t, &yc, &mut dy)?;
+    Ok((event_values_of(model, mode, t, &yc, c), c))
+}
+
+/// The event functions at `(t, yc)` (a state consistent with `mode`) from the contact `c` the
+/// right-hand side computed there.
+fn event_values_of<M: StickSlipModel<N>, const N: usize>(
+    model: &M,
+    mode: &Mode,
+    t: f64,
+    yc: &[f64; N],
+    c: Contact,
+) -> [f64; N_EVENTS] {
     let mut g = [NO_EVENT; N_EVENTS];
     match mode.phase.slip_dir() {
         Some(s) => {
             g[0] = s * c
                 .slip_velocity
-                .unwrap_or_else(|| model.slip_velocity(t, &yc));
+                .unwrap_or_else(|| model.slip_velocity(t, yc));
             g[2] = c.normal;
         }
         None => {
@@ -171,10 +183,10 @@ fn event_values<M: StickSlipModel<N>, const N: usize>(
         }
     }
     for i in 0..model.switching_surfaces().min(MAX_SWITCHING_SURFACES) {
-        let si = model.switching_function(i, t, &yc);
+        let si = model.switching_function(i, t, yc);
         g[3 + i] = if mode.region & (1 << i) != 0 { si } else { -si };
     }
-    Ok((g, c))
+    g
 }
 
 /// Minimum of `g` on `[a, b]` by golden-section search (Kiefer 1953), stopping as soon as a value
@@ -344,6 +356,10 @@ pub struct HybridSolver<'m, M: StickSlipModel<N>, const N: usize> {
     /// The previous accepted step of this phase: its continuous extension and its last interior
     /// event sample, so that a minimum of the samples at a step boundary is searched too.
     prev: Option<(Dense<N>, f64, [f64; N_EVENTS])>,
+    /// The last right-hand-side call of the last attempt: its time, state and contact. When it
+    /// was at the accepted step's end (the FSAL stage), the event functions there read its contact
+    /// instead of solving the model again (bitwise the same values).
+    last_rhs: Option<(f64, [f64; N], Contact)>,
     settled: f64,
     segments: Vec<Segment<N>>,
     quick_transitions: usize,
@@ -402,6 +418,7 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
             f: [0.0; N],
             g_prev: [NO_EVENT; N_EVENTS],
             prev: None,
+            last_rhs: None,
             settled: t0,
             segments: Vec::new(),
             quick_transitions: 0,
@@ -545,9 +562,12 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
         }
         let (model, mode) = (self.model, self.mode);
         let mut evals = 0;
+        let mut last_rhs = None;
         let mut rhs = |tt: f64, yy: &[f64; N], dy: &mut [f64; N]| {
             evals += 1;
-            model.rhs(&mode, tt, yy, dy).map(|_| ())
+            let c = model.rhs(&mode, tt, yy, dy)?;
+            last_rhs = Some((tt, *yy, c));
+            Ok::<(), ModelFault>(())
         };
         let method = self.opts.method;
         let outcome = method.attempt(
@@ -560,6 +580,7 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
             self.opts.atol,
         );
         self.stats.rhs_evals += evals;
+        self.last_rhs = last_rhs;
         match outcome {
             // The right-hand side failed inside the step, or the error estimate or state is not
             // finite (e.g. near a singular constraint): shrink, so the collapse check ends the run.
@@ -610,9 +631,15 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
                 t + h * j as f64 / (m + 1) as f64
             };
             let yj = if j == m + 1 { a.y_new } else { dense.eval(tj) };
-            let (gj, _) =
-                event_values(model, &mode, tj, &yj).map_err(|e| self.fail(tj, &yj, e.into()))?;
-            self.stats.event_evals += 1;
+            let gj = match self.end_event_values(j == m + 1, tj, &yj) {
+                Some(g) => g,
+                None => {
+                    self.stats.event_evals += 1;
+                    event_values(model, &mode, tj, &yj)
+                        .map_err(|e| self.fail(tj, &yj, e.into()))?
+                        .0
+                }
+            };
             for k in 0..N_EVENTS {
                 let bracket = if k >= 3 {
                     // A switching surface: fires on leaving the current region, also when the
@@ -665,6 +692,26 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
             self.prev = Some((dense, tb, gb));
         }
         Ok(found)
+    }
+
+    /// The event functions at the accepted step's end `(t_end, y_end)` from the attempt's last
+    /// right-hand-side call, when that call was at exactly this time and state and the state is
+    /// already consistent with the mode (`complete` leaves it bitwise unchanged): the same function
+    /// of the same arguments as [`event_values`] there, without solving the model again. `None`
+    /// otherwise (`at_end` false, the last stage elsewhere, or a state `complete` changes).
+    fn end_event_values(
+        &mut self,
+        at_end: bool,
+        t_end: f64,
+        y_end: &[f64; N],
+    ) -> Option<[f64; N_EVENTS]> {
+        let (tt, yy, c) = self.last_rhs.take().filter(|_| at_end)?;
+        if tt != t_end || yy != *y_end {
+            return None;
+        }
+        let mut yc = yy;
+        self.model.complete(&self.mode, tt, &mut yc).ok()?;
+        (yc == yy).then(|| event_values_of(self.model, &self.mode, tt, &yc, c))
     }
 
     /// Takes the accepted step without an event.
