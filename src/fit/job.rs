@@ -644,10 +644,12 @@ impl Check<'_> {
         };
         let at = [Key::Name("recording"), Key::Name("import")];
         let format = r.import.resolve_format(&dir.join(&r.file))?;
-        r.import.validate(format).map_err(|e| match e {
-            Error::Config(m) => self.error(&at, format!("[recording.import] {m}")),
-            other => other,
-        })?;
+        r.import
+            .validate(format)
+            .map_err(|e| match crate::import::ImportError::of(&e) {
+                Some(ie) => self.error(&at, format!("[recording.import] {ie}")),
+                None => e,
+            })?;
         let period_s = std::f64::consts::TAU / blade.drive_omega_rad_per_s;
         let t0 = r.import.t0_s;
         if !(0.0..period_s).contains(&t0) {

@@ -354,10 +354,11 @@ fn metres_per_unit(
     let m_per_px = spec.resolved_m_per_px()?;
     Ok(match (units, m_per_px, spec.units_to_m) {
         (_, Some(_), Some(_)) => {
-            return Err(Error::Config(
-                "import: set either m_per_px (pixels) or units_to_m (calibrated units), not both"
-                    .into(),
-            ));
+            return Err(super::ImportError::Exclusive {
+                first: "either m_per_px (pixels)",
+                second: "units_to_m (calibrated units)",
+            }
+            .into());
         }
         (RawUnits::Pixels | RawUnits::Unknown, Some(s), None) => {
             notes.push(format!("units: pixels × {s:e} m/px"));

@@ -68,7 +68,7 @@ struct PointColumns {
 /// * [`Error::Parse`] — a header cell that is not `pt{i}_cam{j}_X|Y` (line 1), a row whose field
 ///   count differs from the header (`line`, column 0), or a cell that is neither a finite number nor
 ///   `NaN` (`file:line:column: field pt2_cam1_X: expected a number or NaN, found "abc"`);
-/// * [`Error::Config`] — settings out of range ([`ImportSpec::validate`]).
+/// * [`super::ImportError`] — settings out of range ([`ImportSpec::validate`]).
 pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
     spec.validate(Format::Dltdv)?;
     let (fps, scale) = required_settings(path, spec)?;

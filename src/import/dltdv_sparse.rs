@@ -192,16 +192,15 @@ fn dense_matrix(path: &Path, triplets: &[(usize, &str)], size: &Size) -> Result<
 /// xypts file — the layout [`read`] reads (used for round-trip tests).
 ///
 /// # Errors
-/// [`Error::Io`] if the file cannot be written; [`Error::Config`] if the tracks differ in length.
+/// [`Error::Io`] if the file cannot be written; [`super::ImportError`] if the tracks differ in length.
 pub fn write(path: &Path, points: &[(Vec<f64>, Vec<f64>)]) -> Result<()> {
     let rows = points.first().map_or(0, |p| p.0.len());
     if points
         .iter()
         .any(|p| p.0.len() != rows || p.1.len() != rows)
     {
-        return Err(Error::Config(
-            "DLTdv sparse writer: tracks differ in length".into(),
-        ));
+        let lengths = points.iter().map(|p| (p.0.len(), p.1.len())).collect();
+        return Err(super::ImportError::TrackLengths { lengths }.into());
     }
     let mut body = String::new();
     let mut nnz = 0;

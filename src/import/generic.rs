@@ -25,11 +25,11 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::import::ImportSpec;
 use crate::import::common::{
     RawTime, RawTrace, RawUnits, Table, header_time_unit, numbered_lines, read_decoded,
     sniff_delimiter, split_cells,
 };
+use crate::import::{ImportError, ImportSpec};
 
 /// How many lines the header search looks at.
 const MAX_PREAMBLE_LINES: usize = 100;
@@ -67,35 +67,28 @@ pub struct GenericColumns {
 /// Read a generic table (module docs) into a [`RawTrace`] in file units.
 ///
 /// # Errors
-/// [`Error::Config`] if no `[generic]` mapping or no point is given, or both `time` and `frame`;
+/// [`ImportError`] if no `[generic]` mapping or no point is given, or both `time` and `frame`;
 /// [`Error::Input`] if no line of the first 100 holds every mapped column name (the message lists
 /// the names wanted); [`Error::Parse`] (line, column, field) for a bad or non-increasing time or
 /// frame, a non-numeric coordinate, a row with fewer fields than the header.
 pub fn read(path: &Path, spec: &ImportSpec) -> Result<RawTrace> {
     let Some(map) = &spec.generic else {
-        return Err(Error::Config(
-            "import: format \"generic\" needs a [generic] column mapping (time or frame column, \
-             and [generic.points] name = [x column, y column])"
-                .into(),
-        ));
+        return Err(ImportError::GenericUnmapped.into());
     };
     if map.points.is_empty() {
-        return Err(Error::Config(
-            "import: [generic.points] is empty: map at least one point to [x column, y column]"
-                .into(),
-        ));
+        return Err(ImportError::GenericNoPoints.into());
     }
     if map.time.is_some() && map.frame.is_some() {
-        return Err(Error::Config(
-            "import: [generic] set time or frame, not both".into(),
-        ));
+        let (first, second) = ("[generic] time", "frame");
+        return Err(ImportError::Exclusive { first, second }.into());
     }
     for (name, cols) in &map.points {
         if cols.is_empty() || cols.len() > 2 {
-            return Err(Error::Config(format!(
-                "import: [generic.points] {name} = {cols:?}: expected [x column, y column] or \
-                 [column]"
-            )));
+            return Err(ImportError::GenericColumns {
+                point: name.clone(),
+                columns: cols.clone(),
+            }
+            .into());
         }
     }
     let mut wanted: Vec<&str> = map

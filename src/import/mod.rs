@@ -58,6 +58,7 @@ pub mod common;
 pub mod deeplabcut;
 pub mod dltdv;
 pub mod dltdv_sparse;
+mod error;
 pub mod generic;
 pub mod kinovea;
 pub mod sleap;
@@ -73,6 +74,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::trace::{PointTrack, Trace};
+pub use error::ImportError;
 
 /// The tracking-tool export layouts wiperlab reads. Serialised in kebab case (`"dltdv"`,
 /// `"tracker"`, `"kinovea-csv"`, ...), the same names `--format` takes.
@@ -382,100 +384,106 @@ impl ImportSpec {
     /// `format` (e.g. a pixel scale for a calibrated Tracker file).
     ///
     /// # Errors
-    /// [`Error::Config`] naming the field and the allowed range.
+    /// [`ImportError`] naming the field and the allowed range.
     pub fn validate(&self, format: Format) -> Result<()> {
-        fn positive(name: &str, v: f64) -> Result<()> {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(Error::Config(format!(
-                    "import: {name} must be finite and > 0, got {v}"
-                )))
+        self.check_ranges(format)?;
+        self.check_points()?;
+        self.check_format(format)?;
+        if self.generic.is_some() && format != Format::Generic {
+            return Err(not_for(
+                "generic",
+                format,
+                "set format = \"generic\" to use a column mapping",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Ranges of the numeric settings, and the settings that exclude each other.
+    fn check_ranges(&self, format: Format) -> Result<()> {
+        for (field, v) in [
+            ("fps_hz", self.fps_hz),
+            ("m_per_px", self.m_per_px),
+            ("units_to_m", self.units_to_m),
+            ("time_to_s", self.time_to_s),
+            ("scale_distance_m", self.scale_distance_m),
+        ] {
+            if let Some(value) = v
+                && !(value.is_finite() && value > 0.0)
+            {
+                return Err(ImportError::NotPositive { field, value }.into());
             }
         }
-        if let Some(fps) = self.fps_hz {
-            positive("fps_hz", fps)?;
-        }
-        if let Some(s) = self.m_per_px {
-            positive("m_per_px", s)?;
-        }
-        if let Some(u) = self.units_to_m {
-            positive("units_to_m", u)?;
-        }
-        if let Some(t) = self.time_to_s {
-            positive("time_to_s", t)?;
-        }
-        if let Some(d) = self.scale_distance_m {
-            positive("scale_distance_m", d)?;
-        }
-        if let Some(a) = self.sweep_angle_deg {
-            if !a.is_finite() {
-                return Err(Error::Config(format!(
-                    "import: sweep_angle_deg must be finite, got {a}"
-                )));
+        if let Some(value) = self.sweep_angle_deg {
+            if !value.is_finite() {
+                let field = "sweep_angle_deg";
+                return Err(ImportError::NotFinite { field, value }.into());
             }
             if self.sweep_from_head {
-                return Err(Error::Config(
-                    "import: set sweep_angle_deg or sweep_from_head, not both".into(),
-                ));
+                let (first, second) = ("sweep_angle_deg", "sweep_from_head");
+                return Err(ImportError::Exclusive { first, second }.into());
             }
         }
-        if let Some(l) = self.min_likelihood
-            && !(0.0..=1.0).contains(&l)
+        if let Some(value) = self.min_likelihood
+            && !(0.0..=1.0).contains(&value)
         {
-            return Err(Error::Config(format!(
-                "import: min_likelihood must be in [0, 1], got {l}"
-            )));
+            return Err(ImportError::MinLikelihood { value }.into());
         }
         if self.n_cameras == 0 || (self.camera > self.n_cameras && format == Format::DltdvSparse) {
-            return Err(Error::Config(format!(
-                "import: n_cameras must be ≥ 1 and ≥ camera, got n_cameras = {} with camera = {}",
-                self.n_cameras, self.camera
-            )));
+            return Err(ImportError::Cameras {
+                n_cameras: self.n_cameras,
+                camera: self.camera,
+            }
+            .into());
         }
         self.resolved_m_per_px()?;
         if !self.origin_px.iter().all(|v| v.is_finite()) {
-            return Err(Error::Config(format!(
-                "import: origin_px must be finite, got {:?}",
-                self.origin_px
-            )));
+            let origin_px = self.origin_px;
+            return Err(ImportError::OriginNotFinite { origin_px }.into());
         }
         if !self.t0_s.is_finite() {
-            return Err(Error::Config(format!(
-                "import: t0_s must be finite, got {}",
-                self.t0_s
-            )));
+            let (field, value) = ("t0_s", self.t0_s);
+            return Err(ImportError::NotFinite { field, value }.into());
         }
+        Ok(())
+    }
+
+    /// Roles and point names: none empty, no point under two roles.
+    fn check_points(&self) -> Result<()> {
         let mut seen: BTreeMap<&str, &str> = BTreeMap::new();
         for (role, name) in &self.points {
             if role.trim().is_empty() || name.trim().is_empty() {
-                return Err(Error::Config(format!(
-                    "import: points: role and point name must not be empty (got {role:?} = {name:?})"
-                )));
+                return Err(ImportError::EmptyRole {
+                    role: role.clone(),
+                    point: name.clone(),
+                }
+                .into());
             }
             if let Some(other) = seen.insert(name, role) {
-                return Err(Error::Config(format!(
-                    "import: points: roles {other:?} and {role:?} both map to point {name:?}"
-                )));
+                return Err(ImportError::SharedPoint {
+                    first: other.to_string(),
+                    second: role.clone(),
+                    point: name.clone(),
+                }
+                .into());
             }
         }
-        let not_for = |field: &str, hint: &str| {
-            Err(Error::Config(format!(
-                "import: {field} does not apply to {format} files; {hint}"
-            )))
-        };
+        Ok(())
+    }
+
+    /// Settings that make no sense for `format`.
+    fn check_format(&self, format: Format) -> Result<()> {
+        let reject = |field, hint| Err(not_for(field, format, hint));
         match format {
             Format::Dltdv | Format::DltdvSparse => {
                 if self.camera == 0 {
-                    return Err(Error::Config(
-                        "import: camera is 1-based (cam1, cam2, ...), got 0".into(),
-                    ));
+                    return Err(ImportError::CameraZero.into());
                 }
                 if self.units_to_m.is_some() {
-                    return not_for("units_to_m", "DLTdv is in pixels: set m_per_px");
+                    return reject("units_to_m", "DLTdv is in pixels: set m_per_px");
                 }
                 if self.decimal_comma {
-                    return not_for("decimal_comma", "DLTdv always writes a decimal point");
+                    return reject("decimal_comma", "DLTdv always writes a decimal point");
                 }
             }
             Format::Canonical => {
@@ -487,44 +495,35 @@ impl ImportSpec {
                     ("time_to_s", self.time_to_s.is_some()),
                 ] {
                     if set {
-                        return not_for(
-                            field,
-                            "a canonical trace is in seconds and metres already",
-                        );
+                        return reject(field, "a canonical trace is in seconds and metres already");
                     }
                 }
             }
             Format::Tracker => {
                 if self.m_per_px.is_some() {
-                    return not_for(
+                    return reject(
                         "m_per_px",
                         "Tracker writes calibrated units: set units_to_m (1 for m, 0.01 for cm)",
                     );
                 }
                 if self.origin_px != [0.0, 0.0] {
-                    return not_for("origin_px", "Tracker coordinates are already calibrated");
+                    return reject("origin_px", "Tracker coordinates are already calibrated");
                 }
                 if self.camera != 1 {
-                    return not_for("camera", "a Tracker export holds one video");
+                    return reject("camera", "a Tracker export holds one video");
                 }
             }
             _ => {
                 if self.camera != 1 {
-                    return not_for("camera", "the file holds one video");
+                    return reject("camera", "the file holds one video");
                 }
                 if self.decimal_comma && format != Format::Generic {
-                    return not_for(
+                    return reject(
                         "decimal_comma",
                         "the reader detects this format's decimal separator itself",
                     );
                 }
             }
-        }
-        if self.generic.is_some() && format != Format::Generic {
-            return not_for(
-                "generic",
-                "set format = \"generic\" to use a column mapping",
-            );
         }
         Ok(())
     }
@@ -546,31 +545,37 @@ impl ImportSpec {
     /// `scale_points_px`, or `None` if neither is set.
     ///
     /// # Errors
-    /// [`Error::Config`] if both ways are given, only one of `scale_points_px` and
+    /// [`ImportError`] if both ways are given, only one of `scale_points_px` and
     /// `scale_distance_m` is, or the two points coincide or are not finite.
     pub fn resolved_m_per_px(&self) -> Result<Option<f64>> {
         match (self.m_per_px, self.scale_points_px, self.scale_distance_m) {
             (m, None, None) => Ok(m),
-            (Some(_), _, _) => Err(Error::Config(
-                "import: set m_per_px or scale_points_px + scale_distance_m, not both".into(),
-            )),
+            (Some(_), _, _) => Err(ImportError::Exclusive {
+                first: "m_per_px",
+                second: "scale_points_px + scale_distance_m",
+            }
+            .into()),
             (None, Some([[x1, y1], [x2, y2]]), Some(d)) => {
                 let len = (x2 - x1).hypot(y2 - y1);
                 if !(len.is_finite() && len > 0.0) {
-                    return Err(Error::Config(format!(
-                        "import: scale_points_px must be two distinct finite points, got \
-                         [[{x1}, {y1}], [{x2}, {y2}]]"
-                    )));
+                    let points_px = [[x1, y1], [x2, y2]];
+                    return Err(ImportError::ScalePoints { points_px }.into());
                 }
                 Ok(Some(d / len))
             }
-            (None, _, _) => Err(Error::Config(
-                "import: scale_points_px and scale_distance_m go together (two image points a \
-                 known distance apart)"
-                    .into(),
-            )),
+            (None, _, _) => Err(ImportError::ScaleIncomplete.into()),
         }
     }
+}
+
+/// [`ImportError::NotForFormat`] for `field`, which `format` does not use; `hint` says what to do.
+fn not_for(field: &'static str, format: Format, hint: &'static str) -> Error {
+    ImportError::NotForFormat {
+        field,
+        format,
+        hint,
+    }
+    .into()
 }
 
 /// Read a tracking export into a [`Trace`] in SI units with roles assigned.
@@ -585,7 +590,7 @@ impl ImportSpec {
 /// * [`Error::Parse`] — a bad cell or header (`file:line:column: field ...: expected ..., found ...`);
 /// * [`Error::Input`] — unknown format, no data rows, DLTdv without `fps_hz`/`m_per_px`, a mapped
 ///   point that is not in the file (the message lists the points that are);
-/// * [`Error::Config`] — a setting out of range or not applicable to the format.
+/// * [`ImportError`] — a setting out of range or not applicable to the format.
 pub fn read_trace(path: &Path, spec: &ImportSpec) -> Result<Trace> {
     read_trace_with_summary(path, spec).map(|(trace, _)| trace)
 }

@@ -146,7 +146,7 @@ struct Layout {
 /// * [`Error::Parse`] — more than one track-name line, a row with fewer fields than the column row
 ///   (or extra non-empty fields), a missing, non-increasing or non-numeric time, or a non-numeric
 ///   x/y cell (`file:line:column: field x (track head): expected a number or an empty cell, found "abc"`);
-/// * [`Error::Config`] — settings out of range or meant for DLTdv ([`ImportSpec::validate`]).
+/// * [`super::ImportError`] — settings out of range or meant for DLTdv ([`ImportSpec::validate`]).
 pub fn read(path: &Path, spec: &ImportSpec) -> Result<Trace> {
     spec.validate(Format::Tracker)?;
     let text = read_text(path)?;
