@@ -34,9 +34,22 @@ pub enum Error {
     /// A file as a whole is not usable (unknown format, no data rows, a required point missing).
     #[error("{}: {message}", path.display())]
     Input { path: PathBuf, message: String },
-    /// A setting (command-line flag or job field) is out of range or inconsistent.
-    #[error("{0}")]
-    Config(String),
+    /// An output path that is the input file itself (the input is never overwritten).
+    #[error(
+        "output {} is the input file {}: choose another output path (the input is never overwritten)",
+        output.display(),
+        input.display()
+    )]
+    SameFile { input: PathBuf, output: PathBuf },
+    /// Values could not be written as `format` (CSV, JSON, TOML) for `target` (a file name, or
+    /// where the text goes, e.g. "stdout").
+    #[error("writing {format} ({target}): {source}")]
+    Write {
+        target: String,
+        format: &'static str,
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync + 'static>,
+    },
     /// A later stage's typed error (`spectrum::SpectrumError`, `simulate::SimulationError`, ...),
     /// kept as that type: each stage's error type gives `of(&Error)` to read it back. The error
     /// module names no later stage, so the stages depend on it and not the other way round.
@@ -46,23 +59,20 @@ pub enum Error {
         source: Box<dyn std::error::Error + Send + Sync + 'static>,
         input: bool,
     },
-    /// A numerical routine was given data it cannot work on (too short a record, all NaN, ...).
-    #[error("{0}")]
-    Numerics(String),
     /// SIGINT or SIGTERM stopped the work; `written` is the interrupted result, when one was
     /// written (never over a complete result).
     #[error("interrupted{}", written.as_ref().map(|p| format!("; the best result so far is in {}", p.display())).unwrap_or_default())]
     Interrupted { written: Option<PathBuf> },
-    /// The optimiser failed.
-    #[error("fit failed: {0}")]
-    Fit(String),
 }
 
 impl Error {
     /// True for errors caused by the user's input (files, jobs, flags): the CLI exits with code 2.
     pub fn is_input_error(&self) -> bool {
         match self {
-            Error::Io { .. } | Error::Parse { .. } | Error::Input { .. } | Error::Config(_) => true,
+            Error::Io { .. }
+            | Error::Parse { .. }
+            | Error::Input { .. }
+            | Error::SameFile { .. } => true,
             Error::Stage { input, .. } => *input,
             _ => false,
         }
@@ -109,6 +119,18 @@ impl Error {
         match self {
             Error::Stage { source, .. } => source.downcast_ref::<E>(),
             _ => None,
+        }
+    }
+
+    /// Shorthand for [`Error::Write`]: `source` failed writing `format` for `target`.
+    pub fn write<E>(target: impl std::fmt::Display, format: &'static str, source: E) -> Self
+    where
+        E: std::error::Error + Send + Sync + 'static,
+    {
+        Error::Write {
+            target: target.to_string(),
+            format,
+            source: Box::new(source),
         }
     }
 

@@ -97,18 +97,17 @@ pub fn create_dir(dir: &Path) -> Result<()> {
 /// Refuses to write `output` over `input` (the same file, also through another path or a link).
 ///
 /// # Errors
-/// [`Error::Config`] naming both paths when they are the same file.
+/// [`Error::SameFile`] naming both paths when they are the same file.
 pub fn refuse_overwriting_input(input: &Path, output: &Path) -> Result<()> {
     let same = match (std::fs::canonicalize(input), std::fs::canonicalize(output)) {
         (Ok(a), Ok(b)) => a == b,
         _ => false,
     };
     if same {
-        return Err(Error::Config(format!(
-            "output {} is the input file {}: choose another output path (the input is never overwritten)",
-            output.display(),
-            input.display()
-        )));
+        return Err(Error::SameFile {
+            input: input.to_path_buf(),
+            output: output.to_path_buf(),
+        });
     }
     Ok(())
 }

@@ -267,7 +267,7 @@ pub fn blade_burst_start(params: &BladeParams) -> Result<(f64, [f64; 4], f64)> {
         .transitions
         .iter()
         .position(|tr| tr.to == Phase::Stick)
-        .ok_or_else(|| Error::Numerics("the blade never sticks in its window".into()))?;
+        .ok_or(BenchError::NeverSticks { t0_s: t0, t1_s: t1 })?;
     let t = run.transitions[i].t_s;
     let y = run.transition_states[i];
     Ok((t, y, blade.tip_position(t, &y)))
@@ -462,7 +462,7 @@ fn write_csv_rows<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<()> {
     let mut w = csv::Writer::from_writer(Vec::new());
     for r in rows {
         w.serialize(r)
-            .map_err(|e| Error::Numerics(format!("{}: {e}", path.display())))?;
+            .map_err(|e| Error::write(path.display(), "CSV", e))?;
     }
     let bytes = w
         .into_inner()
@@ -773,4 +773,20 @@ fn loosest_passing(rtols: &[f64], ok_all: &[bool]) -> Option<f64> {
         }
     }
     best
+}
+
+/// A benchmark problem that cannot be set up from the blade's parameters.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum BenchError {
+    /// The reference run over the default window `[t0_s, t1_s]` never enters stick: there is no
+    /// stick onset to start the `blade-burst` problem from.
+    #[error("the blade never sticks in its window [{t0_s}, {t1_s}] s")]
+    NeverSticks { t0_s: f64, t1_s: f64 },
+}
+
+impl From<BenchError> for Error {
+    fn from(e: BenchError) -> Self {
+        Error::stage(e, false)
+    }
 }

@@ -184,7 +184,7 @@ fn num(x: f64) -> String {
 /// are empty cells; parameters in SI units as in the result files.
 ///
 /// # Errors
-/// [`Error::Numerics`] if the CSV writer fails (it writes to memory).
+/// [`Error::Write`] if the CSV writer fails (it writes to memory).
 pub fn to_csv(t: &Table) -> Result<String> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut header: Vec<String> = vec!["id".into(), "recording".into()];
@@ -204,7 +204,7 @@ pub fn to_csv(t: &Table) -> Result<String> {
         header.push(format!("peak_{b}_model_hz"));
     }
     header.extend(["model_evaluations", "failed_evaluations", "wall_time_s"].map(String::from));
-    let err = |e: csv::Error| Error::Numerics(format!("writing campaign.csv: {e}"));
+    let err = |e: csv::Error| Error::write("campaign.csv", "CSV", e);
     w.write_record(&header).map_err(err)?;
     for r in &t.rows {
         let mut rec: Vec<String> = vec![r.id.clone(), r.recording.display().to_string()];
@@ -235,8 +235,8 @@ pub fn to_csv(t: &Table) -> Result<String> {
     }
     let bytes = w
         .into_inner()
-        .map_err(|e| Error::Numerics(format!("writing campaign.csv: {e}")))?;
-    String::from_utf8(bytes).map_err(|e| Error::Numerics(e.to_string()))
+        .map_err(|e| Error::write("campaign.csv", "CSV", e.into_error()))?;
+    String::from_utf8(bytes).map_err(|e| Error::write("campaign.csv", "CSV", e))
 }
 
 /// Gathers the campaign and writes `<out dir>/campaign.csv`; returns the table and the path.

@@ -22,11 +22,13 @@
 //! * [`collect::collect`] merges the results into `campaign.csv`.
 
 pub mod collect;
+mod error;
 pub mod run;
 pub mod slurm;
 
 use crate::fit::job::FitJob;
 use crate::{Error, Result};
+pub use error::CampaignError;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

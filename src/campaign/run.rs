@@ -1,6 +1,7 @@
 //! Fitting a campaign's recordings: the generated job of each recording, one recording's fit (what
 //! a Slurm array task runs), and the local parallel run with skipping of finished recordings.
 
+use super::CampaignError;
 use super::{Campaign, Entry, Override};
 use crate::fit::job::LoadedJob;
 use crate::fit::result::sha256_hex;
@@ -208,7 +209,8 @@ pub fn fit_entry(campaign: &Campaign, entry: &Entry) -> Result<Status> {
             Err(e),
         ),
     };
-    let json = serde_json::to_string_pretty(&status).map_err(|e| Error::Numerics(e.to_string()))?;
+    let json = serde_json::to_string_pretty(&status)
+        .map_err(|e| Error::write(paths.status.display(), "JSON", e))?;
     write_atomic(&paths.status, json.as_bytes())?;
     result
 }
@@ -232,13 +234,15 @@ pub type OnDone<'a> = dyn Fn(&str, &Result<Status>, usize, usize) + Sync + 'a;
 /// `on_done(id, status or error, finished, total)` is called as each recording ends (for progress).
 ///
 /// # Errors
-/// [`Error::Config`] for `jobs == 0`; errors generating a job (bad template, unreadable recording)
+/// [`CampaignError::AtLeastOne`] for `jobs == 0`; errors generating a job (bad template, unreadable recording)
 /// end the run, since they concern every recording alike.
 pub fn run_local(campaign: &Campaign, jobs: usize, on_done: &OnDone) -> Result<RunSummary> {
     if jobs == 0 {
-        return Err(Error::Config(
-            "campaign run: --jobs must be at least 1".into(),
-        ));
+        return Err(CampaignError::AtLeastOne {
+            command: "campaign run",
+            flags: "--jobs",
+        }
+        .into());
     }
     let out = campaign.out_dir();
     let mut summary = RunSummary::default();

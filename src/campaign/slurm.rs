@@ -9,6 +9,7 @@
 //! (<https://slurm.schedmd.com/job_array.html>).
 
 use super::Campaign;
+use super::CampaignError;
 use super::run::{EntryPaths, State, read_status};
 use crate::io::write_atomic;
 use crate::{Error, Result};
@@ -54,20 +55,20 @@ pub fn slurm_dir(campaign: &Campaign) -> PathBuf {
 /// The `sbatch` script of the campaign's job array, running `exe`.
 ///
 /// # Errors
-/// [`Error::Config`] for a campaign without recordings, `cpus_per_task` or `max_parallel` of 0, or
+/// [`CampaignError`] for a campaign without recordings, `cpus_per_task` or `max_parallel` of 0, or
 /// a partition or time holding whitespace or quotes.
 pub fn script(campaign: &Campaign, settings: &SlurmSettings, exe: &Path) -> Result<String> {
     let n = campaign.entries.len();
     if n == 0 {
-        return Err(Error::Config(
-            "campaign slurm: the campaign has no recordings".into(),
-        ));
+        return Err(CampaignError::NoRecordings.into());
     }
     let cpus = settings.cpus_per_task.unwrap_or(2);
     if cpus == 0 || settings.max_parallel == Some(0) {
-        return Err(Error::Config(
-            "campaign slurm: --cpus-per-task and --max-parallel must be at least 1".into(),
-        ));
+        return Err(CampaignError::AtLeastOne {
+            command: "campaign slurm",
+            flags: "--cpus-per-task and --max-parallel",
+        }
+        .into());
     }
     for (flag, v) in [
         ("--partition", &settings.partition),
@@ -76,9 +77,11 @@ pub fn script(campaign: &Campaign, settings: &SlurmSettings, exe: &Path) -> Resu
         if let Some(v) = v
             && (v.is_empty() || v.contains(|c: char| c.is_whitespace() || c == '"' || c == '\''))
         {
-            return Err(Error::Config(format!(
-                "campaign slurm: {flag} {v:?} must be one word without quotes"
-            )));
+            return Err(CampaignError::NotOneWord {
+                flag,
+                value: v.clone(),
+            }
+            .into());
         }
     }
     let logs = slurm_dir(campaign).join("logs");

@@ -23,7 +23,9 @@ pub(super) fn run(
     let mut blades = Vec::new();
     for path in &blade {
         let params: BladeParams = parse_toml(path, &read_text(path)?)?;
-        params.validate().map_err(|m| Error::input(path, m))?;
+        params
+            .validate()
+            .map_err(|m| Error::input(path, m.to_string()))?;
         let label = path
             .strip_prefix(tree)
             .unwrap_or(path)
@@ -32,9 +34,7 @@ pub(super) fn run(
         blades.push((label, params));
     }
     let Some((_, params)) = blades.first() else {
-        return Err(Error::Config(
-            "bench: --blade needs at least one file".into(),
-        ));
+        return Err(super::CliError::NoBladeFile.into());
     };
     let rows = crate::bench::run_bench(&crate::bench::BenchOptions {
         quick,

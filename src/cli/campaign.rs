@@ -1,9 +1,9 @@
 //! `wiperlab campaign …`: parses the subcommand, calls `crate::campaign`, prints.
 
+use crate::Result;
 use crate::campaign::Campaign;
 use crate::campaign::run::{Status, describe_overrides, fit_entry, run_local};
 use crate::campaign::slurm::{SlurmSettings, status, submit, write_script};
-use crate::{Error, Result};
 use clap::{Args, Subcommand};
 use std::path::PathBuf;
 
@@ -74,12 +74,13 @@ pub fn run(cmd: CampaignCommand) -> Result<()> {
         }
         CampaignCommand::Task { campaign, index } => {
             let c = Campaign::load(&campaign)?;
-            let entry = c.entries.get(index).ok_or_else(|| {
-                Error::Config(format!(
-                    "campaign task: --index {index} is beyond the campaign's {} recordings",
-                    c.entries.len()
-                ))
-            })?;
+            let entry = c
+                .entries
+                .get(index)
+                .ok_or_else(|| super::CliError::IndexBeyond {
+                    index,
+                    count: c.entries.len(),
+                })?;
             let s = fit_entry(&c, entry)?;
             println!("{}: done in {:.1} s", s.id, s.wall_time_s);
             Ok(())
@@ -181,11 +182,11 @@ fn run_all(c: &Campaign, jobs: usize, quiet: bool) -> Result<()> {
     if s.failed.is_empty() {
         Ok(())
     } else {
-        Err(Error::Fit(format!(
-            "{} of {} recordings failed (the others' results are written; reasons above and in `campaign collect`)",
-            s.failed.len(),
-            c.entries.len()
-        )))
+        Err(super::CliError::RecordingsFailed {
+            failed: s.failed.len(),
+            total: c.entries.len(),
+        }
+        .into())
     }
 }
 
@@ -197,8 +198,7 @@ fn slurm(c: &Campaign, a: &SlurmArgs, go: bool) -> Result<()> {
         max_parallel: a.max_parallel,
     };
     let settings = c.file.slurm.overridden_by(&cli);
-    let exe = std::env::current_exe()
-        .map_err(|e| Error::Config(format!("campaign slurm: cannot find this executable: {e}")))?;
+    let exe = std::env::current_exe().map_err(super::CliError::CurrentExe)?;
     let script = write_script(c, &settings, &exe)?;
     println!("wrote {}", script.display());
     if go {

@@ -1,9 +1,9 @@
 //! `wiperlab explore`: samples a job's freed parameters and writes the reachability map.
 
+use crate::Result;
 use crate::fit::explore::{explore, simulations};
 use crate::fit::job::LoadedJob;
 use crate::report::explore::{SAMPLES_CSV, summary, write_exploration};
-use crate::{Error, Result};
 use std::path::{Path, PathBuf};
 
 /// Loads the job, samples it, writes the tables and the map into `out` (default
@@ -11,10 +11,8 @@ use std::path::{Path, PathBuf};
 pub(super) fn run(job: &Path, samples: usize, seed: u32, out: Option<PathBuf>) -> Result<()> {
     let loaded = LoadedJob::load(job)?;
     if samples == 0 || samples > crate::fit::explore::MAX_SAMPLES {
-        return Err(Error::Config(format!(
-            "--samples {samples}: expected 1 to {}",
-            crate::fit::explore::MAX_SAMPLES
-        )));
+        let max = crate::fit::explore::MAX_SAMPLES;
+        return Err(crate::fit::FitError::Samples { samples, max }.into());
     }
     let dir = out.unwrap_or_else(|| Path::new("reports/explore").join(&loaded.name));
     crate::io::check_creatable_dir(&dir)?;

@@ -15,7 +15,7 @@ pub(super) fn fit(job: &Path, json: bool, quiet: bool) -> Result<()> {
     if json {
         println!(
             "{}",
-            serde_json::to_string(&result).map_err(|e| Error::Numerics(e.to_string()))?
+            serde_json::to_string(&result).map_err(|e| Error::write("stdout", "JSON", e))?
         );
         return Ok(());
     }

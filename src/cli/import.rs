@@ -1,6 +1,7 @@
 //! `wiperlab import`: a tracking-tool export to the canonical trace CSV; and the import options
 //! that `spectrum` shares.
 
+use super::CliError;
 use super::ImportArgs;
 use crate::fit::job::{parse_toml, read_text};
 use crate::import::{Format, ImportSpec};
@@ -50,10 +51,12 @@ pub(super) fn import_spec(a: &ImportArgs) -> Result<ImportSpec> {
     }
     if let Some(p) = &a.scale_points_px {
         let &[x1, y1, x2, y2] = p.as_slice() else {
-            return Err(Error::Config(format!(
-                "--scale-points-px: expected X1,Y1,X2,Y2 in pixels (got {} values)",
-                p.len()
-            )));
+            return Err(CliError::ValueCount {
+                flag: "--scale-points-px",
+                expected: "X1,Y1,X2,Y2 in pixels",
+                got: p.len(),
+            }
+            .into());
         };
         spec.scale_points_px = Some([[x1, y1], [x2, y2]]);
     }
@@ -92,10 +95,12 @@ pub(super) fn import_spec(a: &ImportArgs) -> Result<ImportSpec> {
     }
     if let Some(o) = &a.origin_px {
         let &[x, y] = o.as_slice() else {
-            return Err(Error::Config(format!(
-                "--origin-px: expected X,Y in pixels, e.g. 200,300 (got {} values)",
-                o.len()
-            )));
+            return Err(CliError::ValueCount {
+                flag: "--origin-px",
+                expected: "X,Y in pixels, e.g. 200,300",
+                got: o.len(),
+            }
+            .into());
         };
         spec.origin_px = [x, y];
     }

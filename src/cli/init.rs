@@ -12,10 +12,7 @@ pub(super) fn run(recording: &Path, import: &ImportArgs, output: Option<PathBuf>
         recording.with_file_name(format!("{}.job.toml", super::stem(recording)))
     });
     if out.exists() {
-        return Err(Error::Config(format!(
-            "-o {}: the file exists; init never overwrites a job (choose another -o)",
-            out.display()
-        )));
+        return Err(super::CliError::OutputExists { path: out }.into());
     }
     crate::io::refuse_overwriting_input(recording, &out)?;
     let mut spec = super::import::import_spec(import)?;

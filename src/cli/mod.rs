@@ -9,6 +9,7 @@ use crate::Result;
 use crate::simulate::Method;
 use crate::simulate::blade::ModelKind;
 use clap::{Parser, Subcommand};
+pub use error::CliError;
 use std::path::{Path, PathBuf};
 
 /// Set once by [`run`] from `--quiet`.
@@ -31,6 +32,7 @@ use esay;
 
 mod bench;
 mod campaign;
+mod error;
 mod explore;
 mod fit;
 mod import;

@@ -1,7 +1,8 @@
 //! `wiperlab modes`: the linearised blade's modes in stick and in steady slip.
 
+use super::CliError;
 use crate::fit::job::{parse_toml, read_text};
-use crate::model::modes::{BladeMode, Phase};
+use crate::model::modes::{BladeMode, ModesError, Phase};
 use crate::model::{Blade, BladeParams, StickForm};
 use crate::{Error, Result};
 use std::path::Path;
@@ -10,21 +11,24 @@ use std::path::Path;
 /// default: the window's speeds).
 pub(super) fn run(blade: &Path, speeds: Option<&[f64]>, json: bool) -> Result<()> {
     let params: BladeParams = parse_toml(blade, &read_text(blade)?)?;
-    params.validate().map_err(|m| Error::input(blade, m))?;
+    params
+        .validate()
+        .map_err(|m| Error::input(blade, m.to_string()))?;
     let model = Blade::new(params, StickForm::Reduced);
     let modes = match speeds {
         Some(v) => model.modes(v),
         None => model.window_modes(),
     }
     .map_err(|e| match e {
-        crate::model::modes::ModesError::SpeedOutOfReach { .. } => {
-            Error::Config(format!("--speeds: {e}"))
-        }
-        other => Error::Numerics(format!("{}: {other}", blade.display())),
+        ModesError::SpeedOutOfReach { .. } => CliError::Speeds(e),
+        source => CliError::Modes {
+            path: blade.to_path_buf(),
+            source,
+        },
     })?;
     if json {
         let text =
-            serde_json::to_string_pretty(&modes).map_err(|e| Error::Numerics(e.to_string()))?;
+            serde_json::to_string_pretty(&modes).map_err(|e| Error::write("stdout", "JSON", e))?;
         println!("{text}");
         return Ok(());
     }

@@ -1,5 +1,6 @@
 //! `wiperlab simulate`: the blade model over its reversal window.
 
+use super::CliError;
 use crate::fit::job::{parse_toml, read_text};
 use crate::model::{BladeParams, StickForm};
 use crate::names::named_enum;
@@ -38,31 +39,31 @@ pub(super) struct SimulateArgs {
 /// Simulates, writes the trace and figures, and prints the solver's statistics.
 pub(super) fn run(a: SimulateArgs) -> Result<()> {
     let p: BladeParams = parse_toml(&a.params, &read_text(&a.params)?)?;
-    p.validate().map_err(|m| Error::input(&a.params, m))?;
+    p.validate()
+        .map_err(|m| Error::input(&a.params, m.to_string()))?;
     let win = match a.window.as_deref() {
         Some(&[t0, t1]) => (t0, t1),
         Some(w) => {
-            return Err(Error::Config(format!(
-                "--window: expected T0,T1 in s, e.g. 1.83,1.85 (got {} values)",
-                w.len()
-            )));
+            return Err(CliError::ValueCount {
+                flag: "--window",
+                expected: "T0,T1 in s, e.g. 1.83,1.85",
+                got: w.len(),
+            }
+            .into());
         }
         None => default_window(&p),
     };
     if !(win.0.is_finite() && win.1.is_finite() && win.0 < win.1) {
-        return Err(Error::Config(format!(
-            "--window {},{}: expected T0 < T1, both finite, in s",
-            win.0, win.1
-        )));
+        let (t0_s, t1_s) = win;
+        return Err(CliError::Window { t0_s, t1_s }.into());
     }
     if !(a.fps > 0.0 && a.fps.is_finite()) {
-        return Err(Error::Config(format!("--fps must be > 0 (got {})", a.fps)));
+        let (flag, value) = ("--fps", a.fps);
+        return Err(CliError::NotPositive { flag, value }.into());
     }
-    for (flag, v) in [("--rtol", a.rtol), ("--atol", a.atol)] {
-        if !(v > 0.0 && v.is_finite()) {
-            return Err(Error::Config(format!(
-                "{flag} {v}: expected a positive, finite tolerance"
-            )));
+    for (flag, value) in [("--rtol", a.rtol), ("--atol", a.atol)] {
+        if !(value > 0.0 && value.is_finite()) {
+            return Err(CliError::Tolerance { flag, value }.into());
         }
     }
     let n = ((win.1 - win.0) * a.fps).floor() as usize + 1;

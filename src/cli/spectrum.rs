@@ -1,6 +1,6 @@
 //! `wiperlab spectrum`: Welch PSD, peaks and spectrogram of every tracked coordinate.
 
-use super::ImportArgs;
+use super::{CliError, ImportArgs};
 use crate::Result;
 use crate::spectrum::features::{BandSpec, features};
 use crate::spectrum::signal::SignalExpr;
@@ -71,9 +71,13 @@ pub(super) fn run(a: SpectrumArgs) -> Result<()> {
         b.scaling = a.welch.scaling;
         b.average = a.welch.average;
     }
-    let cfg = bands[0]
-        .welch_config()
-        .map_err(|e| crate::Error::Config(format!("Welch settings (--noverlap, --nfft): {e}")))?;
+    let cfg =
+        bands[0]
+            .welch_config()
+            .map_err(|e| match crate::spectrum::SpectrumError::of(&e) {
+                Some(s) => CliError::Welch(s.clone()).into(),
+                None => e,
+            })?;
 
     let dir = a
         .out_dir
@@ -121,8 +125,13 @@ fn signals(trace: &crate::trace::Trace, given: &[String]) -> Result<Vec<SignalEx
     given
         .iter()
         .map(|s| {
-            SignalExpr::resolve(s, trace)
-                .map_err(|e| crate::Error::Config(format!("--signal {s}: {e}")))
+            SignalExpr::resolve(s, trace).map_err(|reason| {
+                CliError::Signal {
+                    given: s.clone(),
+                    reason,
+                }
+                .into()
+            })
         })
         .collect()
 }
@@ -143,18 +152,21 @@ fn check_settings(
         ));
     }
     if !(8..=n).contains(&nperseg) {
-        return Err(crate::Error::Config(format!(
-            "--nperseg {nperseg}: expected 8 <= nperseg <= the record's {n} samples"
-        )));
+        return Err(CliError::Nperseg {
+            nperseg,
+            samples: n,
+        }
+        .into());
     }
     let nyquist = fs_hz / 2.0;
     for b in bands {
         let [lo, hi] = b.range_hz;
         if !(lo >= 0.0 && lo < hi && hi <= nyquist) {
-            return Err(crate::Error::Config(format!(
-                "--band {}: expected 0 <= LO < HI <= {nyquist} Hz (the Nyquist frequency at {fs_hz} Hz)",
-                b.text
-            )));
+            return Err(CliError::Band {
+                text: b.text.clone(),
+                fs_hz,
+            }
+            .into());
         }
     }
     Ok(())

@@ -372,7 +372,7 @@ pub fn at_fit(problem: &SpectralProblem, u: &[f64]) -> Result<LocalFit> {
         let lik = p
             .likelihood
             .as_ref()
-            .map_err(|why| crate::Error::Fit(format!("no likelihood: {why}")))?;
+            .map_err(|why| super::FitError::NoLikelihood { why: why.clone() })?;
         let sim = p.simulate(&p.params_at(u))?;
         let parts = lik.nll(p, &sim)?;
         info += lik.fisher(p, u, &parts)?;

@@ -159,7 +159,7 @@ pub fn explored_candidate(job: &LoadedJob) -> Candidate {
 /// one-at-a-time sensitivity around the start; `progress` is moved once per simulation.
 ///
 /// # Errors
-/// [`Error::Config`] for 0 or more than [`MAX_SAMPLES`] samples; the errors of reading and
+/// [`super::FitError::Samples`] for 0 or more than [`MAX_SAMPLES`] samples; the errors of reading and
 /// measuring the job's recording. Failed simulations are outcomes, not errors.
 pub fn explore(
     job: &LoadedJob,
@@ -168,9 +168,8 @@ pub fn explore(
     progress: Option<&indicatif::ProgressBar>,
 ) -> Result<Exploration> {
     if samples == 0 || samples > MAX_SAMPLES {
-        return Err(Error::Config(format!(
-            "--samples {samples}: expected 1 to {MAX_SAMPLES} (the Sobol sequence's length per seed)"
-        )));
+        let max = MAX_SAMPLES;
+        return Err(super::FitError::Samples { samples, max }.into());
     }
     let started = std::time::Instant::now();
     let candidate = explored_candidate(job);

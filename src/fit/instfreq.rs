@@ -21,6 +21,7 @@
 
 use super::features::SignalKind;
 use super::job::Weights;
+use crate::Result;
 use crate::simulate::blade::BladeSimulation;
 use crate::simulate::hybrid::Phase;
 use crate::spectrum::SpectrumError;
@@ -29,7 +30,6 @@ use crate::spectrum::instfreq::{
     onset_rate_vs_speed, ridge_vs_speed,
 };
 use crate::trace::Trace;
-use crate::{Error, Result};
 
 /// Number of equal speed bins of the `freq_speed` cost term.
 pub const SPEED_BINS: usize = 8;
@@ -46,12 +46,10 @@ pub struct FreqSpeed {
 }
 
 fn tip_x(trace: &Trace) -> Result<&[f64]> {
-    trace.point("tip").map(|p| p.x_m.as_slice()).ok_or_else(|| {
-        Error::Config(
-            "frequency against tip speed needs a tracked point with role 'tip' (map it in [recording.import.points])"
-                .into(),
-        )
-    })
+    trace
+        .point("tip")
+        .map(|p| p.x_m.as_slice())
+        .ok_or_else(|| super::FitError::NoTip.into())
 }
 
 /// Ridge and stick-onset rate of a measured, uniformly sampled trace (`fs_hz`, first frame at
@@ -59,7 +57,7 @@ fn tip_x(trace: &Trace) -> Result<&[f64]> {
 /// stick onsets.
 ///
 /// # Errors
-/// [`Error::Config`] for a trace without `tip` (or `head` when `signal` needs it) or bad settings.
+/// [`super::FitError::NoTip`] / [`crate::spectrum::SpectrumError`] for a trace without `tip` (or `head` when `signal` needs it) or bad settings.
 /// A trace whose noise cannot be estimated gives no onsets and a [`FreqSpeed::note`], not an error.
 pub fn measured_freq_speed(
     trace: &Trace,
@@ -156,7 +154,7 @@ impl TimeTargets {
     /// (nothing is computed then). `x` is the job's signal of `trace`, sampled at `fs_hz`.
     ///
     /// # Errors
-    /// [`Error::Config`] for a negative weight, a trace without `tip` when `freq_speed > 0`, or no
+    /// [`super::FitError`] for a negative weight, a trace without `tip` when `freq_speed > 0`, or no
     /// ridge point in the measurement (the term would have nothing to compare).
     pub fn for_job(
         weights: &Weights,
@@ -166,10 +164,11 @@ impl TimeTargets {
         signal: SignalKind,
     ) -> Result<Option<TimeTargets>> {
         if !(weights.freq_speed >= 0.0 && weights.trace >= 0.0) {
-            return Err(Error::Config(format!(
-                "[fit.weights] freq_speed and trace must be >= 0 (got {} and {})",
-                weights.freq_speed, weights.trace
-            )));
+            return Err(super::FitError::NegativeWeights {
+                freq_speed: weights.freq_speed,
+                trace: weights.trace,
+            }
+            .into());
         }
         if weights.freq_speed == 0.0 && weights.trace == 0.0 {
             return Ok(None);
@@ -191,12 +190,12 @@ impl TimeTargets {
             let ridge = ridge_vs_speed(t0, fs_hz, x, tip, &cfg, 0.0)?;
             let vmax = ridge.iter().map(|p| p.speed_m_per_s).fold(0.0, f64::max);
             if ridge.is_empty() || vmax <= 0.0 {
-                return Err(Error::Config(format!(
-                    "[fit.weights] freq_speed: the measured {} has no spectrogram ridge point in {:?} Hz with SNR >= {}; nothing to fit",
-                    signal.label(),
-                    cfg.band_hz,
-                    cfg.min_snr
-                )));
+                return Err(super::FitError::NoRidgePoint {
+                    signal: signal.label(),
+                    band_hz: cfg.band_hz,
+                    min_snr: cfg.min_snr,
+                }
+                .into());
             }
             t.floor = band_floor(x, fs_hz, &cfg)?;
             t.max_speed_m_per_s = vmax;

@@ -19,12 +19,10 @@ pub fn stop_requested() -> bool {
 /// Routes SIGINT and SIGTERM (Ctrl-C, `kill`) to [`request_stop`]. Installing it twice is harmless.
 ///
 /// # Errors
-/// [`crate::Error::Config`] when the handler cannot be installed.
+/// [`super::FitError::SignalHandler`] when the handler cannot be installed.
 pub fn install_signal_handler() -> crate::Result<()> {
     match ctrlc::set_handler(request_stop) {
         Ok(()) | Err(ctrlc::Error::MultipleHandlers) => Ok(()),
-        Err(e) => Err(crate::Error::Config(format!(
-            "cannot install the interrupt handler: {e}"
-        ))),
+        Err(e) => Err(super::FitError::SignalHandler(e).into()),
     }
 }

@@ -487,7 +487,9 @@ impl LoadedJob {
         let blade_path = dir.join(&job.blade);
         let blade_text = read_text(&blade_path)?;
         let blade: BladeParams = parse_toml(&blade_path, &blade_text)?;
-        blade.validate().map_err(|m| Error::input(&blade_path, m))?;
+        blade
+            .validate()
+            .map_err(|m| Error::input(&blade_path, m.to_string()))?;
         let check = Check {
             path,
             spans: &spans,

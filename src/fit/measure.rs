@@ -1,6 +1,7 @@
 //! The measured side of a fit: the recording read, its features per band and its noise floors, or
 //! a target job's targets.
 
+use super::FitError;
 use super::features::{self, Features, features, noise_floor};
 use super::instfreq;
 use super::job::{self, LoadedJob};
@@ -17,17 +18,16 @@ pub(super) fn sampling_rate(trace: &Trace, fps: Option<f64>) -> Result<f64> {
         None => crate::spectrum::median_rate_hz(&trace.t_s),
     };
     if !(fs.is_finite() && fs > 0.0) {
-        return Err(Error::Config(
-            "cannot tell the recording's frame rate: give recording.import.fps_hz".into(),
-        ));
+        return Err(FitError::NoFrameRate { median_rate_hz: fs }.into());
     }
     let dt = 1.0 / fs;
     for w in trace.t_s.windows(2) {
         if ((w[1] - w[0]) - dt).abs() > 1e-6 * dt.max(1e-12) * 1e3 {
-            return Err(Error::Config(format!(
-                "the recording's frame times are not uniform at {fs} Hz (step {} s found); resample it first",
-                w[1] - w[0]
-            )));
+            return Err(FitError::NonUniformFrames {
+                fs_hz: fs,
+                step_s: w[1] - w[0],
+            }
+            .into());
         }
     }
     Ok(fs)
@@ -66,10 +66,8 @@ pub(super) fn necklip_view(
     m: &Measurement,
     base: &BladeParams,
 ) -> Result<(Features, Vec<f64>, Vec<bool>)> {
-    let head = m.head.as_ref().map_err(|e| {
-        Error::Config(format!(
-            "the neck/lip model needs the recording's head and tip tracks: {e}"
-        ))
+    let head = m.head.as_ref().map_err(|e| FitError::NecklipNeedsTracks {
+        reason: e.to_string(),
     })?;
     let t = &m.trace.t_s;
     let window = (t[0], *t.last().unwrap_or(&t[0]));
@@ -211,9 +209,13 @@ pub(super) fn measure_targets(job: &LoadedJob, t: &job::TargetsSection) -> Resul
     let mut targets = Vec::new();
     let mut bands = Vec::new();
     for b in &job.job.spectrum.bands {
-        let tp = t.peaks.iter().find(|p| p.band == b.name).ok_or_else(|| {
-            Error::Config(format!("[targets] gives no target for band '{}'", b.name))
-        })?;
+        let tp = t
+            .peaks
+            .iter()
+            .find(|p| p.band == b.name)
+            .ok_or_else(|| FitError::NoTarget {
+                band: b.name.clone(),
+            })?;
         let r = tp.range();
         targets.push(r);
         bands.push(features::BandFeatures {
@@ -251,8 +253,6 @@ pub(super) fn measure(job: &LoadedJob) -> Result<Measurement> {
     match (&job.job.recording, &job.job.targets) {
         (Some(rec), _) => measure_recording(job, &job.recording_path, &rec.import),
         (None, Some(t)) => measure_targets(job, t),
-        (None, None) => Err(Error::Config(
-            "the job gives neither [recording] nor [targets]".into(),
-        )),
+        (None, None) => Err(FitError::NothingToFit.into()),
     }
 }

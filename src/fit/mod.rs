@@ -11,6 +11,7 @@
 //! coordinates `u ∈ [0, 1]` (logarithmic for bounds spanning a factor ≥ 10).
 
 mod candidate;
+mod error;
 pub mod evidence;
 pub mod explore;
 /// The spectral features the fit compares (they belong to the spectrum stage).
@@ -28,6 +29,7 @@ pub mod template;
 mod uncertainty;
 
 pub use candidate::{Candidate, NECK_BAND_MIN_HZ, smallest_capable_model};
+pub use error::FitError;
 pub use measure::HEAD_KERNEL_SIGMA_S;
 pub use problem::{FAILED_COST, FreeParam, SpectralProblem, target_cost};
 pub use result::{

@@ -5,12 +5,12 @@ use super::features::{BandSpec, Features, SignalKind, features};
 use super::instfreq;
 use super::job::{Objective, Weights};
 use super::result::SearchStage;
+use crate::Result;
 use crate::model::BladeParams;
 use crate::model::ParamId;
 use crate::model::blade::StickForm;
 use crate::simulate::SolverOptions;
 use crate::simulate::blade::{BladeSimulation, ModelKind, simulate_model};
-use crate::{Error, Result};
 use argmin::core::CostFunction;
 use serde::Serialize;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -134,9 +134,10 @@ impl SpectralProblem {
         solver: &SolverOptions,
     ) -> Result<BladeSimulation> {
         if self.model == ModelKind::Necklip {
-            let head = self.head.as_ref().ok_or_else(|| {
-                Error::Config("the neck/lip model needs the recording's head track".into())
-            })?;
+            let head = self
+                .head
+                .as_ref()
+                .ok_or_else(|| super::FitError::NecklipNeedsHead)?;
             return crate::simulate::blade::simulate_necklip(
                 params,
                 head,
@@ -208,7 +209,7 @@ impl SpectralProblem {
     /// ([`instfreq::TimeTargets`]).
     ///
     /// # Errors
-    /// The simulation's features' errors, and [`Error::Config`] when the likelihood objective has
+    /// The simulation's features' errors, and [`super::FitError::LikelihoodObjective`] when the likelihood objective has
     /// no likelihood (e.g. a median-averaged band, whose ordinates are not χ²).
     pub fn total_cost(&self, sim: &BladeSimulation) -> Result<f64> {
         self.stage_cost(sim, SearchStage::Polish)
@@ -224,12 +225,10 @@ impl SpectralProblem {
             && self.targets.is_none()
             && stage == SearchStage::Polish
         {
-            let lik = self.likelihood.as_ref().map_err(|why| {
-                Error::Config(format!(
-                    "[fit] objective = \"likelihood\" needs the recording's likelihood: {why}; \
-                     set objective = \"features\""
-                ))
-            })?;
+            let lik = self
+                .likelihood
+                .as_ref()
+                .map_err(|why| super::FitError::LikelihoodObjective { why: why.clone() })?;
             return lik.excess_nll(self, sim);
         }
         let spectral = self.cost_of(&self.model_features(sim)?);

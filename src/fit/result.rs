@@ -332,8 +332,7 @@ impl FitResult {
 
     /// The result as TOML text (`fits/<job>.result.toml`).
     pub fn to_toml(&self) -> Result<String> {
-        toml::to_string_pretty(self)
-            .map_err(|e| Error::Numerics(format!("cannot serialise the result: {e}")))
+        toml::to_string_pretty(self).map_err(|e| Error::write("the fit result", "TOML", e))
     }
 }
 

@@ -1,6 +1,7 @@
 //! Search stage: each candidate fitted by particle swarm and Nelder–Mead polish (argmin), with its
 //! history and progress reported through argmin observers, and the cost's curvature at the optimum.
 
+use super::FitError;
 use super::candidate::Candidate;
 use super::evidence::RecordingLikelihood;
 use super::interrupt;
@@ -8,11 +9,11 @@ use super::job::{self, LoadedJob};
 use super::measure::{Measurement, measure, measure_recording, necklip_view};
 use super::problem::{FreeParam, Shared, SpectralProblem};
 use super::result::{HistoryPoint, SearchStage};
+use crate::Result;
 use crate::model::BladeParams;
 use crate::model::ParamId;
 use crate::simulate::SolverOptions;
 use crate::simulate::blade::ModelKind;
-use crate::{Error, Result};
 use argmin::core::observers::{Observe, ObserverMode};
 use argmin::core::{Executor, KV, State};
 use argmin::solver::neldermead::NelderMead;
@@ -227,9 +228,7 @@ pub(super) fn build_problem(
         .map(|&(n, lo, hi)| FreeParam::new(n, lo, hi))
         .collect();
     if candidate.shoulder {
-        let sb = fit.shoulder.ok_or_else(|| {
-            Error::Config("the shoulder candidate needs [fit.shoulder] bounds".into())
-        })?;
+        let sb = fit.shoulder.ok_or_else(|| FitError::ShoulderBounds)?;
         base.shoulder = Some(crate::model::Shoulder {
             contact_angle_rad: 0.5 * (sb.theta_c[0] + sb.theta_c[1]),
             k1_contact_nm_per_rad: 0.5 * (sb.k1c[0] + sb.k1c[1]),
@@ -602,9 +601,9 @@ pub(super) fn optimise(
     }
     let (u, cost) = best.ok_or_else(|| {
         if interrupt::stop_requested() {
-            Error::Fit("interrupted before the first iteration".into())
+            FitError::InterruptedEarly
         } else {
-            Error::Fit("no optimiser run".into())
+            FitError::NoRun
         }
     })?;
     Ok((u, swarm_iters, polish_iters, cost))
@@ -630,7 +629,7 @@ fn restart(
     log: Option<&Reporting>,
 ) -> Result<Option<Run>> {
     let n = problem.free.len();
-    let fit_err = |e: argmin::core::Error| Error::Fit(e.to_string());
+    let fit_err = FitError::Optimiser;
     let run_evals = Arc::new(AtomicUsize::new(0));
     let observer = |stage: SearchStage| {
         log.map(|reporting| SearchObserver {
@@ -665,13 +664,13 @@ fn restart(
     let res = match ex.run() {
         Ok(res) => res,
         Err(_) if interrupt::stop_requested() => return Ok(None),
-        Err(e) => return Err(fit_err(e)),
+        Err(e) => return Err(fit_err(e).into()),
     };
     let swarm_best = res
         .state()
         .get_best_param()
         .map(|p| p.position.clone())
-        .ok_or_else(|| Error::Fit("particle swarm returned no particle".into()))?;
+        .ok_or(FitError::NoParticle)?;
     let swarm_iters = res.state().get_iter();
     let (u, polish_iters, cost) = match polish(
         problem,
@@ -730,7 +729,7 @@ pub(super) fn polish(
     iterations: u64,
     observer: Option<SearchObserver>,
 ) -> Result<(Vec<f64>, u64, f64)> {
-    let fit_err = |e: argmin::core::Error| Error::Fit(e.to_string());
+    let fit_err = FitError::Optimiser;
     let n = start.len();
     let mut simplex = vec![start.to_vec()];
     for i in 0..n {

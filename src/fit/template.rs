@@ -11,8 +11,8 @@
 //! frame rate by keeping the bin widths, rounded to a power of two no longer than half the
 //! record, and clipped at the Nyquist frequency (half the frame rate).
 
+use crate::Result;
 use crate::import::{ImportSpec, ImportSummary};
-use crate::{Error, Result};
 use serde::Serialize;
 use std::path::Path;
 
@@ -109,14 +109,14 @@ fn roles(spec: &ImportSpec, summary: &ImportSummary) -> (Option<String>, Option<
 /// A TOML value as it is written in a file (strings quoted and escaped).
 fn toml_value<T: Serialize>(v: &T) -> Result<String> {
     let wrapped = toml::to_string(&std::collections::BTreeMap::from([("v", v)]))
-        .map_err(|e| Error::Config(format!("init: cannot write a TOML value: {e}")))?;
+        .map_err(super::FitError::TomlValue)?;
     Ok(wrapped.trim_start_matches("v = ").trim_end().to_string())
 }
 
 /// The commented job template for `input` (see the module docs for what is marked).
 ///
 /// # Errors
-/// [`Error::Config`] if a value cannot be written as TOML (a non-UTF-8 path).
+/// [`super::FitError`] if a value cannot be written as TOML (a non-UTF-8 path).
 pub fn job_template(input: &TemplateInput) -> Result<String> {
     let s = input.summary;
     let spec = input.import;
@@ -127,7 +127,9 @@ pub fn job_template(input: &TemplateInput) -> Result<String> {
     let recording = input
         .recording
         .to_str()
-        .ok_or_else(|| Error::Config("init: the recording's path is not UTF-8".into()))?;
+        .ok_or_else(|| super::FitError::PathNotUtf8 {
+            path: input.recording.to_path_buf(),
+        })?;
     let ctx = minijinja::context! {
         name => toml_value(&input.name)?,
         file_name => recording,
@@ -158,7 +160,7 @@ pub fn job_template(input: &TemplateInput) -> Result<String> {
     env.add_template("job.toml", TEMPLATE)
         .and_then(|_| env.get_template("job.toml"))
         .and_then(|t| t.render(ctx))
-        .map_err(|e| Error::Config(format!("init: the job template does not render: {e}")))
+        .map_err(|e| super::FitError::Template(e).into())
 }
 
 #[cfg(test)]

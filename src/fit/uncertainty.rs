@@ -6,9 +6,9 @@ use super::job::{self, UncertaintyMethod};
 use super::problem::{FreeParam, SpectralProblem};
 use super::result::{FittedParam, Interval, IntervalMethod};
 use super::search::{CandidateFit, optimise, polish};
+use crate::Result;
 use crate::simulate::blade::BladeSimulation;
 use crate::spectrum::stats::quantile_sorted;
-use crate::{Error, Result};
 use rand::SeedableRng;
 use std::sync::{Arc, Mutex};
 
@@ -186,16 +186,14 @@ impl ReplicateSource {
         let floor = problem.floors.last().copied().unwrap_or(0.0);
         let sigma = (floor * problem.fs_hz / 2.0).sqrt();
         if !(sigma.is_finite() && sigma > 0.0) {
-            return Err(Error::Fit(format!(
-                "bootstrap: cannot estimate the measurement noise{} (floor {floor:e}); no intervals",
-                if problem.label.is_empty() {
-                    String::new()
-                } else {
-                    format!(" of recording '{}'", problem.label)
-                }
-            )));
+            return Err(super::FitError::NoNoise {
+                label: problem.label.clone(),
+                floor,
+            }
+            .into());
         }
-        let normal = rand_distr::Normal::new(0.0, sigma).map_err(|e| Error::Fit(e.to_string()))?;
+        let normal = rand_distr::Normal::new(0.0, sigma)
+            .map_err(|source| super::FitError::NoiseDistribution { sigma, source })?;
         Ok(ReplicateSource {
             x_model,
             sigma,

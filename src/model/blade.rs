@@ -173,7 +173,7 @@ impl BladeParams {
     }
 
     /// Checks that every parameter is finite and physical.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), super::ParamError> {
         let named = [
             ("l1_m", self.l1_m, true),
             ("l2_m", self.l2_m, true),
@@ -194,30 +194,31 @@ impl BladeParams {
             ("drive_a_m", self.drive_a_m, false),
             ("drive_omega_rad_per_s", self.drive_omega_rad_per_s, true),
         ];
-        for (name, v, strictly) in named {
-            if !v.is_finite() || v < 0.0 || (strictly && v == 0.0) {
-                return Err(format!(
-                    "blade parameter {name} = {v} must be finite and {}",
-                    if strictly { "> 0" } else { ">= 0" }
-                ));
+        for (name, value, strictly) in named {
+            if !value.is_finite() || value < 0.0 || (strictly && value == 0.0) {
+                return Err(super::ParamError::Blade {
+                    name,
+                    value,
+                    strictly,
+                });
             }
         }
         if let Some(sh) = self.shoulder {
-            if !(sh.contact_angle_rad.is_finite() && sh.contact_angle_rad > 0.0) {
-                return Err(format!(
-                    "blade parameter shoulder.contact_angle_rad = {} must be finite and > 0",
-                    sh.contact_angle_rad
-                ));
-            }
-            if !(sh.k1_contact_nm_per_rad.is_finite() && sh.k1_contact_nm_per_rad > 0.0) {
-                return Err(format!(
-                    "blade parameter shoulder.k1_contact_nm_per_rad = {} must be finite and > 0",
-                    sh.k1_contact_nm_per_rad
-                ));
+            for (name, value) in [
+                ("contact_angle_rad", sh.contact_angle_rad),
+                ("k1_contact_nm_per_rad", sh.k1_contact_nm_per_rad),
+            ] {
+                if !(value.is_finite() && value > 0.0) {
+                    return Err(super::ParamError::Shoulder { name, value });
+                }
             }
         }
-        if self.mass_coefficients().mph <= 0.0 || self.mass_coefficients().mth <= 0.0 {
-            return Err("blade: the neck and lip need mass or inertia (m_θ, m_φ > 0)".into());
+        let m = self.mass_coefficients();
+        if m.mph <= 0.0 || m.mth <= 0.0 {
+            return Err(super::ParamError::NoMass {
+                m_theta: m.mth,
+                m_phi: m.mph,
+            });
         }
         self.friction.validate()
     }

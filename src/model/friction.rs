@@ -73,21 +73,17 @@ impl FrictionLaw {
     }
 
     /// Checks that the coefficients are finite and physical (`μ_s > 0`, `μ_d ≥ 0`, rates ≥ 0).
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), super::ParamError> {
         let ok = |x: f64| x.is_finite() && x >= 0.0;
         match *self {
             FrictionLaw::Exponential { a, b_s_per_m, c } => {
                 if !(ok(a) && ok(b_s_per_m) && ok(c) && a + c > 0.0) {
-                    return Err(format!(
-                        "friction law: A, B, C must be finite and >= 0 with A + C > 0 (got A = {a}, B = {b_s_per_m}, C = {c})"
-                    ));
+                    return Err(super::ParamError::Exponential { a, b_s_per_m, c });
                 }
             }
             FrictionLaw::Coulomb { mu_s, mu_k } => {
                 if !(ok(mu_s) && ok(mu_k) && mu_s > 0.0 && mu_k <= mu_s) {
-                    return Err(format!(
-                        "Coulomb friction: need 0 <= mu_k <= mu_s, mu_s > 0 (got mu_s = {mu_s}, mu_k = {mu_k})"
-                    ));
+                    return Err(super::ParamError::Coulomb { mu_s, mu_k });
                 }
             }
             FrictionLaw::Leine {
@@ -95,9 +91,10 @@ impl FrictionLaw {
                 delta_s_per_m,
             } => {
                 if !(ok(mu_s) && ok(delta_s_per_m) && mu_s > 0.0) {
-                    return Err(format!(
-                        "Leine friction: need mu_s > 0, delta >= 0 (got {mu_s}, {delta_s_per_m})"
-                    ));
+                    return Err(super::ParamError::Leine {
+                        mu_s,
+                        delta_s_per_m,
+                    });
                 }
             }
         }

@@ -3,6 +3,7 @@
 pub mod belt;
 pub mod benchmarks;
 pub mod blade;
+mod error;
 pub mod friction;
 pub mod modes;
 pub mod necklip;
@@ -10,5 +11,6 @@ pub mod params;
 pub mod stick_slip;
 
 pub use blade::{Blade, BladeParams, Shoulder, StickForm};
+pub use error::ParamError;
 pub use friction::FrictionLaw;
 pub use params::ParamId;

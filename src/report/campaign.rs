@@ -236,7 +236,7 @@ fn row_view(i: usize, r: &Row, params: &[String]) -> RowView {
 /// Returns the page's path.
 ///
 /// # Errors
-/// [`Error::Io`] when `dir` or a file cannot be written; [`Error::Numerics`] from drawing or the
+/// [`Error::Io`] when `dir` or a file cannot be written; [`super::ReportError`] from drawing or the
 /// template.
 pub fn write_campaign_report(
     dir: &Path,
@@ -278,7 +278,10 @@ pub fn write_campaign_report(
     env.set_auto_escape_callback(|_| minijinja::AutoEscape::Html);
     let html = env
         .render_str(TEMPLATE, ctx)
-        .map_err(|e| Error::Numerics(format!("campaign report template: {e}")))?;
+        .map_err(|source| super::ReportError::Template {
+            page: "campaign report",
+            source,
+        })?;
     let path = dir.join("index.html");
     crate::io::write_atomic(&path, html.as_bytes())?;
     Ok(path)

@@ -18,7 +18,7 @@ pub const MAP_SVG: &str = "reachability.svg";
 /// Writes the four files into `dir` (created if missing); returns their paths.
 ///
 /// # Errors
-/// [`Error::Io`] naming the file; [`Error::Numerics`] when the figure cannot be drawn.
+/// [`Error::Io`] naming the file; [`super::ReportError`] when the figure cannot be drawn.
 pub fn write_exploration(dir: &Path, e: &Exploration) -> Result<Vec<PathBuf>> {
     crate::io::create_dir(dir)?;
     let mut written = Vec::new();
@@ -39,8 +39,8 @@ pub fn write_exploration(dir: &Path, e: &Exploration) -> Result<Vec<PathBuf>> {
     Ok(written)
 }
 
-fn csv_err(e: impl std::fmt::Display) -> Error {
-    Error::Numerics(format!("writing a CSV table: {e}"))
+fn csv_err(e: impl std::error::Error + Send + Sync + 'static) -> Error {
+    Error::write("an exploration table", "CSV", e)
 }
 
 /// Header cells of one band's columns.
@@ -103,7 +103,7 @@ pub fn samples_csv(e: &Exploration) -> Result<String> {
         row.extend(outcome_cells(&s.outcome, e.bands.len()));
         w.write_record(&row).map_err(csv_err)?;
     }
-    String::from_utf8(w.into_inner().map_err(csv_err)?).map_err(csv_err)
+    String::from_utf8(w.into_inner().map_err(|e| csv_err(e.into_error()))?).map_err(csv_err)
 }
 
 /// `sensitivity.csv`: per freed parameter and end (`lower`, `start`, `upper`), its value, the
@@ -125,7 +125,7 @@ pub fn sensitivity_csv(e: &Exploration) -> Result<String> {
             w.write_record(&row).map_err(csv_err)?;
         }
     }
-    String::from_utf8(w.into_inner().map_err(csv_err)?).map_err(csv_err)
+    String::from_utf8(w.into_inner().map_err(|e| csv_err(e.into_error()))?).map_err(csv_err)
 }
 
 /// A line as `f Hz (prominence ×p)`, or the failure cause.

@@ -590,7 +590,7 @@ fn write_columns(dir: &Path, name: &str, columns: &[(&str, &[f64])]) -> Result<S
 /// computed them (no means removed).
 ///
 /// # Errors
-/// [`Error::Io`] naming the file; [`Error::Config`] if the signal cannot be extracted.
+/// [`Error::Io`] naming the file; [`crate::spectrum::SpectrumError`] if the signal cannot be extracted.
 pub fn fit_data_files(dir: &Path, o: &FitOutcome) -> Result<Vec<String>> {
     let mut files = Vec::new();
     let targets_only = o.measured_trace.points.is_empty();
@@ -647,7 +647,7 @@ pub fn fit_data_files(dir: &Path, o: &FitOutcome) -> Result<Vec<String>> {
 /// (computed upstream by [`crate::fit::instfreq::compare_freq_speed`]).
 ///
 /// # Errors
-/// [`Error::Io`]/[`Error::Numerics`] from drawing.
+/// [`Error::Io`]/[`super::ReportError`] from drawing.
 pub fn freq_vs_speed_figure(dir: &Path, c: &FreqSpeedComparison) -> Result<()> {
     let band_hz = c.band_hz;
     let xy = |p: &[FreqSpeedPoint]| -> (Vec<f64>, Vec<f64>) {

@@ -6,7 +6,10 @@
 //! * [`campaign`]: a campaign's report page, `<campaign dir>/<name>/report/index.html`.
 
 pub mod campaign;
+mod error;
 pub mod explore;
 pub mod figures;
 pub mod html;
 pub mod plot;
+
+pub use error::{HeatmapProblem, ReportError};

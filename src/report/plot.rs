@@ -9,8 +9,8 @@
 //! * [`heatmap`]: a spectrogram-style `z[x][y]` image with a viridis colour map and colour bar.
 //!
 //! Figures are rendered into memory and written with one `crate::io::write_atomic`, so a failed write is an
-//! [`Error::Io`] naming the path; a plotters drawing failure is an [`Error::Numerics`] naming the
-//! path, as is data with nothing plottable.
+//! [`Error::Io`] naming the path; a plotters drawing failure is a [`ReportError::Draw`] naming the
+//! path, data with nothing plottable a [`ReportError::NothingToPlot`].
 //!
 //! The report stage computes nothing: pass it spectra and traces computed upstream.
 
@@ -25,6 +25,7 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::{HeatmapProblem, ReportError};
 use crate::{Error, Result};
 use ticks::{TickAxis, Ticks};
 
@@ -131,10 +132,11 @@ pub struct ChartOpts {
 }
 
 fn draw_err(path: &Path, e: impl std::fmt::Display) -> Error {
-    Error::Numerics(format!(
-        "{}: drawing the figure failed: {e}",
-        path.display()
-    ))
+    ReportError::Draw {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    }
+    .into()
 }
 
 fn write_svg(path: &Path, svg: &str) -> Result<()> {
@@ -283,8 +285,8 @@ impl Plane {
 /// axis ranges; lines are clipped to the plotted range. Log axes are labelled in data units at
 /// powers of ten.
 ///
-/// Errors: [`Error::Config`] for an empty or reversed `x_range`/`y_range` or a non-positive bound
-/// on a log axis; [`Error::Numerics`] if no series has a plottable point (the message names the
+/// Errors: [`ReportError::Range`] for an empty or reversed `x_range`/`y_range` or a non-positive
+/// bound on a log axis; [`ReportError::NothingToPlot`] if no series has a plottable point (the message names the
 /// path) or plotters fails; [`Error::Io`] if the file cannot be written.
 pub fn line_chart(
     path: &Path,
@@ -312,7 +314,7 @@ pub fn line_chart(
     write_svg(path, &svg)
 }
 
-/// Errors ([`Error::Config`], naming the path) unless `opts`' explicit `x_range` and `y_range`
+/// Errors ([`ReportError::Range`], naming the path) unless `opts`' explicit `x_range` and `y_range`
 /// are finite, increasing and, on a log axis, positive.
 fn check_ranges(path: &Path, opts: &ChartOpts) -> Result<()> {
     let ax = Axis { log: opts.log_x };
@@ -321,36 +323,32 @@ fn check_ranges(path: &Path, opts: &ChartOpts) -> Result<()> {
         if let Some((lo, hi)) = r
             && !(axis.valid(lo) && axis.valid(hi) && lo < hi)
         {
-            return Err(Error::Config(format!(
-                "{}: {name} = ({lo}, {hi}) must be finite, increasing{}",
-                path.display(),
-                if axis.log {
-                    " and positive (log axis)"
-                } else {
-                    ""
-                }
-            )));
+            return Err(ReportError::Range {
+                path: path.to_path_buf(),
+                range: name,
+                lo,
+                hi,
+                log: axis.log,
+            }
+            .into());
         }
     }
     Ok(())
 }
 
 /// The plotting plane of [`line_chart`]: the given ranges, else the valid points' x extent and the
-/// padded y extent of the points and markers inside it. [`Error::Numerics`] (naming the path and
+/// padded y extent of the points and markers inside it. [`ReportError::NothingToPlot`] (naming the path and
 /// title) when there is no valid point.
 fn chart_plane(path: &Path, title: &str, series: &[Series], opts: &ChartOpts) -> Result<Plane> {
     let ax = Axis { log: opts.log_x };
     let ay = Axis { log: opts.log_y };
-    let no_data = || {
-        Error::Numerics(format!(
-            "{}: nothing to plot in \"{title}\": no finite (x, y) point{}",
-            path.display(),
-            if opts.log_x || opts.log_y {
-                " with positive values on the log axes"
-            } else {
-                ""
-            }
-        ))
+    let no_data = || -> Error {
+        ReportError::NothingToPlot {
+            path: path.to_path_buf(),
+            title: title.to_string(),
+            log: opts.log_x || opts.log_y,
+        }
+        .into()
     };
     let valid_pts = || {
         series
@@ -745,7 +743,7 @@ fn block_edges(e: &[f64], b: usize) -> Vec<f64> {
 /// `log_z`, non-positive) cells are drawn light grey. The cells are embedded as one PNG `<image>`
 /// (rendered at the plot's pixel size), the axes and colour bar as SVG, which keeps the file small.
 ///
-/// Errors: [`Error::Numerics`] (naming the path) for empty or mismatched shapes, non-increasing
+/// Errors: [`ReportError::Heatmap`] (naming the path) for empty or mismatched shapes, non-increasing
 /// axes, no finite `z`, or a plotters failure; [`Error::Io`] if the file cannot be written.
 #[allow(clippy::too_many_arguments)]
 pub fn heatmap(
@@ -759,7 +757,14 @@ pub fn heatmap(
     z: &[Vec<f64>],
     log_z: bool,
 ) -> Result<()> {
-    let bad = |m: String| Error::Numerics(format!("{}: heatmap \"{title}\": {m}", path.display()));
+    let bad = |problem| -> Error {
+        ReportError::Heatmap {
+            path: path.to_path_buf(),
+            title: title.to_string(),
+            problem,
+        }
+        .into()
+    };
     check_heatmap_shape(x, y, z).map_err(bad)?;
     let (xe, ye, zd) = heatmap_cells(x, y, colour_values(z, log_z));
     let zr = colour_range(&zd, log_z).map_err(bad)?;
@@ -772,45 +777,39 @@ pub fn heatmap(
         let area = r
             .and_then(|a| root.present().map(|_| a))
             .map_err(|e| draw_err(path, e))?;
-        heatmap_image(area, &xe, &ye, &zd, zr)
-            .ok_or_else(|| bad("could not encode the cell image".into()))?
+        heatmap_image(area, &xe, &ye, &zd, zr).ok_or_else(|| bad(HeatmapProblem::CellImage))?
     };
     // Put the image right after the background rectangle, so axes and ticks are drawn over it.
     let at = svg
         .find("<rect")
         .and_then(|i| svg[i..].find("/>").map(|j| i + j + 2))
-        .ok_or_else(|| bad("unexpected SVG from plotters (no background)".into()))?;
+        .ok_or_else(|| bad(HeatmapProblem::NoBackground))?;
     svg.insert_str(at, &format!("\n{image}"));
     write_svg(path, &svg)
 }
 
 /// Why `x`, `y`, `z` are not a [`heatmap`]'s input: empty axes, `z` not `x.len()` rows of
 /// `y.len()` values, or an axis not finite and strictly increasing.
-fn check_heatmap_shape(x: &[f64], y: &[f64], z: &[Vec<f64>]) -> std::result::Result<(), String> {
+fn check_heatmap_shape(
+    x: &[f64],
+    y: &[f64],
+    z: &[Vec<f64>],
+) -> std::result::Result<(), HeatmapProblem> {
     if x.is_empty() || y.is_empty() {
-        return Err(format!(
-            "expected non-empty axes, got {} x and {} y values",
-            x.len(),
-            y.len()
-        ));
+        let (x, y) = (x.len(), y.len());
+        return Err(HeatmapProblem::EmptyAxes { x, y });
     }
     if z.len() != x.len() {
-        return Err(format!(
-            "z has {} rows, expected one per x value ({})",
-            z.len(),
-            x.len()
-        ));
+        let (rows, x) = (z.len(), x.len());
+        return Err(HeatmapProblem::Rows { rows, x });
     }
-    if let Some(i) = z.iter().position(|r| r.len() != y.len()) {
-        return Err(format!(
-            "z row {i} has {} values, expected one per y value ({})",
-            z[i].len(),
-            y.len()
-        ));
+    if let Some(row) = z.iter().position(|r| r.len() != y.len()) {
+        let (len, y) = (z[row].len(), y.len());
+        return Err(HeatmapProblem::RowLength { row, len, y });
     }
-    for (name, a) in [("x", x), ("y", y)] {
+    for (axis, a) in [("x", x), ("y", y)] {
         if a.iter().any(|v| !v.is_finite()) || a.windows(2).any(|w| w[1] <= w[0]) {
-            return Err(format!("{name} must be finite and strictly increasing"));
+            return Err(HeatmapProblem::Axis { axis });
         }
     }
     Ok(())
@@ -852,7 +851,7 @@ fn heatmap_cells(x: &[f64], y: &[f64], zt: Vec<Vec<f64>>) -> (Vec<f64>, Vec<f64>
 
 /// The colour bar's range: the finite cells' extent, widened by ±0.5 when flat; an error message
 /// when no cell is finite.
-fn colour_range(zd: &[Vec<f64>], log_z: bool) -> std::result::Result<(f64, f64), String> {
+fn colour_range(zd: &[Vec<f64>], log_z: bool) -> std::result::Result<(f64, f64), HeatmapProblem> {
     let (zmin, zmax) = zd
         .iter()
         .flatten()
@@ -861,10 +860,7 @@ fn colour_range(zd: &[Vec<f64>], log_z: bool) -> std::result::Result<(f64, f64),
             (a.min(v), b.max(v))
         });
     if zmin > zmax {
-        return Err(format!(
-            "no finite{} z value",
-            if log_z { " positive" } else { "" }
-        ));
+        return Err(HeatmapProblem::NoFiniteZ { log: log_z });
     }
     Ok(if zmax > zmin {
         (zmin, zmax)
@@ -1167,11 +1163,14 @@ mod tests {
         )];
         let e = line_chart(&path, "t", "x", "y", &series, &ChartOpts::default()).unwrap_err();
         assert!(
-            matches!(e, Error::Numerics(ref m) if m.contains("empty.svg")),
+            matches!(ReportError::of(&e), Some(ReportError::NothingToPlot { path, .. }) if path.ends_with("empty.svg")),
             "{e}"
         );
         let e = line_chart(&path, "t", "x", "y", &[], &ChartOpts::default()).unwrap_err();
-        assert!(matches!(e, Error::Numerics(_)), "{e}");
+        assert!(
+            matches!(ReportError::of(&e), Some(ReportError::NothingToPlot { .. })),
+            "{e}"
+        );
         let opts = ChartOpts {
             log_y: true,
             y_range: Some((0.0, 1.0)),
@@ -1180,7 +1179,7 @@ mod tests {
         let series = [Series::line("ok", vec![1.0, 2.0], vec![1.0, 2.0])];
         assert!(matches!(
             line_chart(&path, "t", "x", "y", &series, &opts),
-            Err(Error::Config(_))
+            Err(ref e) if matches!(ReportError::of(e), Some(ReportError::Range { .. }))
         ));
         let missing = d.join("no/such/dir/f.svg");
         let e = line_chart(&missing, "t", "x", "y", &series, &ChartOpts::default()).unwrap_err();
@@ -1267,7 +1266,7 @@ mod tests {
         )
         .unwrap_err();
         assert!(
-            matches!(e, Error::Numerics(ref m) if m.contains("h.svg")),
+            matches!(ReportError::of(&e), Some(ReportError::Heatmap { path, .. }) if path.ends_with("h.svg")),
             "{e}"
         );
         assert!(heatmap(p, "t", "x", "y", "z", &[], &[], &[], false).is_err());

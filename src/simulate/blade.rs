@@ -113,7 +113,7 @@ pub struct ContactForces {
 /// used there). Separate from the simulation so that a fit's runs do not pay for them.
 ///
 /// # Errors
-/// [`Error::Config`] for the neck/lip model (its prescribed head is not kept);
+/// [`super::SettingError`] for the neck/lip model (its prescribed head is not kept);
 /// [`Error::Simulation`] naming the time and state if the right-hand side fails at a sample.
 pub fn contact_forces(
     kind: ModelKind,
@@ -124,9 +124,7 @@ pub fn contact_forces(
     match kind {
         ModelKind::Blade2dof => forces_of(&Blade::new(*params, stick_form), sim),
         ModelKind::Head1dof => forces_of(&LockedBlade::new(*params), sim),
-        ModelKind::Necklip => Err(Error::Config(
-            "contact forces of the neck/lip model need its prescribed head: not available".into(),
-        )),
+        ModelKind::Necklip => Err(super::SettingError::NecklipContactForces.into()),
     }
 }
 
@@ -209,12 +207,10 @@ pub fn simulate_model(
     stick_form: StickForm,
 ) -> Result<BladeSimulation> {
     match kind {
-        ModelKind::Necklip => Err(Error::Config(
-            "the neck/lip model needs a prescribed head motion: use simulate_necklip".into(),
-        )),
+        ModelKind::Necklip => Err(super::SettingError::NecklipWithoutHead.into()),
         ModelKind::Blade2dof => simulate_blade(params, window, sample_times, opts, stick_form),
         ModelKind::Head1dof => {
-            params.validate().map_err(Error::Config)?;
+            params.validate()?;
             let model = LockedBlade::new(*params);
             let y0 = model
                 .slip_equilibrium(window.0)
@@ -251,7 +247,7 @@ pub fn simulate_necklip(
     opts: &SolverOptions,
 ) -> Result<BladeSimulation> {
     use crate::model::necklip::{FLIP_GUARD_OF_REACH, NeckLip};
-    params.validate().map_err(Error::Config)?;
+    params.validate()?;
     let model = NeckLip::new(*params, head.clone());
     let reach = params.l1_m + params.l2_m;
     let segments = head.segments(window, FLIP_GUARD_OF_REACH * reach);
@@ -411,7 +407,7 @@ fn start_from_tracks(
 /// the state at `sample_times` (ascending, inside the window).
 ///
 /// # Errors
-/// [`Error::Config`] for invalid parameters or options; [`Error::Simulation`] (time and state named)
+/// [`crate::model::ParamError`] / [`super::SettingError`] for invalid parameters or options; [`Error::Simulation`] (time and state named)
 /// on contact loss, a singular slip system, a step-size collapse or an exhausted budget.
 pub fn simulate_blade(
     params: &BladeParams,
@@ -420,7 +416,7 @@ pub fn simulate_blade(
     opts: &SolverOptions,
     stick_form: StickForm,
 ) -> Result<BladeSimulation> {
-    params.validate().map_err(Error::Config)?;
+    params.validate()?;
     let blade = Blade::new(*params, stick_form);
     let t0 = window.0;
     let y0 = blade

@@ -76,3 +76,47 @@ impl SimulationError {
         e.stage_error()
     }
 }
+
+/// Solver or simulation settings that cannot be run: the user's `[solver]` table or flags, or a
+/// call the model does not support. Always an input error (exit code 2).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SettingError {
+    /// Tolerances not positive and finite.
+    #[error("solver: rtol and atol must be positive and finite (got rtol = {rtol}, atol = {atol})")]
+    Tolerances { rtol: f64, atol: f64 },
+    /// A relative tolerance below double precision.
+    #[error("solver: rtol = {rtol} is below what double precision can deliver (use >= 1e-14)")]
+    RtolBelowPrecision { rtol: f64 },
+    /// A maximum step that is not positive.
+    #[error("solver: h_max must be > 0 (got {h_max_s})")]
+    HMax { h_max_s: f64 },
+    /// An empty or reversed window.
+    #[error("simulation window must have t_end > t0 (got {t0_s} .. {t_end_s})")]
+    Window { t0_s: f64, t_end_s: f64 },
+    /// A model with more switching surfaces than the integrator tracks.
+    #[error("model declares {declared} switching surfaces; at most {max} are supported")]
+    SwitchingSurfaces { declared: usize, max: usize },
+    /// A fixed time step that is not positive and finite.
+    #[error("time step must be > 0 (got {h_s})")]
+    TimeStep { h_s: f64 },
+    /// The neck/lip model run without its prescribed head motion.
+    #[error("the neck/lip model needs a prescribed head motion: use simulate_necklip")]
+    NecklipWithoutHead,
+    /// Contact forces asked of the neck/lip model, whose prescribed head is not kept.
+    #[error("contact forces of the neck/lip model need its prescribed head: not available")]
+    NecklipContactForces,
+}
+
+impl From<SettingError> for crate::Error {
+    fn from(e: SettingError) -> Self {
+        crate::Error::stage(e, true)
+    }
+}
+
+impl SettingError {
+    /// The simulate stage's setting error inside `e`, if it is one.
+    pub fn of(e: &crate::Error) -> Option<&SettingError> {
+        e.stage_error()
+    }
+}

@@ -22,7 +22,7 @@
 //! it is armed by the first strictly positive value, and if its first sample is already negative the
 //! sub-interval is searched for a positive maximum (a departure and a return within one sub-step).
 
-use super::error::{SimulationError, StopCause};
+use super::error::{SettingError, SimulationError, StopCause};
 use super::method::{Dense, Method, Outcome, Step};
 use crate::{Error, Result};
 
@@ -70,22 +70,19 @@ impl SolverOptions {
     /// Checks ranges: tolerances positive and finite, `h_max > 0`.
     pub fn validate(&self) -> Result<()> {
         if !(self.rtol > 0.0 && self.rtol.is_finite() && self.atol > 0.0 && self.atol.is_finite()) {
-            return Err(Error::Config(format!(
-                "solver: rtol and atol must be positive and finite (got rtol = {}, atol = {})",
-                self.rtol, self.atol
-            )));
+            return Err(SettingError::Tolerances {
+                rtol: self.rtol,
+                atol: self.atol,
+            }
+            .into());
         }
         if self.rtol < 1e-14 {
-            return Err(Error::Config(format!(
-                "solver: rtol = {} is below what double precision can deliver (use >= 1e-14)",
-                self.rtol
-            )));
+            let rtol = self.rtol;
+            return Err(SettingError::RtolBelowPrecision { rtol }.into());
         }
         if self.h_max.is_nan() || self.h_max <= 0.0 {
-            return Err(Error::Config(format!(
-                "solver: h_max must be > 0 (got {})",
-                self.h_max
-            )));
+            let h_max_s = self.h_max;
+            return Err(SettingError::HMax { h_max_s }.into());
         }
         Ok(())
     }
@@ -375,7 +372,7 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
     /// A solver at `(t0, y0)` in `mode0` (made consistent with it) that will stop at `t_end`.
     ///
     /// # Errors
-    /// [`Error::Config`] for invalid options or `t_end ≤ t0`; a simulation error when `y0` cannot
+    /// [`SettingError`] for invalid options or `t_end ≤ t0`; a simulation error when `y0` cannot
     /// be made consistent with `mode0`.
     pub fn new(
         model: &'m M,
@@ -387,15 +384,15 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
     ) -> Result<Self> {
         opts.validate()?;
         if t_end <= t0 {
-            return Err(Error::Config(format!(
-                "simulation window must have t_end > t0 (got {t0} .. {t_end})"
-            )));
+            let (t0_s, t_end_s) = (t0, t_end);
+            return Err(SettingError::Window { t0_s, t_end_s }.into());
         }
         if model.switching_surfaces() > MAX_SWITCHING_SURFACES {
-            return Err(Error::Config(format!(
-                "model declares {} switching surfaces; at most {MAX_SWITCHING_SURFACES} are supported",
-                model.switching_surfaces()
-            )));
+            return Err(SettingError::SwitchingSurfaces {
+                declared: model.switching_surfaces(),
+                max: MAX_SWITCHING_SURFACES,
+            }
+            .into());
         }
         let mut y = y0;
         let mut mode = mode0;

@@ -12,6 +12,6 @@ pub mod method;
 pub mod rk;
 pub mod timestep;
 
-pub use error::{SimulationError, StopCause};
+pub use error::{SettingError, SimulationError, StopCause};
 pub use hybrid::{Phase, SolverOptions, Transition};
 pub use method::Method;

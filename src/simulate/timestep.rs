@@ -70,7 +70,7 @@ fn sim_err<const N: usize>(
 /// the first step decides it). The observable is linearly interpolated to `sample_times`.
 ///
 /// # Errors
-/// [`Error::Config`] for a non-positive step; [`Error::Simulation`] on contact loss or a singular
+/// [`super::SettingError`] for a non-positive step; [`Error::Simulation`] on contact loss or a singular
 /// system.
 pub fn moreau_jean<M: NonsmoothModel<N>, const N: usize>(
     model: &M,
@@ -81,7 +81,7 @@ pub fn moreau_jean<M: NonsmoothModel<N>, const N: usize>(
     sample_times: &[f64],
 ) -> Result<Trajectory> {
     if !(h_s > 0.0 && h_s.is_finite()) {
-        return Err(Error::Config(format!("time step must be > 0 (got {h_s})")));
+        return Err(super::SettingError::TimeStep { h_s }.into());
     }
     let n_steps = ((t1 - t0) / h_s).ceil() as usize;
     let mut out = Trajectory::default();
@@ -136,13 +136,7 @@ pub fn smoothed<M: NonsmoothModel<N>, const N: usize>(
     let mut out = Trajectory::default();
     let mut rhs =
         |t: f64, y: &[f64; N], dy: &mut [f64; N]| model.smoothed_rhs(eps_m_per_s, t, y, dy);
-    let classify = |g: f64| {
-        if g.abs() <= 2.0 * eps_m_per_s {
-            Phase::Stick
-        } else {
-            Phase::slip(g)
-        }
-    };
+    let classify = |g: f64| smoothed_phase(g, eps_m_per_s);
     let mut t = t0;
     let mut y = y0;
     let mut f = [0.0; N];
@@ -191,15 +185,8 @@ pub fn smoothed<M: NonsmoothModel<N>, const N: usize>(
         let g_new = model.slip_speed(t_new, &a.y_new);
         let p_new = classify(g_new);
         if p_new != phase {
-            // Crossing of |γ| = 2ε, linear between the step ends.
-            let (ga, gb) = (g.abs() - 2.0 * eps_m_per_s, g_new.abs() - 2.0 * eps_m_per_s);
-            let w = if (gb - ga).abs() > 0.0 {
-                ga / (ga - gb)
-            } else {
-                1.0
-            };
-            out.transitions
-                .push((t + w.clamp(0.0, 1.0) * h, phase, p_new));
+            let t_cross = crossing_time(t, h, g, g_new, eps_m_per_s);
+            out.transitions.push((t_cross, phase, p_new));
             phase = p_new;
         }
         g = g_new;
@@ -209,6 +196,27 @@ pub fn smoothed<M: NonsmoothModel<N>, const N: usize>(
         h = rk::next_step(h, a.err);
     }
     Ok(out)
+}
+
+/// The phase [`smoothed`] reads off the slip speed `g`: stick while `|g| ≤ 2ε`, slip± outside.
+fn smoothed_phase(g: f64, eps_m_per_s: f64) -> Phase {
+    if g.abs() <= 2.0 * eps_m_per_s {
+        Phase::Stick
+    } else {
+        Phase::slip(g)
+    }
+}
+
+/// Time of the crossing of |γ| = 2ε between the step ends `(t, g)` and `(t + h, g_new)`, by
+/// linear interpolation of `|γ| − 2ε`; the step's end when the two are equal.
+fn crossing_time(t: f64, h: f64, g: f64, g_new: f64, eps_m_per_s: f64) -> f64 {
+    let (ga, gb) = (g.abs() - 2.0 * eps_m_per_s, g_new.abs() - 2.0 * eps_m_per_s);
+    let w = if (gb - ga).abs() > 0.0 {
+        ga / (ga - gb)
+    } else {
+        1.0
+    };
+    t + w.clamp(0.0, 1.0) * h
 }
 
 impl NonsmoothModel<2> for Belt {

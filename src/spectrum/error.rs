@@ -49,11 +49,78 @@ pub enum SpectrumError {
         "stick detector: cannot estimate the tracking noise of the tip trace (σ̂ = {sigma_m} m from {samples} samples); it needs a noisy trace with at least 10 samples"
     )]
     NoNoiseEstimate { sigma_m: f64, samples: usize },
+    /// Ridge settings out of range: the band must satisfy 0 ≤ low < high and `min_snr` ≥ 0.
+    #[error(
+        "instantaneous frequency: need 0 <= band low < band high and min_snr >= 0 (got band {band_hz:?} Hz, min_snr {min_snr})"
+    )]
+    RidgeSettings { band_hz: (f64, f64), min_snr: f64 },
+    /// The analysed signal and the tip position differ in length.
+    #[error(
+        "instantaneous frequency: signal has {signal} samples but the tip position {tip} (expected equal lengths)"
+    )]
+    LengthMismatch { signal: usize, tip: usize },
+    /// Stick-detector settings out of range.
+    #[error(
+        "stick detector: need half_width >= 1, fs_hz > 0 and 0 < enter_sigmas <= leave_sigmas (got half_width {half_width}, enter_sigmas {enter_sigmas}, leave_sigmas {leave_sigmas}, fs {fs_hz} Hz)"
+    )]
+    DetectorSettings {
+        half_width: usize,
+        enter_sigmas: f64,
+        leave_sigmas: f64,
+        fs_hz: f64,
+    },
+    /// A signal needs a tracked point the trace does not have; `present` lists the trace's points.
+    #[error(
+        "signal needs a tracked point with role '{role}' (map it in [recording.import.points]); the trace has: {}",
+        present.join(", ")
+    )]
+    MissingPoint { role: String, present: Vec<String> },
+    /// A feature band that holds no frequency bin of the spectrum.
+    #[error(
+        "band '{band}' [{lo_hz}, {hi_hz}] Hz holds no frequency bin at fs = {fs_hz} Hz, nperseg = {nperseg} (Nyquist {} Hz)",
+        fs_hz / 2.0
+    )]
+    EmptyBand {
+        band: String,
+        lo_hz: f64,
+        hi_hz: f64,
+        fs_hz: f64,
+        nperseg: usize,
+    },
+    /// Resampling: time stamps and samples differ in number.
+    #[error("resample: {times} time stamps but {samples} samples (expected one stamp per sample)")]
+    ResampleLengths { times: usize, samples: usize },
+    /// Resampling an empty record.
+    #[error("resample: empty record (expected at least one sample)")]
+    ResampleEmpty,
+    /// Resampling: a time stamp that is not finite.
+    #[error("resample: time stamp {index} is {t_s} (expected finite times)")]
+    ResampleTime { index: usize, t_s: f64 },
+    /// Resampling: time stamps that do not increase at `index`.
+    #[error(
+        "resample: time stamps not strictly increasing at index {index} ({before_s} s then {after_s} s)"
+    )]
+    ResampleOrder {
+        index: usize,
+        before_s: f64,
+        after_s: f64,
+    },
+    /// Spectrogram: a non-finite sample.
+    #[error("spectrogram: sample {index} of {len} is {value} (expected finite samples)")]
+    SpectrogramNonFinite {
+        index: usize,
+        len: usize,
+        value: f64,
+    },
+    /// Spectrogram: fewer samples than one segment.
+    #[error("spectrogram: record has {len} samples, expected at least nperseg = {nperseg}")]
+    SpectrogramTooShort { len: usize, nperseg: usize },
 }
 
 impl SpectrumError {
-    /// True for errors in the settings (segment length, overlap, FFT length, sampling rate), which
-    /// come from the user's input; false for samples a spectrum cannot be estimated from.
+    /// True for errors in the settings (segment length, overlap, FFT length, sampling rate, ridge
+    /// and detector settings, bands, the points a signal needs), which come from the user's input;
+    /// false for samples a spectrum cannot be estimated from.
     pub fn is_setting(&self) -> bool {
         matches!(
             self,
@@ -61,6 +128,11 @@ impl SpectrumError {
                 | SpectrumError::OverlapTooLarge { .. }
                 | SpectrumError::NfftTooSmall { .. }
                 | SpectrumError::SamplingRate { .. }
+                | SpectrumError::RidgeSettings { .. }
+                | SpectrumError::LengthMismatch { .. }
+                | SpectrumError::DetectorSettings { .. }
+                | SpectrumError::MissingPoint { .. }
+                | SpectrumError::EmptyBand { .. }
         )
     }
 }

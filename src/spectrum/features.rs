@@ -2,11 +2,12 @@
 //! across the band. Measurement and model go through this same estimator at the same sampling
 //! (physics.md §4, "compare like with like").
 
+use super::SpectrumError;
+use crate::Result;
 use crate::spectrum::{
     Average, Detrend, Peak, Scaling, WelchConfig, Window, find_peak, welch_gappy,
 };
 use crate::trace::Trace;
-use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 /// One frequency band and the Welch segment length used in it.
@@ -120,15 +121,15 @@ impl SignalKind {
     /// The signal's samples from `trace` (NaN where a point is missing).
     ///
     /// # Errors
-    /// [`Error::Config`] when the trace lacks a `head` or `tip` point.
+    /// [`SpectrumError::MissingPoint`] when the trace lacks a `head` or `tip` point.
     pub fn extract(self, trace: &Trace) -> Result<Vec<f64>> {
         let need = |name: &str| {
-            trace.point(name).ok_or_else(|| {
-                Error::Config(format!(
-                    "signal needs a tracked point with role '{name}' (map it in [recording.import.points]); the trace has: {}",
-                    trace.points.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")
-                ))
-            })
+            trace
+                .point(name)
+                .ok_or_else(|| SpectrumError::MissingPoint {
+                    role: name.to_string(),
+                    present: trace.points.iter().map(|p| p.name.clone()).collect(),
+                })
         };
         let diff = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a - b).collect();
         Ok(match self {
@@ -194,12 +195,14 @@ pub fn features(x: &[f64], fs_hz: f64, bands: &[BandSpec], max_fill: usize) -> R
             .map(|(f, p)| (*f, *p))
             .unzip();
         if freq.is_empty() {
-            return Err(Error::Config(format!(
-                "band '{}' [{lo}, {hi}] Hz holds no frequency bin at fs = {fs_hz} Hz, nperseg = {} (Nyquist {} Hz)",
-                b.name,
-                b.nperseg,
-                fs_hz / 2.0
-            )));
+            return Err(SpectrumError::EmptyBand {
+                band: b.name.clone(),
+                lo_hz: lo,
+                hi_hz: hi,
+                fs_hz,
+                nperseg: b.nperseg,
+            }
+            .into());
         }
         out.push(BandFeatures {
             spec: b.clone(),

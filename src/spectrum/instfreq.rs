@@ -41,9 +41,10 @@
 //!
 //! Units: seconds, metres, m/s, Hz. Samples are uniform at `fs_hz`; NaN marks a missing sample.
 
+use super::SpectrumError;
 use super::stats::median_in_place;
 use super::stft::spectrogram;
-use crate::{Error, Result};
+use crate::Result;
 
 /// One instantaneous-frequency estimate.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -233,10 +234,11 @@ fn for_each_slice(
 ) -> Result<()> {
     let valid = cfg.band_hz.0 >= 0.0 && cfg.band_hz.0 < cfg.band_hz.1 && cfg.min_snr >= 0.0;
     if !valid {
-        return Err(Error::Config(format!(
-            "instantaneous frequency: need 0 <= band low < band high and min_snr >= 0 (got band {:?} Hz, min_snr {})",
-            cfg.band_hz, cfg.min_snr
-        )));
+        return Err(SpectrumError::RidgeSettings {
+            band_hz: cfg.band_hz,
+            min_snr: cfg.min_snr,
+        }
+        .into());
     }
     let x = fill_short_gaps(signal, cfg.max_fill);
     let step = cfg.nperseg.saturating_sub(cfg.noverlap).max(1);
@@ -273,7 +275,7 @@ fn for_each_slice(
 /// without a local maximum in the band, below `min_snr`, or without a finite speed are left out.
 ///
 /// # Errors
-/// [`Error::Config`] for invalid settings (band, `min_snr`, segment lengths, `fs_hz`) or
+/// [`SpectrumError`] (a setting) for invalid settings (band, `min_snr`, segment lengths, `fs_hz`) or
 /// `signal`/`tip_x_m` of different lengths.
 pub fn ridge_vs_speed(
     t0_s: f64,
@@ -284,11 +286,11 @@ pub fn ridge_vs_speed(
     noise_floor: f64,
 ) -> Result<Vec<FreqSpeedPoint>> {
     if signal.len() != tip_x_m.len() {
-        return Err(Error::Config(format!(
-            "instantaneous frequency: signal has {} samples but the tip position {} (expected equal lengths)",
-            signal.len(),
-            tip_x_m.len()
-        )));
+        return Err(SpectrumError::LengthMismatch {
+            signal: signal.len(),
+            tip: tip_x_m.len(),
+        }
+        .into());
     }
     let mut out = Vec::new();
     let floor = if noise_floor.is_finite() {
@@ -372,8 +374,8 @@ pub struct StickDetection {
 /// starts in slip, and only an entry into stick after at least one slip sample counts as an onset.
 ///
 /// # Errors
-/// [`Error::Config`] for `half_width = 0`, non-positive `fs_hz` or thresholds with
-/// `0 < enter ≤ leave` violated; [`Error::Numerics`] when the noise cannot be estimated (fewer than
+/// [`SpectrumError::DetectorSettings`] for `half_width = 0`, non-positive `fs_hz` or thresholds with
+/// `0 < enter ≤ leave` violated; [`SpectrumError::NoNoiseEstimate`] when the noise cannot be estimated (fewer than
 /// 8 finite second differences) or is zero (a noise-free trace: use the transition list instead).
 pub fn detect_stick_onsets(
     t0_s: f64,
@@ -385,9 +387,13 @@ pub fn detect_stick_onsets(
         || !(fs_hz.is_finite() && fs_hz > 0.0)
         || !(det.enter_sigmas > 0.0 && det.leave_sigmas >= det.enter_sigmas)
     {
-        return Err(Error::Config(format!(
-            "stick detector: need half_width >= 1, fs_hz > 0 and 0 < enter_sigmas <= leave_sigmas (got {det:?}, fs {fs_hz} Hz)"
-        )));
+        return Err(SpectrumError::DetectorSettings {
+            half_width: det.half_width,
+            enter_sigmas: det.enter_sigmas,
+            leave_sigmas: det.leave_sigmas,
+            fs_hz,
+        }
+        .into());
     }
     let sigma = noise_sigma(tip_x_m);
     if !(sigma.is_finite() && sigma > 0.0) {
@@ -635,11 +641,11 @@ mod tests {
         };
         assert!(matches!(
             ridge_vs_speed(0.0, 1e4, &x, &x, &cfg, 0.0),
-            Err(Error::Config(_))
+            Err(ref e) if matches!(SpectrumError::of(e), Some(SpectrumError::RidgeSettings { .. }))
         ));
         assert!(matches!(
             ridge_vs_speed(0.0, 1e4, &x, &x[..10], &RidgeConfig::default(), 0.0),
-            Err(Error::Config(_))
+            Err(ref e) if matches!(SpectrumError::of(e), Some(SpectrumError::LengthMismatch { signal: 600, tip: 10 }))
         ));
         // A noise-free trace has no noise to set the stick threshold.
         assert!(matches!(
@@ -653,7 +659,7 @@ mod tests {
         };
         assert!(matches!(
             detect_stick_onsets(0.0, 1e4, &x, &bad),
-            Err(Error::Config(_))
+            Err(ref e) if matches!(SpectrumError::of(e), Some(SpectrumError::DetectorSettings { .. }))
         ));
     }
 }

@@ -10,7 +10,8 @@
 //! `A·(2πf·h)²/8` for a sinusoid of amplitude `A` and frequency `f`; keep the frame rate well above
 //! the highest frequency of interest.
 
-use crate::{Error, Result};
+use super::SpectrumError;
+use crate::Result;
 
 /// The median sampling rate `1/median(Δt)` in Hz of the time stamps `t_s` (seconds).
 ///
@@ -31,35 +32,35 @@ pub fn median_rate_hz(t_s: &[f64]) -> f64 {
 /// Returns `(t0, samples)`. NaN is preserved: a grid point that falls strictly between two stamps,
 /// either of which is NaN, is NaN; a grid point that coincides with a stamp takes that sample.
 ///
-/// Errors: [`Error::Numerics`] if `t_s` and `x` differ in length, are empty, or the times are not
-/// finite and strictly increasing; [`Error::Config`] if `fs_hz` is not finite and positive.
+/// Errors: [`SpectrumError`] (`Resample*`) if `t_s` and `x` differ in length, are empty, or the
+/// times are not finite and strictly increasing; [`SpectrumError::SamplingRate`] if `fs_hz` is not
+/// finite and positive.
 pub fn resample_uniform(t_s: &[f64], x: &[f64], fs_hz: f64) -> Result<(f64, Vec<f64>)> {
     super::welch::check_fs(fs_hz)?;
     if t_s.len() != x.len() {
-        return Err(Error::Numerics(format!(
-            "resample: {} time stamps but {} samples (expected one stamp per sample)",
-            t_s.len(),
-            x.len()
-        )));
+        return Err(SpectrumError::ResampleLengths {
+            times: t_s.len(),
+            samples: x.len(),
+        }
+        .into());
     }
     if t_s.is_empty() {
-        return Err(Error::Numerics(
-            "resample: empty record (expected at least one sample)".into(),
-        ));
+        return Err(SpectrumError::ResampleEmpty.into());
     }
     if let Some(i) = t_s.iter().position(|t| !t.is_finite()) {
-        return Err(Error::Numerics(format!(
-            "resample: time stamp {i} is {} (expected finite times)",
-            t_s[i]
-        )));
+        return Err(SpectrumError::ResampleTime {
+            index: i,
+            t_s: t_s[i],
+        }
+        .into());
     }
     if let Some(i) = t_s.windows(2).position(|w| w[1] <= w[0]) {
-        return Err(Error::Numerics(format!(
-            "resample: time stamps not strictly increasing at index {} ({} s then {} s)",
-            i + 1,
-            t_s[i],
-            t_s[i + 1]
-        )));
+        return Err(SpectrumError::ResampleOrder {
+            index: i + 1,
+            before_s: t_s[i],
+            after_s: t_s[i + 1],
+        }
+        .into());
     }
     let t0 = t_s[0];
     let last = t_s.len() - 1;

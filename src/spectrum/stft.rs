@@ -19,9 +19,10 @@
 //! detrend='constant', scaling='density', mode='psd')` (checked against a fixture in
 //! `tests/spectrum.rs`), transposed to `[time][freq]`.
 
+use super::SpectrumError;
 use super::peaks::find_peak;
 use super::welch::{WelchConfig, WelchPlan, check_fs, fill_freqs};
-use crate::{Error, Result};
+use crate::Result;
 
 /// A one-sided spectrogram: `density[i][k]` is the PSD (units²/Hz) of the segment centred at
 /// `t_s[i]` at frequency `freq_hz[k]`.
@@ -66,7 +67,8 @@ impl Spectrogram {
 /// Spectrogram of the uniformly sampled `x` at `fs_hz` with the conventions of the module docs.
 ///
 /// Lengths are in samples: `nperseg ≥ 2`, `noverlap < nperseg`, `nfft ≥ nperseg`
-/// ([`Error::Config`] otherwise, also for a non-positive `fs_hz`). [`Error::Numerics`] if `x` is
+/// ([`SpectrumError`], a setting, otherwise, also for a non-positive `fs_hz`).
+/// [`SpectrumError::SpectrogramTooShort`] / [`SpectrumError::SpectrogramNonFinite`] if `x` is
 /// shorter than `nperseg` or holds NaN/±∞ (resample and fill gaps first).
 pub fn spectrogram(
     x: &[f64],
@@ -83,17 +85,19 @@ pub fn spectrogram(
     cfg.validate()?;
     check_fs(fs_hz)?;
     if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-        return Err(Error::Numerics(format!(
-            "spectrogram: sample {i} of {} is {} (expected finite samples)",
-            x.len(),
-            x[i]
-        )));
+        return Err(SpectrumError::SpectrogramNonFinite {
+            index: i,
+            len: x.len(),
+            value: x[i],
+        }
+        .into());
     }
     if x.len() < nperseg {
-        return Err(Error::Numerics(format!(
-            "spectrogram: record has {} samples, expected at least nperseg = {nperseg}",
-            x.len()
-        )));
+        return Err(SpectrumError::SpectrogramTooShort {
+            len: x.len(),
+            nperseg,
+        }
+        .into());
     }
     let mut plan = WelchPlan::new(cfg)?;
     let n_seg = cfg.n_segments(x.len());
@@ -165,7 +169,7 @@ mod tests {
     fn errors() {
         assert!(matches!(
             spectrogram(&[0.0; 10], 1.0, 16, 8, 16),
-            Err(Error::Numerics(_))
+            Err(ref e) if matches!(crate::spectrum::SpectrumError::of(e), Some(crate::spectrum::SpectrumError::SpectrogramTooShort { len: 10, nperseg: 16 }))
         ));
         assert!(matches!(
             spectrogram(&[0.0; 100], 1.0, 16, 16, 16),
@@ -176,7 +180,7 @@ mod tests {
         ));
         assert!(matches!(
             spectrogram(&[f64::NAN; 100], 1.0, 16, 8, 16),
-            Err(Error::Numerics(_))
+            Err(ref e) if matches!(crate::spectrum::SpectrumError::of(e), Some(crate::spectrum::SpectrumError::SpectrogramNonFinite { index: 0, .. }))
         ));
         // A constant signal: no local maximum → NaN ridge.
         let sg = spectrogram(&[1.0; 100], 1.0, 16, 8, 16).unwrap();

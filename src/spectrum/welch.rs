@@ -393,7 +393,7 @@ impl WelchPlan {
 
     /// Welch PSD of `x` sampled at `fs_hz`; see the module docs for the conventions.
     ///
-    /// Errors: [`Error::Config`] if `fs_hz` is not finite and positive; [`Error::Numerics`] if `x`
+    /// Errors: [`SpectrumError::SamplingRate`] if `fs_hz` is not finite and positive; [`SpectrumError`] if `x`
     /// has fewer than `nperseg` samples or holds a non-finite value (use
     /// [`process_gappy`](Self::process_gappy) for records with gaps).
     pub fn process(&mut self, x: &[f64], fs_hz: f64) -> Result<Psd> {
@@ -668,8 +668,8 @@ pub fn default_nperseg(n: usize) -> usize {
 /// Welch PSD of the uniformly sampled `x` at `fs_hz` (Hz): `scipy.signal.welch(x, fs,
 /// window='hann', nperseg, noverlap, nfft, detrend, scaling='density', average='mean')`.
 ///
-/// Returns `nfft/2 + 1` bins in units²/Hz. Errors: [`Error::Config`] for an invalid `cfg` or
-/// `fs_hz`; [`Error::Numerics`] if `x` is shorter than `nperseg` or contains NaN/±∞.
+/// Returns `nfft/2 + 1` bins in units²/Hz. Errors: [`SpectrumError`] (a setting) for an invalid
+/// `cfg` or `fs_hz`; [`SpectrumError::TooShort`] / [`SpectrumError::NonFinite`] if `x` is shorter than `nperseg` or contains NaN/±∞.
 ///
 /// ```
 /// use wiperlab::spectrum::{welch, WelchConfig};
@@ -694,7 +694,7 @@ pub fn welch(x: &[f64], fs_hz: f64, cfg: &WelchConfig) -> Result<Psd> {
 /// only (a segment never straddles a gap), and the mean is over all segments of all runs. A record
 /// without missing samples gives exactly (bit for bit) the result of [`welch`].
 ///
-/// Errors: as [`welch`], and [`Error::Numerics`] if every sample is missing or no finite run (after
+/// Errors: as [`welch`], and [`SpectrumError::AllMissing`] / [`SpectrumError::NoFiniteRun`] if every sample is missing or no finite run (after
 /// filling) has `nperseg` samples; the message gives the longest run.
 pub fn welch_gappy(
     x: &[f64],

@@ -9,7 +9,7 @@ use plotters::prelude::*;
 
 use super::ticks::{self, TickAxis};
 use super::{Axis, DrawResult, SCALE, draw_err, plane_range, px, viridis};
-use crate::{Error, Result};
+use crate::Result;
 
 /// Points of one category (e.g. one failure cause), drawn in one colour with a legend entry.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -68,18 +68,22 @@ const BAR: u32 = 170;
 /// Panels left to right in one SVG at `path`, under `title`.
 ///
 /// # Errors
-/// [`Error::Config`] (naming the path) for a range that is not finite and increasing (and positive
-/// on a log axis); [`Error::Numerics`] for a plotters failure; [`Error::Io`] for the write.
+/// [`crate::report::ReportError::PanelRange`] (naming the path) for a range that is not finite and
+/// increasing (and positive on a log axis); [`crate::report::ReportError::Draw`] for a plotters
+/// failure; [`Error::Io`] for the write.
 pub fn scatter_panels(path: &Path, title: &str, panels: &[Panel]) -> Result<()> {
     for p in panels {
         for (name, (lo, hi), log) in [("x", p.x_range, p.log_x), ("y", p.y_range, p.log_y)] {
             if !(lo.is_finite() && hi.is_finite() && lo < hi && (!log || lo > 0.0)) {
-                return Err(Error::Config(format!(
-                    "{}: panel \"{}\": {name} range ({lo}, {hi}) must be finite and increasing{}",
-                    path.display(),
-                    p.title,
-                    if log { " and positive (log axis)" } else { "" }
-                )));
+                return Err(crate::report::ReportError::PanelRange {
+                    path: path.to_path_buf(),
+                    panel: p.title.clone(),
+                    axis: name,
+                    lo,
+                    hi,
+                    log,
+                }
+                .into());
             }
         }
     }

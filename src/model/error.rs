@@ -1,0 +1,51 @@
+//! Parameters the model cannot run with: [`ParamError`], naming the parameter and its value.
+
+/// A blade or friction parameter that is not finite or not physical. Always an input error: the
+/// parameters come from the user's blade file or job.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ParamError {
+    /// A blade parameter (its key in the blade file) that must be finite and > 0 (`strictly`) or
+    /// ≥ 0.
+    #[error(
+        "blade parameter {name} = {value} must be finite and {}",
+        if *strictly { "> 0" } else { ">= 0" }
+    )]
+    Blade {
+        name: &'static str,
+        value: f64,
+        strictly: bool,
+    },
+    /// A shoulder parameter (`shoulder.<name>`) that must be finite and > 0.
+    #[error("blade parameter shoulder.{name} = {value} must be finite and > 0")]
+    Shoulder { name: &'static str, value: f64 },
+    /// Neck and lip without mass or inertia: the effective masses m_θ, m_φ are not positive.
+    #[error("blade: the neck and lip need mass or inertia (m_θ, m_φ > 0)")]
+    NoMass { m_theta: f64, m_phi: f64 },
+    /// The exponential law's coefficients.
+    #[error(
+        "friction law: A, B, C must be finite and >= 0 with A + C > 0 (got A = {a}, B = {b_s_per_m}, C = {c})"
+    )]
+    Exponential { a: f64, b_s_per_m: f64, c: f64 },
+    /// Coulomb's coefficients.
+    #[error(
+        "Coulomb friction: need 0 <= mu_k <= mu_s, mu_s > 0 (got mu_s = {mu_s}, mu_k = {mu_k})"
+    )]
+    Coulomb { mu_s: f64, mu_k: f64 },
+    /// Leine's coefficients.
+    #[error("Leine friction: need mu_s > 0, delta >= 0 (got {mu_s}, {delta_s_per_m})")]
+    Leine { mu_s: f64, delta_s_per_m: f64 },
+}
+
+impl From<ParamError> for crate::Error {
+    fn from(e: ParamError) -> Self {
+        crate::Error::stage(e, true)
+    }
+}
+
+impl ParamError {
+    /// The model stage's parameter error inside `e`, if it is one.
+    pub fn of(e: &crate::Error) -> Option<&ParamError> {
+        e.stage_error()
+    }
+}
