@@ -307,6 +307,18 @@ fn stem(p: &Path) -> String {
         .unwrap_or_else(|| "out".into())
 }
 
+/// Writes the shell's completion script for wiperlab on stdout.
+fn completions(shell: clap_complete::Shell) -> Result<()> {
+    use clap::CommandFactory;
+    clap_complete::generate(
+        shell,
+        &mut Cli::command(),
+        "wiperlab",
+        &mut std::io::stdout(),
+    );
+    Ok(())
+}
+
 /// Runs the parsed command.
 pub fn run(cli: Cli) -> Result<()> {
     QUIET.store(cli.quiet, std::sync::atomic::Ordering::Relaxed);
@@ -368,16 +380,7 @@ pub fn run(cli: Cli) -> Result<()> {
             out_dir,
         } => bench::run(quick, blade, out_dir),
         Command::Campaign { action } => campaign::run(action),
-        Command::Completions { shell } => {
-            use clap::CommandFactory;
-            clap_complete::generate(
-                shell,
-                &mut Cli::command(),
-                "wiperlab",
-                &mut std::io::stdout(),
-            );
-            Ok(())
-        }
+        Command::Completions { shell } => completions(shell),
         Command::Modes {
             blade,
             speeds,

@@ -80,14 +80,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let input_sha256 = result::sha256_file(&job.recording_path)?;
     let meas = measure(job)?;
     let fit = &job.job.fit;
-    let candidates: Vec<Candidate> = if fit.models.is_empty() {
-        vec![Candidate {
-            kind: smallest_capable_model(&job.job.spectrum.bands),
-            shoulder: false,
-        }]
-    } else {
-        fit.models.clone()
-    };
+    let candidates = candidates_of(job);
     let pb = progress.then(|| progress_bar(job, &candidates));
     let mut fits = fit_candidates(job, &meas, &candidates, &pb)?;
     let mut selection = select::choose(&fits, &job.job.spectrum.bands, !fit.models.is_empty());
@@ -96,26 +89,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let best = BestModel::of(&cf)?;
     let mut parameters = fitted_parameters(job, &cf);
     let peaks = peak_comparisons(&cf, &best.features)?;
-    if let (Some(pb), true) = (
-        &pb,
-        fit.uncertainty.method() == job::UncertaintyMethod::Bootstrap,
-    ) {
-        pb.set_message("bootstrap");
-    }
-    let (intervals, mut warnings) = if interrupt::stop_requested() {
-        (None, Vec::new())
-    } else {
-        match uncertainty::intervals(&cf, &best.sim, fit) {
-            Err(_) if interrupt::stop_requested() => (None, Vec::new()),
-            other => other?,
-        }
-    };
-    let interrupted = interrupt::stop_requested();
-    if interrupted {
-        warnings.push(
-            "interrupted: the best point the search had reached, without the remaining restarts, candidates, curvature or intervals".into(),
-        );
-    }
+    let (intervals, mut warnings, interrupted) = chosen_intervals(&cf, &best, fit, &pb)?;
     if let Some(intervals) = intervals {
         for (p, iv) in parameters.iter_mut().zip(intervals) {
             p.interval = Some(iv);
@@ -132,13 +106,10 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let chosen = &mut selection.trials[selection.chosen];
     chosen.model_evaluations = cf.problem.evaluations.load(Ordering::Relaxed);
     chosen.failed_evaluations = failures(&cf.problem).0;
-    let modes = match blade_modes(&best.params) {
-        Ok(m) => m,
-        Err(e) => {
-            warnings.push(format!("no blade modes at the fitted parameters: {e}"));
-            Vec::new()
-        }
-    };
+    let modes = blade_modes(&best.params).unwrap_or_else(|e| {
+        warnings.push(format!("no blade modes at the fitted parameters: {e}"));
+        Vec::new()
+    });
     let result = assemble_result(
         job,
         &cf,
@@ -165,6 +136,49 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         best_sim: best.sim,
         best_params: best.params,
     })
+}
+
+/// The candidates the job asks for, or the smallest model capable of its bands.
+fn candidates_of(job: &LoadedJob) -> Vec<Candidate> {
+    if job.job.fit.models.is_empty() {
+        vec![Candidate {
+            kind: smallest_capable_model(&job.job.spectrum.bands),
+            shoulder: false,
+        }]
+    } else {
+        job.job.fit.models.clone()
+    }
+}
+
+/// The chosen fit's intervals and their warnings, and whether the run was interrupted (then no
+/// intervals, and a warning saying what was left out).
+fn chosen_intervals(
+    cf: &CandidateFit,
+    best: &BestModel,
+    fit: &job::FitSection,
+    pb: &Option<indicatif::ProgressBar>,
+) -> Result<(Option<Vec<result::Interval>>, Vec<String>, bool)> {
+    if let (Some(pb), true) = (
+        pb,
+        fit.uncertainty.method() == job::UncertaintyMethod::Bootstrap,
+    ) {
+        pb.set_message("bootstrap");
+    }
+    let (intervals, mut warnings) = if interrupt::stop_requested() {
+        (None, Vec::new())
+    } else {
+        match uncertainty::intervals(cf, &best.sim, fit) {
+            Err(_) if interrupt::stop_requested() => (None, Vec::new()),
+            other => other?,
+        }
+    };
+    let interrupted = interrupt::stop_requested();
+    if interrupted {
+        warnings.push(
+            "interrupted: the best point the search had reached, without the remaining restarts, candidates, curvature or intervals".into(),
+        );
+    }
+    Ok((intervals, warnings, interrupted))
 }
 
 /// The chosen candidate's best fit simulated again at the polish's tolerance.

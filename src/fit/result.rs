@@ -379,6 +379,69 @@ mod tests {
         );
     }
 
+    fn sample_parameter() -> FittedParam {
+        FittedParam {
+            name: ParamId::K1,
+            value: 0.03,
+            lower: 0.005,
+            upper: 0.15,
+            std_error: 0.001,
+            determined: true,
+            true_value: Some(0.029),
+            rel_error: Some(0.03 / 0.029 - 1.0),
+            interval: Some(Interval {
+                lo: 0.028,
+                hi: 0.032,
+                level: 0.68,
+                method: IntervalMethod::Profile,
+            }),
+        }
+    }
+
+    fn sample_peak() -> PeakComparison {
+        PeakComparison {
+            band: "low".into(),
+            measured_hz: 49.0,
+            model_hz: 49.5,
+            rel_diff: 0.5 / 49.0,
+            measured_level: 1e-9,
+            model_level: 2e-9,
+            target_range_hz: None,
+            measured_line: None,
+            model_line: None,
+        }
+    }
+
+    fn sample_trial() -> ModelTrial {
+        ModelTrial {
+            model: "head1dof".parse().unwrap(),
+            parameters: vec![ParamId::K0],
+            cost: 3.0,
+            wall_time_s: 0.1,
+            model_evaluations: 5,
+            failed_evaluations: 0,
+            chosen: false,
+            reason: "cost 3.0 > 1.5".into(),
+            evidence: Some(TrialEvidence {
+                log_likelihood_nats: -12.5,
+                spectral_nll_nats: vec![10.0, 2.5],
+                time_nll_nats: None,
+                residual_rms_m: 1e-5,
+                n_effective: 40.0,
+                aic: 27.0,
+                bic: 28.7,
+                delta_aic: 4.0,
+                delta_bic: 2.1,
+                lrt: Some(RatioTest {
+                    against: "head1dof".parse().unwrap(),
+                    statistic: 0.5,
+                    df: 2,
+                    p_value: 0.78,
+                }),
+            }),
+        }
+    }
+
     fn sample() -> FitResult {
         FitResult {
             job: "j".into(),
@@ -386,33 +449,8 @@ mod tests {
             wiperlab_version: "0.1.0".into(),
             model: default_model(),
             cost: 1.5,
-            parameters: vec![FittedParam {
-                name: ParamId::K1,
-                value: 0.03,
-                lower: 0.005,
-                upper: 0.15,
-                std_error: 0.001,
-                determined: true,
-                true_value: Some(0.029),
-                rel_error: Some(0.03 / 0.029 - 1.0),
-                interval: Some(Interval {
-                    lo: 0.028,
-                    hi: 0.032,
-                    level: 0.68,
-                    method: IntervalMethod::Profile,
-                }),
-            }],
-            peaks: vec![PeakComparison {
-                band: "low".into(),
-                measured_hz: 49.0,
-                model_hz: 49.5,
-                rel_diff: 0.5 / 49.0,
-                measured_level: 1e-9,
-                model_level: 2e-9,
-                target_range_hz: None,
-                measured_line: None,
-                model_line: None,
-            }],
+            parameters: vec![sample_parameter()],
+            peaks: vec![sample_peak()],
             undetermined: vec![],
             correlation: vec![vec![f64::NAN]],
             spread_source: SpreadSource::FisherInformation,
@@ -426,33 +464,7 @@ mod tests {
             solver_rtol: 1e-8,
             solver_atol: 1e-10,
             transitions_in_best_model: 10,
-            model_trials: vec![ModelTrial {
-                model: "head1dof".parse().unwrap(),
-                parameters: vec![ParamId::K0],
-                cost: 3.0,
-                wall_time_s: 0.1,
-                model_evaluations: 5,
-                failed_evaluations: 0,
-                chosen: false,
-                reason: "cost 3.0 > 1.5".into(),
-                evidence: Some(TrialEvidence {
-                    log_likelihood_nats: -12.5,
-                    spectral_nll_nats: vec![10.0, 2.5],
-                    time_nll_nats: None,
-                    residual_rms_m: 1e-5,
-                    n_effective: 40.0,
-                    aic: 27.0,
-                    bic: 28.7,
-                    delta_aic: 4.0,
-                    delta_bic: 2.1,
-                    lrt: Some(RatioTest {
-                        against: "head1dof".parse().unwrap(),
-                        statistic: 0.5,
-                        df: 2,
-                        p_value: 0.78,
-                    }),
-                }),
-            }],
+            model_trials: vec![sample_trial()],
             warnings: vec!["w".into()],
             input_sha256: "ab".into(),
             settings: "name = \"j\"\n".into(),

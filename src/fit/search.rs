@@ -220,84 +220,11 @@ pub(super) fn build_problem(
     meas: &Measurement,
     candidate: Candidate,
 ) -> Result<(SpectralProblem, Vec<FreeParam>)> {
-    let fit = &job.job.fit;
-    let mut base = job.blade;
-    let mut free: Vec<FreeParam> = job
-        .free
-        .iter()
-        .map(|&(n, lo, hi)| FreeParam::new(n, lo, hi))
-        .collect();
-    if candidate.shoulder {
-        let sb = fit.shoulder.ok_or_else(|| FitError::ShoulderBounds)?;
-        base.shoulder = Some(crate::model::Shoulder {
-            contact_angle_rad: 0.5 * (sb.theta_c[0] + sb.theta_c[1]),
-            k1_contact_nm_per_rad: 0.5 * (sb.k1c[0] + sb.k1c[1]),
-        });
-        free.push(FreeParam::new(ParamId::K1c, sb.k1c[0], sb.k1c[1]));
-        free.push(FreeParam::new(
-            ParamId::ThetaC,
-            sb.theta_c[0],
-            sb.theta_c[1],
-        ));
-    }
+    let (base, free) = freed(job, candidate)?;
     let evaluations = Arc::new(AtomicUsize::new(0));
-    let build = |m: &Measurement, base: BladeParams, label: String| -> Result<_> {
-        let (measured, floors, nan_mask) = if candidate.kind == ModelKind::Necklip {
-            necklip_view(job, m, &base)?
-        } else {
-            (
-                m.measured.clone(),
-                m.floors.clone(),
-                m.x.iter().map(|v| !v.is_finite()).collect(),
-            )
-        };
-        Ok(SpectralProblem {
-            model: candidate.kind,
-            head: m.head.clone().ok(),
-            targets: m.targets.clone(),
-            time_targets: m.time_targets.clone(),
-            others: Vec::new(),
-            label,
-            base,
-            free: free.clone(),
-            measured,
-            floors,
-            bands: job.job.spectrum.bands.clone(),
-            signal: job.job.spectrum.signal,
-            nan_mask,
-            sample_times: m.trace.t_s.clone(),
-            fs_hz: m.fs_hz,
-            max_fill: job.job.spectrum.max_fill,
-            window: (
-                m.trace.t_s[0],
-                *m.trace.t_s.last().unwrap_or(&m.trace.t_s[0]),
-            ),
-            solver: job.job.solver,
-            swarm_solver: match fit.swarm_rtol {
-                Some(r) => SolverOptions {
-                    rtol: r,
-                    atol: job.job.solver.atol * r / job.job.solver.rtol,
-                    ..job.job.solver
-                },
-                None => job.job.solver,
-            },
-            objective: fit.objective,
-            weights: fit.weights,
-            likelihood: Err("not built yet".into()),
-            evaluations: evaluations.clone(),
-            failures: Arc::new(AtomicUsize::new(0)),
-            first_failure: Mutex::new(None),
-        })
-        .map(|mut p: SpectralProblem| {
-            p.likelihood = if p.targets.is_some() {
-                Err("a target job has no measurement noise".into())
-            } else {
-                RecordingLikelihood::new(&p, &m.x, fit.likelihood.time_domain)
-                    .map(Arc::new)
-                    .map_err(|e| e.to_string())
-            };
-            p
-        })
+    let build = |m: &Measurement, base: BladeParams, label: String| {
+        let recording = Recording { m, base, label };
+        problem_of(job, candidate, recording, &free, evaluations.clone())
     };
     let mut main = build(meas, base, String::new())?;
     let dir = job.path.parent().unwrap_or(std::path::Path::new("."));
@@ -311,6 +238,109 @@ pub(super) fn build_problem(
         main.others.push(build(&m, b, more.name.clone())?);
     }
     Ok((main, free))
+}
+
+/// The base parameters and the freed ones of `candidate`: the job's, and for a shoulder candidate
+/// the shoulder's two, started at the middle of their `[fit.shoulder]` bounds.
+fn freed(job: &LoadedJob, candidate: Candidate) -> Result<(BladeParams, Vec<FreeParam>)> {
+    let mut base = job.blade;
+    let mut free: Vec<FreeParam> = job
+        .free
+        .iter()
+        .map(|&(n, lo, hi)| FreeParam::new(n, lo, hi))
+        .collect();
+    if candidate.shoulder {
+        let sb = job.job.fit.shoulder.ok_or(FitError::ShoulderBounds)?;
+        base.shoulder = Some(crate::model::Shoulder {
+            contact_angle_rad: 0.5 * (sb.theta_c[0] + sb.theta_c[1]),
+            k1_contact_nm_per_rad: 0.5 * (sb.k1c[0] + sb.k1c[1]),
+        });
+        free.push(FreeParam::new(ParamId::K1c, sb.k1c[0], sb.k1c[1]));
+        free.push(FreeParam::new(
+            ParamId::ThetaC,
+            sb.theta_c[0],
+            sb.theta_c[1],
+        ));
+    }
+    Ok((base, free))
+}
+
+/// One recording of a fit: its measurement, the blade's base parameters for it (its own drive) and
+/// its label (empty for the job's main recording).
+struct Recording<'a> {
+    m: &'a Measurement,
+    base: BladeParams,
+    label: String,
+}
+
+/// The solver settings of the particle swarm: the job's, with `rtol` replaced by `[fit]
+/// swarm_rtol` (and `atol` scaled with it) when that is set.
+fn swarm_solver(job: &LoadedJob) -> SolverOptions {
+    let solver = job.job.solver;
+    match job.job.fit.swarm_rtol {
+        Some(r) => SolverOptions {
+            rtol: r,
+            atol: solver.atol * r / solver.rtol,
+            ..solver
+        },
+        None => solver,
+    }
+}
+
+/// The cost problem of `candidate` on one recording `r`, sharing the evaluation counter.
+fn problem_of(
+    job: &LoadedJob,
+    candidate: Candidate,
+    r: Recording,
+    free: &[FreeParam],
+    evaluations: Arc<AtomicUsize>,
+) -> Result<SpectralProblem> {
+    let (fit, m) = (&job.job.fit, r.m);
+    let (measured, floors, nan_mask) = if candidate.kind == ModelKind::Necklip {
+        necklip_view(job, m, &r.base)?
+    } else {
+        (
+            m.measured.clone(),
+            m.floors.clone(),
+            m.x.iter().map(|v| !v.is_finite()).collect(),
+        )
+    };
+    let t = &m.trace.t_s;
+    let mut p = SpectralProblem {
+        model: candidate.kind,
+        head: m.head.clone().ok(),
+        targets: m.targets.clone(),
+        time_targets: m.time_targets.clone(),
+        others: Vec::new(),
+        label: r.label,
+        base: r.base,
+        free: free.to_vec(),
+        measured,
+        floors,
+        bands: job.job.spectrum.bands.clone(),
+        signal: job.job.spectrum.signal,
+        nan_mask,
+        sample_times: t.clone(),
+        fs_hz: m.fs_hz,
+        max_fill: job.job.spectrum.max_fill,
+        window: (t[0], *t.last().unwrap_or(&t[0])),
+        solver: job.job.solver,
+        swarm_solver: swarm_solver(job),
+        objective: fit.objective,
+        weights: fit.weights,
+        likelihood: Err("not built yet".into()),
+        evaluations,
+        failures: Arc::new(AtomicUsize::new(0)),
+        first_failure: Mutex::new(None),
+    };
+    p.likelihood = if p.targets.is_some() {
+        Err("a target job has no measurement noise".into())
+    } else {
+        RecordingLikelihood::new(&p, &m.x, fit.likelihood.time_domain)
+            .map(Arc::new)
+            .map_err(|e| e.to_string())
+    };
+    Ok(p)
 }
 
 /// The cost problem of the candidate `model` on the
