@@ -134,7 +134,7 @@ pub fn write_script(campaign: &Campaign, settings: &SlurmSettings, exe: &Path) -
 /// Submits `script` with `sbatch --parsable` and records the job id in `<out dir>/slurm/job_id`.
 ///
 /// # Errors
-/// [`Error::Simulation`]-free: [`Error::Input`] naming the script when `sbatch` cannot be started
+/// [`Error::Input`] naming the script when `sbatch` cannot be started
 /// or refuses the job (its stderr is quoted).
 pub fn submit(campaign: &Campaign, script: &Path) -> Result<String> {
     let out = Command::new("sbatch")

@@ -114,7 +114,7 @@ pub struct ContactForces {
 ///
 /// # Errors
 /// [`super::SettingError`] for the neck/lip model (its prescribed head is not kept);
-/// [`Error::Simulation`] naming the time and state if the right-hand side fails at a sample.
+/// [`super::SimulationError`] naming the time and state if the right-hand side fails at a sample.
 pub fn contact_forces(
     kind: ModelKind,
     params: &BladeParams,
@@ -237,7 +237,7 @@ pub fn simulate_model(
 /// spectra skip them.
 ///
 /// # Errors
-/// As [`simulate_blade`]; [`Error::Simulation`] too when the lean stays inside the guard over the
+/// As [`simulate_blade`]; [`super::SimulationError`] too when the lean stays inside the guard over the
 /// whole window.
 pub fn simulate_necklip(
     params: &BladeParams,
@@ -407,7 +407,7 @@ fn start_from_tracks(
 /// the state at `sample_times` (ascending, inside the window).
 ///
 /// # Errors
-/// [`crate::model::ParamError`] / [`super::SettingError`] for invalid parameters or options; [`Error::Simulation`] (time and state named)
+/// [`crate::model::ParamError`] / [`super::SettingError`] for invalid parameters or options; [`super::SimulationError`] (time and state named)
 /// on contact loss, a singular slip system, a step-size collapse or an exhausted budget.
 pub fn simulate_blade(
     params: &BladeParams,

@@ -70,7 +70,7 @@ fn sim_err<const N: usize>(
 /// the first step decides it). The observable is linearly interpolated to `sample_times`.
 ///
 /// # Errors
-/// [`super::SettingError`] for a non-positive step; [`Error::Simulation`] on contact loss or a singular
+/// [`super::SettingError`] for a non-positive step; [`super::SimulationError`] on contact loss or a singular
 /// system.
 pub fn moreau_jean<M: NonsmoothModel<N>, const N: usize>(
     model: &M,
@@ -123,7 +123,7 @@ pub fn moreau_jean<M: NonsmoothModel<N>, const N: usize>(
 /// `|γ| − 2ε` between accepted steps.
 ///
 /// # Errors
-/// [`Error::Simulation`] if the step size collapses or the right-hand side fails.
+/// [`super::SimulationError`] if the step size collapses or the right-hand side fails.
 pub fn smoothed<M: NonsmoothModel<N>, const N: usize>(
     model: &M,
     eps_m_per_s: f64,
