@@ -61,7 +61,10 @@ fn main_job_finds_the_truth_for_nine_of_ten_seeds() {
                 .collect();
             intervals.push((seed, ivs));
         }
-        let pct: Vec<String> = errs.iter().map(|e| format!("{:+.2} %", 100.0 * e)).collect();
+        let pct: Vec<String> = errs
+            .iter()
+            .map(|e| format!("{:+.2} %", 100.0 * e))
+            .collect();
         println!(
             "seed {seed}: {} cost {:.4}, A {} B {} C {} k1 {}, {} evaluations, {:.1} s",
             r.model, r.cost, pct[0], pct[1], pct[2], pct[3], r.model_evaluations, r.wall_time_s
@@ -82,14 +85,7 @@ fn main_job_finds_the_truth_for_nine_of_ten_seeds() {
         let _ = writeln!(
             csv,
             "{seed},{},{},{},{},{},{},{ok},{},{}",
-            r.model,
-            r.cost,
-            errs[0],
-            errs[1],
-            errs[2],
-            errs[3],
-            r.model_evaluations,
-            r.wall_time_s
+            r.model, r.cost, errs[0], errs[1], errs[2], errs[3], r.model_evaluations, r.wall_time_s
         );
     }
     // Interval ends against the first seed that ended within 5 %: the largest difference of an

@@ -78,6 +78,9 @@ pub enum FitError {
     /// No optimiser run at all (no restarts).
     #[error("fit failed: no optimiser run")]
     NoRun,
+    /// A nested candidate's local search without a single start point.
+    #[error("fit failed: no start for the nested search")]
+    NoNestedStart,
     /// The particle swarm finished without a best particle.
     #[error("fit failed: particle swarm returned no particle")]
     NoParticle,
@@ -110,6 +113,7 @@ impl FitError {
                 | FitError::InterruptedEarly
                 | FitError::NoRun
                 | FitError::NoParticle
+                | FitError::NoNestedStart
                 | FitError::NoNoise { .. }
                 | FitError::NoiseDistribution { .. }
                 | FitError::NoLikelihood { .. }

@@ -242,9 +242,7 @@ impl SpectralProblem {
     /// recording with a likelihood, not a target job): cost differences are then log-likelihood
     /// ratios.
     pub fn cost_is_nll(&self) -> bool {
-        self.objective == Objective::Likelihood
-            && self.targets.is_none()
-            && self.likelihood.is_ok()
+        self.objective == Objective::Likelihood && self.targets.is_none() && self.likelihood.is_ok()
     }
 
     /// Cost at normalised coordinates, with a quadratic penalty outside the box.

@@ -42,6 +42,23 @@ pub(super) struct Reporting {
 }
 
 impl Reporting {
+    /// The reporting of `candidate`'s search on the progress bar `pb` (from its position now), with
+    /// one-line messages instead when stderr is not a terminal.
+    fn new(pb: &Option<indicatif::ProgressBar>, candidate: Candidate) -> Reporting {
+        let last_line = pb
+            .as_ref()
+            .filter(|_| !std::io::IsTerminal::is_terminal(&std::io::stderr()))
+            .map(|_| Arc::new(Mutex::new(std::time::Instant::now())));
+        Reporting {
+            last_line,
+            history: Arc::new(Mutex::new(Vec::new())),
+            best: Arc::new(Mutex::new(None)),
+            progress: pb.clone(),
+            base: pb.as_ref().map_or(0, |pb| pb.position()),
+            candidate,
+        }
+    }
+
     /// Names the stage on the progress bar.
     fn stage(&self, what: std::fmt::Arguments) {
         if let Some(pb) = &self.progress {
@@ -371,18 +388,7 @@ pub(super) fn fit_candidate(
 ) -> Result<CandidateFit> {
     let started = std::time::Instant::now();
     let fit = &job.job.fit;
-    let last_line = pb
-        .as_ref()
-        .filter(|_| !std::io::IsTerminal::is_terminal(&std::io::stderr()))
-        .map(|_| Arc::new(Mutex::new(std::time::Instant::now())));
-    let reporting = Reporting {
-        last_line,
-        history: Arc::new(Mutex::new(Vec::new())),
-        best: Arc::new(Mutex::new(None)),
-        progress: pb.clone(),
-        base: pb.as_ref().map_or(0, |pb| pb.position()),
-        candidate,
-    };
+    let reporting = Reporting::new(pb, candidate);
     reporting.stage(format_args!("swarm"));
     let (main, free) = build_problem(job, meas, candidate)?;
     let problem = Arc::new(main);
@@ -491,7 +497,7 @@ fn nested_search(
             local = Some((u, cost));
         }
     }
-    let (u, cost) = local.ok_or_else(|| Error::Fit("no start for the nested search".into()))?;
+    let (u, cost) = local.ok_or(FitError::NoNestedStart)?;
     let gain = base - cost;
     if gain <= NESTED_GLOBAL_GAIN_NATS || interrupt::stop_requested() {
         let note = format!(
@@ -508,7 +514,13 @@ fn nested_search(
          {NESTED_GLOBAL_GAIN_NATS})"
     );
     let (u, cost) = if gcost < cost { (gu, gcost) } else { (u, cost) };
-    Ok((u, swarm_iters, polish_iters + global_polish, cost, Some(note)))
+    Ok((
+        u,
+        swarm_iters,
+        polish_iters + global_polish,
+        cost,
+        Some(note),
+    ))
 }
 
 /// Where a nested candidate (`X+shoulder`) starts: `X`'s optimum with k1_contact = k1, so that
