@@ -74,13 +74,10 @@ pub fn run(cmd: CampaignCommand) -> Result<()> {
         }
         CampaignCommand::Task { campaign, index } => {
             let c = Campaign::load(&campaign)?;
-            let entry = c
-                .entries
-                .get(index)
-                .ok_or_else(|| super::CliError::IndexBeyond {
-                    index,
-                    count: c.entries.len(),
-                })?;
+            let entry = c.entries.get(index).ok_or(super::CliError::IndexBeyond {
+                index,
+                count: c.entries.len(),
+            })?;
             let s = fit_entry(&c, entry)?;
             println!("{}: done in {:.1} s", s.id, s.wall_time_s);
             Ok(())
