@@ -477,21 +477,37 @@ fn num_attr(el: &str, name: &str) -> Option<f64> {
 }
 
 /// Every polyline vertex, point along each polyline segment (32 per segment) and circle of `svg`
-/// that lies inside the legend box (`<g class="legend">`'s first `<rect>`, grown by a circle's
-/// radius), described; and the legend box. `Err` when the figure has no legend group.
-fn data_under_legend(svg: &str) -> Result<(Vec<String>, [f64; 4]), String> {
-    let start = svg.find("<g class=\"legend\">").ok_or("no legend group")?;
-    let end = start + svg[start..].find("</g>").ok_or("legend group not closed")?;
-    let legend = &svg[start..end];
-    let rect = &legend[legend.find("<rect").ok_or("legend without a box")?..];
-    let [x, y, w, h] = ["x", "y", "width", "height"].map(|a| num_attr(rect, a).unwrap_or(f64::NAN));
-    if ![x, y, w, h].iter().all(|v| v.is_finite()) || w <= 0.0 || h <= 0.0 {
-        return Err(format!("legend box unreadable: {rect:.80}"));
+/// that lies inside a legend box (each `<g class="legend">`'s first `<rect>`, grown by a circle's
+/// radius), described; and the legend boxes. `Err` when the figure has no legend group.
+fn data_under_legend(svg: &str) -> Result<(Vec<String>, Vec<[f64; 4]>), String> {
+    let mut boxes = Vec::new();
+    let mut data = String::new();
+    let mut rest = svg;
+    while let Some(start) = rest.find("<g class=\"legend\">") {
+        let end = start
+            + rest[start..]
+                .find("</g>")
+                .ok_or("legend group not closed")?;
+        let legend = &rest[start..end];
+        let rect = &legend[legend.find("<rect").ok_or("legend without a box")?..];
+        let [x, y, w, h] =
+            ["x", "y", "width", "height"].map(|a| num_attr(rect, a).unwrap_or(f64::NAN));
+        if ![x, y, w, h].iter().all(|v| v.is_finite()) || w <= 0.0 || h <= 0.0 {
+            return Err(format!("legend box unreadable: {rect:.80}"));
+        }
+        boxes.push([x, y, w, h]);
+        data += &rest[..start];
+        rest = &rest[end..];
     }
+    if boxes.is_empty() {
+        return Err("no legend group".into());
+    }
+    data += rest;
     let inside = |px: f64, py: f64, grow: f64| {
-        px > x - grow && px < x + w + grow && py > y - grow && py < y + h + grow
+        boxes.iter().any(|[x, y, w, h]| {
+            px > x - grow && px < x + w + grow && py > y - grow && py < y + h + grow
+        })
     };
-    let data = format!("{}{}", &svg[..start], &svg[end..]);
     let mut hits = Vec::new();
     for el in data.split('<').skip(1) {
         if el.starts_with("polyline") {
@@ -527,7 +543,55 @@ fn data_under_legend(svg: &str) -> Result<(Vec<String>, [f64; 4]), String> {
             }
         }
     }
-    Ok((hits, [x, y, w, h]))
+    Ok((hits, boxes))
+}
+
+/// The axis titles of a plotters figure: the `<text>` elements turned upright (y axes, colour
+/// bars: `rotate(270, …)`) or hung above their anchor (x axes: `dy="-0.5ex"`); tick labels and
+/// titles are neither.
+fn axis_labels(svg: &str) -> Vec<String> {
+    svg.split("<text")
+        .skip(1)
+        .filter_map(|t| {
+            let (open, rest) = t.split_once('>')?;
+            let text = rest.split("</text>").next()?.trim();
+            (open.contains("transform=\"rotate(") || open.contains("dy=\"-0.5ex\""))
+                .then(|| text.to_string())
+        })
+        .collect()
+}
+
+/// Checks one figure of `what`: drawn at 4× and shown through the viewBox (quarter-pixel
+/// coordinates), every axis title (at least two) names a unit in brackets, and no data passes
+/// under a legend. Figures in `no_legend` (heatmaps: a colour bar, no series) must have none; every
+/// other figure must have one.
+fn check_figure(what: &str, dir: &Path, name: &str, no_legend: bool) {
+    let svg = std::fs::read_to_string(dir.join(name)).unwrap();
+    let f = format!("{what} {name}");
+    let head = &svg[..svg.find('>').unwrap()];
+    let (w, h) = (
+        num_attr(head, "width").unwrap(),
+        num_attr(head, "height").unwrap(),
+    );
+    assert!(
+        head.contains(&format!("viewBox=\"0 0 {} {}\"", 4.0 * w, 4.0 * h)),
+        "{f}: not drawn at 4x: {head}"
+    );
+    let labels = axis_labels(&svg);
+    assert!(labels.len() >= 2, "{f}: axis titles {labels:?}");
+    for l in &labels {
+        let unit = l
+            .find('[')
+            .and_then(|i| l[i..].find(']').filter(|j| *j > 1));
+        assert!(unit.is_some(), "{f}: axis title {l:?} names no unit");
+    }
+    match data_under_legend(&svg) {
+        Ok((hits, b)) => {
+            assert!(!no_legend, "{f}: a legend where none was expected");
+            assert!(hits.is_empty(), "{f}: legend boxes {b:?} cover {hits:?}");
+        }
+        Err(e) => assert!(no_legend, "{f}: {e}"),
+    }
 }
 
 /// The checker finds data under a legend box drawn over it (a hand-made SVG whose polyline
@@ -540,6 +604,23 @@ fn legend_check_can_fail() {
     assert!(hits.iter().any(|h| h.starts_with("polyline")), "{hits:?}");
     assert!(hits.iter().any(|h| h.starts_with("circle")), "{hits:?}");
     assert!(data_under_legend("<svg><polyline points=\"0,0 1,1\"/></svg>").is_err());
+    // With two legends (a panel each), data under the second one is found too.
+    let two = "<svg><g class=\"legend\"><rect x=\"0\" y=\"0\" width=\"10\" height=\"10\"/></g>\
+               <circle cx=\"50\" cy=\"50\" r=\"1\"/>\
+               <g class=\"legend\"><rect x=\"45\" y=\"45\" width=\"10\" height=\"10\"/></g></svg>";
+    let (hits, boxes) = data_under_legend(two).unwrap();
+    assert_eq!((hits.len(), boxes.len()), (1, 2), "{hits:?}");
+}
+
+/// The axis-title reader finds plotters' x title (hung above its anchor) and rotated y title, and
+/// not tick labels or the title.
+#[test]
+fn axis_titles_are_found_with_and_without_units() {
+    let svg = "<svg><text x=\"1\" y=\"1\" dy=\"0.76em\" text-anchor=\"middle\">\ntitle\n</text>\
+               <text x=\"5\" y=\"9\" dy=\"0.5ex\">\n0.5\n</text>\
+               <text x=\"5\" y=\"9\" dy=\"-0.5ex\" text-anchor=\"middle\">\nt [s]\n</text>\
+               <text x=\"2\" y=\"3\" transform=\"rotate(270, 2, 3)\">\nphase\n</text></svg>";
+    assert_eq!(axis_labels(svg), ["t [s]", "phase"]);
 }
 
 /// Every figure the quick fit writes has a legend, and no data line, point or marker passes under
@@ -558,14 +639,178 @@ fn legends_cover_no_data_in_any_fit_figure() {
     assert!(figs.len() >= 5, "{figs:?}");
     for f in &figs {
         let svg = std::fs::read_to_string(dir.join(f)).unwrap();
-        let (hits, b) = data_under_legend(&svg).unwrap_or_else(|e| panic!("{f}: {e}"));
-        assert!(hits.is_empty(), "{f}: legend box {b:?} covers {hits:?}");
         assert!(
             svg.starts_with("<svg width=\"900\" height=\"500\" viewBox=\"0 0 3600 2000\""),
             "{f}: {:.100}",
             svg
         );
+        check_figure("fit", &dir, f, false);
     }
+}
+
+/// The SVG files of `dir`, checked to be at least `min` many.
+fn svgs_at_least(dir: &Path, min: usize) -> Vec<String> {
+    let figs = svgs(dir);
+    assert!(figs.len() >= min, "{}: {figs:?}", dir.display());
+    figs
+}
+
+/// The figures of every other command that draws, made with the real binary on small inputs in a
+/// temp dir: `spectrum` of the shipped recording (import settings of fits/reversal.toml),
+/// `simulate` of the true blade, `bench --quick`, `explore` of the seed-experiment job with
+/// three freed parameters (16 samples), and `campaign collect` after a tiny two-recording
+/// campaign. Each passes [`check_figure`]: quarter-pixel coordinates, units on every axis and
+/// colour bar, no data under a legend (the spectrograms are the only figures without one).
+/// `modes` prints a table and draws nothing.
+#[test]
+fn every_figure_of_every_command_has_units_and_a_legend_over_no_data() {
+    let tmp = TempDir::new("all_figures");
+    let rec = root().join("data/reversal/wiper_reversal_sample_xypts.csv");
+    let dir = |n: &str| tmp.0.join(n);
+    let s = |p: PathBuf| p.to_str().unwrap().to_string();
+    let run = |args: &[String], what: &str| {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        ok(&wiperlab(&tmp.0, &args), what)
+    };
+    let spectrum = [
+        "spectrum",
+        &s(rec),
+        "--fps",
+        "10000",
+        "--m-per-px",
+        "1.5e-5",
+        "--origin-px",
+        "200,300",
+        "--out-dir",
+        &s(dir("spectrum")),
+        "-q",
+    ];
+    run(&spectrum.map(String::from), "spectrum");
+    let blade = root().join("data/reversal/blade_true.toml");
+    run(
+        &["simulate", &s(blade), "--out-dir", &s(dir("simulate"))].map(String::from),
+        "simulate",
+    );
+    run(
+        &["bench", "--quick", "--out-dir", &s(dir("bench")), "-q"].map(String::from),
+        "bench --quick",
+    );
+    let job = explore_job(&tmp.0);
+    run(
+        &[
+            "explore",
+            &s(job),
+            "--samples",
+            "16",
+            "--seed",
+            "1",
+            "-o",
+            &s(dir("explore")),
+            "-q",
+        ]
+        .map(String::from),
+        "explore",
+    );
+    let campaign = tiny_campaign(&dir("campaign"));
+    run(
+        &["campaign", "run", &s(campaign.clone()), "-q"].map(String::from),
+        "campaign run",
+    );
+    run(
+        &["campaign", "collect", &s(campaign)].map(String::from),
+        "campaign collect",
+    );
+
+    let spec = svgs_at_least(&dir("spectrum"), 8);
+    for f in &spec {
+        check_figure(
+            "spectrum",
+            &dir("spectrum"),
+            f,
+            f.starts_with("spectrogram_"),
+        );
+    }
+    for (what, n) in [("simulate", 3), ("bench", 5), ("explore", 1)] {
+        for f in svgs_at_least(&dir(what), n) {
+            check_figure(what, &dir(what), &f, false);
+        }
+    }
+    let report = dir("campaign/c/report");
+    for f in svgs_at_least(&report, 3) {
+        check_figure("campaign collect", &report, &f, false);
+    }
+    // Both of the map's panels have their legend (targets and start; failure causes).
+    let map = std::fs::read_to_string(dir("explore/reachability.svg")).unwrap();
+    assert_eq!(
+        map.matches("<g class=\"legend\">").count(),
+        2,
+        "reachability.svg"
+    );
+}
+
+/// fits/seed_experiment_geometry.toml (target job: 78.4 Hz and 900 Hz) with absolute paths, C,
+/// the head mass and the lip length freed, and a tiny search.
+fn explore_job(dir: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(root().join("fits/seed_experiment_geometry.toml")).unwrap();
+    let text = text.replace(
+        "\"../data/",
+        &format!("\"{}/", root().join("data").display()),
+    );
+    let head = text.split("[fit]").next().unwrap();
+    let path = dir.join("explore_job.toml");
+    std::fs::write(
+        &path,
+        format!(
+            "{head}[fit]\nparticles = 4\nswarm_iterations = 1\npolish_iterations = 2\nseed = 1\n\n\
+             [fit.parameters]\nC = [0.3, 0.8]\nhead_mass = [0.01, 0.15]\nl2 = [0.003, 0.006]\n"
+        ),
+    )
+    .unwrap();
+    path
+}
+
+/// A campaign in `dir` over copies of two of data/campaign/'s recordings (two compounds at the
+/// normal sweep), on the example template with a tiny search (4 particles, 1 swarm iteration, 3
+/// Nelder–Mead iterations, 1 restart): `dir/c.toml`.
+fn tiny_campaign(dir: &Path) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let data = root().join("data/campaign");
+    let table = std::fs::read_to_string(data.join("conditions.csv")).unwrap();
+    let mut rows = vec![table.lines().next().unwrap().to_string()];
+    for r in ["hard_normal_xypts.csv", "soft_normal_xypts.csv"] {
+        std::fs::copy(data.join(r), dir.join(r)).unwrap();
+        rows.extend(
+            table
+                .lines()
+                .filter(|l| l.starts_with(&format!("{r},")))
+                .map(String::from),
+        );
+    }
+    std::fs::write(dir.join("conditions.csv"), rows.join("\n") + "\n").unwrap();
+    let template = std::fs::read_to_string(root().join("campaigns/example_template.toml")).unwrap();
+    let template: String = template
+        .replace(
+            "\"../data/",
+            &format!("\"{}/", root().join("data").display()),
+        )
+        .lines()
+        .map(|l| match l.split(' ').next() {
+            Some("particles") => "particles = 4".to_string(),
+            Some("swarm_iterations") => "swarm_iterations = 1".to_string(),
+            Some("polish_iterations") => "polish_iterations = 3".to_string(),
+            Some("restarts") => "restarts = 1".to_string(),
+            _ => l.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(dir.join("t.toml"), template).unwrap();
+    let c = dir.join("c.toml");
+    std::fs::write(
+        &c,
+        "template = \"t.toml\"\nrecordings = [\"*_xypts.csv\"]\nconditions = \"conditions.csv\"\n",
+    )
+    .unwrap();
+    c
 }
 
 /// `fit` writes the numbers behind its figures as CSV beside the SVGs, with the column names the

@@ -529,24 +529,24 @@ fn work_precision_figures(dir: &Path, rows: &[BenchRow]) -> Result<()> {
     line_chart(
         &dir.join("work_precision.svg"),
         "Work-precision: transition-time error vs wall time",
-        "wall time per run (s)",
-        "max transition-time error (s)",
+        "wall time per run [s]",
+        "max transition-time error [s]",
         &series(&|r| r.wall_s, &|r| r.transition_err_s),
         &log_log(),
     )?;
     line_chart(
         &dir.join("work_precision_rhs.svg"),
         "Work-precision: transition-time error vs right-hand-side evaluations",
-        "RHS evaluations (incl. event functions; Moreau-Jean: contact solves)",
-        "max transition-time error (s)",
+        "RHS evaluations (incl. event functions; Moreau-Jean: contact solves) [count]",
+        "max transition-time error [s]",
         &series(&|r| r.rhs_evals as f64, &|r| r.transition_err_s),
         &log_log(),
     )?;
     line_chart(
         &dir.join("work_precision_trace.svg"),
         "Work-precision: trace error vs wall time",
-        "wall time per run (s)",
-        "max error of x (belt) / lip-tip v3 (blade) (m)",
+        "wall time per run [s]",
+        "max error of x (belt) / lip-tip v3 (blade) [m]",
         &series(&|r| r.wall_s, &|r| r.trace_err_m),
         &log_log(),
     )
@@ -571,8 +571,8 @@ fn event_order_figure(dir: &Path, rows: &[BenchRow]) -> Result<()> {
     line_chart(
         &dir.join("event_order.svg"),
         "Stick-onset time error vs fixed step (undamped Coulomb belt, closed form)",
-        "step h (s)",
-        "|t_onset - closed form| (s)",
+        "step h [s]",
+        "|t_onset - closed form| [s]",
         &[s, Series::line("slope 5 (h^5)", x, slope)],
         &log_log(),
     )
@@ -751,8 +751,8 @@ fn spectra_figure(dir: &Path, rtols: &[f64], rel: f64, mut series: Vec<Series>) 
             "Fit spectral peaks vs rtol (relative to rtol {:e}; floor 1e-9 = identical)",
             rtols[0]
         ),
-        "rtol",
-        "|peak - converged| / converged",
+        "rtol [-]",
+        "|peak - converged| / converged [-]",
         &series,
         &ChartOpts {
             log_x: true,

@@ -88,7 +88,19 @@ impl Override {
         }
     }
 
-    fn from_column(name: &str) -> Option<Override> {
+    /// The column's unit, for a figure's axis.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Override::T0S => "s",
+            Override::FpsHz => "Hz",
+            Override::MPerPx => "m/px",
+            Override::DriveAM => "m",
+            Override::DriveOmegaRadPerS => "rad/s",
+        }
+    }
+
+    /// The override whose column is `name`.
+    pub fn from_column(name: &str) -> Option<Override> {
         Override::ALL.into_iter().find(|o| o.column() == name)
     }
 

@@ -68,6 +68,28 @@ impl ParamId {
         }
     }
 
+    /// The parameter's SI unit (`-` for a pure number).
+    pub fn unit(self) -> &'static str {
+        match self {
+            ParamId::A | ParamId::C => "-",
+            ParamId::B => "s/m",
+            ParamId::C0 => "N·s/m",
+            ParamId::C1 | ParamId::C2 => "N·m·s/rad",
+            ParamId::Hd | ParamId::L2 => "m",
+            ParamId::HeadMass | ParamId::LipMass => "kg",
+            ParamId::K0 => "N/m",
+            ParamId::K1 | ParamId::K1c | ParamId::K2 => "N·m/rad",
+            ParamId::ThetaC => "rad",
+        }
+    }
+
+    /// A figure's axis label: what the parameter is and its unit, e.g. `"neck stiffness k1
+    /// [N·m/rad]"`.
+    pub fn axis_label(self) -> String {
+        let what = self.meaning().split(", ").next().unwrap_or(self.name());
+        format!("{what} [{}]", self.unit())
+    }
+
     /// Whether the parameter belongs to the shoulder contact ([`super::Shoulder`]).
     pub fn is_shoulder(self) -> bool {
         matches!(self, ParamId::K1c | ParamId::ThetaC)

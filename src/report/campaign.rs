@@ -81,7 +81,19 @@ fn condition_axis(values: &[String]) -> (Vec<f64>, String) {
         .map(|(i, c)| format!("{} = {c}", i + 1))
         .collect::<Vec<_>>()
         .join(", ");
-    (x, format!(" ({legend})"))
+    (x, format!(" [category: {legend}]"))
+}
+
+/// The x axis label of condition `cond`: with the categories' legend (`" [category: …]"`), with
+/// an override's unit, or, for a numeric column of the conditions table, in that table's unit.
+fn condition_label(cond: &str, legend: &str) -> String {
+    if !legend.is_empty() {
+        return format!("{cond}{legend}");
+    }
+    match crate::campaign::Override::from_column(cond) {
+        Some(o) => format!("{cond} [{}]", o.unit()),
+        None => format!("{cond} [unit of the conditions table]"),
+    }
 }
 
 /// The condition columns of `t` with their value per row: the labels, then the overrides set for
@@ -153,8 +165,9 @@ fn param_figure(dir: &Path, t: &Table, p: &str, cond: &str, values: &[String]) -
     line_chart(
         &dir.join(&file),
         &format!("{p} against {cond}, one point per recording"),
-        &format!("{cond}{legend}"),
-        p,
+        &condition_label(cond, &legend),
+        &p.parse::<crate::model::ParamId>()
+            .map_or_else(|_| p.to_string(), |id| id.axis_label()),
         &series,
         &ChartOpts {
             x_range: lo.is_finite().then_some((lo - pad, hi + pad)),
@@ -298,6 +311,6 @@ mod tests {
         assert!(legend.is_empty());
         let (x, legend) = condition_axis(&["soft".into(), "hard".into(), "soft".into()]);
         assert_eq!(x, vec![1.0, 2.0, 1.0]);
-        assert_eq!(legend, " (1 = soft, 2 = hard)");
+        assert_eq!(legend, " [category: 1 = soft, 2 = hard]");
     }
 }

@@ -234,7 +234,7 @@ fn map_panels(e: &Exploration) -> Vec<Panel> {
         x_range: (b0.1[0], b0.1[1]),
         y_range: (b1.1[0], b1.1[1]),
         coloured,
-        z_label: "weaker line's prominence (power over local floor)".into(),
+        z_label: "weaker line's prominence, power over local floor [-]".into(),
         targets,
         ..Panel::default()
     };
@@ -283,8 +283,8 @@ fn failure_panel(e: &Exploration) -> Panel {
     }
     Panel {
         title: "failed runs by cause".into(),
-        x_label: format!("{} ({})", fi.name, fi.name.meaning()),
-        y_label: format!("{} ({})", fj.name, fj.name.meaning()),
+        x_label: fi.name.axis_label(),
+        y_label: fj.name.axis_label(),
         log_x: fi.log,
         log_y: fj.log,
         x_range: (fi.lower, fi.upper),

@@ -113,7 +113,7 @@ pub fn write_simulation(dir: &Path, sim: &BladeSimulation, forces: &ContactForce
         &dir.join("phase.svg"),
         "contact phase (1 slip+, 0 stick, −1 slip−)",
         "t [s]",
-        "phase",
+        "contact phase [1 slip+, 0 stick, −1 slip−]",
         &[Series::line("phase", sim.t_s.clone(), phase)],
         &ChartOpts::default(),
     )?;
@@ -377,8 +377,7 @@ fn max_tip_speed(o: &FitOutcome) -> Option<f64> {
 /// `g = (e^(−Bv), −A v e^(−Bv), 1)` and `Σ` the fitted parameters' covariance (their 1σ and
 /// correlations from the result). `None` unless A, B and C were all fitted with finite 1σ and
 /// correlations.
-fn friction_sigma(o: &FitOutcome, v: &[f64]) -> Option<Vec<f64>> {
-    let r = &o.result;
+fn friction_sigma(r: &FitResult, v: &[f64]) -> Option<Vec<f64>> {
     let idx = |n: &str| r.parameters.iter().position(|p| p.name == n);
     let ids = [idx("A")?, idx("B")?, idx("C")?];
     let sd: Vec<f64> = ids.iter().map(|&i| r.parameters[i].std_error).collect();
@@ -394,6 +393,21 @@ fn friction_sigma(o: &FitOutcome, v: &[f64]) -> Option<Vec<f64>> {
     }
     let (a, b) = (r.parameters[ids[0]].value, r.parameters[ids[1]].value);
     Some(delta_band(a, b, &cov, v))
+}
+
+/// The friction-law figure's title: it says whether the ±1σ band is drawn, and when A, B and C
+/// were all fitted but it is not, why (the curvature was not positive definite, so the result
+/// holds no finite 1σ or correlations for them).
+fn friction_title(r: &FitResult, band: bool) -> String {
+    let law = "dynamic friction coefficient μ_d = A e^(−B|v|) + C (seed eq. 4)";
+    let abc = ["A", "B", "C"]
+        .iter()
+        .all(|n| r.parameters.iter().any(|p| p.name == *n));
+    match (band, abc) {
+        (true, _) => format!("{law}, ±1σ from the fit"),
+        (false, true) => format!("{law}; no ±1σ: the cost's curvature is not positive definite"),
+        (false, false) => format!("{law}; no ±1σ: A, B and C were not all fitted"),
+    }
 }
 
 /// `σ_μ(v) = √(gᵀ Σ g)`, `g = (e^(−Bv), −A v e^(−Bv), 1)`: the delta method's 1σ of
@@ -424,12 +438,13 @@ fn friction_law_figure(dir: &Path, o: &FitOutcome) -> Result<()> {
         .map(|x| o.best_params.friction.mu_slip(*x))
         .collect();
     let mut series = vec![Series::line("fitted", v.clone(), mu.clone())];
-    if let Some(sigma) = friction_sigma(o, &v) {
+    let sigma = friction_sigma(&o.result, &v);
+    if let Some(sigma) = &sigma {
         for (label, sign) in [("fitted + 1σ", 1.0), ("fitted − 1σ", -1.0)] {
             series.push(Series::line(
                 label,
                 v.clone(),
-                mu.iter().zip(&sigma).map(|(m, s)| m + sign * s).collect(),
+                mu.iter().zip(sigma).map(|(m, s)| m + sign * s).collect(),
             ));
         }
     }
@@ -450,7 +465,7 @@ fn friction_law_figure(dir: &Path, o: &FitOutcome) -> Result<()> {
     }
     line_chart(
         &dir.join("friction_law.svg"),
-        "dynamic friction coefficient μ_d = A e^(−B|v|) + C (seed eq. 4), ±1σ from the fit",
+        &friction_title(&o.result, sigma.is_some()),
         "slip speed |v̇3| [m/s] (up to the fastest the model's tip reaches)",
         "dynamic friction coefficient μ_d [-]",
         &series,
@@ -493,14 +508,14 @@ fn cost_figure(dir: &Path, history: &[HistoryPoint], objective: Objective) -> Re
         .filter(|s| !s.x.is_empty())
         .collect();
     let y_label = if split {
-        "best cost (swarm: feature cost; polish: NLL above saturated, nats)"
+        "best cost (swarm: feature cost [-]; polish: NLL above saturated [nats])"
     } else {
-        "best cost"
+        "best cost [-]"
     };
     line_chart(
         &dir.join("cost.svg"),
         "best cost against model evaluations",
-        "model evaluations of the restart",
+        "model evaluations of the restart [count]",
         y_label,
         &series,
         &ChartOpts {
@@ -745,7 +760,42 @@ pub fn fit_summary(r: &FitResult) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::delta_band;
+    use super::{delta_band, friction_sigma, friction_title};
+
+    /// The ±1σ band needs A, B and C fitted with finite 1σ and correlations: with uncorrelated
+    /// A, B, C it is the delta method's (at v = 0: √(σ_A² + σ_C²), B drops out); with NaN
+    /// correlations (the curvature was not positive definite) it is not drawn and the title says
+    /// why; without all three it is not drawn either.
+    #[test]
+    fn friction_band_hidden_and_marked_without_positive_curvature() {
+        let mut r = crate::report::html::tests::result();
+        let base = r.parameters[0].clone();
+        r.parameters = [("A", 0.9, 0.03), ("B", 70.0, 5.0), ("C", 0.5, 0.04)]
+            .iter()
+            .map(|&(n, value, std_error)| crate::fit::result::FittedParam {
+                name: n.parse().unwrap(),
+                value,
+                std_error,
+                ..base.clone()
+            })
+            .collect();
+        r.correlation = (0..3)
+            .map(|i| (0..3).map(|j| if i == j { 1.0 } else { 0.0 }).collect())
+            .collect();
+        let band = friction_sigma(&r, &[0.0]).expect("a band with positive curvature");
+        assert!((band[0] - (0.03f64.powi(2) + 0.04f64.powi(2)).sqrt()).abs() < 1e-15);
+        assert!(friction_title(&r, true).ends_with("±1σ from the fit"));
+        r.correlation = vec![vec![f64::NAN; 3]; 3];
+        assert_eq!(friction_sigma(&r, &[0.0, 0.1]), None);
+        assert!(
+            friction_title(&r, false)
+                .ends_with("no ±1σ: the cost's curvature is not positive definite")
+        );
+        r.parameters.pop();
+        r.correlation = vec![vec![1.0; 2]; 2];
+        assert_eq!(friction_sigma(&r, &[0.0]), None);
+        assert!(friction_title(&r, false).ends_with("A, B and C were not all fitted"));
+    }
 
     #[test]
     fn friction_band_by_the_delta_method() {

@@ -737,7 +737,7 @@ fn result_warnings(r: &FitResult) -> Vec<String> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::fit::result::sha256_hex;
 
@@ -752,7 +752,8 @@ mod tests {
         assert_eq!(pct(-0.0245066), "-2.45 %");
     }
 
-    fn result() -> FitResult {
+    /// A small result (k1 and B fitted) for the report stage's unit tests.
+    pub(in crate::report) fn result() -> FitResult {
         use crate::fit::result::{FittedParam, Interval, PeakComparison};
         let p = |name: &str, determined: bool, interval: Option<Interval>| FittedParam {
             name: name.parse().unwrap(),

@@ -458,32 +458,60 @@ fn shown_at_figure_size(svg: &str, size: (u32, u32)) -> String {
     )
 }
 
-/// The series legend of [`line_chart`], drawn in a strip below the plotting area (entries flow
-/// left to right, then onto a new row) so that it covers no data. In the SVG it is the group
-/// `<g class="legend">` whose first `<rect>` is its box.
-struct Legend {
-    /// `(label, colour, drawn as points, x offset from the box, row)` per series.
-    entries: Vec<(String, RGBColor, bool, u32, u32)>,
-    /// Width of the box and height of the strip, in drawing units (height 0 without series).
+/// How a legend entry shows its series: a line sample, a filled circle of the given radius (drawing
+/// units), or a cross (a marked target).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Mark {
+    Line,
+    Point(u32),
+    Cross,
+}
+
+/// A legend drawn in a strip below the plotting area (entries flow left to right, then onto a new
+/// row) so that it covers no data: [`line_chart`]'s series, the categories and targets of a
+/// [`scatter_panels`] panel. In the SVG it is a group `<g class="legend">` whose first `<rect>` is
+/// its box.
+pub(crate) struct Legend {
+    /// `(label, colour, mark, x offset from the box, row)` per entry.
+    entries: Vec<(String, RGBColor, Mark, u32, u32)>,
+    /// Width of the box and height of the strip, in drawing units (height 0 without entries).
     width: u32,
-    height: u32,
+    pub(crate) height: u32,
 }
 
 impl Legend {
     const ROW: u32 = px(18);
 
+    /// The legend of [`line_chart`]'s series, in the figure's width.
     fn of(series: &[Series]) -> Legend {
-        let room = px(FIGURE_SIZE.0 - 24);
+        Legend::new(
+            series.iter().enumerate().map(|(i, s)| {
+                let mark = if s.style == SeriesStyle::Points {
+                    Mark::Point(px(3))
+                } else {
+                    Mark::Line
+                };
+                (s.label.clone(), series_colour(i), mark)
+            }),
+            FIGURE_SIZE.0,
+        )
+    }
+
+    /// A legend of `items` laid out in a strip `room_px` display pixels wide.
+    pub(crate) fn new(
+        items: impl IntoIterator<Item = (String, RGBColor, Mark)>,
+        room_px: u32,
+    ) -> Legend {
+        let room = px(room_px.saturating_sub(24).max(60));
         let (mut x, mut row, mut width) = (px(6), 0, 0);
         let mut entries = Vec::new();
-        for (i, s) in series.iter().enumerate() {
+        for (label, colour, mark) in items {
             // About 7 px per character of 13 px sans-serif, plus the sample and a gap.
-            let w = px(7 * s.label.chars().count() as u32 + 48).min(room);
+            let w = px(7 * label.chars().count() as u32 + 48).min(room);
             if x + w > room && x > px(6) {
                 (x, row) = (px(6), row + 1);
             }
-            let points = s.style == SeriesStyle::Points;
-            entries.push((s.label.clone(), series_colour(i), points, x, row));
+            entries.push((label, colour, mark, x, row));
             x += w;
             width = width.max(x);
         }
@@ -501,10 +529,16 @@ impl Legend {
 
     /// The legend group, then `</svg>`, in the strip that starts at `top`.
     fn svg(&self, top: u32) -> String {
+        self.group(0, top) + "</svg>"
+    }
+
+    /// The legend group in the strip whose top-left corner is `(left, top)` (drawing units);
+    /// empty without entries.
+    pub(crate) fn group(&self, left: u32, top: u32) -> String {
         if self.entries.is_empty() {
-            return "</svg>".into();
+            return String::new();
         }
-        let (x, y) = (px(12), top + px(4));
+        let (x, y) = (left + px(12), top + px(4));
         let h = self.height - px(8);
         let mut g = format!(
             "<g class=\"legend\">\n<rect x=\"{x}\" y=\"{y}\" width=\"{}\" height=\"{h}\" \
@@ -512,23 +546,9 @@ impl Legend {
             self.width,
             px(1)
         );
-        for (label, c, points, dx, row) in &self.entries {
+        for (label, c, mark, dx, row) in &self.entries {
             let (ex, ey) = (x + dx, y + px(4) + Self::ROW * row + Self::ROW / 2);
-            let colour = format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2);
-            g += &if *points {
-                format!(
-                    "<circle cx=\"{}\" cy=\"{ey}\" r=\"{}\" fill=\"{colour}\"/>\n",
-                    ex + px(10),
-                    px(3)
-                )
-            } else {
-                format!(
-                    "<line x1=\"{ex}\" y1=\"{ey}\" x2=\"{}\" y2=\"{ey}\" stroke=\"{colour}\" \
-                     stroke-width=\"{}\"/>\n",
-                    ex + px(20),
-                    px(2)
-                )
-            };
+            g += &legend_mark(*mark, *c, ex, ey);
             g += &format!(
                 "<text x=\"{}\" y=\"{ey}\" dy=\"0.35em\" font-family=\"sans-serif\" \
                  font-size=\"{}\">{}</text>\n",
@@ -537,7 +557,38 @@ impl Legend {
                 html_escape::encode_text(label)
             );
         }
-        g + "</g>\n</svg>"
+        g + "</g>\n"
+    }
+}
+
+/// The sample of one legend entry whose row starts at `(ex, ey)`.
+fn legend_mark(mark: Mark, c: RGBColor, ex: u32, ey: u32) -> String {
+    let colour = format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2);
+    match mark {
+        Mark::Point(r) => format!(
+            "<circle cx=\"{}\" cy=\"{ey}\" r=\"{r}\" fill=\"{colour}\"/>\n",
+            ex + px(10)
+        ),
+        Mark::Line => format!(
+            "<line x1=\"{ex}\" y1=\"{ey}\" x2=\"{}\" y2=\"{ey}\" stroke=\"{colour}\" \
+             stroke-width=\"{}\"/>\n",
+            ex + px(20),
+            px(2)
+        ),
+        Mark::Cross => {
+            let (cx, d, w) = (ex + px(10), px(5), px(2));
+            format!(
+                "<path d=\"M{} {} L{} {} M{} {} L{} {}\" stroke=\"{colour}\" stroke-width=\"{w}\"/>\n",
+                cx - d,
+                ey - d,
+                cx + d,
+                ey + d,
+                cx - d,
+                ey + d,
+                cx + d,
+                ey - d
+            )
+        }
     }
 }
 
@@ -769,9 +820,10 @@ pub fn heatmap(
     let (xe, ye, zd) = heatmap_cells(x, y, colour_values(z, log_z));
     let zr = colour_range(&zd, log_z).map_err(bad)?;
 
+    let size = (FIGURE_SIZE.0 * SCALE, FIGURE_SIZE.1 * SCALE);
     let mut svg = String::new();
     let image = {
-        let root = SVGBackend::with_string(&mut svg, FIGURE_SIZE).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         let labels = (title, x_label, y_label, z_label);
         let r = draw_heatmap_axes(&root, labels, &xe, &ye, zr, log_z);
         let area = r
@@ -785,7 +837,7 @@ pub fn heatmap(
         .and_then(|i| svg[i..].find("/>").map(|j| i + j + 2))
         .ok_or_else(|| bad(HeatmapProblem::NoBackground))?;
     svg.insert_str(at, &format!("\n{image}"));
-    write_svg(path, &svg)
+    write_svg(path, &shown_at_figure_size(&svg, size))
 }
 
 /// Why `x`, `y`, `z` are not a [`heatmap`]'s input: empty axes, `z` not `x.len()` rows of
@@ -882,16 +934,16 @@ fn draw_heatmap_axes(
     log_z: bool,
 ) -> std::result::Result<PixelArea, DrawingAreaErrorKind<std::io::Error>> {
     root.fill(&WHITE)?;
-    let root = root.titled(title, ("sans-serif", 22))?;
-    let (main, bar) = root.split_horizontally(FIGURE_SIZE.0 - 140);
+    let root = root.titled(title, ("sans-serif", px(22)))?;
+    let (main, bar) = root.split_horizontally(px(FIGURE_SIZE.0 - 140));
     let (x0, x1) = (xe[0], xe[xe.len() - 1]);
     let (y0, y1) = (ye[0], ye[ye.len() - 1]);
     let xt = ticks::linear(x0, x1, 10);
     let yt = ticks::linear(y0, y1, 6);
     let mut chart = ChartBuilder::on(&main)
-        .margin(10)
-        .x_label_area_size(45)
-        .y_label_area_size(75)
+        .margin(px(10))
+        .x_label_area_size(px(45))
+        .y_label_area_size(px(75))
         .build_cartesian_2d(TickAxis::new(x0..x1, &xt), TickAxis::new(y0..y1, &yt))?;
     let xf = |v: &f64| xt.label(*v);
     let yf = |v: &f64| yt.label(*v);
@@ -902,15 +954,15 @@ fn draw_heatmap_axes(
         .y_desc(y_label)
         .x_label_formatter(&xf)
         .y_label_formatter(&yf)
-        .label_style(("sans-serif", 13))
-        .axis_desc_style(("sans-serif", 15))
+        .label_style(("sans-serif", px(13)))
+        .axis_desc_style(("sans-serif", px(15)))
         .draw()?;
-    let (px, py) = chart.plotting_area().get_pixel_range();
+    let (xr, yr) = chart.plotting_area().get_pixel_range();
     let area = (
-        px.start,
-        py.start,
-        (px.end - px.start).max(1) as u32,
-        (py.end - py.start).max(1) as u32,
+        xr.start,
+        yr.start,
+        (xr.end - xr.start).max(1) as u32,
+        (yr.end - yr.start).max(1) as u32,
     );
 
     let zt = if log_z {
@@ -919,10 +971,10 @@ fn draw_heatmap_axes(
         ticks::linear(zlo, zhi, 6)
     };
     let mut cb = ChartBuilder::on(&bar)
-        .margin_top(10)
-        .margin_bottom(55)
-        .margin_right(5)
-        .y_label_area_size(90)
+        .margin_top(px(10))
+        .margin_bottom(px(55))
+        .margin_right(px(5))
+        .y_label_area_size(px(90))
         .build_cartesian_2d(0.0..1.0, TickAxis::new(zlo..zhi, &zt))?;
     let zf = |v: &f64| zt.label(*v);
     let desc = if log_z {
@@ -934,16 +986,18 @@ fn draw_heatmap_axes(
         .disable_mesh()
         .disable_x_axis()
         .y_desc(desc)
-        .set_tick_mark_size(LabelAreaPosition::Left, 6)
+        .set_tick_mark_size(LabelAreaPosition::Left, px(6) as i32)
         .y_label_formatter(&zf)
-        .label_style(("sans-serif", 12))
-        .axis_desc_style(("sans-serif", 13))
+        .label_style(("sans-serif", px(12)))
+        .axis_desc_style(("sans-serif", px(13)))
         .draw()?;
+    // Each band reaches half a band into the next (not the last): no seams between rectangles
+    // that end on fractions of a pixel.
     let n = 100;
     let span = zhi - zlo;
     cb.draw_series((0..n).map(|k| {
         let a = zlo + span * k as f64 / n as f64;
-        let b = zlo + span * (k + 1) as f64 / n as f64;
+        let b = zlo + span * ((k + 1) as f64 + if k + 1 < n { 0.5 } else { 0.0 }) / n as f64;
         Rectangle::new(
             [(0.0, a), (1.0, b)],
             viridis((k as f64 + 0.5) / n as f64).filled(),
@@ -964,14 +1018,16 @@ fn heatmap_image(
     let (ya, yb) = (ye[0], ye[ye.len() - 1]);
     // Cell index of a coordinate: the last edge ≤ v, clamped to the cell range.
     let cell = |e: &[f64], v: f64| e.partition_point(|&b| b <= v).clamp(1, e.len() - 1) - 1;
-    let cols: Vec<usize> = (0..w)
-        .map(|c| cell(xe, xa + (c as f64 + 0.5) / w as f64 * (xb - xa)))
+    // One image pixel per display pixel: the drawing is SCALE times the displayed size.
+    let (iw, ih) = ((w / SCALE).max(1), (h / SCALE).max(1));
+    let cols: Vec<usize> = (0..iw)
+        .map(|c| cell(xe, xa + (c as f64 + 0.5) / iw as f64 * (xb - xa)))
         .collect();
-    let rows: Vec<usize> = (0..h)
-        .map(|r| cell(ye, yb - (r as f64 + 0.5) / h as f64 * (yb - ya)))
+    let rows: Vec<usize> = (0..ih)
+        .map(|r| cell(ye, yb - (r as f64 + 0.5) / ih as f64 * (yb - ya)))
         .collect();
     let span = zhi - zlo;
-    let mut rgb = Vec::with_capacity(w as usize * h as usize * 3);
+    let mut rgb = Vec::with_capacity(iw as usize * ih as usize * 3);
     for &j in &rows {
         for &i in &cols {
             let v = z[i][j];
@@ -983,7 +1039,7 @@ fn heatmap_image(
             rgb.extend_from_slice(&[r, g, b]);
         }
     }
-    let png = png::encode_rgb(w, h, &rgb)?;
+    let png = png::encode_rgb(iw, ih, &rgb)?;
     Some(format!(
         "<image x=\"{x0}\" y=\"{y0}\" width=\"{w}\" height=\"{h}\" preserveAspectRatio=\"none\" \
          href=\"{}\"/>",

@@ -8,7 +8,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::ticks::{self, TickAxis};
-use super::{Axis, DrawResult, SCALE, draw_err, plane_range, px, viridis};
+use super::{Axis, DrawResult, Legend, Mark, SCALE, draw_err, plane_range, px, viridis};
 use crate::Result;
 
 /// Points of one category (e.g. one failure cause), drawn in one colour with a legend entry.
@@ -91,14 +91,27 @@ pub fn scatter_panels(path: &Path, title: &str, panels: &[Panel]) -> Result<()> 
         .iter()
         .map(|p| PANEL.0 + if p.coloured.is_empty() { 0 } else { BAR })
         .collect();
-    let shown = (widths.iter().sum::<u32>().max(1), PANEL.1 + 40);
+    let legends: Vec<Legend> = panels
+        .iter()
+        .zip(&widths)
+        .map(|(p, w)| panel_legend(p, *w))
+        .collect();
+    let strip = legends.iter().map(|l| l.height).max().unwrap_or(0);
+    let shown = (
+        widths.iter().sum::<u32>().max(1),
+        PANEL.1 + 40 + strip / SCALE,
+    );
     let size = (shown.0 * SCALE, shown.1 * SCALE);
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         let drawn = root
             .fill(&WHITE)
-            .and_then(|_| root.titled(title, ("sans-serif", px(20))))
+            .and_then(|_| {
+                root.split_vertically(size.1 - strip)
+                    .0
+                    .titled(title, ("sans-serif", px(20)))
+            })
             .and_then(|area| {
                 let mut rest = area;
                 for (p, w) in panels.iter().zip(&widths) {
@@ -110,12 +123,44 @@ pub fn scatter_panels(path: &Path, title: &str, panels: &[Panel]) -> Result<()> 
             });
         drawn.map_err(|e| draw_err(path, e))?;
     }
-    let svg = svg.replacen(
-        &format!("<svg width=\"{}\" height=\"{}\"", size.0, size.1),
-        &format!("<svg width=\"{}\" height=\"{}\"", shown.0, shown.1),
-        1,
-    );
+    // Each panel's legend in the strip under it, where it covers no data.
+    let mut groups = String::new();
+    let mut left = 0;
+    for (l, w) in legends.iter().zip(&widths) {
+        groups += &l.group(left, size.1 - strip);
+        left += px(*w);
+    }
+    let svg = svg
+        .replacen(
+            &format!("<svg width=\"{}\" height=\"{}\"", size.0, size.1),
+            &format!("<svg width=\"{}\" height=\"{}\"", shown.0, shown.1),
+            1,
+        )
+        .replace("</svg>", &(groups + "</svg>"));
     crate::io::write_atomic(path, svg.as_bytes())
+}
+
+/// The legend of a panel `width_px` wide: its categories (by their colour and point size), then its
+/// targets (black crosses).
+fn panel_legend(p: &Panel, width_px: u32) -> Legend {
+    let cats = p.categories.iter().enumerate().map(|(i, c)| {
+        let (col, r) = category_style(i, c);
+        (c.label.clone(), col, Mark::Point(r))
+    });
+    let targets = p
+        .targets
+        .iter()
+        .map(|t| (t.label.clone(), BLACK, Mark::Cross));
+    Legend::new(cats.chain(targets), width_px)
+}
+
+/// Colour and radius (drawing units) of category number `i`.
+fn category_style(i: usize, c: &Category) -> (RGBColor, u32) {
+    if c.muted {
+        (RGBColor(200, 200, 200), px(2))
+    } else {
+        (CATEGORY_COLOURS[i % CATEGORY_COLOURS.len()], px(3))
+    }
 }
 
 /// The log10 colour range of the positive finite z values, widened when flat.
@@ -177,31 +222,15 @@ fn draw_panel(area: &DrawingArea<SVGBackend<'_>, Shift>, p: &Panel) -> DrawResul
         inside(x, y).map(|q| Circle::new(q, px(3), colour(z).filled()))
     }))?;
     for (i, c) in p.categories.iter().enumerate() {
-        let (col, r) = if c.muted {
-            (RGBColor(200, 200, 200), px(2))
-        } else {
-            (CATEGORY_COLOURS[i % CATEGORY_COLOURS.len()], px(3))
-        };
-        chart
-            .draw_series(
-                c.x.iter()
-                    .zip(&c.y)
-                    .filter_map(|(&x, &y)| inside(x, y))
-                    .map(move |q| Circle::new(q, r, col.filled())),
-            )?
-            .label(c.label.as_str())
-            .legend(move |(x, y)| Circle::new((x, y), r, col.filled()));
+        let (col, r) = category_style(i, c);
+        chart.draw_series(
+            c.x.iter()
+                .zip(&c.y)
+                .filter_map(|(&x, &y)| inside(x, y))
+                .map(move |q| Circle::new(q, r, col.filled())),
+        )?;
     }
     draw_targets(&mut chart, p, &inside)?;
-    if !p.categories.is_empty() || !p.targets.is_empty() {
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.4))
-            .label_font(("sans-serif", px(12)))
-            .draw()?;
-    }
     match zr {
         Some(r) => colour_bar(&bar, r, &p.z_label),
         None => Ok(()),
@@ -238,18 +267,15 @@ fn draw_targets(
         let Some(q) = inside(cx, cy) else {
             continue;
         };
-        chart
-            .draw_series(std::iter::once(
-                EmptyElement::at(q)
-                    + Cross::new((0, 0), px(7), BLACK.stroke_width(px(3)))
-                    + Text::new(
-                        t.label.clone(),
-                        (px(9) as i32, -(px(16) as i32)),
-                        ("sans-serif", px(12)).into_font(),
-                    ),
-            ))?
-            .label(t.label.as_str())
-            .legend(|(x, y)| Cross::new((x, y), px(5), BLACK.stroke_width(px(2))));
+        chart.draw_series(std::iter::once(
+            EmptyElement::at(q)
+                + Cross::new((0, 0), px(7), BLACK.stroke_width(px(3)))
+                + Text::new(
+                    t.label.clone(),
+                    (px(9) as i32, -(px(16) as i32)),
+                    ("sans-serif", px(12)).into_font(),
+                ),
+        ))?;
     }
     Ok(())
 }
@@ -277,10 +303,12 @@ fn colour_bar(
         .label_style(("sans-serif", px(11)))
         .axis_desc_style(("sans-serif", px(12)))
         .draw()?;
+    // Each band reaches half a band into the next (not the last): no seams between rectangles
+    // that end on fractions of a pixel.
     let n = 100;
     cb.draw_series((0..n).map(|k| {
         let a = lo + (hi - lo) * k as f64 / n as f64;
-        let b = lo + (hi - lo) * (k + 1) as f64 / n as f64;
+        let b = lo + (hi - lo) * ((k + 1) as f64 + if k + 1 < n { 0.5 } else { 0.0 }) / n as f64;
         Rectangle::new(
             [(0.0, a), (1.0, b)],
             viridis((k as f64 + 0.5) / n as f64).filled(),
