@@ -296,6 +296,8 @@ fn report_page_after_a_quick_fit_loads_every_figure_in_chromium() {
     ] {
         assert!(html.contains(needle), "page lacks {needle:?}");
     }
+    // A job fitted to a recording has no targets to map.
+    assert!(!html.contains("id=\"reachability\""), "a map section");
     // Every figure is linked once; nothing is fetched from elsewhere.
     for f in &figs {
         assert_eq!(
@@ -968,4 +970,62 @@ fn piped_fit_prints_progress_lines() {
     let quiet = run(true);
     assert!(quiet.status.success());
     assert!(!String::from_utf8_lossy(&quiet.stderr).contains("progress: "));
+}
+
+/// A target job's page (issue 17 point 6): the blade's modes table, and the reachability map of
+/// `wiperlab explore` once an exploration of the job exists beside the page
+/// (`reports/explore/<job>/reachability.svg`, linked as `../explore/<job>/reachability.svg`);
+/// before it, the section says how to make one. In Chromium the map loads with the fit's figures.
+#[test]
+fn target_job_page_shows_the_modes_and_the_exploration_map() {
+    let tmp = TempDir::new("target_map");
+    let job = explore_job(&tmp.0);
+    let job_s = job.to_str().unwrap();
+    ok(&wiperlab(&tmp.0, &["fit", job_s, "--quiet"]), "target fit");
+    ok(&wiperlab(&tmp.0, &["report", job_s, "--quiet"]), "report");
+    let dir = tmp.0.join("reports/seed_experiment_geometry");
+    let page = dir.join("index.html");
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(html.contains("<h2 id=\"reachability\">"), "no map section");
+    assert!(
+        html.contains("<p id=\"reachability-map\">No exploration of this job"),
+        "no hint without an exploration"
+    );
+    // The modes table: stick and steady slip at the window's speeds.
+    let modes = &html[html
+        .find("<table id=\"modes-table\">")
+        .expect("modes table")..];
+    let modes = &modes[..modes.find("</table>").unwrap()];
+    assert!(modes.contains("<td class=\"l\">stick</td>"), "{modes}");
+    assert!(
+        modes.matches("<td class=\"l\">slip at ").count() >= 3,
+        "{modes}"
+    );
+
+    ok(
+        &wiperlab(
+            &tmp.0,
+            &["explore", job_s, "--samples", "8", "--seed", "1", "--quiet"],
+        ),
+        "explore",
+    );
+    assert!(
+        tmp.0
+            .join("reports/explore/seed_experiment_geometry/reachability.svg")
+            .is_file()
+    );
+    ok(&wiperlab(&tmp.0, &["report", job_s, "--quiet"]), "report");
+    let html = std::fs::read_to_string(&page).unwrap();
+    let link = "<img class=\"figure\" src=\"../explore/seed_experiment_geometry/reachability.svg\"";
+    assert_eq!(html.matches(link).count(), 1, "map not linked once");
+    assert!(!html.contains("No exploration of this job"));
+    let n = svgs(&dir).len() + 1;
+
+    let Some(chromium) = chromium() else { return };
+    let check = figure_check(&dump_dom(&chromium, &page, &tmp.0.join("profile")));
+    println!("target job page: {check:?}");
+    assert_eq!(
+        (check.status.as_str(), check.loaded, check.total),
+        ("ok", n, n)
+    );
 }

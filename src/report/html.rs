@@ -480,6 +480,10 @@ struct PageView<'a> {
     correlation: Vec<CorrelationRow>,
     warnings: &'a [String],
     figures: Vec<FigureView<'a>>,
+    /// A target job (no recording): the page has a reachability-map section.
+    target_job: bool,
+    /// `wiperlab explore`'s map of this job, when there is one.
+    map: Option<FigureView<'a>>,
     prov: ProvenanceView<'a>,
     sha256_fit: &'a str,
     version_fit: &'a str,
@@ -530,6 +534,7 @@ fn provenance_view(prov: &Provenance) -> ProvenanceView<'_> {
 fn page_view<'a>(
     r: &'a FitResult,
     figures: &'a [Figure],
+    map: Option<&'a Figure>,
     warnings: &'a [String],
     prov: &'a Provenance,
 ) -> PageView<'a> {
@@ -569,6 +574,11 @@ fn page_view<'a>(
                 caption: &f.caption,
             })
             .collect(),
+        target_job: r.target_job,
+        map: map.map(|f| FigureView {
+            file: &f.file,
+            caption: &f.caption,
+        }),
         prov: provenance_view(prov),
         sha256_fit: &r.input_sha256,
         version_fit: &r.wiperlab_version,
@@ -608,6 +618,7 @@ fn escape_html(
 pub fn render_html(
     r: &FitResult,
     figures: &[Figure],
+    map: Option<&Figure>,
     warnings: &[String],
     prov: &Provenance,
 ) -> std::result::Result<String, minijinja::Error> {
@@ -615,7 +626,7 @@ pub fn render_html(
     env.set_formatter(escape_html);
     env.add_template("report.html", TEMPLATE)?;
     env.get_template("report.html")?
-        .render(page_view(r, figures, warnings, prov))
+        .render(page_view(r, figures, map, warnings, prov))
 }
 
 /// Writes `paths.dir/index.html` for result `r`: links every SVG in `paths.dir` (the fit's own
@@ -659,7 +670,8 @@ pub fn write_report(r: &FitResult, paths: &ReportPaths) -> Result<ReportSummary>
         written_utc: utc(jiff::Timestamp::now()),
     };
     let path = dir.join(INDEX);
-    let html = render_html(r, &figures, &warnings, &prov)
+    let map = exploration_map(r, dir);
+    let html = render_html(r, &figures, map.as_ref(), &warnings, &prov)
         .map_err(|e| Error::io(&path, "cannot render", std::io::Error::other(e)))?;
     crate::io::write_atomic(&path, html.as_bytes())?;
     Ok(ReportSummary {
@@ -707,6 +719,21 @@ fn report_figures(r: &FitResult, dir: &Path) -> Result<(Vec<Figure>, Vec<String>
         });
     }
     Ok((figures, missing))
+}
+
+/// `wiperlab explore`'s reachability map of a target job, linked from the page in `dir`
+/// (`reports/<job>/`): `reports/explore/<job>/reachability.svg` beside it, when it exists.
+/// `None` for a job fitted to a recording (it has no targets to map) or without an exploration.
+fn exploration_map(r: &FitResult, dir: &Path) -> Option<Figure> {
+    let rel = format!("explore/{}/{}", r.job, crate::report::explore::MAP_SVG);
+    let path = dir.parent()?.join(&rel);
+    (r.target_job && path.is_file()).then(|| Figure {
+        file: format!("../{rel}"),
+        caption: "achieved line pairs of the job's freed parameters coloured by the weaker \
+                  line's prominence, the targets and the start marked, and the failed runs by \
+                  cause (`wiperlab explore`)"
+            .into(),
+    })
 }
 
 /// The result's own warnings, one per undetermined parameter they do not already name, and one
@@ -935,7 +962,7 @@ pub(super) mod tests {
             recording_sha256_now: Err("gone & away".into()),
             written_utc: "now".into(),
         };
-        let html = render_html(&r, &figures, &["<i>w</i>".into()], &prov).unwrap();
+        let html = render_html(&r, &figures, None, &["<i>w</i>".into()], &prov).unwrap();
         assert!(
             html.contains("<h1>Fit report: &lt;b&gt;job&lt;/b&gt;</h1>"),
             "{html}"
@@ -948,7 +975,7 @@ pub(super) mod tests {
         assert!(html.contains("model <b>blade2dof</b> (2-DOF blade)"));
         assert!(html.contains("<th>± 1σ</th>"));
         r.correlation = vec![vec![f64::NAN; 2]; 2];
-        let html = render_html(&r, &figures, &[], &prov).unwrap();
+        let html = render_html(&r, &figures, None, &[], &prov).unwrap();
         assert!(!html.contains("<th>± 1σ</th>"), "{html}");
         assert!(html.contains("1σ: not shown"));
         assert!(!html.contains("correlation-table"));
