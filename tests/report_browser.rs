@@ -148,6 +148,8 @@ fn dump_dom(chromium: &Path, page: &Path, profile: &Path) -> String {
             "--allow-file-access-from-files",
             &format!("--user-data-dir={}", profile.display()),
             "--virtual-time-budget=20000",
+            "--hide-scrollbars",
+            &format!("--window-size={WINDOW_W},800"),
             "--dump-dom",
             &url,
         ])
@@ -175,6 +177,183 @@ fn dump_dom(chromium: &Path, page: &Path, profile: &Path) -> String {
         String::from_utf8_lossy(&o.stderr)
     );
     dom
+}
+
+/// Width of the browser window, CSS pixels, for the DOM dump and the screenshots alike (the
+/// layout, and so the boxes the page's script records, depend on it).
+const WINDOW_W: u32 = 1100;
+
+/// A decoded screenshot: width, height and RGB pixels row by row.
+struct Shot {
+    w: u32,
+    h: u32,
+    rgb: Vec<[u8; 3]>,
+}
+
+impl Shot {
+    /// Fraction of the pixels of box `(x, y, w, h)` (clipped to the image) that carry ink: any
+    /// channel below 200 (text, axes, data; not the white page, the light grid or the #ddd frame).
+    fn ink(&self, [x, y, w, h]: [i64; 4]) -> f64 {
+        let clip = |v: i64, max: u32| v.clamp(0, max as i64) as u32;
+        let (x0, y0) = (clip(x, self.w), clip(y, self.h));
+        let (x1, y1) = (clip(x + w, self.w), clip(y + h, self.h));
+        let (mut ink, mut all) = (0usize, 0usize);
+        for yy in y0..y1 {
+            for xx in x0..x1 {
+                all += 1;
+                if self.rgb[(yy * self.w + xx) as usize]
+                    .iter()
+                    .any(|c| *c < 200)
+                {
+                    ink += 1;
+                }
+            }
+        }
+        if all == 0 {
+            0.0
+        } else {
+            ink as f64 / all as f64
+        }
+    }
+}
+
+/// A screenshot of `page` in a `WINDOW_W` × `height` window, kept as the PNG `out` and decoded.
+/// Killed after 120 s.
+fn screenshot(chromium: &Path, page: &Path, profile: &Path, height: u32, out: &Path) -> Shot {
+    let url = format!("file://{}", page.canonicalize().unwrap().display());
+    let mut child = Command::new(chromium)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--allow-file-access-from-files",
+            "--hide-scrollbars",
+            &format!("--user-data-dir={}", profile.display()),
+            "--virtual-time-budget=20000",
+            &format!("--window-size={WINDOW_W},{height}"),
+            &format!("--screenshot={}", out.display()),
+            &url,
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("cannot start chromium");
+    let started = Instant::now();
+    while child.try_wait().expect("wait for chromium").is_none() {
+        if started.elapsed() > Duration::from_secs(120) {
+            let _ = child.kill();
+            panic!("chromium took no screenshot within 120 s of {url}");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let file = std::fs::File::open(out).unwrap_or_else(|e| panic!("{}: {e}", out.display()));
+    let mut dec = png::Decoder::new(std::io::BufReader::new(file));
+    dec.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+    let mut reader = dec.read_info().expect("a PNG screenshot");
+    let mut buf = vec![0; reader.output_buffer_size().expect("PNG size")];
+    let info = reader.next_frame(&mut buf).expect("PNG frame");
+    let n = info.color_type.samples();
+    assert!(n >= 3, "screenshot in {:?}", info.color_type);
+    let rgb = buf[..info.buffer_size()]
+        .chunks(n)
+        .map(|p| [p[0], p[1], p[2]])
+        .collect();
+    Shot {
+        w: info.width,
+        h: info.height,
+        rgb,
+    }
+}
+
+/// Boxes `x,y,w,h` separated by spaces, as the page's script writes them.
+fn boxes(list: &str) -> Vec<[i64; 4]> {
+    list.split_whitespace()
+        .map(|b| {
+            let v: Vec<i64> = b.split(',').map(|n| n.parse().unwrap()).collect();
+            [v[0], v[1], v[2], v[3]]
+        })
+        .collect()
+}
+
+/// Takes a full-page screenshot of `page` (its height as the page's script measured it in
+/// `dom`), keeps it as `out`, and returns what did not render: a screenshot not of the page's
+/// size, or blank (under 1 % ink); a figure whose box is not its SVG's shape (the file's width ×
+/// height, within 3 px inside the 1 px frame) or has under 0.5 % ink; a table with under 0.5 %
+/// ink. Figures are named by their `src`.
+fn screenshot_problems(
+    chromium: &Path,
+    page: &Path,
+    dom: &str,
+    profile: &Path,
+    out: &Path,
+) -> Vec<String> {
+    let i = dom.find("id=\"figure-check\"").expect("figure check");
+    let tag = &dom[dom[..i].rfind('<').unwrap()..i + dom[i..].find('>').unwrap()];
+    let size: Vec<u32> = attr(tag, "data-page")
+        .expect("the page's size in the DOM")
+        .split(',')
+        .map(|n| n.parse().unwrap())
+        .collect();
+    assert!(
+        size[0] <= WINDOW_W,
+        "page {size:?} in a {WINDOW_W} px window"
+    );
+    let ph = size[1];
+    let shot = screenshot(chromium, page, profile, ph, out);
+    if (shot.w, shot.h) != (WINDOW_W, ph) {
+        return vec![format!(
+            "screenshot {}x{}, expected {WINDOW_W}x{ph}",
+            shot.w, shot.h
+        )];
+    }
+    let mut problems = Vec::new();
+    let all = shot.ink([0, 0, shot.w as i64, shot.h as i64]);
+    if all < 0.01 {
+        problems.push(format!("page blank ({:.3} % ink)", 100.0 * all));
+    }
+    let html = std::fs::read_to_string(page).unwrap();
+    let srcs: Vec<&str> = html
+        .split("<img class=\"figure\" src=\"")
+        .skip(1)
+        .filter_map(|s| s.split('"').next())
+        .collect();
+    let figs = boxes(&attr(tag, "data-figure-boxes").unwrap_or_default());
+    assert_eq!(figs.len(), srcs.len(), "a box per figure");
+    for (src, b) in srcs.iter().zip(figs) {
+        let inner = [b[0] + 1, b[1] + 1, b[2] - 2, b[3] - 2];
+        let svg = std::fs::read_to_string(page.parent().unwrap().join(src)).unwrap_or_default();
+        let head = &svg[..svg.find('>').unwrap_or(0)];
+        let want_h = match (num_attr(head, "width"), num_attr(head, "height")) {
+            (Some(w), Some(h)) => inner[2] as f64 * h / w,
+            _ => f64::NAN,
+        };
+        let ink = shot.ink(inner);
+        if !((inner[3] as f64 - want_h).abs() <= 3.0 && ink >= 0.005) {
+            problems.push(format!(
+                "{src}: box {b:?} (height {want_h:.0} expected), {:.2} % ink",
+                100.0 * ink
+            ));
+        }
+    }
+    for (k, b) in boxes(&attr(tag, "data-table-boxes").unwrap_or_default())
+        .iter()
+        .enumerate()
+    {
+        let ink = shot.ink(*b);
+        if ink < 0.005 || b[3] < 10 {
+            problems.push(format!("table {k}: box {b:?}, {:.2} % ink", 100.0 * ink));
+        }
+    }
+    problems
+}
+
+/// Keeps the screenshot `shot` as `reports/screenshots/<name>` in the source tree (git-ignored:
+/// a CI artefact).
+fn keep_screenshot(shot: &Path, name: &str) {
+    let dir = root().join("reports/screenshots");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(shot, dir.join(name)).unwrap();
 }
 
 /// The figure check's outcome as the page's script left it in the DOM.
@@ -340,6 +519,11 @@ fn report_page_after_a_quick_fit_loads_every_figure_in_chromium() {
             broken: vec![],
         }
     );
+    // A full-page screenshot: every figure and table rendered where the page laid it out.
+    let shot = tmp.0.join("report_quick.png");
+    let problems = screenshot_problems(&chromium, &page, &dom, &tmp.0.join("shot"), &shot);
+    assert!(problems.is_empty(), "{problems:?}");
+    keep_screenshot(&shot, "report_quick.png");
 }
 
 /// The check must be able to fail: a page whose link points at a missing file, and a figure whose
@@ -380,11 +564,47 @@ fn browser_check_catches_a_broken_link_and_a_corrupt_svg() {
         html.replace("src=\"psd_high.svg\"", "src=\"psd_missing.svg\""),
     )
     .unwrap();
-    let check = figure_check(&dump_dom(&chromium, &bad_link, &tmp.0.join("p1")));
+    let dom = dump_dom(&chromium, &bad_link, &tmp.0.join("p1"));
+    let check = figure_check(&dom);
     println!("broken link: {check:?}");
     assert_eq!(check.status, "broken");
     assert_eq!((check.loaded, check.total), (n - 1, n));
     assert_eq!(check.broken, ["psd_missing.svg"]);
+    // The screenshot check names the missing figure, and only it.
+    let problems = screenshot_problems(
+        &chromium,
+        &bad_link,
+        &dom,
+        &tmp.0.join("s1"),
+        &tmp.0.join("broken.png"),
+    );
+    println!("broken link, screenshot: {problems:?}");
+    assert_eq!(problems.len(), 1, "{problems:?}");
+    assert!(problems[0].starts_with("psd_missing.svg: "), "{problems:?}");
+
+    // A figure that loads but shows nothing (a valid, all-white SVG of the usual size): the
+    // figure check counts it loaded, the screenshot finds it blank.
+    let head = dir.join("traces_head.svg");
+    let kept = std::fs::read(&head).unwrap();
+    std::fs::write(
+        &head,
+        "<svg width=\"900\" height=\"500\" viewBox=\"0 0 3600 2000\" \
+         xmlns=\"http://www.w3.org/2000/svg\"><rect width=\"3600\" height=\"2000\" fill=\"#FFFFFF\"/></svg>",
+    )
+    .unwrap();
+    let dom = dump_dom(&chromium, &page, &tmp.0.join("p3"));
+    assert_eq!(figure_check(&dom).status, "ok");
+    let problems = screenshot_problems(
+        &chromium,
+        &page,
+        &dom,
+        &tmp.0.join("s3"),
+        &tmp.0.join("blank.png"),
+    );
+    println!("blank figure, screenshot: {problems:?}");
+    assert_eq!(problems.len(), 1, "{problems:?}");
+    assert!(problems[0].starts_with("traces_head.svg: "), "{problems:?}");
+    std::fs::write(&head, kept).unwrap();
 
     // 2. A corrupt figure: the original page, with traces_tip.svg truncated (unclosed XML).
     let svg = dir.join("traces_tip.svg");
@@ -1022,10 +1242,15 @@ fn target_job_page_shows_the_modes_and_the_exploration_map() {
     let n = svgs(&dir).len() + 1;
 
     let Some(chromium) = chromium() else { return };
-    let check = figure_check(&dump_dom(&chromium, &page, &tmp.0.join("profile")));
+    let dom = dump_dom(&chromium, &page, &tmp.0.join("profile"));
+    let check = figure_check(&dom);
     println!("target job page: {check:?}");
     assert_eq!(
         (check.status.as_str(), check.loaded, check.total),
         ("ok", n, n)
     );
+    let shot = tmp.0.join("report_target_job.png");
+    let problems = screenshot_problems(&chromium, &page, &dom, &tmp.0.join("shot"), &shot);
+    assert!(problems.is_empty(), "{problems:?}");
+    keep_screenshot(&shot, "report_target_job.png");
 }
