@@ -99,14 +99,22 @@ fn deeplabcut(likelihoods: &[&str]) -> String {
     s
 }
 
-/// The shipped main job with its `../data/` paths made absolute and `edits` (old → new) applied.
+/// The main job's line that puts its figures in the repository's `reports/`.
+const REPORTS_DIR_LINE: &str = "reports_dir = \"../reports\"";
+
+/// The shipped main job with its `../data/` paths made absolute, its `reports_dir` dropped (the
+/// default, `reports/` beside the job) and `edits` (old → new) applied.
 fn job(edits: &[(&str, &str)]) -> String {
     let text =
         std::fs::read_to_string(root().join("fits/reversal.toml")).expect("read the main job");
-    let mut text = text.replace(
-        "\"../data/",
-        &format!("\"{}/", root().join("data").display()),
-    );
+    // Its figures go to the repository's reports/ (`reports_dir = "../reports"`); here they would
+    // go to `reports/` beside the job, in the case's directory, where the listing would see them.
+    let mut text = text
+        .replace(
+            "\"../data/",
+            &format!("\"{}/", root().join("data").display()),
+        )
+        .replace(REPORTS_DIR_LINE, "");
     for (old, new) in edits {
         assert!(text.contains(old), "the main job has no {old:?}");
         text = text.replacen(old, new, 1);

@@ -108,15 +108,22 @@ fn edit(text: &str, old: &str, new: &str) -> String {
     text.replacen(old, new, 1)
 }
 
-/// The shipped main job `fits/reversal.toml`, with its relative `../data/reversal/...` paths made
-/// absolute so that a copy works from a temp dir.
+/// The shipped main job `fits/reversal.toml` with its relative `../data/reversal/...` paths made
+/// absolute and its `reports_dir` dropped, so that a copy works from a temp dir and writes there.
 fn job_text() -> String {
     let text =
         std::fs::read_to_string(root().join("fits/reversal.toml")).expect("read the main job");
     let data = root().join("data");
     // blade, recording file and truth json
     assert_eq!(text.matches("\"../data/").count(), 3, "{text}");
+    // Without `reports_dir = "../reports"` the figures go to `reports/` beside the job.
+    assert_eq!(
+        text.matches("reports_dir = \"../reports\"").count(),
+        1,
+        "{text}"
+    );
     text.replace("\"../data/", &format!("\"{}/", data.display()))
+        .replace("reports_dir = \"../reports\"", "")
 }
 
 /// Asserts a bad-input failure: exit code 2 and exactly one stderr line `error: ...` containing

@@ -137,6 +137,9 @@ pub struct Campaign {
     pub entries: Vec<Entry>,
     /// The condition label columns, in the table's order.
     pub label_columns: Vec<String>,
+    /// `--out-dir` (absolute): where everything the campaign writes goes instead of
+    /// `<campaign dir>/<name>/`.
+    pub out_dir_override: Option<PathBuf>,
 }
 
 impl Campaign {
@@ -193,15 +196,30 @@ impl Campaign {
             template_text,
             entries,
             label_columns,
+            out_dir_override: None,
         })
     }
 
-    /// `<campaign dir>/<name>/`: everything the campaign writes.
+    /// The campaign with everything it writes in `dir` (made absolute) instead of
+    /// `<campaign dir>/<name>/`; `None` keeps the default.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the path cannot be made absolute.
+    pub fn with_out_dir(mut self, dir: Option<&Path>) -> Result<Campaign> {
+        self.out_dir_override = dir.map(absolute).transpose()?;
+        Ok(self)
+    }
+
+    /// `<campaign dir>/<name>/` (or `--out-dir`): everything the campaign writes.
     pub fn out_dir(&self) -> PathBuf {
-        self.path
-            .parent()
-            .unwrap_or(Path::new("."))
-            .join(&self.name)
+        match &self.out_dir_override {
+            Some(d) => d.clone(),
+            None => self
+                .path
+                .parent()
+                .unwrap_or(Path::new("."))
+                .join(&self.name),
+        }
     }
 
     /// The entry with identifier `id`.

@@ -104,8 +104,14 @@ pub fn script(campaign: &Campaign, settings: &SlurmSettings, exe: &Path) -> Resu
     }
     s.push_str(&format!("#SBATCH --output={}/%A_%a.out\n", logs.display()));
     s.push_str("export RAYON_NUM_THREADS=\"${SLURM_CPUS_PER_TASK:-1}\"\n");
+    let out_dir = campaign
+        .out_dir_override
+        .as_ref()
+        .map_or(String::new(), |d| {
+            format!(" --out-dir {}", shell_quote(&d.to_string_lossy()))
+        });
     s.push_str(&format!(
-        "exec {} campaign task {} --index \"$SLURM_ARRAY_TASK_ID\"\n",
+        "exec {} campaign task {} --index \"$SLURM_ARRAY_TASK_ID\"{out_dir}\n",
         shell_quote(&exe.to_string_lossy()),
         shell_quote(&campaign.path.to_string_lossy())
     ));

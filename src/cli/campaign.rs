@@ -66,14 +66,13 @@ pub struct SlurmArgs {
 /// # Errors
 /// Those of the campaign functions; a `task` whose fit failed returns the fit's error (after the
 /// failure is recorded in the recording's status file).
-pub fn run(cmd: CampaignCommand) -> Result<()> {
+pub fn run(cmd: CampaignCommand, out_dir: Option<PathBuf>) -> Result<()> {
+    let load = |p: &PathBuf| Campaign::load(p)?.with_out_dir(out_dir.as_deref());
     match cmd {
-        CampaignCommand::List { campaign } => list(&Campaign::load(&campaign)?),
-        CampaignCommand::Run { campaign, jobs } => {
-            run_all(&Campaign::load(&campaign)?, jobs, super::quiet())
-        }
+        CampaignCommand::List { campaign } => list(&load(&campaign)?),
+        CampaignCommand::Run { campaign, jobs } => run_all(&load(&campaign)?, jobs, super::quiet()),
         CampaignCommand::Task { campaign, index } => {
-            let c = Campaign::load(&campaign)?;
+            let c = load(&campaign)?;
             let entry = c.entries.get(index).ok_or(super::CliError::IndexBeyond {
                 index,
                 count: c.entries.len(),
@@ -86,9 +85,9 @@ pub fn run(cmd: CampaignCommand) -> Result<()> {
             campaign,
             settings,
             submit: go,
-        } => slurm(&Campaign::load(&campaign)?, &settings, go),
+        } => slurm(&load(&campaign)?, &settings, go),
         CampaignCommand::Status { campaign } => {
-            let st = status(&Campaign::load(&campaign)?);
+            let st = status(&load(&campaign)?);
             if let Some(id) = &st.job_id {
                 println!("Slurm job {id}");
             }
@@ -104,7 +103,7 @@ pub fn run(cmd: CampaignCommand) -> Result<()> {
             Ok(())
         }
         CampaignCommand::Collect { campaign } => {
-            let c = Campaign::load(&campaign)?;
+            let c = load(&campaign)?;
             let (table, path) = crate::campaign::collect::collect(&c)?;
             let outliers = crate::campaign::collect::outliers(&table);
             let page = crate::report::campaign::write_campaign_report(

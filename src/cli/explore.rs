@@ -6,15 +6,16 @@ use crate::fit::job::LoadedJob;
 use crate::report::explore::{SAMPLES_CSV, summary, write_exploration};
 use std::path::{Path, PathBuf};
 
-/// Loads the job, samples it, writes the tables and the map into `out` (default
-/// `reports/explore/<job name>/`) and prints the summary.
+/// Loads the job, samples it, writes the tables and the map into `out` (default the job's
+/// `<reports_dir>/explore/<job name>/`, `reports/` beside the job unless the job says otherwise)
+/// and prints the summary.
 pub(super) fn run(job: &Path, samples: usize, seed: u32, out: Option<PathBuf>) -> Result<()> {
     let loaded = LoadedJob::load(job)?;
     if samples == 0 || samples > crate::fit::explore::MAX_SAMPLES {
         let max = crate::fit::explore::MAX_SAMPLES;
         return Err(crate::fit::FitError::Samples { samples, max }.into());
     }
-    let dir = out.unwrap_or_else(|| Path::new("reports/explore").join(&loaded.name));
+    let dir = out.unwrap_or_else(|| loaded.reports_dir().join("explore").join(&loaded.name));
     crate::io::check_creatable_dir(&dir)?;
     let previous = dir.join(SAMPLES_CSV);
     if previous.exists() {

@@ -4,10 +4,12 @@ use crate::fit::job::LoadedJob;
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};
 
-/// Fits the job, writes the result and figures, and prints the summary (or the JSON result).
-pub(super) fn fit(job: &Path, json: bool, quiet: bool) -> Result<()> {
+/// Fits the job, writes the result and figures (in `out_dir`, default the job's
+/// `<reports_dir>/<name>/`), and prints the summary (or the JSON result).
+pub(super) fn fit(job: &Path, json: bool, quiet: bool, out_dir: Option<PathBuf>) -> Result<()> {
     let loaded = LoadedJob::load(job)?;
-    let (result, result_path, report_dir) = fit_and_write(&loaded, !quiet && !json)?;
+    let report_dir = out_dir.unwrap_or_else(|| report_dir(&loaded));
+    let (result, result_path) = fit_and_write(&loaded, &report_dir, !quiet && !json)?;
     // Each warning once, on stderr (also in the result file and on the report page).
     for w in &result.warnings {
         eprintln!("warning: {w}");
@@ -33,14 +35,15 @@ pub(super) fn fit(job: &Path, json: bool, quiet: bool) -> Result<()> {
     Ok(())
 }
 
-/// Writes the report page from the job's result; `refit` fits first. Without a result (and without
-/// `refit`) it is an input error (exit 2) that says how to get one.
-pub(super) fn report(job: &Path, refit: bool, quiet: bool) -> Result<()> {
+/// Writes the report page from the job's result into `out_dir` (default the job's
+/// `<reports_dir>/<name>/`, where the fit put its figures); `refit` fits first. Without a result
+/// (and without `refit`) it is an input error (exit 2) that says how to get one.
+pub(super) fn report(job: &Path, refit: bool, quiet: bool, out_dir: Option<PathBuf>) -> Result<()> {
     let loaded = LoadedJob::load(job)?;
     let result_path = result_path(&loaded);
-    let report_dir = report_dir(&loaded);
+    let report_dir = out_dir.unwrap_or_else(|| report_dir(&loaded));
     let result = if refit {
-        fit_and_write(&loaded, !quiet)?.0
+        fit_and_write(&loaded, &report_dir, !quiet)?.0
     } else if !result_path.exists() {
         return Err(Error::input(
             &result_path,
@@ -74,37 +77,35 @@ pub(super) fn report(job: &Path, refit: bool, quiet: bool) -> Result<()> {
 
 /// `<job dir>/<name>.result.toml`.
 fn result_path(job: &LoadedJob) -> PathBuf {
-    job.path
-        .parent()
-        .unwrap_or(Path::new("."))
-        .join(format!("{}.result.toml", job.name))
+    job.dir().join(format!("{}.result.toml", job.name))
 }
 
-/// `reports/<name>/` (relative to the working directory).
+/// `<job dir>/<reports_dir>/<name>/` (default `<job dir>/reports/<name>/`), wherever the command
+/// runs.
 fn report_dir(job: &LoadedJob) -> PathBuf {
-    Path::new("reports").join(&job.name)
+    job.reports_dir().join(&job.name)
 }
 
 /// `<job dir>/<name>.interrupted.result.toml`: where an interrupted fit's result goes, so that a
 /// previous complete result stays in place.
 fn interrupted_path(job: &LoadedJob) -> PathBuf {
-    job.path
-        .parent()
-        .unwrap_or(Path::new("."))
+    job.dir()
         .join(format!("{}.interrupted.result.toml", job.name))
 }
 
-/// Runs the fit, writes the result TOML and the fit's figures; returns the result and both paths.
+/// Runs the fit, writes the result TOML and the fit's figures in `report_dir`; returns the result
+/// and the result's path.
 /// SIGINT or SIGTERM stops the fit: the best result so far is written to
 /// `<name>.interrupted.result.toml` and the error is [`Error::Interrupted`] (exit code 130).
 fn fit_and_write(
     job: &LoadedJob,
+    report_dir: &Path,
     progress: bool,
-) -> Result<(crate::fit::FitResult, PathBuf, PathBuf)> {
+) -> Result<(crate::fit::FitResult, PathBuf)> {
     // Outputs that cannot be written are found now, not after the whole fit.
     crate::io::check_writable_file(&result_path(job))?;
     crate::io::check_writable_file(&interrupted_path(job))?;
-    crate::io::check_creatable_dir(&report_dir(job))?;
+    crate::io::check_creatable_dir(report_dir)?;
     crate::fit::interrupt::install_signal_handler()?;
     let mut outcome = match crate::fit::run_fit(job, progress) {
         Err(_) if crate::fit::interrupt::stop_requested() => {
@@ -119,13 +120,12 @@ fn fit_and_write(
             written: Some(path),
         });
     }
-    let report_dir = report_dir(job);
-    crate::io::create_dir(&report_dir)?;
-    outcome.result.data_files = crate::report::figures::fit_data_files(&report_dir, &outcome)?;
+    crate::io::create_dir(report_dir)?;
+    outcome.result.data_files = crate::report::figures::fit_data_files(report_dir, &outcome)?;
     let result_path = result_path(job);
     let toml_text = outcome.result.to_toml()?;
     crate::io::write_atomic(&result_path, toml_text.as_bytes())?;
     let freq_speed = crate::fit::instfreq::compare_freq_speed(&outcome)?;
-    crate::report::figures::fit_figures(&report_dir, &outcome, freq_speed.as_ref())?;
-    Ok((outcome.result, result_path, report_dir))
+    crate::report::figures::fit_figures(report_dir, &outcome, freq_speed.as_ref())?;
+    Ok((outcome.result, result_path))
 }

@@ -8,13 +8,21 @@ use crate::import::{Format, ImportSpec};
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};
 
-/// Converts `file` (or only describes it) and writes `output` (default `<stem>.trace.csv`).
+/// Converts `file` (or only describes it) and writes `output` (default `<stem>.trace.csv` in
+/// `out_dir`, itself by default the input's directory).
 pub(super) fn run(
     file: &Path,
     import: &ImportArgs,
     describe: bool,
     output: Option<PathBuf>,
+    out_dir: Option<PathBuf>,
 ) -> Result<()> {
+    let output = output.or_else(|| {
+        let name = format!("{}.trace.csv", super::stem(file));
+        out_dir
+            .as_deref()
+            .map(|d| super::single_output(file, Some(d), &name))
+    });
     if let Some(out) = output.as_deref().filter(|o| *o != Path::new("-")) {
         crate::io::refuse_overwriting_input(file, out)?;
     }
@@ -27,6 +35,9 @@ pub(super) fn run(
     }
     let (trace, summary) = crate::import::read_trace_with_summary(file, &spec)?;
     let out = output.unwrap_or_else(|| file.with_extension("trace.csv"));
+    if let Some(d) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        crate::io::create_dir(d)?;
+    }
     if out == Path::new("-") {
         // `-o -`: the CSV on stdout, the summary on stderr.
         let bytes = crate::import::canonical::trace_csv_bytes(&out, &trace)?;

@@ -6,10 +6,17 @@ use crate::{Error, Result};
 use std::path::{Path, PathBuf};
 
 /// Describes `recording` (without a calibration if the flags give none), writes the job template
-/// to `output` (default `<stem>.job.toml` beside the recording) and says what is still missing.
-pub(super) fn run(recording: &Path, import: &ImportArgs, output: Option<PathBuf>) -> Result<()> {
+/// to `output` (default `<stem>.job.toml` in `out_dir`, itself by default the recording's
+/// directory) and says what is still missing.
+pub(super) fn run(
+    recording: &Path,
+    import: &ImportArgs,
+    output: Option<PathBuf>,
+    out_dir: Option<PathBuf>,
+) -> Result<()> {
     let out = output.unwrap_or_else(|| {
-        recording.with_file_name(format!("{}.job.toml", super::stem(recording)))
+        let name = format!("{}.job.toml", super::stem(recording));
+        super::single_output(recording, out_dir.as_deref(), &name)
     });
     if out.exists() {
         return Err(super::CliError::OutputExists { path: out }.into());
@@ -18,6 +25,9 @@ pub(super) fn run(recording: &Path, import: &ImportArgs, output: Option<PathBuf>
     let mut spec = super::import::import_spec(import)?;
     let (_, summary) = crate::import::describe_file(recording, &spec)?;
     spec.format = summary.format;
+    if let Some(d) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        crate::io::create_dir(d)?;
+    }
     let name = plain_name(&super::stem(recording));
     let text = job_template(&TemplateInput {
         name: &name,

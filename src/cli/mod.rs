@@ -150,9 +150,13 @@ pub enum Command {
         /// Print what the file holds (format, points, frames, time base, gaps) without converting.
         #[arg(long)]
         describe: bool,
-        /// Output CSV (default: <file stem>.trace.csv beside the input; `-`: stdout).
-        #[arg(short, long)]
+        /// Output CSV (default: <file stem>.trace.csv in --out-dir; `-`: stdout).
+        #[arg(short, long, conflicts_with = "out_dir")]
         output: Option<PathBuf>,
+        /// Directory of <file stem>.trace.csv (default: the input's directory, wherever the
+        /// command runs).
+        #[arg(long)]
+        out_dir: Option<PathBuf>,
     },
     /// Write a commented fit-job template for a recording: format detected, points listed, what a
     /// fit still needs marked MISSING and guesses marked CHECK.
@@ -161,10 +165,14 @@ pub enum Command {
         recording: PathBuf,
         #[command(flatten)]
         import: ImportArgs,
-        /// Job file to write (default: <recording stem>.job.toml beside the recording; never
-        /// overwrites a file).
-        #[arg(short, long)]
+        /// Job file to write (default: <recording stem>.job.toml in --out-dir; never overwrites
+        /// a file).
+        #[arg(short, long, conflicts_with = "out_dir")]
         output: Option<PathBuf>,
+        /// Directory of <recording stem>.job.toml (default: the recording's directory, wherever
+        /// the command runs).
+        #[arg(long)]
+        out_dir: Option<PathBuf>,
     },
     /// Welch PSD, peaks and spectrogram of every tracked coordinate (and tip − head).
     Spectrum {
@@ -187,7 +195,8 @@ pub enum Command {
         /// every point's x and y, and tip_rel_x when there are a head and a tip.
         #[arg(long)]
         signal: Vec<String>,
-        /// Directory for the SVG figures (default: reports/spectrum/<file stem>).
+        /// Directory of the figures, psd.csv and peaks.json (default: reports/spectrum/<file
+        /// stem>/ beside the input file, wherever the command runs).
         #[arg(long)]
         out_dir: Option<PathBuf>,
         /// Longest gap (samples) filled by linear interpolation; longer gaps split the record
@@ -221,7 +230,8 @@ pub enum Command {
         /// necklip needs a recorded head and runs only inside a fit).
         #[arg(long, value_enum, default_value_t = ModelKind::Blade2dof)]
         model: ModelKind,
-        /// Output directory (default: reports/simulate/<params stem>).
+        /// Output directory (default: reports/simulate/<params stem>/ beside the parameter file,
+        /// wherever the command runs).
         #[arg(long)]
         out_dir: Option<PathBuf>,
     },
@@ -238,12 +248,18 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Fit friction (A, B, C) and neck stiffness to a recording's spectra.
+    /// Fit friction (A, B, C) and neck stiffness to a recording's spectra. Writes
+    /// <name>.result.toml beside the job and the figures in <reports_dir>/<name>/ (the job's
+    /// reports_dir, default reports/ beside the job; wherever the command runs).
     Fit {
         job: PathBuf,
         /// Print the result as one JSON object on stdout.
         #[arg(long)]
         json: bool,
+        /// Directory of the figures and data files (default: <reports_dir>/<name>/ beside the
+        /// job). The result stays beside the job.
+        #[arg(long)]
+        out_dir: Option<PathBuf>,
     },
     /// Sample a job's freed parameters (seeded Sobol points over [fit.parameters]) and map where
     /// they take the model's lines: explore.csv (parameters, each band's line, prominence and
@@ -257,23 +273,33 @@ pub enum Command {
         /// Scramble seed of the Sobol sequence (same seed, same samples).
         #[arg(long, default_value_t = 1)]
         seed: u32,
-        /// Output directory (default: reports/explore/<job name>/); an exploration already there
-        /// is replaced, with a note on stderr.
+        /// Output directory (default: <reports_dir>/explore/<job name>/, the job's reports_dir,
+        /// default reports/ beside the job; wherever the command runs); an exploration already
+        /// there is replaced, with a note on stderr.
         #[arg(short = 'o', long = "out-dir")]
         out_dir: Option<PathBuf>,
     },
-    /// Write the report page reports/<job>/index.html from fits/<job>.result.toml (with --refit:
-    /// fit first; without a result and without --refit: exit 2).
+    /// Write the report page <reports_dir>/<name>/index.html from <name>.result.toml beside the
+    /// job (with --refit: fit first; without a result and without --refit: exit 2).
     Report {
         job: PathBuf,
         /// Run the fit again even if the result file exists.
         #[arg(long)]
         refit: bool,
+        /// Directory of the page, holding the fit's figures (default: <reports_dir>/<name>/, the
+        /// job's reports_dir, default reports/ beside the job; wherever the command runs).
+        #[arg(long)]
+        out_dir: Option<PathBuf>,
     },
     /// Campaigns: one fit job over many recordings, locally or as a Slurm job array.
     Campaign {
         #[command(subcommand)]
         action: campaign::CampaignCommand,
+        /// Directory of everything the campaign writes (jobs/, results/, slurm/, campaign.csv,
+        /// report/); default: <campaign name>/ beside the campaign file, wherever the command
+        /// runs. Give the same --out-dir to every subcommand of one campaign.
+        #[arg(long, global = true)]
+        out_dir: Option<PathBuf>,
     },
     /// Print a shell completion script on stdout, e.g.
     /// `wiperlab completions bash > ~/.local/share/bash-completion/completions/wiperlab`.
@@ -319,6 +345,28 @@ fn completions(shell: clap_complete::Shell) -> Result<()> {
     Ok(())
 }
 
+/// The directory holding `input` (`.` for a bare file name).
+fn input_dir(input: &Path) -> &Path {
+    match input.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// The output rule for figures and tables: `<input dir>/reports/<command>/<input stem>/`, beside
+/// the input whatever the working directory.
+fn default_report_dir(input: &Path, command: &str) -> PathBuf {
+    input_dir(input)
+        .join(crate::fit::job::DEFAULT_REPORTS_DIR)
+        .join(command)
+        .join(stem(input))
+}
+
+/// The output rule for single-file outputs: `<out_dir>/<file_name>`, by default beside `input`.
+fn single_output(input: &Path, out_dir: Option<&Path>, file_name: &str) -> PathBuf {
+    out_dir.unwrap_or_else(|| input_dir(input)).join(file_name)
+}
+
 /// Runs the parsed command.
 pub fn run(cli: Cli) -> Result<()> {
     QUIET.store(cli.quiet, std::sync::atomic::Ordering::Relaxed);
@@ -328,12 +376,14 @@ pub fn run(cli: Cli) -> Result<()> {
             import,
             describe,
             output,
-        } => import::run(&file, &import, describe, output),
+            out_dir,
+        } => import::run(&file, &import, describe, output, out_dir),
         Command::Init {
             recording,
             import,
             output,
-        } => init::run(&recording, &import, output),
+            out_dir,
+        } => init::run(&recording, &import, output, out_dir),
         Command::Spectrum {
             file,
             import,
@@ -379,20 +429,24 @@ pub fn run(cli: Cli) -> Result<()> {
             blade,
             out_dir,
         } => bench::run(quick, blade, out_dir),
-        Command::Campaign { action } => campaign::run(action),
+        Command::Campaign { action, out_dir } => campaign::run(action, out_dir),
         Command::Completions { shell } => completions(shell),
         Command::Modes {
             blade,
             speeds,
             json,
         } => modes::run(&blade, speeds.as_deref(), json),
-        Command::Fit { job, json } => fit::fit(&job, json, cli.quiet),
+        Command::Fit { job, json, out_dir } => fit::fit(&job, json, cli.quiet, out_dir),
         Command::Explore {
             job,
             samples,
             seed,
             out_dir,
         } => explore::run(&job, samples, seed, out_dir),
-        Command::Report { job, refit } => fit::report(&job, refit, cli.quiet),
+        Command::Report {
+            job,
+            refit,
+            out_dir,
+        } => fit::report(&job, refit, cli.quiet, out_dir),
     }
 }

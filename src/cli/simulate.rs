@@ -7,7 +7,7 @@ use crate::names::named_enum;
 use crate::simulate::blade::{ModelKind, contact_forces, default_window, simulate_model};
 use crate::simulate::{Method, SolverOptions};
 use crate::{Error, Result};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 named_enum! {
     /// How the stick phase is integrated ([`StickForm`]).
@@ -86,7 +86,7 @@ pub(super) fn run(a: SimulateArgs) -> Result<()> {
     let wall = t.elapsed().as_secs_f64();
     let dir = a
         .out_dir
-        .unwrap_or_else(|| Path::new("reports/simulate").join(super::stem(&a.params)));
+        .unwrap_or_else(|| super::default_report_dir(&a.params, "simulate"));
     crate::io::create_dir(&dir)?;
     crate::report::figures::write_simulation(&dir, &sim, &forces)?;
     println!(

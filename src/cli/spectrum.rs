@@ -81,7 +81,7 @@ pub(super) fn run(a: SpectrumArgs) -> Result<()> {
 
     let dir = a
         .out_dir
-        .unwrap_or_else(|| Path::new("reports/spectrum").join(super::stem(&a.file)));
+        .unwrap_or_else(|| super::default_report_dir(&a.file, "spectrum"));
     crate::io::create_dir(&dir)?;
     println!(
         "{}: {} samples at {:.6} Hz (median frame rate), Welch nperseg {nperseg} ({} window, noverlap {}, nfft {}, detrend {}, {} scaling, {} average), bin {:.4} Hz",

@@ -12,13 +12,23 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+/// The directory, beside its input, where a command's figures and tables go by default: every
+/// command writes `<input dir>/reports/…` (a fit job may move it with `reports_dir`).
+pub const DEFAULT_REPORTS_DIR: &str = "reports";
+
 /// A fit job as written in TOML.
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct FitJob {
-    /// Name used for outputs (`fits/<name>.result.toml`, `reports/<name>/`); default: file stem.
+    /// Name used for outputs (`<name>.result.toml` beside the job, `<reports_dir>/<name>/`);
+    /// default: file stem.
     #[serde(default)]
     pub name: Option<String>,
+    /// Directory of the job's figures and report page, `<reports_dir>/<name>/`, and of its
+    /// exploration, `<reports_dir>/explore/<name>/`; relative to the job file like every path in
+    /// a job. Default: `reports`, beside the job. The shipped jobs in `fits/` say `"../reports"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reports_dir: Option<PathBuf>,
     /// The recording to fit; a job gives either this or `[targets]`.
     #[serde(default)]
     pub recording: Option<RecordingSection>,
@@ -521,6 +531,25 @@ impl LoadedJob {
 }
 
 impl LoadedJob {
+    /// `<job dir>/<reports_dir>` (default `<job dir>/reports`): where the job's figures, report
+    /// page and exploration go, wherever the command runs.
+    pub fn reports_dir(&self) -> PathBuf {
+        self.dir().join(
+            self.job
+                .reports_dir
+                .as_deref()
+                .unwrap_or(Path::new(DEFAULT_REPORTS_DIR)),
+        )
+    }
+
+    /// The job file's directory (`.` for a bare file name).
+    pub fn dir(&self) -> &Path {
+        match self.path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        }
+    }
+
     /// [`Error::Parse`] in the job file at the value at `key_path`, for checks that need the
     /// recording (the job's text is read again for its spans).
     pub fn error_at(&self, key_path: &[Key], message: impl Into<String>) -> Error {
