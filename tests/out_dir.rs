@@ -1,6 +1,6 @@
 //! Where every command's outputs land: beside its input (single files in the input's directory,
 //! figures and tables in `reports/` there; a fit job's `reports_dir` moves its figures), never in
-//! the working directory, and in `--out-dir` when it is given (README, "Outputs").
+//! the working directory, and in `--out-dir` when it is given (the rule docs/results.md states).
 //!
 //! Each test runs the real binary with a working directory (`cwd/`) different from the directory
 //! of its inputs (`proj/`), both in a fresh temp dir, and checks the exact files on both sides.
@@ -154,7 +154,12 @@ fn import_init_spectrum_simulate_write_beside_their_input() {
         assert!(files.contains(f), "{f} missing: {files:?}");
     }
     let spectrum = t.files_under("proj/reports/spectrum/rec.trace");
-    for f in ["psd.csv", "peaks.json", "psd_tip_rel_x.svg", "spectrogram_tip_rel_x.svg"] {
+    for f in [
+        "psd.csv",
+        "peaks.json",
+        "psd_tip_rel_x.svg",
+        "spectrogram_tip_rel_x.svg",
+    ] {
         assert!(spectrum.contains(f), "spectrum's {f} missing: {spectrum:?}");
     }
     assert_eq!(
@@ -318,7 +323,13 @@ fn campaign_writes_beside_the_campaign_file_or_in_out_dir() {
         "collect",
         "../proj/camp.toml",
     ]);
-    t.ok(&["campaign", "slurm", "../proj/camp.toml", "--out-dir", "../o"]);
+    t.ok(&[
+        "campaign",
+        "slurm",
+        "../proj/camp.toml",
+        "--out-dir",
+        "../o",
+    ]);
     assert_eq!(
         t.files_under("o"),
         set(&["campaign.csv", "report/index.html", "slurm/array.sh"])
@@ -331,13 +342,15 @@ fn campaign_writes_beside_the_campaign_file_or_in_out_dir() {
         .unwrap_or_else(|| panic!("no --out-dir in the task line:\n{script}"));
     assert!(Path::new(given).is_absolute(), "{script}");
     assert_eq!(
-        Path::new(given).canonicalize().expect("the --out-dir exists"),
+        Path::new(given)
+            .canonicalize()
+            .expect("the --out-dir exists"),
         t.0.join("o").canonicalize().expect("o/")
     );
     assert!(t.files_under("cwd").is_empty());
 }
 
-/// The shipped jobs keep their committed outputs where README and docs show them: `reports_dir =
+/// The shipped jobs keep their committed outputs where the docs show them: `reports_dir =
 /// "../reports"` resolves to the repository's `reports/`, from the job file alone.
 #[test]
 fn shipped_jobs_write_to_the_repositorys_reports() {
