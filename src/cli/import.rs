@@ -35,7 +35,8 @@ pub(super) fn run(
     }
     let (trace, summary) = crate::import::read_trace_with_summary(file, &spec)?;
     let out = output.unwrap_or_else(|| file.with_extension("trace.csv"));
-    if let Some(d) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+    // `--out-dir` is created if need be; an `-o` into a missing directory is refused.
+    if let Some(d) = &out_dir {
         crate::io::create_dir(d)?;
     }
     if out == Path::new("-") {

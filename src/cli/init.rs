@@ -25,7 +25,8 @@ pub(super) fn run(
     let mut spec = super::import::import_spec(import)?;
     let (_, summary) = crate::import::describe_file(recording, &spec)?;
     spec.format = summary.format;
-    if let Some(d) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+    // `--out-dir` is created if need be; an `-o` into a missing directory is refused.
+    if let Some(d) = &out_dir {
         crate::io::create_dir(d)?;
     }
     let name = plain_name(&super::stem(recording));
