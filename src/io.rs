@@ -13,6 +13,22 @@ use std::path::Path;
 /// [`Error::Io`] naming the directory when it does not exist or is not writable, or `path` when the
 /// file cannot be written or renamed.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomic_with(path, |w| {
+        w.write_all(bytes)
+            .map_err(|e| Error::io(path, "cannot write", e))
+    })
+}
+
+/// [`write_atomic`] for output made piece by piece: `write` streams into a buffered writer on the
+/// temporary file, which is renamed into place only when `write` succeeds (a failed or partial
+/// output is removed with the temporary file). A large file is never held in memory whole.
+///
+/// # Errors
+/// As [`write_atomic`], and whatever `write` returns.
+pub fn write_atomic_with(
+    path: &Path,
+    write: impl FnOnce(&mut dyn std::io::Write) -> Result<()>,
+) -> Result<()> {
     use std::io::Write as _;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
@@ -20,8 +36,11 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     };
     let mut tmp = tempfile::NamedTempFile::new_in(dir)
         .map_err(|e| Error::io(dir, "cannot create a temporary file in", e))?;
-    tmp.write_all(bytes)
-        .map_err(|e| Error::io(path, "cannot write", e))?;
+    {
+        let mut w = std::io::BufWriter::with_capacity(1 << 16, tmp.as_file_mut());
+        write(&mut w)?;
+        w.flush().map_err(|e| Error::io(path, "cannot write", e))?;
+    }
     tmp.persist(path)
         .map_err(|e| Error::io(path, "cannot rename into place", e.error))?;
     Ok(())

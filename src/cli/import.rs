@@ -41,9 +41,13 @@ pub(super) fn run(
     }
     if out == Path::new("-") {
         // `-o -`: the CSV on stdout, the summary on stderr.
-        let bytes = crate::import::canonical::trace_csv_bytes(&out, &trace)?;
-        std::io::Write::write_all(&mut std::io::stdout().lock(), &bytes)
-            .map_err(|e| Error::io(Path::new("<stdout>"), "cannot write", e))?;
+        let mut stdout = std::io::BufWriter::new(std::io::stdout().lock());
+        crate::import::canonical::write_trace_csv_to(
+            &mut stdout,
+            Path::new("<stdout>"),
+            &trace,
+            &[],
+        )?;
         super::esay!("{summary}");
         return Ok(());
     }

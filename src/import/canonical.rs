@@ -23,13 +23,22 @@ use crate::trace::{PointTrack, Trace};
 /// Shortest round-trip text of `v`: plain decimal in [1e-4, 1e15), exponent form otherwise,
 /// `NaN` for any NaN.
 fn format_f64(v: f64) -> String {
-    if v.is_nan() {
-        "NaN".to_owned()
+    let mut s = String::new();
+    push_f64(&mut s, v);
+    s
+}
+
+/// [`format_f64`] appended to `out`.
+fn push_f64(out: &mut String, v: f64) {
+    use std::fmt::Write as _;
+    // Writing into a String cannot fail.
+    let _ = if v.is_nan() {
+        out.write_str("NaN")
     } else if v == 0.0 || (1e-4..1e15).contains(&v.abs()) || v.is_infinite() {
-        format!("{v}")
+        write!(out, "{v}")
     } else {
-        format!("{v:e}")
-    }
+        write!(out, "{v:e}")
+    };
 }
 
 /// A column after the points: numbers (written as the positions are) or labels. Its name must not
@@ -91,8 +100,7 @@ fn column_order(trace: &Trace) -> Vec<usize> {
 ///   name is empty, or two points share a name;
 /// * [`Error::Io`] if the file cannot be created or written.
 pub fn write_trace_csv(path: &Path, trace: &Trace) -> Result<()> {
-    let bytes = trace_csv_bytes(path, trace)?;
-    crate::io::write_atomic(path, &bytes)
+    write_trace_csv_with(path, trace, &[])
 }
 
 /// The canonical CSV of `trace` as bytes (what [`write_trace_csv`] writes); `path` only names the
@@ -111,8 +119,8 @@ pub fn trace_csv_bytes(path: &Path, trace: &Trace) -> Result<Vec<u8>> {
 /// As [`write_trace_csv`]; [`Error::Input`] naming `path` too when an extra column's length is not
 /// the trace's, its name is empty, `t_s`, a point column's (`_x_m`, `_y_m`) or repeated.
 pub fn write_trace_csv_with(path: &Path, trace: &Trace, extra: &[ExtraColumn]) -> Result<()> {
-    let bytes = trace_csv_bytes_with(path, trace, extra)?;
-    crate::io::write_atomic(path, &bytes)
+    check_trace(path, trace, extra)?;
+    crate::io::write_atomic_with(path, |w| write_rows(w, path, trace, extra))
 }
 
 /// Checks the extra columns against `trace` ([`write_trace_csv_with`]).
@@ -143,6 +151,27 @@ fn check_extra(path: &Path, trace: &Trace, extra: &[ExtraColumn]) -> Result<()> 
 /// # Errors
 /// As [`write_trace_csv_with`], without the file's.
 pub fn trace_csv_bytes_with(path: &Path, trace: &Trace, extra: &[ExtraColumn]) -> Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    write_trace_csv_to(&mut bytes, path, trace, extra)?;
+    Ok(bytes)
+}
+
+/// [`trace_csv_bytes_with`] streamed into `w` (e.g. stdout), row by row.
+///
+/// # Errors
+/// As [`write_trace_csv_with`]; a failed write of `w` is [`Error::Io`] naming `path`.
+pub fn write_trace_csv_to(
+    w: &mut dyn std::io::Write,
+    path: &Path,
+    trace: &Trace,
+    extra: &[ExtraColumn],
+) -> Result<()> {
+    check_trace(path, trace, extra)?;
+    write_rows(w, path, trace, extra)
+}
+
+/// The checks before writing: the extra columns, the trace's invariants, the points' names.
+fn check_trace(path: &Path, trace: &Trace, extra: &[ExtraColumn]) -> Result<()> {
     check_extra(path, trace, extra)?;
     trace
         .check()
@@ -161,10 +190,21 @@ pub fn trace_csv_bytes_with(path: &Path, trace: &Trace, extra: &[ExtraColumn]) -
             ));
         }
     }
+    Ok(())
+}
+
+/// The header and one row per sample of a checked trace, into `w`; each cell is formatted into one
+/// reused buffer, so memory stays that of one row whatever the trace's length.
+fn write_rows(
+    w: &mut dyn std::io::Write,
+    path: &Path,
+    trace: &Trace,
+    extra: &[ExtraColumn],
+) -> Result<()> {
     let order = column_order(trace);
     let mut w = csv::WriterBuilder::new()
         .terminator(csv::Terminator::Any(b'\n'))
-        .from_writer(Vec::new());
+        .from_writer(w);
     let mut header = vec!["t_s".to_owned()];
     for &i in &order {
         let name = &trace.points[i].name;
@@ -174,21 +214,28 @@ pub fn trace_csv_bytes_with(path: &Path, trace: &Trace, extra: &[ExtraColumn]) -
     header.extend(extra.iter().map(|c| c.name().to_owned()));
     w.write_record(&header)
         .map_err(|e| csv_error(path, "write", e))?;
-    let mut row: Vec<String> = Vec::with_capacity(header.len());
+    let mut cell = String::new();
+    let mut field = |w: &mut csv::Writer<_>, v: f64| {
+        cell.clear();
+        push_f64(&mut cell, v);
+        w.write_field(&cell)
+    };
     for (k, &t) in trace.t_s.iter().enumerate() {
-        row.clear();
-        row.push(format_f64(t));
-        for &i in &order {
-            let p = &trace.points[i];
-            row.push(format_f64(p.x_m[k]));
-            row.push(format_f64(p.y_m[k]));
-        }
-        row.extend(extra.iter().map(|c| c.cell(k)));
-        w.write_record(&row)
-            .map_err(|e| csv_error(path, "write", e))?;
+        let mut row = || -> csv::Result<()> {
+            field(&mut w, t)?;
+            for &i in &order {
+                let p = &trace.points[i];
+                field(&mut w, p.x_m[k])?;
+                field(&mut w, p.y_m[k])?;
+            }
+            for c in extra {
+                w.write_field(c.cell(k))?;
+            }
+            w.write_record(None::<&[u8]>)
+        };
+        row().map_err(|e| csv_error(path, "write", e))?;
     }
-    w.into_inner()
-        .map_err(|e| Error::io(path, "write", e.into_error()))
+    w.flush().map_err(|e| Error::io(path, "cannot write", e))
 }
 
 /// Read a canonical trace CSV (module docs) written by [`write_trace_csv`] or by hand.
