@@ -253,6 +253,43 @@ fn trackmate_spots_in_tracks() {
     assert!(err.contains("fps_hz"), "{err}");
 }
 
+/// `describe_file` describes every real export without a calibration (issue 15 point 6): the
+/// TrackMate table without a time unit, which an import refuses without `fps_hz` (above), is
+/// described in frames, with the same 1074 frames and 118 tracks as the calibrated import and the
+/// note that a fit needs `--fps`; the DLTdv file likewise in frames and pixels.
+#[test]
+fn describe_needs_no_calibration() {
+    use wiperlab::import::describe_file;
+    let cases = [
+        (
+            "realdata/trackmate/Spots in tracks statistics.csv",
+            1074,
+            118,
+        ),
+        (
+            "realdata/dltdv/LapsanskyArmstrong2022_data_xypts.csv",
+            1481,
+            0,
+        ),
+    ];
+    for (rel, frames, points) in cases {
+        let Some(path) = shared(rel) else { return };
+        let (t, sum) =
+            describe_file(&path, &ImportSpec::default()).unwrap_or_else(|e| panic!("{rel}: {e}"));
+        assert_eq!(t.len(), frames, "{rel}");
+        if points > 0 {
+            assert_eq!(t.points.len(), points, "{rel}");
+        }
+        assert!(sum.uncalibrated.frames, "{rel}: described in frames");
+        let text = sum.to_string();
+        assert!(text.contains("a fit needs fps_hz (--fps)"), "{rel}: {text}");
+        assert!(
+            text.contains("a fit needs m_per_px (--m-per-px)"),
+            "{rel}: {text}"
+        );
+    }
+}
+
 /// Every file above is detected by content (no `format` given).
 #[test]
 fn detects_every_new_format() {

@@ -738,7 +738,11 @@ fn read_format(
             trace
         }
         other => {
-            let raw = read_raw(path, other, &spec)?;
+            let raw = if stand_in {
+                read_raw_described(path, other, &spec)?
+            } else {
+                read_raw(path, other, &spec)?
+            };
             if stand_in {
                 unc.frames =
                     matches!(raw.time, common::RawTime::Frames(_)) && spec.fps_hz.is_none();
@@ -773,6 +777,23 @@ fn stand_ins(spec: &mut ImportSpec, unc: Uncalibrated, notes: &mut Vec<String>) 
              needs m_per_px (--m-per-px), scale_points_px + scale_distance_m, or units_to_m"
                 .into(),
         );
+    }
+}
+
+/// [`read_raw`] for a description: a TrackMate spot table without a time unit (and no `fps_hz`)
+/// is read by its frame numbers instead of refused, so that it is described in frames like every
+/// other frame-indexed format. Any other error is the reader's own (it does not depend on the frame
+/// rate, so the second read returns it again).
+fn read_raw_described(path: &Path, format: Format, spec: &ImportSpec) -> Result<common::RawTrace> {
+    match read_raw(path, format, spec) {
+        Err(_) if format == Format::Trackmate && spec.fps_hz.is_none() => {
+            let framed = ImportSpec {
+                fps_hz: Some(1.0),
+                ..spec.clone()
+            };
+            read_raw(path, format, &framed)
+        }
+        other => other,
     }
 }
 
