@@ -176,3 +176,30 @@ fn describe_needs_no_calibration_and_says_what_a_fit_needs() {
     assert!(out.contains("t = 0 … 1.8868 s"), "{out}");
     assert!(!out.contains("a fit needs"), "{out}");
 }
+
+/// `-o -` prints the job on stdout (the recording by absolute path, since the job's place is
+/// unknown) and writes no file; the same job as `-o FILE` apart from that path.
+#[test]
+fn dash_o_dash_prints_the_job_on_stdout() {
+    let s = Scratch::new("stdout");
+    let o = wiperlab(&s.0, &["init", "rec_xypts.csv", "-o", "-"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let printed = String::from_utf8_lossy(&o.stdout).into_owned();
+    let abs = s.0.canonicalize().unwrap().join("rec_xypts.csv");
+    assert!(
+        printed.contains(&format!("file = {:?}", abs.display().to_string())),
+        "{printed}"
+    );
+    let files: Vec<_> = std::fs::read_dir(&s.0).unwrap().collect();
+    assert_eq!(files.len(), 1, "only the recording: {files:?}");
+    let o = wiperlab(&s.0, &["init", "rec_xypts.csv", "-o", "job.toml"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let written = std::fs::read_to_string(s.0.join("job.toml")).unwrap();
+    let strip = |t: &str| -> Vec<String> {
+        t.lines()
+            .filter(|l| !l.starts_with("file = ") && !l.starts_with("# Fit job for "))
+            .map(str::to_string)
+            .collect()
+    };
+    assert_eq!(strip(&printed), strip(&written));
+}

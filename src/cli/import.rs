@@ -5,7 +5,7 @@ use super::CliError;
 use super::ImportArgs;
 use crate::fit::job::{parse_toml, read_text};
 use crate::import::{Format, ImportSpec};
-use crate::{Error, Result};
+use crate::Result;
 use std::path::{Path, PathBuf};
 
 /// Converts `file` (or only describes it) and writes `output` (default `<stem>.trace.csv` in

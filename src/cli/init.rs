@@ -18,7 +18,8 @@ pub(super) fn run(
         let name = format!("{}.job.toml", super::stem(recording));
         super::single_output(recording, out_dir.as_deref(), &name)
     });
-    if out.exists() {
+    let stdout = out == Path::new("-");
+    if out.exists() && !stdout {
         return Err(super::CliError::OutputExists { path: out }.into());
     }
     crate::io::refuse_overwriting_input(recording, &out)?;
@@ -32,13 +33,25 @@ pub(super) fn run(
     let name = plain_name(&super::stem(recording));
     let text = job_template(&TemplateInput {
         name: &name,
-        recording: &recording_as_seen_from(&out, recording)?,
+        recording: &if stdout {
+            // Where the job will be saved is unknown: the recording's absolute path.
+            std::path::absolute(recording)
+                .map_err(|e| Error::io(recording, "cannot resolve the path", e))?
+        } else {
+            recording_as_seen_from(&out, recording)?
+        },
         import: &spec,
         summary: &summary,
     })?;
-    crate::io::write_atomic(&out, text.as_bytes())?;
     let missing = text.lines().filter(|l| l.contains("MISSING")).count();
     let check = text.lines().filter(|l| l.contains("CHECK")).count();
+    if stdout {
+        // `-o -`: the job on stdout, the count on stderr.
+        print!("{text}");
+        super::esay!("({missing} MISSING, {check} CHECK)");
+        return Ok(());
+    }
+    crate::io::write_atomic(&out, text.as_bytes())?;
     println!(
         "wrote {} ({missing} MISSING, {check} CHECK); fill it in, then `wiperlab fit {}`",
         out.display(),

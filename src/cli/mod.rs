@@ -166,7 +166,7 @@ pub enum Command {
         #[command(flatten)]
         import: ImportArgs,
         /// Job file to write (default: <recording stem>.job.toml in --out-dir; never overwrites
-        /// a file).
+        /// a file; `-`: stdout).
         #[arg(short, long, conflicts_with = "out_dir")]
         output: Option<PathBuf>,
         /// Directory of <recording stem>.job.toml (default: the recording's directory, wherever
