@@ -357,6 +357,7 @@ fn shipped_jobs_write_to_the_repositorys_reports() {
     let reports = root().join("reports").canonicalize().expect("reports/");
     for job in [
         "reversal",
+        "reversal_tracker",
         "seed_experiment",
         "seed_experiment_geometry",
         "seed_simulation",

@@ -3,9 +3,9 @@
 
 use super::CliError;
 use super::ImportArgs;
+use crate::Result;
 use crate::fit::job::{parse_toml, read_text};
 use crate::import::{Format, ImportSpec};
-use crate::Result;
 use std::path::{Path, PathBuf};
 
 /// Converts `file` (or only describes it) and writes `output` (default `<stem>.trace.csv` in
