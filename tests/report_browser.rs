@@ -974,10 +974,14 @@ fn every_figure_of_every_command_has_units_and_a_legend_over_no_data() {
 /// the head mass and the lip length freed, and a tiny search.
 fn explore_job(dir: &Path) -> PathBuf {
     let text = std::fs::read_to_string(root().join("fits/seed_experiment_geometry.toml")).unwrap();
-    let text = text.replace(
-        "\"../data/",
-        &format!("\"{}/", root().join("data").display()),
-    );
+    // Without its `reports_dir = "../reports"`, the page and the exploration go to `reports/`
+    // beside the copy, in `dir`.
+    let text = text
+        .replace(
+            "\"../data/",
+            &format!("\"{}/", root().join("data").display()),
+        )
+        .replace("reports_dir = \"../reports\"", "");
     let head = text.split("[fit]").next().unwrap();
     let path = dir.join("explore_job.toml");
     std::fs::write(
