@@ -178,8 +178,9 @@ fn local_campaign_fits_collects_skips_and_survives_a_failure() {
             row["compound"],
             row["sweep"]
         );
-        // The friction offset within the single-recording tests' 5 % (tests/fit_recovery.rs).
-        assert!((c / c_true - 1.0).abs() < 0.05, "{row:?}");
+        // C and k1 within the single-recording tests' 5 % (tests/fit_recovery.rs).
+        assert!((c / c_true - 1.0).abs() < 0.05, "C: {row:?}");
+        assert!((k1 / k1_true - 1.0).abs() < 0.05, "k1: {row:?}");
         // The conditions table's labels and overrides reach the row.
         assert!(["soft", "hard"].contains(&row["compound"].as_str()));
         assert!(num(row, "drive_omega_rad_per_s") > 0.0 && num(row, "t0_s") > 0.0);
