@@ -35,7 +35,7 @@ const C_TRUE: f64 = 0.56;
 /// and C within [0.3, 0.8], prints and checks the recovery; returns the fit and the true blade.
 fn recover(id: ParamId, value: f64, bounds: [f64; 2], seed: u64) -> (FitOutcome, BladeParams) {
     let base = common::true_blade();
-    let mut truth = base.clone();
+    let mut truth = base;
     assert!(id.set(&mut truth, value));
     let (t0, t1) = default_window(&truth);
     let times = common::frame_times(t0, t1, 1e4);
