@@ -6,9 +6,7 @@ mod common;
 
 use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
-use wiperlab::model::{BladeParams, FrictionLaw, StickForm};
-use wiperlab::simulate::SolverOptions;
-use wiperlab::simulate::blade::{default_window, simulate_blade};
+use wiperlab::model::{BladeParams, FrictionLaw};
 
 #[test]
 fn fit_recovers_friction_c_and_neck_stiffness() {
@@ -20,31 +18,14 @@ fn fit_recovers_friction_c_and_neck_stiffness() {
     if let FrictionLaw::Exponential { c, .. } = &mut truth.friction {
         *c = c_true;
     }
-    let (t0, t1) = default_window(&truth);
-    let fps = 1e4;
-    let n = ((t1 - t0) * fps) as usize;
-    let times: Vec<f64> = (0..n).map(|k| t0 + k as f64 / fps).collect();
-    let sim = simulate_blade(
-        &truth,
-        (t0, *times.last().unwrap()),
-        &times,
-        &SolverOptions {
-            rtol: 1e-10,
-            atol: 1e-12,
-            ..SolverOptions::default()
-        },
-        StickForm::Reduced,
-    )
-    .unwrap();
-    let dir = std::env::temp_dir().join(format!("wiperlab_fit_recovery_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    common::write_dltdv(&dir.join("rec_xypts.csv"), &sim, &mut || 0.0);
-    std::fs::write(dir.join("blade.toml"), toml::to_string(&base).unwrap()).unwrap();
-    std::fs::write(
-        dir.join("truth.json"),
-        format!("{{\"C\": {c_true}, \"k1\": {k1_true}}}"),
-    )
-    .unwrap();
+    let (sim, t0) = common::recording_of(&truth).unwrap();
+    let dir = common::write_case(
+        "fit_recovery",
+        &sim,
+        &base,
+        &format!("{{\"C\": {c_true}, \"k1\": {k1_true}}}"),
+        &mut || 0.0,
+    );
     let job = format!(
         r#"name = "recovery"
 blade = "blade.toml"
@@ -108,18 +89,7 @@ keys = {{ C = "/C", k1 = "/k1" }}
 #[test]
 fn evaluation_and_failure_counts_add_up_and_failures_are_reported() {
     let truth = common::true_blade();
-    let (t0, t1) = default_window(&truth);
-    let fps = 1e4;
-    let n = ((t1 - t0) * fps) as usize;
-    let times: Vec<f64> = (0..n).map(|k| t0 + k as f64 / fps).collect();
-    let sim = simulate_blade(
-        &truth,
-        (t0, *times.last().unwrap()),
-        &times,
-        &SolverOptions::default(),
-        StickForm::Reduced,
-    )
-    .unwrap();
+    let (sim, t0) = common::recording_of(&truth).unwrap();
     let dir = std::env::temp_dir().join(format!("wiperlab_fit_counts_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     common::write_dltdv(&dir.join("rec_xypts.csv"), &sim, &mut || 0.0);

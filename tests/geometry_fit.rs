@@ -24,9 +24,7 @@ use rand_distr::{Distribution, Normal};
 use wiperlab::fit::FitOutcome;
 use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
-use wiperlab::model::{BladeParams, ParamId, StickForm};
-use wiperlab::simulate::SolverOptions;
-use wiperlab::simulate::blade::{default_window, simulate_blade};
+use wiperlab::model::{BladeParams, ParamId};
 
 /// The sample's friction offset C (data/reversal/blade_true.toml `[friction] c`), left unchanged.
 const C_TRUE: f64 = 0.56;
@@ -37,33 +35,17 @@ fn recover(id: ParamId, value: f64, bounds: [f64; 2], seed: u64) -> (FitOutcome,
     let base = common::true_blade();
     let mut truth = base;
     assert!(id.set(&mut truth, value));
-    let (t0, t1) = default_window(&truth);
-    let times = common::frame_times(t0, t1, 1e4);
-    let sim = simulate_blade(
-        &truth,
-        (t0, *times.last().unwrap()),
-        &times,
-        &SolverOptions {
-            rtol: 1e-10,
-            atol: 1e-12,
-            ..SolverOptions::default()
-        },
-        StickForm::Reduced,
-    )
-    .expect("the changed blade keeps contact over the window");
-    let dir = std::env::temp_dir().join(format!("wiperlab_geometry_{id}_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let (sim, t0) =
+        common::recording_of(&truth).expect("the changed blade keeps contact over the window");
     let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
     let noise = Normal::new(0.0, 0.1).unwrap();
-    common::write_dltdv(&dir.join("rec_xypts.csv"), &sim, &mut || {
-        noise.sample(&mut rng)
-    });
-    std::fs::write(dir.join("blade.toml"), toml::to_string(&base).unwrap()).unwrap();
-    std::fs::write(
-        dir.join("truth.json"),
-        format!("{{\"{id}\": {value}, \"C\": {C_TRUE}}}"),
-    )
-    .unwrap();
+    let dir = common::write_case(
+        &format!("geometry_{id}"),
+        &sim,
+        &base,
+        &format!("{{\"{id}\": {value}, \"C\": {C_TRUE}}}"),
+        &mut || noise.sample(&mut rng),
+    );
     let job = format!(
         r#"name = "geometry"
 blade = "blade.toml"

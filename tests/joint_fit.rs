@@ -9,28 +9,11 @@ mod common;
 use std::path::Path;
 use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
-use wiperlab::model::{BladeParams, FrictionLaw, StickForm};
-use wiperlab::simulate::SolverOptions;
-use wiperlab::simulate::blade::{default_window, simulate_blade};
+use wiperlab::model::{BladeParams, FrictionLaw};
 
 /// Simulates `p` over its default window at 10 kfps and writes a DLTdv xypts file; returns t0.
 fn write_recording(p: &BladeParams, path: &Path) -> f64 {
-    let (t0, t1) = default_window(p);
-    let fps = 1e4;
-    let n = ((t1 - t0) * fps) as usize;
-    let times: Vec<f64> = (0..n).map(|k| t0 + k as f64 / fps).collect();
-    let sim = simulate_blade(
-        p,
-        (t0, *times.last().unwrap()),
-        &times,
-        &SolverOptions {
-            rtol: 1e-10,
-            atol: 1e-12,
-            ..SolverOptions::default()
-        },
-        StickForm::Reduced,
-    )
-    .unwrap();
+    let (sim, t0) = common::recording_of(p).unwrap();
     common::write_dltdv(path, &sim, &mut || 0.0);
     t0
 }

@@ -8,9 +8,7 @@ mod common;
 
 use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
-use wiperlab::model::{BladeParams, Shoulder, StickForm};
-use wiperlab::simulate::SolverOptions;
-use wiperlab::simulate::blade::{default_window, simulate_blade};
+use wiperlab::model::{BladeParams, Shoulder};
 
 #[test]
 fn fit_prefers_and_recovers_the_shoulder() {
@@ -24,35 +22,18 @@ fn fit_prefers_and_recovers_the_shoulder() {
         contact_angle_rad: theta_c,
         k1_contact_nm_per_rad: k1c,
     });
-    let (t0, t1) = default_window(&truth);
-    let fps = 1e4;
-    let n = ((t1 - t0) * fps) as usize;
-    let times: Vec<f64> = (0..n).map(|k| t0 + k as f64 / fps).collect();
-    let sim = simulate_blade(
-        &truth,
-        (t0, *times.last().unwrap()),
-        &times,
-        &SolverOptions {
-            rtol: 1e-10,
-            atol: 1e-12,
-            ..SolverOptions::default()
-        },
-        StickForm::Reduced,
-    )
-    .unwrap();
+    let (sim, t0) = common::recording_of(&truth).unwrap();
     assert!(
         !sim.switches.is_empty(),
         "the recording should touch the shoulder"
     );
-    let dir = std::env::temp_dir().join(format!("wiperlab_shoulder_fit_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    common::write_dltdv(&dir.join("rec_xypts.csv"), &sim, &mut || 0.0);
-    std::fs::write(dir.join("blade.toml"), toml::to_string(&base).unwrap()).unwrap();
-    std::fs::write(
-        dir.join("truth.json"),
-        format!("{{\"k1\": {k1_free}, \"k1c\": {k1c}, \"theta_c\": {theta_c}}}"),
-    )
-    .unwrap();
+    let dir = common::write_case(
+        "shoulder_fit",
+        &sim,
+        &base,
+        &format!("{{\"k1\": {k1_free}, \"k1c\": {k1c}, \"theta_c\": {theta_c}}}"),
+        &mut || 0.0,
+    );
     let job = format!(
         r#"name = "shoulder"
 blade = "blade.toml"

@@ -59,6 +59,47 @@ pub fn true_blade() -> wiperlab::model::BladeParams {
     toml::from_str(&std::fs::read_to_string(p).expect("read blade_true.toml")).expect("parse")
 }
 
+/// A model-made recording's motion: `p`'s reversal window (`default_window`) simulated at 10,000
+/// frames/s with DOPRI5 at rtol 1e-10, atol 1e-12 (`SolverOptions::default()`, tighter than any
+/// fit's, so a fit's error comes from the fit and the noise added when it is written), the lip
+/// equations in reduced form. Returns the simulation and the first frame's time.
+pub fn recording_of(
+    p: &wiperlab::model::BladeParams,
+) -> wiperlab::Result<(wiperlab::simulate::blade::BladeSimulation, f64)> {
+    let (t0, t1) = wiperlab::simulate::blade::default_window(p);
+    let times = frame_times(t0, t1, 1e4);
+    let sim = wiperlab::simulate::blade::simulate_blade(
+        p,
+        (t0, *times.last().expect("a window of at least one frame")),
+        &times,
+        &wiperlab::simulate::SolverOptions::default(),
+        wiperlab::model::StickForm::Reduced,
+    )?;
+    Ok((sim, t0))
+}
+
+/// A fresh temp directory `wiperlab_<tag>_<pid>` holding a model-made fit case: the recording
+/// `rec_xypts.csv` ([`write_dltdv`] of `sim` with `noise_px`), `blade.toml` (`start`, the blade the
+/// fit starts from) and `truth.json` (`truth_json`, the values the recording was made with).
+pub fn write_case(
+    tag: &str,
+    sim: &wiperlab::simulate::blade::BladeSimulation,
+    start: &wiperlab::model::BladeParams,
+    truth_json: &str,
+    noise_px: &mut dyn FnMut() -> f64,
+) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("wiperlab_{tag}_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("create the case's temp dir");
+    write_dltdv(&dir.join("rec_xypts.csv"), sim, noise_px);
+    std::fs::write(
+        dir.join("blade.toml"),
+        toml::to_string(start).expect("blade to TOML"),
+    )
+    .expect("write blade.toml");
+    std::fs::write(dir.join("truth.json"), truth_json).expect("write truth.json");
+    dir
+}
+
 /// Frame times `t0 + k/fps` covering `[t0, t1)`.
 pub fn frame_times(t0: f64, t1: f64, fps: f64) -> Vec<f64> {
     let n = ((t1 - t0) * fps) as usize;
