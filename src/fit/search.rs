@@ -183,18 +183,28 @@ pub(super) fn piped_interval() -> std::time::Duration {
 
 /// The job's progress bar, its length the model runs the search is expected to take: per
 /// candidate and restart the swarm's particles × (iterations + 1), the polish's simplex and two
-/// runs per iteration, and the curvature's stencil.
+/// runs per iteration, and the curvature's stencil. A nested candidate searched adaptively counts
+/// its local polishes only; its global search, when it runs, lengthens the bar
+/// ([`nested_search`]).
 pub(super) fn progress_bar(job: &LoadedJob, candidates: &[Candidate]) -> indicatif::ProgressBar {
     let fit = &job.job.fit;
     let mut budget = 0u64;
-    for c in candidates {
+    for (i, c) in candidates.iter().enumerate() {
         let n = job.free.len() + if c.shoulder { 2 } else { 0 };
-        let hess_evals = 1 + 2 * n + 2 * n * n.saturating_sub(1);
-        budget += fit.restarts.max(1) as u64
-            * (fit.particles as u64 * (fit.swarm_iterations + 1)
-                + (n as u64 + 1)
-                + 2 * fit.polish_iterations)
-            + hess_evals as u64;
+        let hess_evals = (1 + 2 * n + 2 * n * n.saturating_sub(1)) as u64;
+        let nested = candidates[..i]
+            .iter()
+            .any(|f| c.shoulder && f.kind == c.kind && !f.shoulder);
+        let adaptive = nested
+            && fit.nested_search == job::NestedSearch::Adaptive
+            && fit.objective == job::Objective::Likelihood
+            && job.job.targets.is_none();
+        budget += hess_evals
+            + if adaptive {
+                NESTED_WARM_POINTS * polish_budget(fit, n)
+            } else {
+                restarts_budget(fit, n)
+            };
     }
     let pb = indicatif::ProgressBar::new(budget);
     pb.set_style(
@@ -205,6 +215,20 @@ pub(super) fn progress_bar(job: &LoadedJob, candidates: &[Candidate]) -> indicat
         .progress_chars("=> "),
     );
     pb
+}
+
+/// How many warm points a nested candidate's search starts from ([`nested_warm_points`]).
+const NESTED_WARM_POINTS: u64 = 3;
+
+/// Model runs of one Nelder–Mead polish over `n` parameters: its simplex and two per iteration.
+fn polish_budget(fit: &job::FitSection, n: usize) -> u64 {
+    n as u64 + 1 + 2 * fit.polish_iterations
+}
+
+/// Model runs of [`optimise`]'s restarts over `n` parameters: each a swarm and a polish.
+fn restarts_budget(fit: &job::FitSection, n: usize) -> u64 {
+    fit.restarts.max(1) as u64
+        * (fit.particles as u64 * (fit.swarm_iterations + 1) + polish_budget(fit, n))
 }
 
 /// Fits every candidate in turn; a `+shoulder` candidate starts from the fit of the same model
@@ -387,21 +411,13 @@ pub(super) fn fit_candidate(
     nested: Option<&CandidateFit>,
 ) -> Result<CandidateFit> {
     let started = std::time::Instant::now();
-    let fit = &job.job.fit;
     let reporting = Reporting::new(pb, candidate);
     reporting.stage(format_args!("swarm"));
     let (main, free) = build_problem(job, meas, candidate)?;
     let problem = Arc::new(main);
     let warm = nested.map_or_else(Vec::new, |smaller| nested_warm_points(smaller, &free));
-    let adaptive = nested.is_some()
-        && fit.nested_search == job::NestedSearch::Adaptive
-        && problem.cost_is_nll();
-    let (best_u, swarm_iters, polish_iters, cost, search_note) = if adaptive {
-        nested_search(&problem, fit, &warm, &reporting)?
-    } else {
-        let (u, s, p, c) = optimise(&problem, fit, fit.seed, &warm, Some(&reporting))?;
-        (u, s, p, c, None)
-    };
+    let (best_u, swarm_iters, polish_iters, cost, search_note) =
+        search(job, &problem, nested.is_some(), &warm, &reporting)?;
 
     // The likelihood at the optimum → NLL for model choice, and the inverse Fisher information →
     // standard errors, correlations, identifiability; the cost's curvature where there is no
@@ -448,6 +464,36 @@ pub(super) fn fit_candidate(
         cost,
         search_note,
     })
+}
+
+/// The search of one candidate: [`nested_search`] for a nested candidate searched adaptively (a
+/// likelihood to gauge the local gain by), else [`optimise`]'s restarts. Returns [`optimise`]'s
+/// tuple and the nested search's note.
+#[allow(clippy::type_complexity)]
+fn search(
+    job: &LoadedJob,
+    problem: &Arc<SpectralProblem>,
+    nested: bool,
+    warm: &[Vec<f64>],
+    reporting: &Reporting,
+) -> Result<(Vec<f64>, u64, u64, f64, Option<String>)> {
+    let fit = &job.job.fit;
+    let configured = nested
+        && fit.nested_search == job::NestedSearch::Adaptive
+        && fit.objective == job::Objective::Likelihood
+        && job.job.targets.is_none();
+    if configured && problem.cost_is_nll() {
+        return nested_search(problem, fit, warm, reporting);
+    }
+    if configured && let Some(pb) = &reporting.progress {
+        // The bar counted an adaptive search, but this problem has no likelihood to gauge it.
+        let n = problem.free.len();
+        pb.inc_length(
+            restarts_budget(fit, n).saturating_sub(NESTED_WARM_POINTS * polish_budget(fit, n)),
+        );
+    }
+    let (u, s, p, c) = optimise(problem, fit, fit.seed, warm, Some(reporting))?;
+    Ok((u, s, p, c, None))
 }
 
 /// The NLL gain (nats) above which a nested candidate's local search is followed by the global one
@@ -507,6 +553,9 @@ fn nested_search(
              nothing near that model's optimum, so no global search"
         );
         return Ok((u, 0, polish_iters, cost, Some(note)));
+    }
+    if let Some(pb) = &reporting.progress {
+        pb.inc_length(restarts_budget(fit, problem.free.len()));
     }
     let (gu, swarm_iters, global_polish, gcost) =
         optimise(problem, fit, fit.seed, warm, Some(reporting))?;
