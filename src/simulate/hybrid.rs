@@ -560,10 +560,13 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
         let (model, mode) = (self.model, self.mode);
         let mut evals = 0;
         let mut last_rhs = None;
+        // Only calls at the step's end can serve the end's event functions (`end_event_values`):
+        // keep those, not a copy of every stage.
+        let t_step_end = self.t + self.h;
         let mut rhs = |tt: f64, yy: &[f64; N], dy: &mut [f64; N]| {
             evals += 1;
             let c = model.rhs(&mode, tt, yy, dy)?;
-            last_rhs = Some((tt, *yy, c));
+            last_rhs = (tt == t_step_end).then_some((tt, *yy, c)).or(last_rhs);
             Ok::<(), ModelFault>(())
         };
         let method = self.opts.method;
