@@ -35,8 +35,14 @@ fn dop853_evaluations_on_the_whole_window_add_up_and_undercut_dopri5() {
     let run = |m| simulate_blade(&p, win, &times, &opts(1e-10, m), StickForm::Reduced).unwrap();
     let (d5, d8) = (run(Method::Dopri5), run(Method::Dop853));
     let (s5, s8) = (d5.stats, d8.stats);
-    eprintln!("rtol 1e-10: DOPRI5 {s5:?}, {} transitions", d5.transitions.len());
-    eprintln!("rtol 1e-10: DOP853 {s8:?}, {} transitions", d8.transitions.len());
+    eprintln!(
+        "rtol 1e-10: DOPRI5 {s5:?}, {} transitions",
+        d5.transitions.len()
+    );
+    eprintln!(
+        "rtol 1e-10: DOP853 {s8:?}, {} transitions",
+        d8.transitions.len()
+    );
     // Every evaluation accounted for (Hairer, Nørsett & Wanner §II.10: 12 stages, the first the
     // previous step's end derivative, 3 dense-output stages): phase starts are the window's start
     // and one per transition (this blade has no switching surface).
@@ -72,7 +78,11 @@ fn dop853_and_dopri5_place_the_bursts_transitions_alike() {
     let rtol = 1e-10;
     let run = |m| integrate(&blade, ta, ya, mode, ta + 0.02, &[], &opts(rtol, m)).unwrap();
     let (r5, r8) = (run(Method::Dopri5), run(Method::Dop853));
-    assert!(r5.transitions.len() > 20, "{} transitions", r5.transitions.len());
+    assert!(
+        r5.transitions.len() > 20,
+        "{} transitions",
+        r5.transitions.len()
+    );
     assert_eq!(r5.transitions.len(), r8.transitions.len());
     let mut worst: f64 = 0.0;
     for (a, b) in r5.transitions.iter().zip(&r8.transitions) {
