@@ -57,11 +57,23 @@ pub struct LineOrigin {
 }
 
 impl LineOrigin {
-    /// One sentence for a warning when the line is a harmonic or lies more than 100× below the
-    /// spectrum's dominant line; `None` otherwise. `what` names the line, e.g. "the model's line in
-    /// band 'low'".
+    /// One sentence for a warning when the line is a harmonic, stands less than
+    /// [`MIN_PROMINENCE`]× over its local floor (or its floor cannot be measured), or lies more than
+    /// 100× below the spectrum's dominant line; `None` otherwise. `what` names the line, e.g. "the
+    /// model's line in band 'low'".
     pub fn concern(&self, what: &str) -> Option<String> {
         let mut parts = Vec::new();
+        if self.prominence.is_nan() {
+            parts.push(
+                "has no measurable prominence (the band's Welch bins are too coarse for a floor within ±30 % of the line, more than 3 bins from it)"
+                    .to_string(),
+            );
+        } else if self.prominence < MIN_PROMINENCE {
+            parts.push(format!(
+                "stands only {:.1}× over its local floor (a prominent line needs {MIN_PROMINENCE}×)",
+                self.prominence
+            ));
+        }
         if let Some(h) = self.harmonic_of {
             parts.push(format!(
                 "is harmonic {} of a line at {:.2} Hz that is {:.1}× stronger (a stick–slip comb: the band sees a harmonic, not the cycle's fundamental)",
@@ -203,7 +215,32 @@ mod tests {
         let o = classify_line(&f, &p, &line, 5.0).unwrap();
         assert!(o.harmonic_of.is_none(), "{o:?}");
         assert_eq!(o.below_dominant, 1.0);
-        assert!(o.concern("the line").is_none());
+        // At 4096 points and 10 kHz the bins are 2.44 Hz apart: ±30 % of 26 Hz (20–34 Hz) holds
+        // bins 9–13, all within 3 bins of the line's bin 11, so the line has no floor to stand
+        // over, and that is the only concern.
+        assert!(o.prominence.is_nan(), "{o:?}");
+        let c = o.concern("the line").expect("no floor");
+        assert!(c.contains("no measurable prominence"), "{c}");
+        assert!(!c.contains("harmonic") && !c.contains("below"), "{c}");
+    }
+
+    #[test]
+    fn a_line_barely_over_its_floor_is_flagged() {
+        // The threshold is MIN_PROMINENCE = 5 (a power ratio): 4.9 is flagged, 5 is not; a NaN
+        // prominence (no floor bins, peaks::prominence) is flagged as unmeasurable.
+        let line = |prominence: f64| LineOrigin {
+            freq_hz: 900.0,
+            prominence,
+            harmonic_of: None,
+            dominant_hz: 900.0,
+            below_dominant: 1.0,
+        };
+        let weak = line(4.9).concern("the line").expect("a weak line");
+        assert!(weak.contains("only 4.9×"), "{weak}");
+        assert!(line(5.0).concern("the line").is_none());
+        assert!(line(f64::INFINITY).concern("the line").is_none());
+        let nan = line(f64::NAN).concern("the line").expect("no floor");
+        assert!(nan.contains("no measurable prominence"), "{nan}");
     }
 
     #[test]
