@@ -263,8 +263,9 @@ struct PeakView {
     model_line: String,
 }
 
-/// A line's origin in words: its own, or a harmonic of a stronger line; and its distance below the
-/// spectrum's dominant line when that exceeds 100×.
+/// A line's origin in words: its own, or a harmonic of a stronger line; its prominence over the
+/// local floor (or that the band's bins leave none); and its distance below the spectrum's dominant
+/// line when that exceeds 100×.
 fn line_words(o: Option<crate::spectrum::harmonics::LineOrigin>) -> String {
     let Some(o) = o else {
         return "—".into();
@@ -273,6 +274,11 @@ fn line_words(o: Option<crate::spectrum::harmonics::LineOrigin>) -> String {
         Some(h) => format!("harmonic {} of {} Hz", h.order, num(h.freq_hz, 4)),
         None => "its own line".into(),
     };
+    if o.prominence.is_nan() {
+        w.push_str("; no measurable floor");
+    } else {
+        w.push_str(&format!("; {}× its floor", num(o.prominence, 3)));
+    }
     if o.below_dominant > 100.0 {
         w.push_str(&format!(
             "; {}× below the dominant line ({} Hz)",
@@ -767,6 +773,33 @@ fn result_warnings(r: &FitResult) -> Vec<String> {
 pub(super) mod tests {
     use super::*;
     use crate::fit::result::sha256_hex;
+
+    #[test]
+    fn line_words_give_the_origin_and_the_prominence() {
+        use crate::spectrum::harmonics::{Fundamental, LineOrigin};
+        // The seed experiment's cluster fit: 905.5 Hz, 65.19× its floor, harmonic 2 of 447.7 Hz.
+        let mut o = LineOrigin {
+            freq_hz: 905.46,
+            prominence: 65.19,
+            harmonic_of: Some(Fundamental {
+                freq_hz: 447.71,
+                order: 2,
+                level_ratio: 2.21,
+            }),
+            dominant_hz: 77.93,
+            below_dominant: 3.737e7,
+        };
+        let w = line_words(Some(o));
+        assert!(
+            w.starts_with("harmonic 2 of 447.7 Hz; 65.2× its floor; "),
+            "{w}"
+        );
+        assert!(w.contains("below the dominant line (77.93 Hz)"), "{w}");
+        o.harmonic_of = None;
+        o.prominence = f64::NAN;
+        o.below_dominant = 1.0;
+        assert_eq!(line_words(Some(o)), "its own line; no measurable floor");
+    }
 
     #[test]
     fn numbers_keep_significant_digits() {
