@@ -835,6 +835,24 @@ fn fit_cases() -> Vec<Case> {
             &["$D/job.toml:", "swarm_rtol"],
         ),
         case(
+            "fit: block means without the time-domain term",
+            j(&[(
+                "method = \"laplace\"",
+                "method = \"laplace\"\n[fit.likelihood]\nblock_s = 0.02",
+            )]),
+            fit,
+            &["$D/job.toml:", "block_s", "time_domain = true"],
+        ),
+        case(
+            "fit: block length zero",
+            j(&[(
+                "method = \"laplace\"",
+                "method = \"laplace\"\n[fit.likelihood]\ntime_domain = true\nblock_s = 0.0",
+            )]),
+            fit,
+            &["$D/job.toml:", "block_s", "> 0 s"],
+        ),
+        case(
             "fit: frame rate zero in the job",
             j(&[("fps_hz = 10000.0", "fps_hz = 0.0")]),
             fit,

@@ -50,9 +50,21 @@ pub struct RecordingLikelihood {
     pub sigma_m: f64,
     /// Whether the time-domain term is part of the likelihood.
     pub time_domain: bool,
+    /// The time-domain term's block length, samples: block means with their variance profiled
+    /// out ([`likelihood::profiled_gaussian_nll`]); `None` reads every sample at `sigma_m`.
+    pub block_len: Option<usize>,
     /// The bands' NLL of the saturated model (every expected ordinate equal to the measured one),
     /// nats: the lowest value each band's term can take.
     saturated_spectral_nats: f64,
+}
+
+/// The time-domain term at one simulation.
+struct TimeTerm {
+    nats: f64,
+    n_eff: f64,
+    rms: f64,
+    rho: f64,
+    block_rms: Option<f64>,
 }
 
 /// A fit's negative log-likelihood, by term.
@@ -66,6 +78,9 @@ pub struct NllParts {
     pub residual_rms_m: f64,
     /// Lag-one autocorrelation of the residuals.
     pub residual_rho: f64,
+    /// RMS of the residuals' block means, m, when the time-domain term reads block means.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub block_rms_m: Option<f64>,
     /// Effective number of observations: the bands' independent bins plus (with the time term) the
     /// residuals' AR(1) effective sample size.
     pub n_effective: f64,
@@ -124,7 +139,47 @@ impl RecordingLikelihood {
             measured_x,
             sigma_m,
             time_domain,
+            block_len: None,
             saturated_spectral_nats,
+        })
+    }
+
+    /// The same likelihood with the time-domain term read from block means of `block_len`
+    /// samples (see [`RecordingLikelihood::block_len`]).
+    pub fn with_blocks(mut self, block_len: Option<usize>) -> Self {
+        self.block_len = block_len.filter(|&l| l > 1);
+        self
+    }
+
+    /// The time-domain term, nats, and its effective number of observations: the Gaussian NLL of
+    /// the residuals at the tracking noise (AR(1)-weighted), or of their block means with the
+    /// variance profiled out; with the residuals' RMS and lag-one autocorrelation.
+    fn time_term(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<TimeTerm> {
+        let m = self.model_x(problem, sim)?;
+        let e = likelihood::demeaned_residuals(&self.measured_x, &m)?;
+        let size = likelihood::effective_sample_size(&e)?;
+        let rms = (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt();
+        let (nats, n_eff, block_rms) = match self.block_len {
+            Some(len) => {
+                let b = likelihood::block_mean_residuals(&self.measured_x, &m, len)?;
+                let brms = (b.iter().map(|v| v * v).sum::<f64>() / b.len().max(1) as f64).sqrt();
+                // White tracking noise averages down to σ²/L in a block mean.
+                let floor = self.sigma_m * self.sigma_m / len as f64;
+                let nats = likelihood::profiled_gaussian_nll(&b, floor)?;
+                (nats, b.len() as f64, Some(brms.max(floor.sqrt())))
+            }
+            None => (
+                likelihood::gaussian_nll(&e, self.sigma_m, size.n_eff)?,
+                size.n_eff,
+                None,
+            ),
+        };
+        Ok(TimeTerm {
+            nats,
+            n_eff,
+            rms,
+            rho: size.rho,
+            block_rms,
         })
     }
 
@@ -180,10 +235,14 @@ impl RecordingLikelihood {
         let (spectral_nats, _) = self.spectral_terms(problem, sim)?;
         let mut excess = spectral_nats.iter().sum::<f64>() - self.saturated_spectral_nats;
         if self.time_domain {
-            let (e, size) = self.residuals(problem, sim)?;
-            let nll = likelihood::gaussian_nll(&e, self.sigma_m, size.n_eff)?;
-            excess +=
-                nll - 0.5 * size.n_eff * (std::f64::consts::TAU * self.sigma_m * self.sigma_m).ln();
+            let t = self.time_term(problem, sim)?;
+            excess += match self.block_len {
+                Some(_) => t.nats,
+                None => {
+                    t.nats
+                        - 0.5 * t.n_eff * (std::f64::consts::TAU * self.sigma_m * self.sigma_m).ln()
+                }
+            };
         }
         Ok(excess)
     }
@@ -204,33 +263,22 @@ impl RecordingLikelihood {
         Ok((spectral_nats, effective_bins))
     }
 
-    /// The de-meaned time-domain residuals and their AR(1) effective sample size.
-    fn residuals(
-        &self,
-        problem: &SpectralProblem,
-        sim: &BladeSimulation,
-    ) -> Result<(Vec<f64>, likelihood::SampleSize)> {
-        let e = likelihood::demeaned_residuals(&self.measured_x, &self.model_x(problem, sim)?)?;
-        let size = likelihood::effective_sample_size(&e)?;
-        Ok((e, size))
-    }
-
     /// The NLL by term.
     fn terms(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<NllParts> {
         let (spectral_nats, mut n_effective) = self.spectral_terms(problem, sim)?;
-        let (e, size) = self.residuals(problem, sim)?;
-        let residual_rms_m = (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt();
+        let t = self.time_term(problem, sim)?;
         let time_nats = if self.time_domain {
-            n_effective += size.n_eff;
-            Some(likelihood::gaussian_nll(&e, self.sigma_m, size.n_eff)?)
+            n_effective += t.n_eff;
+            Some(t.nats)
         } else {
             None
         };
         Ok(NllParts {
             spectral_nats,
             time_nats,
-            residual_rms_m,
-            residual_rho: size.rho,
+            residual_rms_m: t.rms,
+            residual_rho: t.rho,
+            block_rms_m: t.block_rms,
             n_effective,
         })
     }
@@ -244,7 +292,12 @@ impl RecordingLikelihood {
             .flatten()
             .map(f64::ln)
             .collect();
-        if self.time_domain {
+        if self.time_domain
+            && let Some(len) = self.block_len
+        {
+            let m = self.model_x(problem, sim)?;
+            r.extend(likelihood::block_means(&self.measured_x, &m, len, |_, m| m));
+        } else if self.time_domain {
             let m = self.model_x(problem, sim)?;
             let both: Vec<f64> = m
                 .iter()
@@ -268,7 +321,15 @@ impl RecordingLikelihood {
                 b.measured.len(),
             ));
         }
-        if self.time_domain {
+        if self.time_domain
+            && let Some(b) = parts.block_rms_m
+        {
+            // The profiled variance's estimate: 1/s² per block mean.
+            w.extend(std::iter::repeat_n(
+                1.0 / (b * b).max(f64::MIN_POSITIVE),
+                n_time,
+            ));
+        } else if self.time_domain {
             let s2 = (self.sigma_m * self.sigma_m).max(parts.residual_rms_m.powi(2));
             let n_eff = if parts.residual_rho > 0.0 {
                 (1.0 - parts.residual_rho) / (1.0 + parts.residual_rho)

@@ -246,6 +246,9 @@ pub struct FitSection {
 pub struct LikelihoodSection {
     /// Add the Gaussian likelihood of the signal's time-domain residuals to the Welch spectra's.
     pub time_domain: bool,
+    /// Read the time-domain term from block means of this length, s, with their variance
+    /// profiled out, instead of every sample at the tracking noise.
+    pub block_s: Option<f64>,
 }
 
 crate::names::named_enum! {
@@ -753,6 +756,26 @@ impl Check<'_> {
                 &[Key::Name("fit"), Key::Name("swarm_rtol")],
                 format!("[fit] swarm_rtol must be in (0, 1) (got {r})"),
             ));
+        }
+        if let Some(b) = fit.likelihood.block_s {
+            let at = [
+                Key::Name("fit"),
+                Key::Name("likelihood"),
+                Key::Name("block_s"),
+            ];
+            if !fit.likelihood.time_domain {
+                return Err(self.error(
+                    &at,
+                    "[fit.likelihood] block_s reads the time-domain term: set time_domain = true \
+                     to use it",
+                ));
+            }
+            if !(b.is_finite() && b > 0.0) {
+                return Err(self.error(
+                    &at,
+                    format!("[fit.likelihood] block_s must be a duration > 0 s (got {b})"),
+                ));
+            }
         }
         Ok(())
     }

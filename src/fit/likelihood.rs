@@ -418,6 +418,76 @@ pub fn demeaned_residuals(measured: &[f64], model: &[f64]) -> Result<Vec<f64>> {
     Ok(both().map(|(d, m)| (d - dm) - (m - mm)).collect())
 }
 
+/// Block means of the de-meaned residuals: `d − m` averaged over consecutive blocks of `len`
+/// samples (over the samples of a block where both are finite; a block with fewer than half its
+/// samples finite is left out), minus the mean of `d − m` over every such sample (camera and model
+/// frames differ by a constant offset). Returns the block means and, per block kept, its first
+/// sample's index.
+///
+/// # Errors
+/// [`LikelihoodError::LengthMismatch`] for different lengths.
+pub fn block_mean_residuals(measured: &[f64], model: &[f64], len: usize) -> Result<Vec<f64>> {
+    if measured.len() != model.len() {
+        return Err(LikelihoodError::LengthMismatch {
+            measured: measured.len(),
+            model: model.len(),
+        });
+    }
+    Ok(block_means(measured, model, len, |d, m| d - m))
+}
+
+/// Block means of `f(d_i, m_i)` over the blocks [`block_mean_residuals`] keeps, de-meaned.
+pub fn block_means(
+    measured: &[f64],
+    model: &[f64],
+    len: usize,
+    f: impl Fn(f64, f64) -> f64,
+) -> Vec<f64> {
+    let len = len.max(1);
+    let mut means = Vec::with_capacity(measured.len() / len + 1);
+    let (mut total, mut count) = (0.0, 0usize);
+    for (d, m) in measured.chunks(len).zip(model.chunks(len)) {
+        let (mut s, mut c) = (0.0, 0usize);
+        for (a, b) in d.iter().zip(m) {
+            if a.is_finite() && b.is_finite() {
+                s += f(*a, *b);
+                c += 1;
+            }
+        }
+        if 2 * c >= len {
+            means.push(s / c as f64);
+        }
+        total += s;
+        count += c;
+    }
+    let mean = total / count.max(1) as f64;
+    means.iter_mut().for_each(|v| *v -= mean);
+    means
+}
+
+/// Gaussian NLL of `residuals` whose variance is the known noise variance `floor_var` plus an
+/// unknown non-negative discrepancy variance, estimated by maximum likelihood (profiled out; the
+/// concentrated likelihood, Pawitan 2001, *In All Likelihood*, §10.3): with `v = max(Σe²/n,
+/// floor_var)`, `n/2·ln(2πv) + Σe²/(2v)`, i.e. `n/2·(ln(2π·Σe²/n) + 1)` for a model whose residuals
+/// exceed the noise and the known-noise Gaussian NLL for one that reaches it.
+///
+/// # Errors
+/// [`LikelihoodError::TooFewSamples`] with fewer than 3 residuals,
+/// [`LikelihoodError::NonFinite`] for a non-finite one, [`LikelihoodError::InvalidSigma`] for a
+/// floor that is not finite and > 0.
+pub fn profiled_gaussian_nll(residuals: &[f64], floor_var: f64) -> Result<f64> {
+    check_residuals(residuals)?;
+    if !(floor_var.is_finite() && floor_var > 0.0) {
+        return Err(LikelihoodError::InvalidSigma {
+            sigma: floor_var.sqrt(),
+        });
+    }
+    let n = residuals.len() as f64;
+    let ss: f64 = residuals.iter().map(|e| e * e).sum();
+    let var = (ss / n).max(floor_var);
+    Ok(0.5 * n * (std::f64::consts::TAU * var).ln() + ss / (2.0 * var))
+}
+
 /// Effective sample size of serially correlated residuals.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SampleSize {
@@ -557,4 +627,40 @@ pub fn likelihood_ratio_test(smaller: &Evidence, larger: &Evidence) -> Result<Li
         df,
         p_value: chi2.sf(statistic.max(0.0)),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn block_means_of_a_constant_offset_vanish_and_a_step_is_resolved() {
+        // d − m = 5 everywhere: the de-meaned block means are 0. A step of height 2 at a block
+        // boundary gives −1, +1 (mean removed), and a NaN-heavy block is left out.
+        let d = [5.0; 8];
+        let m = [0.0; 8];
+        assert!(
+            block_mean_residuals(&d, &m, 4)
+                .unwrap()
+                .iter()
+                .all(|v| v.abs() < 1e-15)
+        );
+        let d = [0.0, 0.0, 2.0, 2.0, f64::NAN, f64::NAN, f64::NAN, 1.0];
+        let b = block_mean_residuals(&d, &[0.0; 8], 2).unwrap();
+        assert_eq!(b.len(), 3);
+        assert!((b[0] + 1.0).abs() < 1e-12 && (b[1] - 1.0).abs() < 1e-12 && b[2].abs() < 1e-12);
+    }
+
+    #[test]
+    fn profiled_nll_is_the_concentrated_likelihood_above_the_floor_and_gaussian_below() {
+        // Σe² = 4·9 = 36, n = 4: v̂ = 9 → 2·ln(2π·9) + 2. Below a floor of 16: the Gaussian NLL
+        // at σ² = 16, 2·ln(2π·16) + 36/32.
+        let e = [3.0, -3.0, 3.0, -3.0];
+        let tau = std::f64::consts::TAU;
+        let above = profiled_gaussian_nll(&e, 1.0).unwrap();
+        assert!((above - (2.0 * (tau * 9.0).ln() + 2.0)).abs() < 1e-12);
+        let below = profiled_gaussian_nll(&e, 16.0).unwrap();
+        assert!((below - (2.0 * (tau * 16.0).ln() + 36.0 / 32.0)).abs() < 1e-12);
+        assert!(profiled_gaussian_nll(&e, 0.0).is_err());
+    }
 }

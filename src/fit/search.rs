@@ -378,6 +378,13 @@ fn problem_of(
         Err("a target job has no measurement noise".into())
     } else {
         RecordingLikelihood::new(&p, &m.x, fit.likelihood.time_domain)
+            .map(|l| {
+                l.with_blocks(
+                    fit.likelihood
+                        .block_s
+                        .map(|b| (b * p.fs_hz).round() as usize),
+                )
+            })
             .map(Arc::new)
             .map_err(|e| e.to_string())
     };

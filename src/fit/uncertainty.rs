@@ -248,7 +248,9 @@ impl ReplicateSource {
             // The replicate's own likelihood: its measured ordinates and noise, the recording's
             // terms.
             let time_domain = problem.likelihood.as_ref().is_ok_and(|l| l.time_domain);
+            let blocks = problem.likelihood.as_ref().ok().and_then(|l| l.block_len);
             rep.likelihood = RecordingLikelihood::new(&rep, &x, time_domain)
+                .map(|l| l.with_blocks(blocks))
                 .map(Arc::new)
                 .map_err(|e| e.to_string());
             rep
