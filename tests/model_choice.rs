@@ -254,31 +254,71 @@ keys = {{ {keys} }}
     Ok((path, sim.switches.len()))
 }
 
+/// ln L of the recording at the truth, nats: the true model's likelihood (its job's, spectral
+/// terms) at the parameters that made the recording, simulated at the job's tolerance. A fit whose
+/// ln L is below it stopped short of the truth's likelihood (a search that missed); one above it
+/// found parameters the recording likes better than the truth (the recording does not determine
+/// them that closely).
+fn log_likelihood_at_truth(job: &LoadedJob, s: &Scene) -> Result<f64, String> {
+    let p = wiperlab::fit::problem_for(job, s.truth_model.parse().unwrap())
+        .map_err(|e| e.to_string())?;
+    let lik = p.likelihood.as_ref().map_err(|e| e.clone())?;
+    let sim = p.simulate(&truth_params(s)).map_err(|e| e.to_string())?;
+    let parts = lik.nll(&p, &sim).map_err(|e| e.to_string())?;
+    Ok(-parts.total())
+}
+
+/// The likelihood at the truth of every scene, beside the table (seconds, no fits):
+/// `cargo test --release --test model_choice likelihood_at_the_truth -- --ignored --nocapture`.
+#[test]
+#[ignore = "prints the table's reference likelihoods"]
+fn likelihood_at_the_truth() {
+    let dir = std::env::temp_dir().join(format!("wiperlab_truth_lnl_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (i, s) in SCENES.iter().enumerate() {
+        match write_scene(&dir, i, s) {
+            Ok((job, _)) => {
+                let job = LoadedJob::load(&job).unwrap();
+                let l = log_likelihood_at_truth(&job, s).unwrap();
+                assert!(l.is_finite(), "{}: ln L {l}", s.name);
+                println!(
+                    "{}: ln L at the truth ({}) = {l:.2} nats",
+                    s.name, s.truth_model
+                );
+            }
+            Err(e) => println!("{}: {e}", s.name),
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 #[test]
 #[ignore = "about 20 minutes on 2 cores: cargo test --release --test model_choice -- --ignored"]
 fn likelihood_choice_confusion_table() {
     let dir = std::env::temp_dir().join(format!("wiperlab_model_choice_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let mut md = String::from(
-        "| recording | shoulder switches | true model | chosen | ΔAIC of the true model | A | B | C | k1 | k1c | warnings | truth outside the 68 % interval |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| recording | shoulder switches | true model | chosen | ΔAIC of the true model | A | B | C | k1 | k1c | warnings | truth outside the 68 % interval | ln L of the true model's fit − at the truth |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut csv = String::from(
-        "recording,switches,true_model,chosen_model,delta_aic_true,err_A,err_B,err_C,err_k1,err_k1c,wall_time_s,outside_interval\n",
+        "recording,switches,true_model,chosen_model,delta_aic_true,err_A,err_B,err_C,err_k1,err_k1c,wall_time_s,outside_interval,lnl_fit_minus_truth\n",
     );
     let mut failures = Vec::new();
     for (i, s) in SCENES.iter().enumerate() {
         let fitted = write_scene(&dir, i, s).and_then(|(job, switches)| {
-            run_fit(&LoadedJob::load(&job).map_err(|e| e.to_string())?, false)
-                .map(|o| (o, switches))
+            let job = LoadedJob::load(&job).map_err(|e| e.to_string())?;
+            let at_truth = log_likelihood_at_truth(&job, s)?;
+            run_fit(&job, false)
+                .map(|o| (o, switches, at_truth))
                 .map_err(|e| format!("the fit failed: {e}"))
         });
-        let (out, switches) = match fitted {
+        let (out, switches, at_truth) = match fitted {
             Ok(f) => f,
             Err(e) => {
                 println!("{}: {e}", s.name);
                 let _ = writeln!(
                     md,
-                    "| {} | — | {} | ({e}) | | | | | | | | |",
+                    "| {} | — | {} | ({e}) | | | | | | | | | |",
                     s.name, s.truth_model
                 );
                 failures.push(format!("{}: {e}", s.name));
@@ -296,6 +336,11 @@ fn likelihood_choice_confusion_table() {
             .evidence
             .as_ref()
             .map_or(f64::NAN, |e| e.delta_aic);
+        // ln L of the true model's fit above its value at the truth.
+        let above_truth = true_trial
+            .evidence
+            .as_ref()
+            .map_or(f64::NAN, |e| e.log_likelihood_nats - at_truth);
         let err = |name: &str| {
             r.parameters
                 .iter()
@@ -348,7 +393,7 @@ fn likelihood_choice_confusion_table() {
         }
         let _ = writeln!(
             md,
-            "| {} | {switches} | {} | {chosen} | {d_true:+.2} | {} | {} | {} | {} | {} | {} | {outside} |",
+            "| {} | {switches} | {} | {chosen} | {d_true:+.2} | {} | {} | {} | {} | {} | {} | {outside} | {above_truth:+.2} |",
             s.name,
             s.truth_model,
             pct(err("A")),
@@ -361,7 +406,7 @@ fn likelihood_choice_confusion_table() {
         let num = |e: Option<f64>| e.map_or(String::new(), |e| format!("{e}"));
         let _ = writeln!(
             csv,
-            "\"{}\",{switches},{},{chosen},{d_true},{},{},{},{},{},{},\"{outside}\"",
+            "\"{}\",{switches},{},{chosen},{d_true},{},{},{},{},{},{},\"{outside}\",{above_truth}",
             s.name,
             s.truth_model,
             num(err("A")),
