@@ -191,7 +191,10 @@ pub(super) fn progress_bar(job: &LoadedJob, candidates: &[Candidate]) -> indicat
     let mut budget = 0u64;
     for (i, c) in candidates.iter().enumerate() {
         let n = job.free.len() + if c.shoulder { 2 } else { 0 };
-        let hess_evals = (1 + 2 * n + 2 * n * n.saturating_sub(1)) as u64;
+        // The curvature's stencil, or the likelihood's settling steps and its Fisher information.
+        let hess_evals = (1 + 2 * n + 2 * n * n.saturating_sub(1))
+            .max(super::evidence::SETTLE_STEPS * 4 * n + 1 + 2 * n + 1)
+            as u64;
         let nested = candidates[..i]
             .iter()
             .any(|f| c.shoulder && f.kind == c.kind && !f.shoulder);
@@ -423,7 +426,7 @@ pub(super) fn fit_candidate(
     let (main, free) = build_problem(job, meas, candidate)?;
     let problem = Arc::new(main);
     let warm = nested.map_or_else(Vec::new, |smaller| nested_warm_points(smaller, &free));
-    let (best_u, swarm_iters, polish_iters, cost, search_note) =
+    let (mut best_u, swarm_iters, polish_iters, mut cost, search_note) =
         search(job, &problem, nested.is_some(), &warm, &reporting)?;
 
     // The likelihood at the optimum → NLL for model choice, and the inverse Fisher information →
@@ -438,7 +441,20 @@ pub(super) fn fit_candidate(
             Err("interrupted".to_string()),
         )
     } else {
-        match super::evidence::at_fit(&problem, &best_u) {
+        // With the likelihood as the cost, the estimate is its optimum at the intervals' scale
+        // ([`super::evidence::settle`]), not the ripple the polish stopped in.
+        let local = if problem.cost_is_nll() {
+            super::evidence::settle(&problem, &best_u).map(|(u, l)| {
+                if u != best_u {
+                    cost = problem.cost_at(&u);
+                    best_u = u;
+                }
+                l
+            })
+        } else {
+            super::evidence::at_fit(&problem, &best_u)
+        };
+        match local {
             Ok(l) => (l.sigma_u, l.corr, Ok(l.nll)),
             Err(e) => {
                 let (s, c) = curvature(&problem, &best_u);

@@ -136,6 +136,12 @@ pub fn bootstrap_intervals(
             } else {
                 polish(&rep, best_u, 0.05, settings.polish_iterations, None)?.0
             };
+            // The estimator's last stage, as in the fit (`search::fit_candidate`).
+            let u = if rep.cost_is_nll() {
+                super::evidence::settle(&rep, &u)?.0
+            } else {
+                u
+            };
             Ok(problem
                 .free
                 .iter()
