@@ -469,38 +469,59 @@ pub const SETTLE_STEPS: usize = 6;
 /// Half-span of [`settle`]'s gradient stencil, in each coordinate's 1σ.
 pub const SETTLE_SPAN_SIGMA: f64 = 0.5;
 
-/// The likelihood's optimum at the scale of its own intervals, from a search's end `u0`: up to
-/// [`SETTLE_STEPS`] Newton steps `δ = −F⁻¹ g` with the Gauss–Newton Fisher information `F` of
-/// [`at_fit`] as the Hessian and the gradient `g` from central differences of the cost over
-/// `±` [`SETTLE_SPAN_SIGMA`]`·σ` per coordinate, each step clamped to `±1σ` and to the box. Returns
-/// the point and [`at_fit`] there.
+/// The most [`settle`] may raise the cost above the search's end, nats: the rise of a quadratic
+/// NLL at 1σ.
+pub const SETTLE_MAX_RISE_NATS: f64 = 0.5;
+
+/// The likelihood's optimum at the scale of its own intervals, from a search's end `u0` of cost
+/// `cost0`: up to [`SETTLE_STEPS`] Newton steps `δ = −F⁻¹ g` with the Gauss–Newton Fisher
+/// information `F` of [`at_fit`] as the Hessian and the gradient `g` from central differences of
+/// the cost over `±` [`SETTLE_SPAN_SIGMA`]`·σ` per coordinate, each step clamped to `±1σ`, the
+/// whole move to `±1σ` (σ at `u0`) and the box. Returns the point, its cost and [`at_fit`] there;
+/// `u0` itself (and its [`at_fit`]) when the settled point's cost exceeds `cost0` by more than
+/// [`SETTLE_MAX_RISE_NATS`] (then the bowl is not quadratic over its interval).
 ///
 /// Why: the stick–slip likelihood is rough at a scale far below its intervals. On the main job's
 /// fit its cost jitters by about 0.05 nats between points σ/50 apart, while its bowl rises by 0.5
-/// nats at 1σ, so a Nelder–Mead polish stops in whichever ripple it meets, within about ±0.3σ of
+/// nats at 1σ, so a Nelder–Mead polish stops in whichever ripple it meets, up to about ±0.4σ from
 /// the bowl's centre, and two swarm seeds end that far apart (docs/fit.md, "Uncertainty"). A
 /// gradient over a stencil of ±σ/2 sees the bowl, not the ripples (implicit filtering: Kelley 2011,
 /// *Implicit Filtering*, SIAM, ch. 1), and the Laplace interval assumes that bowl. Steps stop where
 /// a coordinate is uninformed (infinite σ), where the stencil would leave the box, or where a
-/// stencil's simulation fails. Costs `SETTLE_STEPS · 4k + 1 + 2k` simulations for k coordinates.
+/// stencil's simulation fails. Costs up to `SETTLE_STEPS · 4k + 2 + 2k` simulations for k
+/// coordinates.
 ///
 /// # Errors
 /// Those of [`at_fit`] at `u0` and at each new point.
-pub fn settle(problem: &SpectralProblem, u0: &[f64]) -> Result<(Vec<f64>, LocalFit)> {
+pub fn settle(
+    problem: &SpectralProblem,
+    u0: &[f64],
+    cost0: f64,
+) -> Result<(Vec<f64>, f64, LocalFit)> {
     use rayon::prelude::*;
-    let mut u = u0.to_vec();
-    let mut local = at_fit(problem, &u)?;
+    let start = at_fit(problem, u0)?;
+    let (mut u, mut local) = (u0.to_vec(), start.clone());
     for _ in 0..SETTLE_STEPS {
-        let cost = |p: &[f64]| problem.cost_at(p);
-        let costs =
-            |points: &[Vec<f64>]| -> Vec<f64> { points.par_iter().map(|p| cost(p)).collect() };
+        let costs = |points: &[Vec<f64>]| -> Vec<f64> {
+            points.par_iter().map(|p| problem.cost_at(p)).collect()
+        };
         let Some(step) = newton_step(&u, &local.sigma_u, &local.corr, costs) else {
             break;
         };
-        u.iter_mut().zip(&step).for_each(|(x, d)| *x += d);
+        for ((x, d), (x0, s0)) in u.iter_mut().zip(&step).zip(u0.iter().zip(&start.sigma_u)) {
+            *x = (*x + d).clamp(x0 - s0, x0 + s0).clamp(0.0, 1.0);
+        }
         local = at_fit(problem, &u)?;
     }
-    Ok((u, local))
+    if u == u0 {
+        return Ok((u, cost0, start));
+    }
+    let cost = problem.cost_at(&u);
+    if cost.is_finite() && cost <= cost0 + SETTLE_MAX_RISE_NATS {
+        Ok((u, cost, local))
+    } else {
+        Ok((u0.to_vec(), cost0, start))
+    }
 }
 
 /// One step of [`settle`] at `u` with the 1σ `sigma` and correlations `corr` of the inverse Fisher

@@ -193,8 +193,7 @@ pub(super) fn progress_bar(job: &LoadedJob, candidates: &[Candidate]) -> indicat
         let n = job.free.len() + if c.shoulder { 2 } else { 0 };
         // The curvature's stencil, or the likelihood's settling steps and its Fisher information.
         let hess_evals = (1 + 2 * n + 2 * n * n.saturating_sub(1))
-            .max(super::evidence::SETTLE_STEPS * 4 * n + 1 + 2 * n + 1)
-            as u64;
+            .max(super::evidence::SETTLE_STEPS * 4 * n + 2 + 2 * n) as u64;
         let nested = candidates[..i]
             .iter()
             .any(|f| c.shoulder && f.kind == c.kind && !f.shoulder);
@@ -444,11 +443,8 @@ pub(super) fn fit_candidate(
         // With the likelihood as the cost, the estimate is its optimum at the intervals' scale
         // ([`super::evidence::settle`]), not the ripple the polish stopped in.
         let local = if problem.cost_is_nll() {
-            super::evidence::settle(&problem, &best_u).map(|(u, l)| {
-                if u != best_u {
-                    cost = problem.cost_at(&u);
-                    best_u = u;
-                }
+            super::evidence::settle(&problem, &best_u, cost).map(|(u, c, l)| {
+                (best_u, cost) = (u, c);
                 l
             })
         } else {

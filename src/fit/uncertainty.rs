@@ -131,14 +131,17 @@ pub fn bootstrap_intervals(
                 rep.others.push(src.replicate(o, &mut rng)?);
             }
             let rep = Arc::new(rep);
-            let u = if settings.full_refit {
-                optimise(&rep, fit, fit.seed.wrapping_add(1 + r as u64), &[], None)?.0
+            let (u, cost) = if settings.full_refit {
+                let (u, _, _, cost) =
+                    optimise(&rep, fit, fit.seed.wrapping_add(1 + r as u64), &[], None)?;
+                (u, cost)
             } else {
-                polish(&rep, best_u, 0.05, settings.polish_iterations, None)?.0
+                let (u, _, cost) = polish(&rep, best_u, 0.05, settings.polish_iterations, None)?;
+                (u, cost)
             };
             // The estimator's last stage, as in the fit (`search::fit_candidate`).
             let u = if rep.cost_is_nll() {
-                super::evidence::settle(&rep, &u)?.0
+                super::evidence::settle(&rep, &u, cost)?.0
             } else {
                 u
             };
