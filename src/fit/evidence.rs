@@ -482,9 +482,9 @@ pub const SETTLE_MAX_RISE_NATS: f64 = 0.5;
 /// [`SETTLE_MAX_RISE_NATS`] (then the bowl is not quadratic over its interval).
 ///
 /// Why: the stick–slip likelihood is rough at a scale far below its intervals. On the main job's
-/// fit its cost jitters by about 0.05 nats between points σ/50 apart, while its bowl rises by 0.5
-/// nats at 1σ, so a Nelder–Mead polish stops in whichever ripple it meets, up to about ±0.4σ from
-/// the bowl's centre, and two swarm seeds end that far apart (docs/fit.md, "Uncertainty"). A
+/// fit its cost jitters by about 0.05 nats between points σ/50 apart, while its bowl rises by
+/// tenths of a nat to nats at ±σ/2, so a Nelder–Mead polish stops in whichever ripple it meets,
+/// and two swarm seeds ended up to 0.4 of an interval's width apart (docs/fit.md, "Uncertainty"). A
 /// gradient over a stencil of ±σ/2 sees the bowl, not the ripples (implicit filtering: Kelley 2011,
 /// *Implicit Filtering*, SIAM, ch. 1), and the Laplace interval assumes that bowl. Steps stop where
 /// a coordinate is uninformed (infinite σ), where the stencil would leave the box, or where a
