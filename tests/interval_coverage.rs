@@ -183,7 +183,7 @@ fn bootstrap_intervals_cover_the_truth_at_their_rate() {
 }
 
 /// Laplace intervals (the likelihood's Fisher information, no refits) on 24 recordings do not
-/// under-cover. Measured: C 19/24, k1 20/24 against 16.4 expected; over the 20 fits that found the
+/// under-cover. Measured: C 20/24, k1 20/24 against 16.4 expected; over the 20 fits that found the
 /// truth's basin the half-widths are 2.3× the RMS error (conservative), because the Whittle likelihood treats the deterministic
 /// stick–slip signal's ordinates as scattering like a random process's, about 3× more than they
 /// do under tracking noise (docs/fit.md, "Uncertainty"). So this asserts the conservative side only.
