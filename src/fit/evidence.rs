@@ -161,12 +161,8 @@ impl RecordingLikelihood {
         let rms = (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt();
         let (nats, n_eff, block_rms) = match self.block_len {
             Some(len) => {
-                let b = likelihood::block_mean_residuals(&self.measured_x, &m, len)?;
-                let brms = (b.iter().map(|v| v * v).sum::<f64>() / b.len().max(1) as f64).sqrt();
-                // White tracking noise averages down to σ²/L in a block mean.
-                let floor = self.sigma_m * self.sigma_m / len as f64;
-                let nats = likelihood::profiled_gaussian_nll(&b, floor)?;
-                (nats, b.len() as f64, Some(brms.max(floor.sqrt())))
+                let (nats, blocks, brms) = self.block_term(&m, len)?;
+                (nats, blocks as f64, Some(brms))
             }
             None => (
                 likelihood::gaussian_nll(&e, self.sigma_m, size.n_eff)?,
@@ -181,6 +177,17 @@ impl RecordingLikelihood {
             rho: size.rho,
             block_rms,
         })
+    }
+
+    /// The block-mean form of the time-domain term for the model signal `m`: its NLL, nats, the
+    /// blocks kept and their RMS (at least the block-averaged noise), m.
+    fn block_term(&self, m: &[f64], len: usize) -> Result<(f64, usize, f64)> {
+        let b = likelihood::block_mean_residuals(&self.measured_x, m, len)?;
+        // White tracking noise averages down to σ²/L in a block mean.
+        let floor = self.sigma_m * self.sigma_m / len as f64;
+        let nats = likelihood::profiled_gaussian_nll(&b, floor)?;
+        let rms = (b.iter().map(|v| v * v).sum::<f64>() / b.len() as f64).sqrt();
+        Ok((nats, b.len(), rms.max(floor.sqrt())))
     }
 
     /// The model's expected ordinates of every band: the simulation's plus the noise density.
@@ -235,10 +242,10 @@ impl RecordingLikelihood {
         let (spectral_nats, _) = self.spectral_terms(problem, sim)?;
         let mut excess = spectral_nats.iter().sum::<f64>() - self.saturated_spectral_nats;
         if self.time_domain {
-            let t = self.time_term(problem, sim)?;
             excess += match self.block_len {
-                Some(_) => t.nats,
+                Some(len) => self.block_term(&self.model_x(problem, sim)?, len)?.0,
                 None => {
+                    let t = self.time_term(problem, sim)?;
                     t.nats
                         - 0.5 * t.n_eff * (std::f64::consts::TAU * self.sigma_m * self.sigma_m).ln()
                 }
