@@ -166,6 +166,8 @@ pub(super) struct CandidateFit {
     pub(super) wall_time_s: f64,
     pub(super) history: Vec<HistoryPoint>,
     pub(super) cost: f64,
+    /// The cost where the search ended, before settling (nats with the likelihood objective).
+    pub(super) search_cost: f64,
     /// How a nested candidate was searched (adaptive search), for the model-choice reason.
     pub(super) search_note: Option<String>,
 }
@@ -425,8 +427,14 @@ pub(super) fn fit_candidate(
     let (main, free) = build_problem(job, meas, candidate)?;
     let problem = Arc::new(main);
     let warm = nested.map_or_else(Vec::new, |smaller| nested_warm_points(smaller, &free));
-    let (mut best_u, swarm_iters, polish_iters, mut cost, search_note) =
-        search(job, &problem, nested.is_some(), &warm, &reporting)?;
+    let (mut best_u, swarm_iters, polish_iters, mut cost, search_note) = search(
+        job,
+        &problem,
+        nested.map(|s| s.search_cost),
+        &warm,
+        &reporting,
+    )?;
+    let search_cost = cost;
 
     // The likelihood at the optimum → NLL for model choice, and the inverse Fisher information →
     // standard errors, correlations, identifiability; the cost's curvature where there is no
@@ -481,28 +489,30 @@ pub(super) fn fit_candidate(
         wall_time_s: started.elapsed().as_secs_f64(),
         history,
         cost,
+        search_cost,
         search_note,
     })
 }
 
 /// The search of one candidate: [`nested_search`] for a nested candidate searched adaptively (a
 /// likelihood to gauge the local gain by), else [`optimise`]'s restarts. Returns [`optimise`]'s
-/// tuple and the nested search's note.
+/// tuple and the nested search's note. `nested`: the cost where the smaller model's search ended,
+/// for a nested candidate.
 #[allow(clippy::type_complexity)]
 fn search(
     job: &LoadedJob,
     problem: &Arc<SpectralProblem>,
-    nested: bool,
+    nested: Option<f64>,
     warm: &[Vec<f64>],
     reporting: &Reporting,
 ) -> Result<(Vec<f64>, u64, u64, f64, Option<String>)> {
     let fit = &job.job.fit;
-    let configured = nested
+    let configured = nested.is_some()
         && fit.nested_search == job::NestedSearch::Adaptive
         && fit.objective == job::Objective::Likelihood
         && job.job.targets.is_none();
     if configured && problem.cost_is_nll() {
-        return nested_search(problem, fit, warm, reporting);
+        return nested_search(problem, fit, warm, nested, reporting);
     }
     if configured && let Some(pb) = &reporting.progress {
         // The bar counted an adaptive search, but this problem has no likelihood to gauge it.
@@ -528,17 +538,23 @@ pub const NESTED_GLOBAL_GAIN_NATS: f64 = 0.1;
 /// The adaptive search of a nested candidate: Nelder–Mead polishes from each of `warm` (in
 /// parallel), then [`optimise`]'s global search only when the best of them lowers the cost (the
 /// recording's NLL, nats) by more than [`NESTED_GLOBAL_GAIN_NATS`] below the first warm point (the
-/// smaller model's optimum). Returns [`optimise`]'s tuple and a note for the model-choice reason.
+/// smaller model's optimum) or below `smaller_search_cost`, where the smaller model's own search
+/// ended, whichever is lower. The warm point is the smaller model's settled optimum, at the centre
+/// of the likelihood's bowl, where a polish descends by a ripple's depth (about 0.05–0.1 nats on the
+/// main job) without any help from the shoulder; the gain is therefore read polish end against
+/// polish end. Returns [`optimise`]'s tuple and a note for the model-choice reason.
 #[allow(clippy::type_complexity)]
 fn nested_search(
     problem: &Arc<SpectralProblem>,
     fit: &job::FitSection,
     warm: &[Vec<f64>],
+    smaller_search_cost: Option<f64>,
     reporting: &Reporting,
 ) -> Result<(Vec<f64>, u64, u64, f64, Option<String>)> {
     use rayon::prelude::*;
     reporting.stage(format_args!("local search"));
-    let base = warm.first().map_or(f64::INFINITY, |w| problem.cost_at(w));
+    let at_warm = warm.first().map_or(f64::INFINITY, |w| problem.cost_at(w));
+    let base = at_warm.min(smaller_search_cost.unwrap_or(f64::INFINITY));
     let observer = |r: usize| SearchObserver {
         stage: SearchStage::Polish,
         restart: r,
@@ -551,7 +567,7 @@ fn nested_search(
         .enumerate()
         .map(|(r, w)| polish(problem, w, 0.05, fit.polish_iterations, Some(observer(r))))
         .collect();
-    let mut local: Option<(Vec<f64>, f64)> = warm.first().map(|w| (w.clone(), base));
+    let mut local: Option<(Vec<f64>, f64)> = warm.first().map(|w| (w.clone(), at_warm));
     let mut polish_iters = 0;
     for run in runs {
         let (u, iters, cost) = match run {
@@ -567,8 +583,8 @@ fn nested_search(
     let gain = base - cost;
     if gain <= NESTED_GLOBAL_GAIN_NATS || interrupt::stop_requested() {
         let note = format!(
-            "local search only: it lowered the NLL by {gain:.3} nats below the model without \
-             shoulder, not more than {NESTED_GLOBAL_GAIN_NATS} nats: its extra parameters do \
+            "local search only: it ended {gain:.3} nats below the model without shoulder's \
+             search, not more than {NESTED_GLOBAL_GAIN_NATS} nats: its extra parameters do \
              nothing near that model's optimum, so no global search"
         );
         return Ok((u, 0, polish_iters, cost, Some(note)));
@@ -579,8 +595,8 @@ fn nested_search(
     let (gu, swarm_iters, global_polish, gcost) =
         optimise(problem, fit, fit.seed, warm, Some(reporting))?;
     let note = format!(
-        "global search: the local search lowered the NLL by {gain:.3} nats (> \
-         {NESTED_GLOBAL_GAIN_NATS})"
+        "global search: the local search ended {gain:.3} nats below the model without \
+         shoulder's search (> {NESTED_GLOBAL_GAIN_NATS})"
     );
     let (u, cost) = if gcost < cost { (gu, gcost) } else { (u, cost) };
     Ok((
