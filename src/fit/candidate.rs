@@ -41,6 +41,13 @@ impl Candidate {
         self.to_string()
     }
 
+    /// Whether this candidate takes one of `bands` from the recording's head track (the neck/lip
+    /// model on a prescribed head, for a band below [`NECK_BAND_MIN_HZ`]): its likelihood there is
+    /// not a model's, so it cannot be compared with the others'.
+    pub fn imposes_a_band(&self, bands: &[BandSpec]) -> bool {
+        !self.kind.has_head_mode() && bands.iter().any(|b| b.range_hz[0] < NECK_BAND_MIN_HZ)
+    }
+
     /// Why this candidate cannot produce `bands` (None if it can).
     pub fn cannot_produce(&self, bands: &[BandSpec]) -> Option<String> {
         if !self.kind.has_head_mode() {

@@ -45,9 +45,12 @@ fn evidences(fits: &[CandidateFit]) -> Option<Vec<Option<Evidence>>> {
     (complete && e.iter().any(Option::is_some)).then_some(e)
 }
 
-/// Chooses by AIC among the candidates that produced a model and can produce every band (the
-/// neck/lip model imposes a low band from the head track, so its fit there proves nothing); if
-/// none can, among all. `listed`: the job named its candidates (else the smallest capable model
+/// Chooses by AIC among the candidates that produced a model and can be compared: with the
+/// recording's likelihood, every candidate but one that imposes a band from the head track (the
+/// neck/lip model's low band, whose fit there proves nothing), since a model without a mode a band
+/// needs is judged by how well it explains that band (on a head-only recording the high band holds
+/// no neck–lip line, and the head model is the right answer); without a likelihood, the candidates
+/// that can produce every band. If none qualifies, among all. `listed`: the job named its candidates (else the smallest capable model
 /// was the only one).
 pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) -> Selection {
     let evidence = evidences(fits);
@@ -62,7 +65,10 @@ pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) ->
         .collect();
     let capable: Vec<bool> = fits
         .iter()
-        .map(|f| f.candidate.cannot_produce(bands).is_none())
+        .map(|f| match &evidence {
+            Some(_) => !f.candidate.imposes_a_band(bands),
+            None => f.candidate.cannot_produce(bands).is_none(),
+        })
         .collect();
     let any_capable = capable.contains(&true);
     let scores: Vec<f64> = (0..fits.len())
