@@ -1,5 +1,5 @@
 //! One line per step of the event-driven integrator on the true blade's default window
-//! (`data/reversal/blade_true.toml`, atol = rtol/100): end time, step size, accepted steps,
+//! (`data/reversal/blade_true.toml`; arguments rtol, method, atol, default atol = rtol/100): end time, step size, accepted steps,
 //! rejected attempts and right-hand-side evaluations since the last line, why the step ended and
 //! the phase it ran in; the totals on stderr. Where the evaluations go by part of the window
 //! (docs/validation.md, "DOP853 against DOPRI5"):
@@ -31,7 +31,9 @@ fn main() {
     };
     let opts = SolverOptions {
         rtol,
-        atol: rtol / 100.0,
+        atol: args
+            .get(3)
+            .map_or(rtol / 100.0, |a| a.parse().expect("atol")),
         method,
         ..SolverOptions::default()
     };
