@@ -11,9 +11,9 @@ use rand::SeedableRng;
 use rand::rngs::StdRng;
 use rand_distr::{Distribution, Normal};
 use wiperlab::fit::likelihood::{
-    Evidence, LikelihoodError, Side, WelchLikelihood, bin_correlation, demeaned_residuals,
-    effective_sample_size, gaussian_nll, interior_bin, likelihood_ratio_test, noise_psd,
-    tracking_noise_sigma, welch_dof,
+    Evidence, LINE_FALSE_ALARM, LikelihoodError, Side, WelchLikelihood, band_has_line,
+    bin_correlation, demeaned_residuals, effective_sample_size, gaussian_nll, interior_bin,
+    likelihood_ratio_test, noise_psd, tracking_noise_sigma, welch_dof,
 };
 use wiperlab::spectrum::{Scaling, WelchConfig, WelchPlan, Window};
 
@@ -507,4 +507,40 @@ fn whittle_nll_rejects_bad_input_with_its_numbers() {
     assert_eq!(one.dof, 2.0);
     let got = one.nll(&[3.0], &[2.0]).unwrap();
     assert!((got - (2f64.ln() + 1.5)).abs() < 1e-12, "{got}");
+}
+
+/// `band_has_line` on white noise alone and with a sinusoid at 2.7 times the noise's density
+/// (a bin-centred 195.3 Hz line of amplitude 0.25 beside σ = 1: Welch peak `a²/(2·ENBW)`, ENBW =
+/// 1.5 fs/nperseg for Hann, 0.0053 against `2σ²/fs` = 0.002). On noise its false alarms must stay
+/// near `LINE_FALSE_ALARM` (Bonferroni over the band's bins: at most that rate); a per-bin quantile
+/// instead would call a line in nearly every band. The line must be found in (almost) every seed.
+#[test]
+fn a_band_of_noise_has_no_line_and_a_line_above_the_noise_is_found() {
+    use wiperlab::fit::features::{BandSpec, features};
+    let bands = [BandSpec::new("b", [50.0, 450.0], NPERSEG)];
+    let seeds = 300;
+    let (mut false_alarms, mut found) = (0, 0);
+    for seed in 0..seeds {
+        let x = white(9000 + seed, 1.0, N_SAMPLES);
+        let f = features(&x, FS_HZ, &bands, 0).unwrap();
+        false_alarms += usize::from(band_has_line(&f.bands[0]));
+        let f_line = 50.0 * FS_HZ / NPERSEG as f64;
+        let y: Vec<f64> = x
+            .iter()
+            .enumerate()
+            .map(|(i, v)| v + 0.25 * (std::f64::consts::TAU * f_line * i as f64 / FS_HZ).sin())
+            .collect();
+        let f = features(&y, FS_HZ, &bands, 0).unwrap();
+        found += usize::from(band_has_line(&f.bands[0]));
+    }
+    println!(
+        "white noise: {false_alarms} of {seeds} bands called a line (α = {LINE_FALSE_ALARM}); \
+         with the line: found in {found} of {seeds}"
+    );
+    // Binomial(300, 0.01): P(≥ 9) = 0.4 %.
+    assert!(false_alarms <= 8, "{false_alarms} false alarms in {seeds}");
+    assert!(
+        found >= seeds as usize * 99 / 100,
+        "line found in {found} of {seeds}"
+    );
 }

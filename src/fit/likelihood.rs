@@ -361,6 +361,48 @@ impl WelchLikelihood {
     }
 }
 
+/// Family-wise false-alarm rate of [`band_has_line`]: the chance that a band of pure noise is
+/// taken to have a line.
+pub const LINE_FALSE_ALARM: f64 = 0.01;
+
+/// Whether a band of a Welch estimate has a line: its largest ordinate stands above what white
+/// noise reaches. Under noise alone each ordinate is `S·χ²_ν/ν` ([`welch_dof`]), and the band's
+/// median ordinate estimates `S·m_ν` (`m_ν` the median of `χ²_ν/ν`); the band has a line when
+/// its largest ordinate exceeds the median by more than `q/m_ν`, `q` the `1 − α/M` quantile of
+/// `χ²_ν/ν` for `M` bins and `α` = [`LINE_FALSE_ALARM`] (Bonferroni over the bins, conservative as
+/// neighbouring bins correlate). A band whose motion raises its median only makes the test
+/// stricter. Without a distribution for the band (median average, no segments) it says yes.
+///
+/// On the confusion table's head-only recording (docs/fit.md) the high band's largest ordinate is
+/// 1.4 times its median, against a threshold of about 1.5: tracking noise, whose maximum falls
+/// anywhere in 500–5000 Hz.
+pub fn band_has_line(band: &crate::spectrum::features::BandFeatures) -> bool {
+    let mut finite: Vec<f64> = band
+        .psd
+        .iter()
+        .copied()
+        .filter(|p| p.is_finite() && *p > 0.0)
+        .collect();
+    if finite.len() < 3 {
+        return true;
+    }
+    finite.sort_by(f64::total_cmp);
+    let median = finite[finite.len() / 2];
+    let largest = finite[finite.len() - 1];
+    let Ok(cfg) = band.spec.welch_config() else {
+        return true;
+    };
+    let Ok(nu) = welch_dof(&cfg, band.segments) else {
+        return true;
+    };
+    let Ok(chi2) = ChiSquared::new(nu) else {
+        return true;
+    };
+    let q = chi2.inverse_cdf(1.0 - LINE_FALSE_ALARM / finite.len() as f64);
+    let m = chi2.inverse_cdf(0.5);
+    largest > median * q / m
+}
+
 /// One-sided PSD of white noise of standard deviation `sigma` (signal units) sampled at `fs_hz`,
 /// as a Welch estimate with `cfg` reads it: `2σ²/fs` for density scaling, `2σ²·Σh²/(Σh)²` for
 /// spectrum scaling.

@@ -82,6 +82,10 @@ pub struct SpectralProblem {
     pub free: Vec<FreeParam>,
     pub measured: Features,
     pub floors: Vec<f64>,
+    /// Per band, whether the measured band has a line above its noise
+    /// ([`super::likelihood::band_has_line`]); [`SpectralProblem::cost_of`] compares peak
+    /// frequencies only where it has.
+    pub lines: Vec<bool>,
     pub bands: Vec<BandSpec>,
     pub signal: SignalKind,
     pub sample_times: Vec<f64>,
@@ -174,16 +178,23 @@ impl SpectralProblem {
         }
         let w = &self.weights;
         let mut total = 0.0;
-        for ((d, m), floor) in self
+        for (i, ((d, m), floor)) in self
             .measured
             .bands
             .iter()
             .zip(&model.bands)
             .zip(&self.floors)
+            .enumerate()
         {
             match (d.peak, m.peak) {
                 (Some(pd), Some(pm)) => {
-                    let df = (pm.freq_hz / pd.freq_hz).ln() / 0.01;
+                    // The frequency of a band's largest noise ordinate is no measured quantity: a
+                    // band without a line compares levels and shape only.
+                    let df = if self.lines.get(i).copied().unwrap_or(true) {
+                        (pm.freq_hz / pd.freq_hz).ln() / 0.01
+                    } else {
+                        0.0
+                    };
                     let dl = ((pm.level + floor) / pd.level).ln() / std::f64::consts::LN_2;
                     total += w.peak * df * df + w.level * dl * dl;
                 }

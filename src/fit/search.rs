@@ -360,6 +360,11 @@ fn problem_of(
         label: r.label,
         base: r.base,
         free: free.to_vec(),
+        lines: measured
+            .bands
+            .iter()
+            .map(super::likelihood::band_has_line)
+            .collect(),
         measured,
         floors,
         bands: job.job.spectrum.bands.clone(),

@@ -235,6 +235,8 @@ impl ReplicateSource {
             label: problem.label.clone(),
             base: problem.base,
             free: problem.free.clone(),
+            // The replicate's bands keep the recording's verdict on lines: the same comparison.
+            lines: problem.lines.clone(),
             measured,
             floors,
             bands: problem.bands.clone(),
