@@ -104,6 +104,11 @@ fn cost(c: &mut Criterion) {
         base: p,
         free: Vec::new(),
         floors: vec![0.0; bands.len()],
+        lines: measured
+            .bands
+            .iter()
+            .map(wiperlab::fit::likelihood::band_has_line)
+            .collect(),
         measured,
         bands,
         signal: SignalKind::TipRelX,
