@@ -33,10 +33,11 @@ pub(super) fn intervals(
     }
     match fit.uncertainty.method() {
         UncertaintyMethod::Laplace => match &cf.evidence {
-            Ok(_) => Ok((
-                Some(laplace_intervals(&cf.free, &cf.best_u, &cf.sigma_u)),
-                Vec::new(),
-            )),
+            Ok(_) => {
+                let mut intervals = laplace_intervals(&cf.free, &cf.best_u, &cf.sigma_u);
+                let warnings = along_contact_ridge(cf, &mut intervals);
+                Ok((Some(intervals), warnings))
+            }
             Err(why) => Ok((None, vec![format!("no Laplace intervals: {why}")])),
         },
         UncertaintyMethod::Bootstrap if fit.uncertainty.bootstrap == 0 => Ok((
@@ -80,6 +81,90 @@ pub fn laplace_intervals(free: &[FreeParam], best_u: &[f64], sigma_u: &[f64]) ->
             }
         })
         .collect()
+}
+
+/// How far [`along_contact_ridge`] looks: the free neck stiffness times each factor.
+pub const RIDGE_K1_FACTORS: [f64; 4] = [
+    0.5,
+    std::f64::consts::FRAC_1_SQRT_2,
+    std::f64::consts::SQRT_2,
+    2.0,
+];
+
+/// The rise of the NLL at a 68.27 % one-parameter profile-likelihood bound: half the 68.27 % point of
+/// χ²₁ (Pawitan 2001, *In All Likelihood*, §2.6).
+pub const PROFILE_68_NATS: f64 = 0.5;
+
+/// Widens the intervals of `k1` and `theta_c` along the shoulder's contact-moment ridge, where a
+/// fit frees both with `k1c`. While the neck rests on the shoulder its moment is
+/// `k1c·θ − (k1c − k1)·θ_c` (docs/model.md, "Shoulder contact"), so a neck that rarely leaves the
+/// shoulder shows the spectra `(k1c − k1)·θ_c`, not k1 and θ_c apart; the Fisher information at
+/// the fit sees the stick–slip likelihood's ripples there and can call both determined
+/// (docs/fit.md, "Why the free k1 of a resting neck is not recovered"). Each point
+/// `k1' = f·k1`, `θ_c' = (k1c − k1)·θ_c / (k1c − k1')` for f in [`RIDGE_K1_FACTORS`] inside the
+/// search box is evaluated with the other parameters held; one whose cost is within
+/// [`PROFILE_68_NATS`] of the fit's lies inside the 68.27 % profile-likelihood region (holding the
+/// others only raises the cost), so the two intervals are widened to contain it. Returns a warning
+/// naming the span found; nothing when the fit frees no such triple or no point qualifies. Costs
+/// up to 4 simulations.
+fn along_contact_ridge(cf: &CandidateFit, intervals: &mut [Interval]) -> Vec<String> {
+    let cost = |u: &[f64]| cf.problem.cost_at(u);
+    match widen_along_ridge(&cf.free, &cf.best_u, cf.cost, cost, intervals) {
+        Some((lo, hi)) => vec![format!(
+            "k1 and theta_c trade along the shoulder's contact-moment ridge ((k1c − k1)·θ_c held): \
+             k1 from {lo:.4e} to {hi:.4e} N·m/rad stays within {PROFILE_68_NATS} nats of the fit, so \
+             both intervals span it; the recording determines the moment at contact, not k1 and \
+             theta_c apart"
+        )],
+        None => Vec::new(),
+    }
+}
+
+/// The point of the contact-moment ridge through `(k1, k1c, theta_c)` with free stiffness
+/// `k1_r`: the contact angle that keeps `(k1c − k1)·θ_c`, or `None` where `k1_r` is on the other
+/// side of `k1c` (no such angle).
+pub fn ridge_theta_c(k1: f64, k1c: f64, theta_c: f64, k1_r: f64) -> Option<f64> {
+    ((k1c - k1_r) * (k1c - k1) > 0.0).then(|| (k1c - k1) * theta_c / (k1c - k1_r))
+}
+
+/// [`along_contact_ridge`] on any `cost` of the normalised coordinates, with `cost0` at `best_u`:
+/// the span of k1 found inside the profile region, `None` when the freed parameters lack k1, k1c
+/// or theta_c or no ridge point qualifies.
+fn widen_along_ridge(
+    free: &[FreeParam],
+    best_u: &[f64],
+    cost0: f64,
+    cost: impl Fn(&[f64]) -> f64,
+    intervals: &mut [Interval],
+) -> Option<(f64, f64)> {
+    use crate::model::ParamId;
+    let at = |id: ParamId| free.iter().position(|f| f.name == id);
+    let (i_k1, i_kc, i_th) = (at(ParamId::K1)?, at(ParamId::K1c)?, at(ParamId::ThetaC)?);
+    let value = |i: usize| free[i].value(best_u[i]);
+    let (k1, k1c, theta_c) = (value(i_k1), value(i_kc), value(i_th));
+    let inside = |i: usize, v: f64| (free[i].lower..=free[i].upper).contains(&v);
+    let mut span: Option<(f64, f64)> = None;
+    for k1_r in RIDGE_K1_FACTORS.map(|f| f * k1) {
+        let Some(theta_r) = ridge_theta_c(k1, k1c, theta_c, k1_r) else {
+            continue;
+        };
+        if !inside(i_k1, k1_r) || !inside(i_th, theta_r) {
+            continue;
+        }
+        let mut u = best_u.to_vec();
+        u[i_k1] = free[i_k1].u_of(k1_r);
+        u[i_th] = free[i_th].u_of(theta_r);
+        if cost(&u) - cost0 > PROFILE_68_NATS {
+            continue;
+        }
+        for (i, v) in [(i_k1, k1_r), (i_th, theta_r)] {
+            intervals[i].lo = intervals[i].lo.min(v);
+            intervals[i].hi = intervals[i].hi.max(v);
+        }
+        let (lo, hi) = span.unwrap_or((k1, k1));
+        span = Some((lo.min(k1_r), hi.max(k1_r)));
+    }
+    span
 }
 
 /// Confidence intervals (68.27 %, i.e. ±1σ-equivalent) for every freed parameter by a parametric
@@ -310,4 +395,60 @@ pub fn identifiability_warnings(
         }
     }
     w
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::ParamId;
+
+    #[test]
+    fn a_ridge_point_keeps_the_moment_at_contact() {
+        // (k1c − k1)·θ_c = (0.1 − 0.03)·0.05 = 3.5e-3 N·m at every point of the ridge.
+        for k1_r in [0.015, 0.0212, 0.0424, 0.06] {
+            let th = ridge_theta_c(0.03, 0.1, 0.05, k1_r).unwrap();
+            assert!(((0.1 - k1_r) * th - 3.5e-3).abs() < 1e-15);
+        }
+        // Past k1c no angle keeps it.
+        assert!(ridge_theta_c(0.03, 0.1, 0.05, 0.12).is_none());
+    }
+
+    fn setup() -> (Vec<FreeParam>, Vec<f64>, Vec<Interval>) {
+        let free = vec![
+            FreeParam::new(ParamId::K1, 0.005, 0.15),
+            FreeParam::new(ParamId::K1c, 0.005, 0.15),
+            FreeParam::new(ParamId::ThetaC, 0.02, 0.2),
+        ];
+        let u: Vec<f64> = [0.03, 0.1, 0.05]
+            .iter()
+            .zip(&free)
+            .map(|(v, f)| f.u_of(*v))
+            .collect();
+        let iv = laplace_intervals(&free, &u, &[0.01, 0.01, 0.01]);
+        (free, u, iv)
+    }
+
+    #[test]
+    fn intervals_widen_over_a_flat_contact_moment_ridge_and_not_over_a_bowl() {
+        let (free, u, iv0) = setup();
+        let phys =
+            |u: &[f64]| -> Vec<f64> { free.iter().zip(u).map(|(f, x)| f.value(*x)).collect() };
+        // A cost that sees only the moment at contact and k1c: flat along the ridge.
+        let ridge = |u: &[f64]| {
+            let p = phys(u);
+            (((p[1] - p[0]) * p[2] - 3.5e-3) / 1e-5).powi(2) + ((p[1] - 0.1) / 1e-3).powi(2)
+        };
+        let mut iv = iv0.clone();
+        let span = widen_along_ridge(&free, &u, 0.0, ridge, &mut iv).unwrap();
+        assert!((span.0 - 0.015).abs() < 1e-12 && (span.1 - 0.06).abs() < 1e-12);
+        assert!(iv[0].lo <= 0.015 + 1e-12 && iv[0].hi >= 0.06 - 1e-12);
+        // θ_c spans the ridge's angles: 3.5e-3/(0.1 − 0.015) to 3.5e-3/(0.1 − 0.06).
+        assert!(iv[2].lo <= 3.5e-3 / 0.085 + 1e-12 && iv[2].hi >= 3.5e-3 / 0.04 - 1e-12);
+        assert_eq!((iv[1].lo, iv[1].hi), (iv0[1].lo, iv0[1].hi));
+        // A cost that also sees k1 (1 nat at ±1 % of it): no ridge point is within 0.5 nats.
+        let bowl = |u: &[f64]| ridge(u) + ((phys(u)[0] - 0.03) / 3e-4).powi(2);
+        let mut iv = iv0.clone();
+        assert!(widen_along_ridge(&free, &u, 0.0, bowl, &mut iv).is_none());
+        assert_eq!(iv, iv0);
+    }
 }
