@@ -35,6 +35,8 @@ named_enum! {
         L2 => "l2",
         /// Lip mass m2, kg, with the head's and the free neck's natural frequencies held.
         LipMass => "lip_mass",
+        /// Preload N0 = k0·h_d, N, set through h_d (k0 as the other freed parameters leave it).
+        Preload => "preload",
         /// Shoulder contact angle, rad.
         ThetaC => "theta_c",
     }
@@ -64,6 +66,9 @@ impl ParamId {
             ParamId::LipMass => {
                 "lip mass m2, kg (its inertia scales with it; k0 and k1 follow: head and free neck frequencies held)"
             }
+            ParamId::Preload => {
+                "preload N0 = k0·h_d, N (h_d follows, after the head mass, lip mass or k0 have set k0)"
+            }
             ParamId::ThetaC => "shoulder contact angle, rad (needs a [shoulder] in the blade)",
         }
     }
@@ -78,6 +83,7 @@ impl ParamId {
             ParamId::Hd | ParamId::L2 => "m",
             ParamId::HeadMass | ParamId::LipMass => "kg",
             ParamId::K0 => "N/m",
+            ParamId::Preload => "N",
             ParamId::K1 | ParamId::K1c | ParamId::K2 => "N·m/rad",
             ParamId::ThetaC => "rad",
         }
@@ -104,15 +110,19 @@ impl ParamId {
     /// Whether the parameter must be strictly positive (a mass, a length, a spring the model divides
     /// by or the preload), not merely non-negative.
     pub fn strictly_positive(self) -> bool {
-        self.is_geometry() || matches!(self, ParamId::K0 | ParamId::K1 | ParamId::Hd)
+        self.is_geometry() || matches!(
+                self,
+                ParamId::K0 | ParamId::K1 | ParamId::Hd | ParamId::Preload
+            )
     }
 
     /// The freed parameters that `self` moves when set ([`ParamId::set`]), and that a job therefore
     /// cannot free beside it: the lip mass holds the head's and the free neck's frequencies through
-    /// k0 and k1.
+    /// k0 and k1, the preload is set through h_d.
     pub fn holds(self) -> &'static [ParamId] {
         match self {
             ParamId::LipMass => &[ParamId::K0, ParamId::K1],
+            ParamId::Preload => &[ParamId::Hd],
             _ => &[],
         }
     }
@@ -139,6 +149,7 @@ impl ParamId {
             ParamId::K2 => p.k2_nm_per_rad,
             ParamId::L2 => p.l2_m,
             ParamId::LipMass => p.lip_mass_kg,
+            ParamId::Preload => p.k0_n_per_m * p.hd_m,
             ParamId::ThetaC => p.shoulder?.contact_angle_rad,
         })
     }
@@ -152,7 +163,10 @@ impl ParamId {
     /// - `lip_mass`: the lip's inertia J2 scales with m2 (the same shape), and k0 and k1 follow so
     ///   that f_head and the free neck's [`BladeParams::neck_freq_hz`] stay;
     /// - `l2`: the lip's centre of mass d2 scales with l2 and J2 with l2² (the same rod, longer);
-    ///   its mass stays.
+    ///   its mass stays;
+    /// - `preload`: h_d = N0 / k0 with the k0 `p` has, so a job sets it after the parameters that
+    ///   move k0 (the freed parameters are set in [`ParamId`]'s order, and `preload` comes after
+    ///   `head_mass`, `k0` and `lip_mass`).
     pub fn set(self, p: &mut BladeParams, v: f64) -> bool {
         let slot: &mut f64 = match self {
             ParamId::A | ParamId::B | ParamId::C => match &mut p.friction {
@@ -167,6 +181,10 @@ impl ParamId {
             ParamId::C1 => &mut p.c1_nms_per_rad,
             ParamId::C2 => &mut p.c2_nms_per_rad,
             ParamId::Hd => &mut p.hd_m,
+            ParamId::Preload => {
+                p.hd_m = v / p.k0_n_per_m;
+                return true;
+            }
             ParamId::K0 => &mut p.k0_n_per_m,
             ParamId::K1 => &mut p.k1_nm_per_rad,
             ParamId::K1c | ParamId::ThetaC => match &mut p.shoulder {
@@ -265,11 +283,34 @@ mod tests {
             (p.k0_n_per_m, p.k1_nm_per_rad),
             (base.k0_n_per_m, base.k1_nm_per_rad)
         );
-        for id in [ParamId::HeadMass, ParamId::L2, ParamId::LipMass] {
+        for id in [
+            ParamId::HeadMass,
+            ParamId::L2,
+            ParamId::LipMass,
+            ParamId::Preload,
+        ] {
             let v = id.get(&base).unwrap();
             let mut p = base;
             id.set(&mut p, 0.5 * v);
-            assert_eq!(id.get(&p), Some(0.5 * v), "{id}");
+            let got = id.get(&p).unwrap();
+            assert!((got / (0.5 * v) - 1.0).abs() < 1e-12, "{id}: {got} against {}", 0.5 * v);
         }
+    }
+
+    /// The preload set after the head mass is k0·h_d with the new head's k0: the experiment blade
+    /// (head 20 Hz) with a 10 g head and 1.5 N needs k0 = M_t (2π 20 Hz)², h_d = 1.5 N / k0.
+    #[test]
+    fn preload_follows_the_head_mass_it_is_set_after() {
+        let base = experiment_blade();
+        let reconstruction = base.k0_n_per_m * base.hd_m;
+        assert!((reconstruction - 1.1124336838764888).abs() < 1e-12, "{reconstruction}");
+        let mut p = base;
+        assert!(ParamId::HeadMass.set(&mut p, 0.010));
+        assert!(ParamId::Preload.set(&mut p, 1.5));
+        let mt = 0.010 + p.neck_mass_kg + p.lip_mass_kg;
+        let k0 = mt * (std::f64::consts::TAU * 20.0).powi(2);
+        assert!((p.hd_m - 1.5 / k0).abs() < 1e-15, "{} against {}", p.hd_m, 1.5 / k0);
+        assert!(ParamId::HeadMass < ParamId::Preload && ParamId::LipMass < ParamId::Preload);
+        assert_eq!(ParamId::Preload.holds(), &[ParamId::Hd]);
     }
 }
