@@ -142,6 +142,10 @@ pub struct Exploration {
     /// The job's start (the blade file's values of the freed parameters) and what it gave.
     pub start: Sample,
     pub sensitivity: Vec<Sensitivity>,
+    /// The closest achievable pair ([`super::reach::closest_pair`]): an index into `samples`.
+    pub closest_pair: Option<usize>,
+    /// The one-at-a-time sensitivity around the closest achievable pair (empty without one).
+    pub around_closest: Vec<Sensitivity>,
     pub wall_time_s: f64,
     pub threads: usize,
 }
@@ -205,15 +209,24 @@ pub fn explore(
         outcome: outcome(&problem, &problem.base),
     };
     tick();
-    let sensitivity = (0..dims)
-        .into_par_iter()
-        .map(|i| {
-            let s = sensitivity(&problem, i, &start);
-            tick();
-            tick();
-            s
-        })
-        .collect();
+    let oat = |at: &Sample, origin: &BladeParams| -> Vec<Sensitivity> {
+        (0..dims)
+            .into_par_iter()
+            .map(|i| {
+                let s = sensitivity(&problem, i, at, origin);
+                tick();
+                tick();
+                s
+            })
+            .collect()
+    };
+    let sensitivity = oat(&start, &problem.base);
+    let targets = targets(&problem);
+    let closest_pair = super::reach::closest_pair(&drawn, &targets).map(|c| c.sample);
+    let around_closest = match closest_pair {
+        Some(k) => oat(&drawn[k], &params_with(&problem, &drawn[k].values)),
+        None => Vec::new(),
+    };
     Ok(Exploration {
         job: job.name.clone(),
         model: candidate.name(),
@@ -223,21 +236,34 @@ pub fn explore(
             .iter()
             .map(|b| (b.name.clone(), b.range_hz))
             .collect(),
-        targets: targets(&problem),
+        targets,
         signal: problem.signal,
         seed,
         samples: drawn,
         start,
         sensitivity,
+        closest_pair,
+        around_closest,
         wall_time_s: started.elapsed().as_secs_f64(),
         threads: rayon::current_num_threads(),
     })
 }
 
 /// Simulations [`explore`] runs for `samples` samples of a job with `free` freed parameters (for
-/// a progress bar's length).
+/// a progress bar's length): the samples, the start, and the one-at-a-time steps around the start
+/// and around the closest achievable pair (when there is one; the bar may stop short otherwise).
 pub fn simulations(samples: usize, free: usize) -> u64 {
-    (samples + 1 + 2 * free) as u64
+    (samples + 1 + 4 * free) as u64
+}
+
+/// The job's blade with the freed parameters set to `values` (job order, as
+/// [`SpectralProblem::params_at`] sets them).
+fn params_with(problem: &SpectralProblem, values: &[f64]) -> BladeParams {
+    let mut p = problem.base;
+    for (f, v) in problem.free.iter().zip(values) {
+        f.name.set(&mut p, *v);
+    }
+    p
 }
 
 /// The blade file's values of the freed parameters.
@@ -300,23 +326,35 @@ pub fn outcome(problem: &SpectralProblem, p: &BladeParams) -> Outcome {
     }
 }
 
-/// Freed parameter `i` moved alone by ±[`OAT_STEP`] of its start value (±[`OAT_STEP`] of its
-/// range when the start is 0), the other parameters at the start.
-fn sensitivity(problem: &SpectralProblem, i: usize, start: &Sample) -> Sensitivity {
+/// Freed parameter `i` moved alone by ±[`OAT_STEP`] of its value at `at` (±[`OAT_STEP`] of its
+/// range when that is 0), the other parameters at `at` (`origin` is the blade there). A freed
+/// preload is set again after the move, so it stays what `at` says (it is set through h_d, which a
+/// moved head or lip mass would otherwise carry to another preload).
+fn sensitivity(
+    problem: &SpectralProblem,
+    i: usize,
+    at: &Sample,
+    origin: &BladeParams,
+) -> Sensitivity {
     let f = &problem.free[i];
-    let v0 = start.values[i];
+    let v0 = at.values[i];
     let h = if v0 != 0.0 {
         OAT_STEP * v0.abs()
     } else {
         OAT_STEP * (f.upper - f.lower)
     };
-    let at = |v: f64| {
-        let mut p = problem.base;
+    let moved = |v: f64| {
+        let mut p = *origin;
         f.name.set(&mut p, v);
+        for (g, w) in problem.free.iter().zip(&at.values).skip(i + 1) {
+            if g.name == crate::model::ParamId::Preload {
+                g.name.set(&mut p, *w);
+            }
+        }
         outcome(problem, &p)
     };
     let (lo, hi) = (v0 - h, v0 + h);
-    let outcomes = [at(lo), start.outcome.clone(), at(hi)];
+    let outcomes = [moved(lo), at.outcome.clone(), moved(hi)];
     let bands = problem.bands.len();
     let elasticity = (0..bands)
         .map(|b| {

@@ -22,6 +22,7 @@ pub mod job;
 pub mod likelihood;
 mod measure;
 mod problem;
+pub mod reach;
 pub mod result;
 mod search;
 mod select;

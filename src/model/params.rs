@@ -110,7 +110,8 @@ impl ParamId {
     /// Whether the parameter must be strictly positive (a mass, a length, a spring the model divides
     /// by or the preload), not merely non-negative.
     pub fn strictly_positive(self) -> bool {
-        self.is_geometry() || matches!(
+        self.is_geometry()
+            || matches!(
                 self,
                 ParamId::K0 | ParamId::K1 | ParamId::Hd | ParamId::Preload
             )
@@ -293,7 +294,11 @@ mod tests {
             let mut p = base;
             id.set(&mut p, 0.5 * v);
             let got = id.get(&p).unwrap();
-            assert!((got / (0.5 * v) - 1.0).abs() < 1e-12, "{id}: {got} against {}", 0.5 * v);
+            assert!(
+                (got / (0.5 * v) - 1.0).abs() < 1e-12,
+                "{id}: {got} against {}",
+                0.5 * v
+            );
         }
     }
 
@@ -303,13 +308,21 @@ mod tests {
     fn preload_follows_the_head_mass_it_is_set_after() {
         let base = experiment_blade();
         let reconstruction = base.k0_n_per_m * base.hd_m;
-        assert!((reconstruction - 1.1124336838764888).abs() < 1e-12, "{reconstruction}");
+        assert!(
+            (reconstruction - 1.1124336838764888).abs() < 1e-12,
+            "{reconstruction}"
+        );
         let mut p = base;
         assert!(ParamId::HeadMass.set(&mut p, 0.010));
         assert!(ParamId::Preload.set(&mut p, 1.5));
         let mt = 0.010 + p.neck_mass_kg + p.lip_mass_kg;
         let k0 = mt * (std::f64::consts::TAU * 20.0).powi(2);
-        assert!((p.hd_m - 1.5 / k0).abs() < 1e-15, "{} against {}", p.hd_m, 1.5 / k0);
+        assert!(
+            (p.hd_m - 1.5 / k0).abs() < 1e-15,
+            "{} against {}",
+            p.hd_m,
+            1.5 / k0
+        );
         assert!(ParamId::HeadMass < ParamId::Preload && ParamId::LipMass < ParamId::Preload);
         assert_eq!(ParamId::Preload.holds(), &[ParamId::Hd]);
     }
