@@ -121,12 +121,99 @@ fn explore_csv_has_a_row_per_sample_and_a_seed_repeats_it() {
     assert!(rows[0].ends_with(",cost,failure,failure_message"));
     assert_eq!(a, run("b", "7"), "the same seed gave another table");
     assert_ne!(a, run("c", "8"), "another seed gave the same samples");
-    for f in ["sensitivity.csv", "sensitivity.md", "reachability.svg"] {
+    for f in [
+        "sensitivity.csv",
+        "sensitivity.md",
+        "reachability.svg",
+        "constraint.txt",
+    ] {
         assert!(dir.join("a").join(f).is_file(), "{f} missing");
     }
     // The sensitivity table: three rows (lower, start, upper) per freed parameter.
     let sens = std::fs::read_to_string(dir.join("a/sensitivity.csv")).unwrap();
     assert_eq!(sens.lines().count(), 1 + 3 * 3);
+    // The closest achievable pair named in constraint.txt is the one this test finds in
+    // explore.csv by the stated rule (own lines at least 5x their floor, smallest largest miss
+    // over tolerance: 1 % for 78.4 Hz, 2 % for 900 Hz).
+    let expected = closest_in_csv(&a);
+    let text = std::fs::read_to_string(dir.join("a/constraint.txt")).unwrap();
+    match expected {
+        Some((k, d)) => assert!(
+            text.starts_with("Closest achievable pair")
+                && text.contains(&format!("sample {k}, distance {d:.2}:")),
+            "expected sample {k} at {d:.2}:\n{text}"
+        ),
+        None => assert!(text.starts_with("No sample gave every band"), "{text}"),
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The closest achievable pair of an `explore.csv` of the experiment's targets (78.4 Hz ± 1 %,
+/// 900 Hz ± 2 %), recomputed from the table: rows with both lines their own (no harmonic_of) and
+/// prominence ≥ 5, the smallest max(|f_low/78.4 − 1|/0.01, |f_high/900 − 1|/0.02).
+fn closest_in_csv(table: &str) -> Option<(usize, f64)> {
+    let mut r = csv::Reader::from_reader(table.as_bytes());
+    let h = r.headers().unwrap().clone();
+    let col = |n: &str| h.iter().position(|c| c == n).unwrap();
+    let (lf, lp, lh) = (
+        col("low_hz"),
+        col("low_prominence"),
+        col("low_harmonic_of_hz"),
+    );
+    let (hf, hp, hh) = (
+        col("high_hz"),
+        col("high_prominence"),
+        col("high_harmonic_of_hz"),
+    );
+    let mut best: Option<(usize, f64)> = None;
+    for (i, rec) in r.records().enumerate() {
+        let rec = rec.unwrap();
+        let num = |c: usize| rec[c].parse::<f64>().ok();
+        let (Some(fl), Some(pl), Some(fh), Some(ph)) = (num(lf), num(lp), num(hf), num(hp)) else {
+            continue;
+        };
+        if !rec[lh].is_empty() || !rec[hh].is_empty() || !(pl >= 5.0 && ph >= 5.0) {
+            continue;
+        }
+        let d = ((fl / 78.4 - 1.0).abs() / 0.01).max((fh / 900.0 - 1.0).abs() / 0.02);
+        if best.is_none_or(|b| d < b.1) {
+            best = Some((i, d));
+        }
+    }
+    best
+}
+
+/// A job cannot free the preload beside h_d (the preload is set through h_d): exit 2 naming the
+/// preload's line, nothing written.
+#[test]
+fn the_preload_cannot_be_freed_beside_hd() {
+    let dir = temp_dir("preload");
+    let path = job(
+        &dir,
+        "C = [0.3, 0.8]\nhd = [1e-4, 1e-3]\npreload = [1.0, 2.0]",
+    );
+    let out = dir.join("out");
+    let o = wiperlab(&[
+        "explore",
+        path.to_str().unwrap(),
+        "--samples",
+        "2",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    let line = std::fs::read_to_string(&path)
+        .unwrap()
+        .lines()
+        .position(|l| l.starts_with("preload"))
+        .unwrap()
+        + 1;
+    assert!(
+        err.contains(&format!("{}:{line}:", path.display())) && err.contains("'hd'"),
+        "{err}"
+    );
+    assert!(!out.exists(), "a refused job wrote {}", out.display());
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -146,6 +146,8 @@ pub struct Exploration {
     pub closest_pair: Option<usize>,
     /// The one-at-a-time sensitivity around the closest achievable pair (empty without one).
     pub around_closest: Vec<Sensitivity>,
+    /// The closest pair with each lever set to its first-order value, simulated ([`lever_checks`]).
+    pub lever_checks: Vec<super::reach::LeverCheck>,
     pub wall_time_s: f64,
     pub threads: usize,
 }
@@ -227,7 +229,7 @@ pub fn explore(
         Some(k) => oat(&drawn[k], &params_with(&problem, &drawn[k].values)),
         None => Vec::new(),
     };
-    Ok(Exploration {
+    let mut e = Exploration {
         job: job.name.clone(),
         model: candidate.name(),
         free: problem.free.clone(),
@@ -244,16 +246,51 @@ pub fn explore(
         sensitivity,
         closest_pair,
         around_closest,
-        wall_time_s: started.elapsed().as_secs_f64(),
+        lever_checks: Vec::new(),
+        wall_time_s: 0.0,
         threads: rayon::current_num_threads(),
-    })
+    };
+    e.lever_checks = lever_checks(&problem, &e, &tick);
+    e.wall_time_s = started.elapsed().as_secs_f64();
+    Ok(e)
+}
+
+/// The closest achievable pair with each lever of its binding band ([`super::reach::Push`] within
+/// [`super::reach::MAX_LEVER_FACTOR`]) set alone to its first-order value, inside the box or beyond
+/// it, and simulated.
+fn lever_checks(
+    problem: &SpectralProblem,
+    e: &Exploration,
+    tick: &(dyn Fn() + Sync),
+) -> Vec<super::reach::LeverCheck> {
+    let Some(k) = e.closest_pair else {
+        return Vec::new();
+    };
+    let at = &e.samples[k];
+    let c = super::reach::constraint(e);
+    c.pushes
+        .par_iter()
+        .filter(|p| p.is_lever(at.values[p.param]))
+        .map(|p| {
+            let mut values = at.values.clone();
+            values[p.param] = p.needed;
+            let outcome = outcome(problem, &params_with(problem, &values));
+            tick();
+            super::reach::LeverCheck {
+                param: p.param,
+                value: p.needed,
+                outcome,
+            }
+        })
+        .collect()
 }
 
 /// Simulations [`explore`] runs for `samples` samples of a job with `free` freed parameters (for
-/// a progress bar's length): the samples, the start, and the one-at-a-time steps around the start
-/// and around the closest achievable pair (when there is one; the bar may stop short otherwise).
+/// a progress bar's length): the samples, the start, the one-at-a-time steps around the start and
+/// around the closest achievable pair, and at most one lever check per parameter (when there is a
+/// pair; the bar may stop short otherwise).
 pub fn simulations(samples: usize, free: usize) -> u64 {
-    (samples + 1 + 4 * free) as u64
+    (samples + 1 + 5 * free) as u64
 }
 
 /// The job's blade with the freed parameters set to `values` (job order, as

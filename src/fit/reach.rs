@@ -28,6 +28,10 @@ pub const BOUND_MARGIN: f64 = 0.03;
 /// The outer share of the box beside a bound whose samples show what lies beyond it.
 pub const EDGE_SHARE: f64 = 0.1;
 
+/// A parameter whose first-order value for the target is more than this factor from the sample's
+/// moves the line too little to count as a lever (the linear estimate means nothing that far).
+pub const MAX_LEVER_FACTOR: f64 = 10.0;
+
 /// The relative tolerance of band `b`: 1 % for the first band, 2 % for the others (issue 17's
 /// criterion for the paper's pairs, 78.4 Hz ± 1 % and 900 Hz ± 2 %).
 pub fn band_tolerance(b: usize) -> f64 {
@@ -176,6 +180,13 @@ pub fn bound_hits(e: &Exploration, s: &Sample) -> Vec<BoundHit> {
         .collect()
 }
 
+/// Whether the line of band `b` is the band's own, prominent line in `o` (a run with lines).
+fn own_line(o: &Outcome, b: usize) -> bool {
+    o.lines()
+        .and_then(|l| l.get(b))
+        .is_some_and(|l| LineFlaw::of(l).is_none())
+}
+
 /// What moving one freed parameter alone does for the binding band, to first order.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Push {
@@ -188,6 +199,23 @@ pub struct Push {
     pub beyond: Option<Side>,
     /// Whether the sample already sits on that bound ([`BoundHit`]).
     pub on_bound: bool,
+}
+
+impl Push {
+    /// Whether the first-order value lies within [`MAX_LEVER_FACTOR`] of the sample's.
+    pub fn is_lever(&self, value: f64) -> bool {
+        let r = self.needed / value;
+        r.is_finite() && (1.0 / MAX_LEVER_FACTOR..=MAX_LEVER_FACTOR).contains(&r)
+    }
+}
+
+/// One freed parameter of the closest sample set to its first-order value ([`Push::needed`]) and
+/// simulated: what the linear estimate is worth (computed by [`super::explore::explore`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LeverCheck {
+    pub param: usize,
+    pub value: f64,
+    pub outcome: Outcome,
 }
 
 /// What the outer [`EDGE_SHARE`] of the box beside one bound gave.
@@ -206,6 +234,8 @@ pub struct Edge {
 pub struct Nearer {
     /// How many, per the flaw of their first flawed band.
     pub by_flaw: Vec<(LineFlaw, usize)>,
+    /// Of these, the ones within every tolerance (distance ≤ 1), per flaw.
+    pub within: Vec<(LineFlaw, usize)>,
     /// The nearest of them: sample index, distance, its first flawed band and flaw.
     pub best: Option<(usize, f64, usize, LineFlaw)>,
 }
@@ -219,6 +249,8 @@ pub struct Constraint {
     pub hits: Vec<BoundHit>,
     /// Per freed parameter with an elasticity for the binding band, in job order.
     pub pushes: Vec<Push>,
+    /// The freed parameters whose ±step lost the binding band's own line ([`line_jumps`]).
+    pub jumps: Vec<usize>,
     /// Beside every bound a push lies beyond.
     pub edges: Vec<Edge>,
     pub nearer: Nearer,
@@ -241,7 +273,8 @@ fn binding_band(e: &Exploration, s: &Sample) -> Option<(usize, f64)> {
 }
 
 /// Each freed parameter's first-order push of the binding band `band` to its target, from the
-/// sensitivity `around` the closest sample `s`.
+/// sensitivity `around` the closest sample `s`: only where both ±steps kept the band's line its
+/// own and prominent (else the step jumped to another line, see [`line_jumps`]).
 fn pushes(e: &Exploration, s: &Sample, band: usize, around: &[Sensitivity]) -> Vec<Push> {
     let (Some(lines), Some(target)) = (s.outcome.lines(), e.targets[band]) else {
         return Vec::new();
@@ -252,6 +285,7 @@ fn pushes(e: &Exploration, s: &Sample, band: usize, around: &[Sensitivity]) -> V
     around
         .iter()
         .enumerate()
+        .filter(|(_, r)| own_line(&r.outcomes[0], band) && own_line(&r.outcomes[2], band))
         .filter_map(|(param, r)| {
             let el = r.elasticity.get(band).copied().flatten()?;
             let v = s.values[param];
@@ -278,6 +312,17 @@ fn pushes(e: &Exploration, s: &Sample, band: usize, around: &[Sensitivity]) -> V
                 on_bound,
             })
         })
+        .collect()
+}
+
+/// The freed parameters whose ±step around the closest sample left band `band` without an own,
+/// prominent line (a failed run, or the band's largest maximum became another, flawed line).
+fn line_jumps(band: usize, around: &[Sensitivity]) -> Vec<usize> {
+    around
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| !(own_line(&r.outcomes[0], band) && own_line(&r.outcomes[2], band)))
+        .map(|(i, _)| i)
         .collect()
 }
 
@@ -319,6 +364,12 @@ pub fn edge(e: &Exploration, param: usize, side: Side) -> Edge {
 /// The samples nearer than `limit` (all samples with lines when `None`) whose lines do not count.
 fn nearer(e: &Exploration, limit: Option<f64>) -> Nearer {
     let mut by_flaw: Vec<(LineFlaw, usize)> = Vec::new();
+    let mut within: Vec<(LineFlaw, usize)> = Vec::new();
+    let count = |v: &mut Vec<(LineFlaw, usize)>, flaw| match v.iter_mut().find(|(f, _)| *f == flaw)
+    {
+        Some((_, n)) => *n += 1,
+        None => v.push((flaw, 1)),
+    };
     let mut best: Option<(usize, f64, usize, LineFlaw)> = None;
     for (i, s) in e.samples.iter().enumerate() {
         let (Some((band, flaw)), Some(d)) = (first_flaw(s), distance(s, &e.targets)) else {
@@ -327,16 +378,21 @@ fn nearer(e: &Exploration, limit: Option<f64>) -> Nearer {
         if limit.is_some_and(|l| d >= l) {
             continue;
         }
-        match by_flaw.iter_mut().find(|(f, _)| *f == flaw) {
-            Some((_, n)) => *n += 1,
-            None => by_flaw.push((flaw, 1)),
+        count(&mut by_flaw, flaw);
+        if d <= 1.0 {
+            count(&mut within, flaw);
         }
         if best.is_none_or(|b| d < b.1) {
             best = Some((i, d, band, flaw));
         }
     }
     by_flaw.sort_by(|a, b| b.1.cmp(&a.1));
-    Nearer { by_flaw, best }
+    within.sort_by(|a, b| b.1.cmp(&a.1));
+    Nearer {
+        by_flaw,
+        within,
+        best,
+    }
 }
 
 /// The closest achievable pair of `e` and what keeps it from the targets, from the exploration's
@@ -352,6 +408,7 @@ pub fn constraint(e: &Exploration) -> Constraint {
             binding: None,
             hits: Vec::new(),
             pushes: Vec::new(),
+            jumps: Vec::new(),
             edges: Vec::new(),
             nearer: nearer(e, None),
         };
@@ -359,8 +416,10 @@ pub fn constraint(e: &Exploration) -> Constraint {
     let s = &e.samples[c.sample];
     let binding = binding_band(e, s);
     let pushes = binding.map_or_else(Vec::new, |(b, _)| pushes(e, s, b, &e.around_closest));
+    let jumps = binding.map_or_else(Vec::new, |(b, _)| line_jumps(b, &e.around_closest));
     let edges = pushes
         .iter()
+        .filter(|p| p.is_lever(s.values[p.param]))
         .filter_map(|p| p.beyond.map(|side| edge(e, p.param, side)))
         .collect();
     Constraint {
@@ -368,6 +427,7 @@ pub fn constraint(e: &Exploration) -> Constraint {
         binding,
         hits: bound_hits(e, s),
         pushes,
+        jumps,
         edges,
         nearer: nearer(e, Some(c.distance)),
     }
@@ -434,6 +494,7 @@ mod tests {
             sensitivity: Vec::new(),
             closest_pair: None,
             around_closest: Vec::new(),
+            lever_checks: Vec::new(),
             wall_time_s: 0.0,
             threads: 1,
         }
@@ -507,8 +568,11 @@ mod tests {
         };
         e.around_closest = vec![
             sens(ParamId::HeadMass, [Some(-0.5), Some(0.1)]),
-            sens(ParamId::A, [None, Some(0.3)]),
+            sens(ParamId::A, [Some(5.0), Some(0.3)]),
         ];
+        // A's lower step gave a weak low line (sample 3's): its elasticity of 5 is a jump to
+        // another line, not a lever.
+        e.around_closest[1].outcomes[0] = e.samples[3].outcome.clone();
         let c = constraint(&e);
         assert_eq!(c.closest.map(|c| c.sample), Some(2));
         // Head mass 0.0101 kg: u = ln(1.01)/ln(15) = 0.0037, on its lower bound; A 1.49:
@@ -530,6 +594,8 @@ mod tests {
             "{}",
             p.needed
         );
+        assert!(p.is_lever(0.0101));
+        assert_eq!(c.jumps, [1]);
         // The lowest tenth of the head-mass box (u ≤ 0.1: M ≤ 0.01·15^0.1 = 0.01311 kg) holds
         // samples 2 and 4: one with lines, one contact loss.
         assert_eq!(c.edges.len(), 1);
@@ -540,6 +606,9 @@ mod tests {
         let mut flaws = c.nearer.by_flaw.clone();
         flaws.sort();
         assert_eq!(flaws, [(LineFlaw::Harmonic, 1), (LineFlaw::Weak, 1)]);
+        let mut within = c.nearer.within.clone();
+        within.sort();
+        assert_eq!(within, [(LineFlaw::Harmonic, 1), (LineFlaw::Weak, 1)]);
         let best = c.nearer.best.unwrap();
         assert_eq!((best.0, best.2, best.3), (3, 0, LineFlaw::Weak));
     }

@@ -1,8 +1,12 @@
 //! The files of `wiperlab explore`: the samples (`explore.csv`), the one-at-a-time sensitivity
-//! (`sensitivity.csv`, `sensitivity.md`) and the reachability map (`reachability.svg`), from an
-//! [`Exploration`] computed upstream.
+//! (`sensitivity.csv`, `sensitivity.md`), the closest achievable pair and its constraint
+//! (`constraint.txt`, also in `sensitivity.md` and the terminal summary) and the reachability map
+//! (`reachability.svg`, the pair marked), from an [`Exploration`] computed upstream.
 
-use crate::fit::explore::{Exploration, Outcome, Sample};
+use crate::fit::explore::{Exploration, Outcome, Sample, Sensitivity};
+use crate::fit::reach::{
+    BOUND_MARGIN, Constraint, EDGE_SHARE, MAX_LEVER_FACTOR, Push, Side, band_tolerance, constraint,
+};
 use crate::report::plot::{Category, Panel, Target, scatter_panels};
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};
@@ -14,6 +18,9 @@ pub const SENSITIVITY_CSV: &str = "sensitivity.csv";
 pub const SENSITIVITY_MD: &str = "sensitivity.md";
 /// The reachability map.
 pub const MAP_SVG: &str = "reachability.svg";
+/// The closest achievable pair and its constraint, one sentence a line (the report page shows it
+/// under the map).
+pub const CONSTRAINT_TXT: &str = "constraint.txt";
 
 /// Writes the four files into `dir` (created if missing); returns their paths.
 ///
@@ -31,6 +38,11 @@ pub fn write_exploration(dir: &Path, e: &Exploration) -> Result<Vec<PathBuf>> {
     let md = dir.join(SENSITIVITY_MD);
     crate::io::write_atomic(&md, sensitivity_markdown(e).as_bytes())?;
     written.push(md);
+    let txt = dir.join(CONSTRAINT_TXT);
+    let mut lines = constraint_lines(e, &constraint(e)).join("\n");
+    lines.push('\n');
+    crate::io::write_atomic(&txt, lines.as_bytes())?;
+    written.push(txt);
     if e.bands.len() >= 2 {
         let map = dir.join(MAP_SVG);
         scatter_panels(&map, &map_title(e), &map_panels(e))?;
@@ -144,22 +156,42 @@ fn line_text(o: &Outcome, band: usize) -> String {
 }
 
 /// `sensitivity.md`: one row per freed parameter: its start and step, each band's line at the
-/// lower end, the start and the upper end, and the elasticity.
+/// lower end, the start and the upper end, and the elasticity; then the closest achievable pair,
+/// its constraint and the same table around that pair.
 pub fn sensitivity_markdown(e: &Exploration) -> String {
     let mut s = format!(
-        "# One-at-a-time sensitivity of `{}` ({}, signal {})\n\nEach freed parameter moved alone by ±{:.0} % around the job's start (the blade file's values); per band the line (prominence over the local floor) at the lower end → start → upper end, and its elasticity d ln f / d ln θ.\n\n| parameter | start | ± step |",
+        "# One-at-a-time sensitivity of `{}` ({}, signal {})\n\nEach freed parameter moved alone by ±{:.0} % around the job's start (the blade file's values); per band the line (prominence over the local floor) at the lower end → start → upper end, and its elasticity d ln f / d ln θ.\n\n",
         e.job,
         e.model,
         e.signal.label(),
         100.0 * crate::fit::explore::OAT_STEP
     );
+    s += &oat_table(e, &e.sensitivity);
+    s += "\n## Closest achievable pair and the constraint\n\n";
+    for l in constraint_lines(e, &constraint(e)) {
+        s += &format!("- {l}\n");
+    }
+    if let Some(k) = e.closest_pair {
+        s += &format!(
+            "\nAround sample {k}, each freed parameter moved alone by ±{:.0} % (a bound may be crossed):\n\n",
+            100.0 * crate::fit::explore::OAT_STEP
+        );
+        s += &oat_table(e, &e.around_closest);
+    }
+    s
+}
+
+/// A one-at-a-time table in Markdown: per parameter its value and step, each band's line at the
+/// three points and the elasticity.
+fn oat_table(e: &Exploration, rows: &[Sensitivity]) -> String {
+    let mut s = "| parameter | value | ± step |".to_string();
     for (b, _) in &e.bands {
-        s += &format!(" {b}: lower → start → upper | {b}: d ln f / d ln θ |");
+        s += &format!(" {b}: lower → at → upper | {b}: d ln f / d ln θ |");
     }
     s += "\n|---|---|---|";
     s += &"---|---|".repeat(e.bands.len());
     s.push('\n');
-    for r in &e.sensitivity {
+    for r in rows {
         s += &format!(
             "| {} | {:.4e} | {:.2e} |",
             r.parameter,
@@ -178,6 +210,330 @@ pub fn sensitivity_markdown(e: &Exploration) -> String {
         s.push('\n');
     }
     s
+}
+
+/// A value with its parameter's unit, e.g. `1.000e-2 kg`.
+fn with_unit(e: &Exploration, param: usize, v: f64) -> String {
+    match e.free[param].name.unit() {
+        "-" => format!("{v:.3e}"),
+        u => format!("{v:.3e} {u}"),
+    }
+}
+
+/// The closest pair's lines against the targets, e.g. `low 61.0 Hz (×900) against 78.4 Hz (−22.2 %)`.
+fn pair_text(e: &Exploration, s: &Sample) -> String {
+    let Some(lines) = s.outcome.lines() else {
+        return String::new();
+    };
+    let parts: Vec<String> = lines
+        .iter()
+        .zip(&e.bands)
+        .zip(&e.targets)
+        .map(|((l, (name, _)), t)| {
+            let against = t.map_or(String::new(), |t| {
+                format!(
+                    " against {} Hz ({:+.2} %)",
+                    span_text(t),
+                    100.0 * crate::fit::reach::relative_miss(l.freq_hz, t)
+                )
+            });
+            format!("{name} {:.1} Hz (x{:.1}){against}", l.freq_hz, l.prominence)
+        })
+        .collect();
+    parts.join(", ")
+}
+
+/// The closest achievable pair and its constraint in sentences (computed from `c`).
+pub fn constraint_lines(e: &Exploration, c: &Constraint) -> Vec<String> {
+    let tol: Vec<String> = (0..e.bands.len())
+        .map(|b| format!("{} {:.0} %", e.bands[b].0, 100.0 * band_tolerance(b)))
+        .collect();
+    let metric = format!(
+        "distance = the largest |relative miss| / tolerance over the bands ({})",
+        tol.join(", ")
+    );
+    let mut out = Vec::new();
+    let Some(closest) = c.closest else {
+        out.push(format!(
+            "No sample gave every band an own line at least {}x its local floor, so there is no closest achievable pair.",
+            crate::spectrum::harmonics::MIN_PROMINENCE
+        ));
+        out.extend(nearer_line(e, c, "with lines"));
+        return out;
+    };
+    let s = &e.samples[closest.sample];
+    let values: Vec<String> = (0..e.free.len())
+        .map(|i| format!("{}={}", e.free[i].name, with_unit(e, i, s.values[i])))
+        .collect();
+    out.push(format!(
+        "Closest achievable pair (own lines, at least {}x their floor; {metric}): sample {}, distance {:.2}: {}.",
+        crate::spectrum::harmonics::MIN_PROMINENCE,
+        closest.sample,
+        closest.distance,
+        pair_text(e, s)
+    ));
+    out.push(format!("Its parameters: {}.", values.join(", ")));
+    out.push(bounds_line(e, c, s));
+    match c.binding {
+        None => out.push("It reaches every target within its tolerance.".into()),
+        Some((b, miss)) => out.extend(binding_lines(e, c, s, b, miss)),
+    }
+    out.extend(nearer_line(e, c, "nearer than it"));
+    out
+}
+
+/// Which freed parameters of the closest sample sit on a bound.
+fn bounds_line(e: &Exploration, c: &Constraint, s: &Sample) -> String {
+    if c.hits.is_empty() {
+        return format!(
+            "No freed parameter is within {:.0} % of the box of a bound there.",
+            100.0 * BOUND_MARGIN
+        );
+    }
+    let hits: Vec<String> = c
+        .hits
+        .iter()
+        .map(|h| {
+            let f = &e.free[h.param];
+            let bound = if h.side == Side::Lower {
+                f.lower
+            } else {
+                f.upper
+            };
+            format!(
+                "{} {} ({} at the bound {})",
+                f.name,
+                with_unit(e, h.param, s.values[h.param]),
+                h.side,
+                with_unit(e, h.param, bound)
+            )
+        })
+        .collect();
+    format!(
+        "On a bound (within {:.0} % of the box): {}.",
+        100.0 * BOUND_MARGIN,
+        hits.join("; ")
+    )
+}
+
+/// The binding band, what each lever would need to move it to its target (checked by a
+/// simulation), which bound stops that, and what lies beside that bound.
+fn binding_lines(e: &Exploration, c: &Constraint, s: &Sample, b: usize, miss: f64) -> Vec<String> {
+    let f_hz = s.outcome.lines().map_or(f64::NAN, |l| l[b].freq_hz);
+    let goal = e.targets[b].map_or(f64::NAN, |t| f_hz.clamp(t[0], t[1]));
+    let name = &e.bands[b].0;
+    let mut out = vec![format!(
+        "Farthest from its target: band {name}, {f_hz:.1} Hz ({:+.2} %, {:.1} tolerances). Levers (elasticity d ln f / d ln θ from the sample's ±{:.0} % steps, both keeping an own, prominent line; first-order value for {goal} Hz within {}x of the sample's), strongest first:",
+        100.0 * miss,
+        miss.abs() / band_tolerance(b),
+        100.0 * crate::fit::explore::OAT_STEP,
+        MAX_LEVER_FACTOR
+    )];
+    let mut levers: Vec<&Push> = c
+        .pushes
+        .iter()
+        .filter(|p| p.is_lever(s.values[p.param]))
+        .collect();
+    levers.sort_by(|x, y| y.elasticity.abs().total_cmp(&x.elasticity.abs()));
+    let mut blocked = Vec::new();
+    for p in &levers {
+        let (line, stop) = lever_line(e, p, b, miss);
+        out.push(line);
+        blocked.extend(stop);
+    }
+    if levers.is_empty() {
+        out.push("  none.".into());
+    }
+    out.extend(others_line(e, c, s));
+    out.push(if blocked.is_empty() {
+        format!(
+            "Constraint: no bound stops a lever of band {name}; {}.",
+            if levers.is_empty() {
+                "no freed parameter moves its own line far enough"
+            } else {
+                "its levers reach inside the box only to first order (see what their simulations gave)"
+            }
+        )
+    } else {
+        format!("Constraint: band {name} needs {}.", blocked.join("; or "))
+    });
+    out.extend(c.edges.iter().map(|x| edge_line(e, c, x)));
+    out
+}
+
+/// One lever of band `b` (the sample's relative miss `miss`): its elasticity, first-order value,
+/// the bound beyond it, and what its simulation gave ([`Exploration::lever_checks`]), nearer to the
+/// target than the sample or not; and the constraint's phrase when a bound stops it.
+fn lever_line(e: &Exploration, p: &Push, b: usize, miss: f64) -> (String, Option<String>) {
+    let f = &e.free[p.param];
+    let goal = e.targets[b].map_or(f64::NAN, |t| if miss < 0.0 { t[0] } else { t[1] });
+    let check = e.lever_checks.iter().find(|k| k.param == p.param);
+    let verdict = check.map_or(String::new(), |k| check_verdict(e, &k.outcome, b, miss));
+    let needed = with_unit(e, p.param, p.needed);
+    let stop = p.beyond.map(|side| {
+        let bound = if side == Side::Lower {
+            f.lower
+        } else {
+            f.upper
+        };
+        let on = if p.on_bound {
+            " (the sample sits on it)"
+        } else {
+            ""
+        };
+        format!(
+            "{} {} {}{on}: {needed} to first order{verdict}",
+            f.name,
+            side.text(),
+            with_unit(e, p.param, bound)
+        )
+    });
+    let place = match &stop {
+        Some(_) => "beyond the box",
+        None => "inside the box",
+    };
+    let simulated = check
+        .map(|k| format!("; simulated there: {}", outcome_text(e, &k.outcome)))
+        .unwrap_or_default();
+    (
+        format!(
+            "  {}: elasticity {:+.3}; {goal} Hz needs {needed} ({place}){simulated}{verdict}.",
+            f.name, p.elasticity
+        ),
+        stop,
+    )
+}
+
+/// Whether a lever's simulated set brought band `b` nearer to its target than the sample's
+/// relative miss `miss`, e.g. `, which gave band low −47.30 %, not nearer than the sample`.
+fn check_verdict(e: &Exploration, o: &Outcome, b: usize, miss: f64) -> String {
+    let (Some(lines), Some(t)) = (o.lines(), e.targets[b]) else {
+        return ", where the simulation failed".into();
+    };
+    let m = crate::fit::reach::relative_miss(lines[b].freq_hz, t);
+    let how = if m.abs() <= band_tolerance(b) {
+        "within the tolerance"
+    } else if m.abs() < miss.abs() {
+        "nearer than the sample"
+    } else {
+        "not nearer than the sample"
+    };
+    format!(
+        ", where the simulation gave band {} {:+.2} %, {how}",
+        e.bands[b].0,
+        100.0 * m
+    )
+}
+
+/// The freed parameters that are not levers: too weak, or their step lost the line.
+fn others_line(e: &Exploration, c: &Constraint, s: &Sample) -> Option<String> {
+    let weak: Vec<String> = c
+        .pushes
+        .iter()
+        .filter(|p| !p.is_lever(s.values[p.param]))
+        .map(|p| format!("{} ({:+.3})", e.free[p.param].name, p.elasticity))
+        .collect();
+    let jumps: Vec<String> = c
+        .jumps
+        .iter()
+        .map(|i| e.free[*i].name.to_string())
+        .collect();
+    let mut parts = Vec::new();
+    if !weak.is_empty() {
+        parts.push(format!(
+            "move it too little (more than {}x their value needed): {}",
+            MAX_LEVER_FACTOR,
+            weak.join(", ")
+        ));
+    }
+    if !jumps.is_empty() {
+        parts.push(format!(
+            "a ±{:.0} % step lost the band's own, prominent line (another line took its place, or the run failed): {}",
+            100.0 * crate::fit::explore::OAT_STEP,
+            jumps.join(", ")
+        ));
+    }
+    (!parts.is_empty()).then(|| format!("Not levers: {}.", parts.join("; ")))
+}
+
+/// Every band's line of an outcome, or the failure cause.
+fn outcome_text(e: &Exploration, o: &Outcome) -> String {
+    match o {
+        Outcome::Lines { .. } => (0..e.bands.len())
+            .map(|b| format!("{} {}", e.bands[b].0, line_text(o, b)))
+            .collect::<Vec<_>>()
+            .join(", "),
+        Outcome::Failed { cause, .. } => format!("failed: {cause}"),
+    }
+}
+
+/// What the outer [`EDGE_SHARE`] of the box beside a bound gave, and the one-at-a-time step past it.
+fn edge_line(e: &Exploration, c: &Constraint, x: &crate::fit::reach::Edge) -> String {
+    let f = &e.free[x.param];
+    let causes: Vec<String> = x.failures.iter().map(|(k, n)| format!("{k} {n}")).collect();
+    let failed = x.samples - x.with_lines;
+    let all_failed = e
+        .samples
+        .iter()
+        .filter(|s| s.outcome.lines().is_none())
+        .count();
+    let mut s = format!(
+        "Beside {}'s {} bound (the outer {:.0} % of its box): {} samples, {} gave lines, {failed} failed{} (over the whole box {all_failed} of {} failed)",
+        f.name,
+        x.side,
+        100.0 * EDGE_SHARE,
+        x.samples,
+        x.with_lines,
+        if causes.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", causes.join(", "))
+        },
+        e.samples.len()
+    );
+    let step = c
+        .pushes
+        .iter()
+        .find(|p| p.param == x.param && p.on_bound)
+        .and_then(|_| e.around_closest.get(x.param))
+        .map(|r| &r.outcomes[if x.side == Side::Lower { 0 } else { 2 }]);
+    if let Some(o) = step {
+        let what = outcome_text(e, o);
+        s += &format!(
+            "; the sample's ±{:.0} % step past it gave {what}",
+            100.0 * crate::fit::explore::OAT_STEP
+        );
+    }
+    s.push('.');
+    s
+}
+
+/// The samples that came nearer than the closest pair (or at all) with lines that do not count.
+fn nearer_line(e: &Exploration, c: &Constraint, what: &str) -> Option<String> {
+    let (k, d, band, flaw) = c.nearer.best?;
+    let n: usize = c.nearer.by_flaw.iter().map(|x| x.1).sum();
+    let list = |v: &[(crate::fit::reach::LineFlaw, usize)]| {
+        v.iter()
+            .map(|(f, n)| format!("{f} {n}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let within: usize = c.nearer.within.iter().map(|x| x.1).sum();
+    let within = if within > 0 {
+        format!(
+            "; {within} of them within every tolerance ({})",
+            list(&c.nearer.within)
+        )
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "{n} samples {what} had a line that does not count ({}){within}; the nearest, sample {k} at distance {d:.2} ({}), has band {}'s line {}.",
+        list(&c.nearer.by_flaw),
+        pair_text(e, &e.samples[k]),
+        e.bands[band].0,
+        flaw.text()
+    ))
 }
 
 fn map_title(e: &Exploration) -> String {
@@ -219,6 +575,18 @@ fn map_panels(e: &Exploration) -> Vec<Panel> {
     if let Some(l) = e.start.outcome.lines() {
         targets.push(Target {
             label: format!("start ({:.1} Hz, {:.1} Hz)", l[0].freq_hz, l[1].freq_hz),
+            x_span: [l[0].freq_hz; 2],
+            y_span: [l[1].freq_hz; 2],
+        });
+    }
+    if let Some(k) = e.closest_pair
+        && let Some(l) = e.samples[k].outcome.lines()
+    {
+        targets.push(Target {
+            label: format!(
+                "closest achievable pair, sample {k} ({:.1} Hz x{:.0}, {:.1} Hz x{:.0})",
+                l[0].freq_hz, l[0].prominence, l[1].freq_hz, l[1].prominence
+            ),
             x_span: [l[0].freq_hz; 2],
             y_span: [l[1].freq_hz; 2],
         });
@@ -314,16 +682,17 @@ pub fn summary(e: &Exploration) -> String {
     for (cause, n) in e.failure_counts() {
         s += &format!("  failed: {cause} {n}\n");
     }
-    let tol: Vec<f64> = (0..e.bands.len())
-        .map(|b| if b == 0 { 0.01 } else { 0.02 })
-        .collect();
+    let tol: Vec<f64> = (0..e.bands.len()).map(band_tolerance).collect();
     let reached = e.samples.iter().filter(|x| e.reaches(x, &tol)).count();
     s += &format!(
         "  reaching every target (first band within 1 %, the others within 2 %, each line its own and at least {}x its local floor): {reached}\n",
         crate::spectrum::harmonics::MIN_PROMINENCE
     );
+    for l in constraint_lines(e, &constraint(e)) {
+        s += &format!("  {l}\n");
+    }
     if let Some(c) = e.closest() {
-        s += "  closest to the targets (lowest job cost):";
+        s += "  lowest job cost:";
         for (f, v) in e.free.iter().zip(&c.values) {
             s += &format!(" {}={v:.4e}", f.name);
         }

@@ -728,17 +728,31 @@ fn report_figures(r: &FitResult, dir: &Path) -> Result<(Vec<Figure>, Vec<String>
 }
 
 /// `wiperlab explore`'s reachability map of a target job, linked from the page in `dir`
-/// (`reports/<job>/`): `reports/explore/<job>/reachability.svg` beside it, when it exists.
+/// (`reports/<job>/`): `reports/explore/<job>/reachability.svg` beside it, when it exists, its
+/// caption followed by the exploration's closest achievable pair and constraint
+/// (`constraint.txt` beside the map, when there is one).
 /// `None` for a job fitted to a recording (it has no targets to map) or without an exploration.
 fn exploration_map(r: &FitResult, dir: &Path) -> Option<Figure> {
-    let rel = format!("explore/{}/{}", r.job, crate::report::explore::MAP_SVG);
+    use crate::report::explore::{CONSTRAINT_TXT, MAP_SVG};
+    let rel = format!("explore/{}/{MAP_SVG}", r.job);
     let path = dir.parent()?.join(&rel);
+    let mut caption = "achieved line pairs of the job's freed parameters coloured by the weaker \
+                       line's prominence, the targets, the start and the closest achievable pair \
+                       marked, and the failed runs by cause (`wiperlab explore`)"
+        .to_string();
+    let notes = path.with_file_name(CONSTRAINT_TXT);
+    if let Ok(text) = std::fs::read_to_string(&notes) {
+        let text: Vec<&str> = text
+            .lines()
+            .map(str::trim)
+            .filter(|l| !l.is_empty())
+            .collect();
+        caption += &format!(". {}", text.join(" "));
+        caption = caption.trim_end_matches('.').to_string();
+    }
     (r.target_job && path.is_file()).then(|| Figure {
         file: format!("../{rel}"),
-        caption: "achieved line pairs of the job's freed parameters coloured by the weaker \
-                  line's prominence, the targets and the start marked, and the failed runs by \
-                  cause (`wiperlab explore`)"
-            .into(),
+        caption,
     })
 }
 
