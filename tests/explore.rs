@@ -172,7 +172,7 @@ fn closest_in_csv(table: &str) -> Option<(usize, f64)> {
         let (Some(fl), Some(pl), Some(fh), Some(ph)) = (num(lf), num(lp), num(hf), num(hp)) else {
             continue;
         };
-        if !rec[lh].is_empty() || !rec[hh].is_empty() || !(pl >= 5.0 && ph >= 5.0) {
+        if !(rec[lh].is_empty() && rec[hh].is_empty() && pl >= 5.0 && ph >= 5.0) {
             continue;
         }
         let d = ((fl / 78.4 - 1.0).abs() / 0.01).max((fh / 900.0 - 1.0).abs() / 0.02);
@@ -181,6 +181,53 @@ fn closest_in_csv(table: &str) -> Option<(usize, f64)> {
         }
     }
     best
+}
+
+/// On the experiment's pair box (`fits/seed_experiment_pair.toml`, where most sets give own,
+/// prominent lines) the closest achievable pair of `constraint.txt` and of the map is the one this
+/// test finds in `explore.csv` by the stated rule.
+#[test]
+fn the_closest_achievable_pair_is_the_one_the_table_gives() {
+    let dir = temp_dir("pair");
+    let job = root().join("fits/seed_experiment_pair.toml");
+    let out = dir.join("out");
+    let o = wiperlab(&[
+        "explore",
+        job.to_str().unwrap(),
+        "--samples",
+        "8",
+        "--seed",
+        "3",
+        "-o",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let table = std::fs::read_to_string(out.join("explore.csv")).unwrap();
+    let (k, d) =
+        closest_in_csv(&table).expect("no own, prominent pair in 8 samples of the pair box");
+    let text = std::fs::read_to_string(out.join("constraint.txt")).unwrap();
+    assert!(
+        text.starts_with("Closest achievable pair")
+            && text.contains(&format!("sample {k}, distance {d:.2}:")),
+        "expected sample {k} at {d:.2}:\n{text}"
+    );
+    let map = std::fs::read_to_string(out.join("reachability.svg")).unwrap();
+    assert!(
+        map.contains(&format!("closest achievable pair, sample {k} (")),
+        "map lacks the pair"
+    );
+    let summary = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        summary.contains(&format!("sample {k}, distance {d:.2}:")),
+        "{summary}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A job cannot free the preload beside h_d (the preload is set through h_d): exit 2 naming the

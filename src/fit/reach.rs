@@ -348,7 +348,7 @@ pub fn edge(e: &Exploration, param: usize, side: Side) -> Edge {
         })
         .filter(|(_, n)| *n > 0)
         .collect();
-    failures.sort_by(|a, b| b.1.cmp(&a.1));
+    failures.sort_by_key(|x| std::cmp::Reverse(x.1));
     Edge {
         param,
         side,
@@ -386,8 +386,8 @@ fn nearer(e: &Exploration, limit: Option<f64>) -> Nearer {
             best = Some((i, d, band, flaw));
         }
     }
-    by_flaw.sort_by(|a, b| b.1.cmp(&a.1));
-    within.sort_by(|a, b| b.1.cmp(&a.1));
+    by_flaw.sort_by_key(|x| std::cmp::Reverse(x.1));
+    within.sort_by_key(|x| std::cmp::Reverse(x.1));
     Nearer {
         by_flaw,
         within,
