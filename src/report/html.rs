@@ -1027,4 +1027,38 @@ pub(super) mod tests {
         assert!(html.contains("1σ: not shown"));
         assert!(!html.contains("correlation-table"));
     }
+
+    /// A target job's map comes with the exploration's constraint.txt in its caption; a job fitted
+    /// to a recording has no map.
+    #[test]
+    fn the_map_caption_carries_the_constraint() {
+        let root = std::env::temp_dir().join(format!("wiperlab_map_{}", std::process::id()));
+        let page = root.join("reports").join("job");
+        let explore = root.join("reports").join("explore").join("job");
+        std::fs::create_dir_all(&page).unwrap();
+        std::fs::create_dir_all(&explore).unwrap();
+        std::fs::write(explore.join(crate::report::explore::MAP_SVG), "<svg/>").unwrap();
+        std::fs::write(
+            explore.join(crate::report::explore::CONSTRAINT_TXT),
+            "Closest achievable pair: sample 7.\nConstraint: band low needs head_mass below its lower bound.\n",
+        )
+        .unwrap();
+        let mut r = result();
+        r.job = "job".into();
+        assert!(
+            exploration_map(&r, &page).is_none(),
+            "a recording's fit got a map"
+        );
+        r.target_job = true;
+        let map = exploration_map(&r, &page).unwrap();
+        assert_eq!(map.file, "../explore/job/reachability.svg");
+        assert!(
+            map.caption.ends_with(
+                "(`wiperlab explore`). Closest achievable pair: sample 7. Constraint: band low needs head_mass below its lower bound"
+            ),
+            "{}",
+            map.caption
+        );
+        std::fs::remove_dir_all(&root).ok();
+    }
 }
