@@ -263,8 +263,9 @@ pub enum Command {
     },
     /// Sample a job's freed parameters (seeded Sobol points over [fit.parameters]) and map where
     /// they take the model's lines: explore.csv (parameters, each band's line, prominence and
-    /// failure cause), the one-at-a-time sensitivity around the job's start (sensitivity.csv, .md)
-    /// and the reachability map (reachability.svg).
+    /// failure cause), the one-at-a-time sensitivity around the job's start (sensitivity.csv, .md),
+    /// the closest achievable pair and the constraint that keeps it from the targets
+    /// (constraint.txt) and the reachability map (reachability.svg).
     Explore {
         job: PathBuf,
         /// Number of samples (1 to 65536).
