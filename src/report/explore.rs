@@ -140,6 +140,16 @@ pub fn sensitivity_csv(e: &Exploration) -> Result<String> {
     String::from_utf8(w.into_inner().map_err(|e| csv_err(e.into_error()))?).map_err(csv_err)
 }
 
+/// A line's prominence over its local floor as `{times}p`, or `floor not measurable` where the
+/// floor has no bins to measure (NaN).
+fn prominence_text(prominence: f64, times: &str) -> String {
+    if prominence.is_finite() {
+        format!("{times}{prominence:.1}")
+    } else {
+        "floor not measurable".into()
+    }
+}
+
 /// A line as `f Hz (prominence ×p)`, or the failure cause.
 fn line_text(o: &Outcome, band: usize) -> String {
     match o {
@@ -149,7 +159,11 @@ fn line_text(o: &Outcome, band: usize) -> String {
                 .harmonic_of_hz
                 .map(|h| format!(", harmonic of {h:.1} Hz"))
                 .unwrap_or_default();
-            format!("{:.1} Hz (×{:.1}{h})", l.freq_hz, l.prominence)
+            format!(
+                "{:.1} Hz ({}{h})",
+                l.freq_hz,
+                prominence_text(l.prominence, "×")
+            )
         }
         Outcome::Failed { cause, .. } => cause.to_string(),
     }
@@ -237,7 +251,11 @@ fn pair_text(e: &Exploration, s: &Sample) -> String {
                     100.0 * crate::fit::reach::relative_miss(l.freq_hz, t)
                 )
             });
-            format!("{name} {:.1} Hz (x{:.1}){against}", l.freq_hz, l.prominence)
+            format!(
+                "{name} {:.1} Hz ({}){against}",
+                l.freq_hz,
+                prominence_text(l.prominence, "x")
+            )
         })
         .collect();
     parts.join(", ")
