@@ -232,19 +232,16 @@ fn the_closest_achievable_pair_is_the_one_the_table_gives() {
 
 /// A job cannot free the preload beside h_d (the preload is set through h_d): exit 2 naming the
 /// preload's line, nothing written.
-#[test]
-fn the_preload_cannot_be_freed_beside_hd() {
-    let dir = temp_dir("preload");
-    let path = job(
-        &dir,
-        "C = [0.3, 0.8]\nhd = [1e-4, 1e-3]\npreload = [1.0, 2.0]",
-    );
+/// Runs `explore` on a job with `params` and checks that it is refused with exit 2, naming the
+/// file, the line of `key` and `'names'`, and that nothing was written.
+fn assert_refused_at(dir: &Path, params: &str, key: &str, names: &str, samples: &str) {
+    let path = job(dir, params);
     let out = dir.join("out");
     let o = wiperlab(&[
         "explore",
         path.to_str().unwrap(),
         "--samples",
-        "2",
+        samples,
         "-o",
         out.to_str().unwrap(),
     ]);
@@ -253,14 +250,26 @@ fn the_preload_cannot_be_freed_beside_hd() {
     let line = std::fs::read_to_string(&path)
         .unwrap()
         .lines()
-        .position(|l| l.starts_with("preload"))
+        .position(|l| l.starts_with(key))
         .unwrap()
         + 1;
     assert!(
-        err.contains(&format!("{}:{line}:", path.display())) && err.contains("'hd'"),
+        err.contains(&format!("{}:{line}:", path.display())) && err.contains(&format!("'{names}'")),
         "{err}"
     );
     assert!(!out.exists(), "a refused job wrote {}", out.display());
+}
+
+#[test]
+fn the_preload_cannot_be_freed_beside_hd() {
+    let dir = temp_dir("preload");
+    assert_refused_at(
+        &dir,
+        "C = [0.3, 0.8]\nhd = [1e-4, 1e-3]\npreload = [1.0, 2.0]",
+        "preload",
+        "hd",
+        "2",
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -268,29 +277,14 @@ fn the_preload_cannot_be_freed_beside_hd() {
 #[test]
 fn explore_refuses_a_bad_job_with_exit_2_and_the_line() {
     let dir = temp_dir("bad");
-    let path = job(&dir, "C = [0.3, 0.8]\nhead_mass = [0.0, 0.15]");
-    let out = dir.join("out");
-    let o = wiperlab(&[
-        "explore",
-        path.to_str().unwrap(),
-        "--samples",
+    assert_refused_at(
+        &dir,
+        "C = [0.3, 0.8]\nhead_mass = [0.0, 0.15]",
+        "head_mass",
+        "head_mass",
         "4",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    let line = std::fs::read_to_string(&path)
-        .unwrap()
-        .lines()
-        .position(|l| l.starts_with("head_mass"))
-        .unwrap()
-        + 1;
-    assert!(
-        err.contains(&format!("{}:{line}:", path.display())) && err.contains("'head_mass'"),
-        "{err}"
     );
-    assert!(!out.exists(), "a refused job wrote {}", out.display());
+    let out = dir.join("out");
     let good = job(&dir, "C = [0.3, 0.8]");
     for n in ["0", "65537"] {
         let o = wiperlab(&[
