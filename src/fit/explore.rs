@@ -409,6 +409,14 @@ fn sensitivity(
 }
 
 impl Exploration {
+    /// How many samples gave a line in every band (the others failed).
+    pub fn with_lines(&self) -> usize {
+        self.samples
+            .iter()
+            .filter(|s| s.outcome.lines().is_some())
+            .count()
+    }
+
     /// Samples that gave lines, and those that failed, per cause (in [`FailureCause::ALL`]'s
     /// order, causes that never occurred left out).
     pub fn failure_counts(&self) -> Vec<(FailureCause, usize)> {

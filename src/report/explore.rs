@@ -490,11 +490,7 @@ fn edge_line(e: &Exploration, c: &Constraint, x: &crate::fit::reach::Edge) -> St
     let f = &e.free[x.param];
     let causes: Vec<String> = x.failures.iter().map(|(k, n)| format!("{k} {n}")).collect();
     let failed = x.samples - x.with_lines;
-    let all_failed = e
-        .samples
-        .iter()
-        .filter(|s| s.outcome.lines().is_none())
-        .count();
+    let all_failed = e.samples.len() - e.with_lines();
     let mut s = format!(
         "Beside {}'s {} bound (the outer {:.0} % of its box): {} samples, {} gave lines, {failed} failed{} (over the whole box {all_failed} of {} failed)",
         f.name,
@@ -683,11 +679,7 @@ fn failure_panel(e: &Exploration) -> Panel {
 /// A few lines for the terminal: counts, failures by cause, the closest sample and where the
 /// files are.
 pub fn summary(e: &Exploration) -> String {
-    let ok = e
-        .samples
-        .iter()
-        .filter(|s| s.outcome.lines().is_some())
-        .count();
+    let ok = e.with_lines();
     let mut s = format!(
         "{}: {} samples of {} ({}), {ok} gave lines in every band, {:.1} s on {} threads\n",
         e.job,
