@@ -205,14 +205,15 @@ impl BestModel {
     }
 }
 
-/// The freed parameters at the optimum, with the curvature's 1σ and, for synthetic recordings,
-/// the truth.
+/// The freed parameters at the optimum, with their 1σ (the sandwich's, and the Fisher
+/// information's alone) and, for synthetic recordings, the truth.
 fn fitted_parameters(job: &LoadedJob, cf: &CandidateFit) -> Vec<FittedParam> {
     cf.free
         .iter()
         .zip(&cf.best_u)
         .zip(&cf.sigma_u)
-        .map(|((fp, u), su)| {
+        .enumerate()
+        .map(|(i, ((fp, u), su))| {
             let value = fp.value(*u);
             let truth = job.truth.get(&fp.name).copied();
             FittedParam {
@@ -221,6 +222,7 @@ fn fitted_parameters(job: &LoadedJob, cf: &CandidateFit) -> Vec<FittedParam> {
                 lower: fp.lower,
                 upper: fp.upper,
                 std_error: su * fp.slope(*u),
+                fisher_std_error: cf.fisher_sigma_u.as_ref().map(|f| f[i] * fp.slope(*u)),
                 determined: su.is_finite() && *su < 0.1,
                 true_value: truth,
                 rel_error: truth.map(|t| (value - t) / t),

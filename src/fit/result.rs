@@ -82,11 +82,17 @@ pub enum IntervalMethod {
     },
     /// From the cost's curvature at the optimum.
     Curvature,
-    /// Laplace's approximation: ±1σ of the inverse Fisher information of the recording's
-    /// likelihood at the fit ([`crate::fit::evidence`]), mapped through the search's coordinates.
+    /// Laplace's approximation: ±1σ of the estimate's sandwich covariance `F⁻¹ V F⁻¹` at the fit,
+    /// with `F` the Fisher information of the recording's likelihood and `V` the variance of its
+    /// gradient under the recording's noise ([`crate::fit::evidence::at_fit`]), mapped through
+    /// the search's coordinates.
     Laplace {
         /// Central-difference step of the Fisher information, normalised coordinates.
         fisher_step_u: f64,
+        /// Noise replicates `V` was estimated from (0 in results written before `V` was: `F⁻¹`
+        /// alone).
+        #[serde(default)]
+        noise_replicates: usize,
     },
 }
 
@@ -95,9 +101,19 @@ impl std::fmt::Display for IntervalMethod {
         match self {
             IntervalMethod::Profile => f.write_str("profile"),
             IntervalMethod::Curvature => f.write_str("curvature"),
-            IntervalMethod::Laplace { fisher_step_u } => write!(
+            IntervalMethod::Laplace {
+                fisher_step_u,
+                noise_replicates: 0,
+            } => write!(
                 f,
                 "Laplace: ±1σ of the inverse Fisher information of the recording's likelihood (Gauss–Newton, central differences of {fisher_step_u} in the normalised coordinates)"
+            ),
+            IntervalMethod::Laplace {
+                fisher_step_u,
+                noise_replicates,
+            } => write!(
+                f,
+                "Laplace: ±1σ of the sandwich F⁻¹VF⁻¹ (F the Gauss–Newton Fisher information of the recording's likelihood, central differences of {fisher_step_u} in the normalised coordinates; V the variance of its gradient over {noise_replicates} replicates of the recording's tracking noise)"
             ),
             IntervalMethod::Bootstrap {
                 replicates,
@@ -133,8 +149,14 @@ pub struct FittedParam {
     pub value: f64,
     pub lower: f64,
     pub upper: f64,
-    /// 1σ from the cost's curvature (cost read as χ² with the module's scales); indicative.
+    /// 1σ of the estimate: with a likelihood, from the sandwich covariance of
+    /// [`crate::fit::evidence::at_fit`]; for a target job, from the cost's curvature (indicative).
     pub std_error: f64,
+    /// 1σ from the likelihood's Fisher information alone (`F⁻¹`, the width of the likelihood's
+    /// bowl), when the fit has a likelihood; `std_error` is the estimate's spread, the sandwich
+    /// `F⁻¹ V F⁻¹` (docs/fit.md, "Uncertainty").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fisher_std_error: Option<f64>,
     /// False when the data do not pin the parameter down (1σ wider than 10 % of its search range,
     /// or no positive curvature).
     pub determined: bool,
@@ -386,6 +408,7 @@ mod tests {
             lower: 0.005,
             upper: 0.15,
             std_error: 0.001,
+            fisher_std_error: None,
             determined: true,
             true_value: Some(0.029),
             rel_error: Some(0.03 / 0.029 - 1.0),

@@ -158,8 +158,11 @@ pub(super) struct CandidateFit {
     pub(super) best_u: Vec<f64>,
     pub(super) sigma_u: Vec<f64>,
     pub(super) corr: Vec<Vec<f64>>,
-    /// The recording's NLL at the optimum (`sigma_u` and `corr` then come from its Fisher
-    /// information), or why there is none (then from the cost's curvature).
+    /// 1σ of the normalised coordinates from the Fisher information alone, with a likelihood.
+    pub(super) fisher_sigma_u: Option<Vec<f64>>,
+    /// The recording's NLL at the optimum (`sigma_u` and `corr` then come from its sandwich
+    /// covariance, [`super::evidence::at_fit`]), or why there is none (then from the cost's
+    /// curvature).
     pub(super) evidence: std::result::Result<super::evidence::NllParts, String>,
     pub(super) swarm_iters: u64,
     pub(super) polish_iters: u64,
@@ -446,10 +449,11 @@ pub(super) fn fit_candidate(
     // likelihood (a target job).
     reporting.stage(format_args!("curvature"));
     let n = best_u.len();
-    let (sigma_u, corr, evidence) = if interrupt::stop_requested() {
+    let (sigma_u, corr, fisher_sigma_u, evidence) = if interrupt::stop_requested() {
         (
             vec![f64::NAN; n],
             vec![vec![f64::NAN; n]; n],
+            None,
             Err("interrupted".to_string()),
         )
     } else {
@@ -464,10 +468,10 @@ pub(super) fn fit_candidate(
             super::evidence::at_fit(&problem, &best_u)
         };
         match local {
-            Ok(l) => (l.sigma_u, l.corr, Ok(l.nll)),
+            Ok(l) => (l.sigma_u, l.corr, Some(l.curvature_sigma_u), Ok(l.nll)),
             Err(e) => {
                 let (s, c) = curvature(&problem, &best_u);
-                (s, c, Err(e.to_string()))
+                (s, c, None, Err(e.to_string()))
             }
         }
     };
@@ -488,6 +492,7 @@ pub(super) fn fit_candidate(
         best_u,
         sigma_u,
         corr,
+        fisher_sigma_u,
         evidence,
         swarm_iters,
         polish_iters,

@@ -52,15 +52,15 @@ pub(super) fn intervals(
 }
 
 /// Laplace intervals (68.27 %): `[θ(u − σ_u), θ(u + σ_u)]` for each freed parameter, with `σ_u`
-/// the 1σ of its normalised coordinate from the inverse Fisher information of the recording's
-/// likelihood ([`super::evidence::at_fit`]); through the search's coordinates, so a parameter
+/// the 1σ of its normalised coordinate from the sandwich covariance `F⁻¹ V F⁻¹` of the recording's
+/// likelihood at the fit ([`super::evidence::at_fit`]); through the search's coordinates, so a parameter
 /// searched on a log scale gets an interval symmetric in `ln θ`. Every interval contains its
 /// estimate. A parameter the likelihood does not inform (`σ_u = ∞`) gets its search range.
 ///
-/// Asymptotically (many effectively independent bins, a smooth likelihood) this is the
-/// maximum-likelihood estimate's interval (Pawitan 2001, *In All Likelihood*, §9.4), which the
-/// fit's estimate is with the default `[fit] objective = "likelihood"`; its coverage is measured in
-/// docs/fit.md, "Uncertainty".
+/// Asymptotically (many effectively independent bins, a smooth likelihood) this is the interval of
+/// the likelihood's maximiser (White 1982, *Econometrica* 50:1, Theorem 3.2, for a likelihood
+/// whose law is not exactly the data's), which the fit's estimate is with the default `[fit]
+/// objective = "likelihood"`; its coverage is measured in docs/fit.md, "Uncertainty".
 pub fn laplace_intervals(free: &[FreeParam], best_u: &[f64], sigma_u: &[f64]) -> Vec<Interval> {
     free.iter()
         .zip(best_u)
@@ -77,6 +77,7 @@ pub fn laplace_intervals(free: &[FreeParam], best_u: &[f64], sigma_u: &[f64]) ->
                 level: 0.6827,
                 method: IntervalMethod::Laplace {
                     fisher_step_u: super::evidence::FISHER_STEP_U,
+                    noise_replicates: super::evidence::NOISE_REPLICATES,
                 },
             }
         })
