@@ -367,8 +367,8 @@ fn main_job_end_to_end() {
         );
         println!("{name}: Laplace 68 % interval [{lo:.6e}, {hi:.6e}]");
     }
-    // Correlations from the Fisher information are finite (positive semi-definite by construction).
-    assert_eq!(r["spread_source"], "fisher_information");
+    // Correlations from the sandwich are finite (positive semi-definite by construction).
+    assert_eq!(r["spread_source"], "sandwich");
     for row in r["correlation"].as_array().expect("correlation") {
         for c in row.as_array().expect("row") {
             let c = c.as_f64().unwrap_or(f64::NAN);

@@ -292,8 +292,8 @@ fn d_objective() -> Objective {
 crate::names::named_enum! {
     /// How the fit gives each parameter an interval.
     pub enum UncertaintyMethod: "uncertainty method" {
-        /// Laplace's approximation: ±1σ from the inverse Fisher information of the recording's
-        /// likelihood at the fit (2k simulations).
+        /// Laplace's approximation: ±1σ of the sandwich `F⁻¹ V F⁻¹` of the recording's
+        /// likelihood at the fit (2k simulations and replicates of the recording's noise).
         Laplace => "laplace",
         /// Basic parametric bootstrap: `bootstrap` replicates, each re-fitted.
         Bootstrap => "bootstrap",

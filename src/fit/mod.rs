@@ -382,7 +382,7 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         undetermined,
         correlation: cf.corr.clone(),
         spread_source: if cf.evidence.is_ok() {
-            result::SpreadSource::FisherInformation
+            result::SpreadSource::Sandwich
         } else {
             result::SpreadSource::CostCurvature
         },

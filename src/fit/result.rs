@@ -27,8 +27,12 @@ named_enum! {
 named_enum! {
     /// Where the fitted parameters' 1σ and correlations come from.
     pub enum SpreadSource: "spread source" {
-        /// The inverse Fisher information of the recording's likelihood (Gauss–Newton, positive
-        /// semi-definite by construction: [`crate::fit::evidence`]).
+        /// The sandwich `F⁻¹ V F⁻¹` of the recording's likelihood: its Gauss–Newton Fisher
+        /// information `F` and its gradient's variance `V` under the recording's noise (positive
+        /// semi-definite by construction: [`crate::fit::evidence::at_fit`]).
+        Sandwich => "sandwich",
+        /// The inverse Fisher information of the recording's likelihood alone (results written
+        /// before the sandwich).
         FisherInformation => "fisher_information",
         /// The cost's curvature at the optimum, read as a χ² (a target job, which has no
         /// likelihood; NaN when the curvature is not positive definite).
@@ -106,7 +110,7 @@ impl std::fmt::Display for IntervalMethod {
                 noise_replicates: 0,
             } => write!(
                 f,
-                "Laplace: ±1σ of the inverse Fisher information of the recording's likelihood (Gauss–Newton, central differences of {fisher_step_u} in the normalised coordinates)"
+                "Laplace: ±1σ of the inverse Fisher information of the recording's likelihood alone (Gauss–Newton, central differences of {fisher_step_u} in the normalised coordinates)"
             ),
             IntervalMethod::Laplace {
                 fisher_step_u,
@@ -476,7 +480,7 @@ mod tests {
             peaks: vec![sample_peak()],
             undetermined: vec![],
             correlation: vec![vec![f64::NAN]],
-            spread_source: SpreadSource::FisherInformation,
+            spread_source: SpreadSource::Sandwich,
             swarm_iterations: 1,
             polish_iterations: 2,
             model_evaluations: 3,

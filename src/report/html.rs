@@ -478,6 +478,7 @@ struct PageView<'a> {
     sigma_shown: bool,
     /// The 1σ come from the likelihood's Fisher information.
     spread_fisher: bool,
+    spread_sandwich: bool,
     parameters: Vec<ParamView>,
     interval_methods: Vec<String>,
     peaks: Vec<PeakView>,
@@ -547,6 +548,7 @@ fn page_view<'a>(
     let (parameters, interval_methods) = parameter_rows(r);
     let (bands, signal, fit_settings) = settings_views(r);
     let fisher = r.spread_source == crate::fit::SpreadSource::FisherInformation;
+    let sandwich = r.spread_source == crate::fit::SpreadSource::Sandwich;
     let pd = fisher || curvature_positive_definite(r);
     PageView {
         style: STYLE,
@@ -566,6 +568,7 @@ fn page_view<'a>(
         fitted_utc: r.fitted_at.map(utc),
         sigma_shown: pd,
         spread_fisher: fisher,
+        spread_sandwich: sandwich,
         parameters,
         interval_methods,
         peaks: peak_rows(r),
