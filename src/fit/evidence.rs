@@ -798,7 +798,8 @@ fn newton_step(
 /// the directions the data inform): per parameter the standard deviation (∞ where the parameter
 /// loads on a direction with no information) and the correlation matrix (NaN there).
 pub fn covariance(f: &DMatrix<f64>) -> (Vec<f64>, Vec<Vec<f64>>) {
-    sandwich_covariance(f, f)
+    let (pinv, uninformed) = pseudo_inverse(f);
+    spread(&pinv, &uninformed)
 }
 
 /// The sandwich covariance `F⁺ V F⁺` of the normalised coordinates for a Fisher information (the
@@ -807,24 +808,39 @@ pub fn covariance(f: &DMatrix<f64>) -> (Vec<f64>, Vec<Vec<f64>>) {
 /// parameter the standard deviation (∞ where the parameter loads on a direction with no
 /// information) and the correlation matrix (NaN there). With `v = f` it is `F⁺`.
 pub fn sandwich_covariance(f: &DMatrix<f64>, v: &DMatrix<f64>) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let (pinv, uninformed) = pseudo_inverse(f);
+    spread(&(&pinv * v * &pinv), &uninformed)
+}
+
+/// The pseudo-inverse of a symmetric positive semi-definite `f` over its informed directions
+/// (eigenvalues above 1e-12 of the largest), and per coordinate whether it loads on an
+/// uninformed direction.
+fn pseudo_inverse(f: &DMatrix<f64>) -> (DMatrix<f64>, Vec<bool>) {
     let k = f.nrows();
     let eig = f.clone().symmetric_eigen();
     let max = eig.eigenvalues.iter().fold(0.0_f64, |a, b| a.max(*b));
-    // Directions with less than 1e-12 of the largest eigenvalue carry no information.
     let informed = |l: f64| l > 1e-12 * max && max > 0.0;
-    let uninformed = |i: usize| {
-        (0..k).any(|j| !informed(eig.eigenvalues[j]) && eig.eigenvectors[(i, j)].powi(2) > 1e-6)
-    };
+    let uninformed = (0..k)
+        .map(|i| {
+            (0..k).any(|j| !informed(eig.eigenvalues[j]) && eig.eigenvectors[(i, j)].powi(2) > 1e-6)
+        })
+        .collect();
     let pinv = DMatrix::from_fn(k, k, |i, j| {
         (0..k)
             .filter(|&m| informed(eig.eigenvalues[m]))
             .map(|m| eig.eigenvectors[(i, m)] * eig.eigenvectors[(j, m)] / eig.eigenvalues[m])
             .sum::<f64>()
     });
-    let cov = &pinv * v * &pinv;
+    (pinv, uninformed)
+}
+
+/// Standard deviations (∞ for an uninformed coordinate) and correlations (NaN there) of a
+/// covariance matrix.
+fn spread(cov: &DMatrix<f64>, uninformed: &[bool]) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let k = cov.nrows();
     let sd: Vec<f64> = (0..k)
         .map(|i| {
-            if uninformed(i) {
+            if uninformed[i] {
                 f64::INFINITY
             } else {
                 cov[(i, i)].max(0.0).sqrt()
