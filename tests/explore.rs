@@ -20,6 +20,32 @@ fn wiperlab(args: &[&str]) -> Output {
         .expect("cannot start the wiperlab binary")
 }
 
+/// Runs `explore JOB --samples N --seed S -o OUT --quiet`, asserts that it succeeds and returns the
+/// `explore.csv` it wrote and its standard output.
+fn explore_csv(job: &Path, samples: &str, seed: &str, out: &Path) -> (String, String) {
+    let o = wiperlab(&[
+        "explore",
+        job.to_str().unwrap(),
+        "--samples",
+        samples,
+        "--seed",
+        seed,
+        "-o",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    (
+        std::fs::read_to_string(out.join("explore.csv")).unwrap(),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+    )
+}
+
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("wiperlab_explore_{name}_{}", std::process::id()));
     std::fs::remove_dir_all(&d).ok();
@@ -94,26 +120,7 @@ fn explore_csv_has_a_row_per_sample_and_a_seed_repeats_it() {
         &dir,
         "C = [0.3, 0.8]\nhead_mass = [0.01, 0.15]\nl2 = [0.003, 0.006]",
     );
-    let run = |out: &str, seed: &str| {
-        let o = wiperlab(&[
-            "explore",
-            path.to_str().unwrap(),
-            "--samples",
-            "6",
-            "--seed",
-            seed,
-            "-o",
-            dir.join(out).to_str().unwrap(),
-            "--quiet",
-        ]);
-        assert_eq!(
-            o.status.code(),
-            Some(0),
-            "{}",
-            String::from_utf8_lossy(&o.stderr)
-        );
-        std::fs::read_to_string(dir.join(out).join("explore.csv")).unwrap()
-    };
+    let run = |out: &str, seed: &str| explore_csv(&path, "6", seed, &dir.join(out)).0;
     let a = run("a", "7");
     let rows: Vec<&str> = a.lines().collect();
     assert_eq!(rows.len(), 1 + 6, "{a}");
@@ -191,24 +198,7 @@ fn the_closest_achievable_pair_is_the_one_the_table_gives() {
     let dir = temp_dir("pair");
     let job = root().join("fits/seed_experiment_pair.toml");
     let out = dir.join("out");
-    let o = wiperlab(&[
-        "explore",
-        job.to_str().unwrap(),
-        "--samples",
-        "8",
-        "--seed",
-        "3",
-        "-o",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    let table = std::fs::read_to_string(out.join("explore.csv")).unwrap();
+    let (table, summary) = explore_csv(&job, "8", "3", &out);
     let (k, d) =
         closest_in_csv(&table).expect("no own, prominent pair in 8 samples of the pair box");
     let text = std::fs::read_to_string(out.join("constraint.txt")).unwrap();
@@ -222,7 +212,6 @@ fn the_closest_achievable_pair_is_the_one_the_table_gives() {
         map.contains(&format!("closest achievable pair, sample {k} (")),
         "map lacks the pair"
     );
-    let summary = String::from_utf8_lossy(&o.stdout);
     assert!(
         summary.contains(&format!("sample {k}, distance {d:.2}:")),
         "{summary}"
