@@ -494,28 +494,20 @@ impl RecordingLikelihood {
             res.extend(fb.psd.iter().zip(s).map(|(p, s)| 1.0 - p / (s + noise)));
         }
         if self.time_domain {
-            res.extend(self.time_residuals(x, m).into_iter().map(|e| -e));
+            res.extend(self.time_residuals(x, m)?.into_iter().map(|e| -e));
         }
         Ok(res)
     }
 
     /// The time-domain residuals of a signal `x` against the model signal `m`, in the order and
-    /// form of the response's time-domain part: de-meaned per sample, or de-meaned block means.
-    fn time_residuals(&self, x: &[f64], m: &[f64]) -> Vec<f64> {
-        match self.block_len {
-            Some(len) => likelihood::block_means(x, m, len, |d, m| d - m),
-            None => {
-                let e: Vec<f64> = x
-                    .iter()
-                    .zip(m)
-                    .zip(&self.measured_x)
-                    .filter(|((a, b), d)| a.is_finite() && b.is_finite() && d.is_finite())
-                    .map(|((a, b), _)| a - b)
-                    .collect();
-                let mean = e.iter().sum::<f64>() / e.len().max(1) as f64;
-                e.iter().map(|v| v - mean).collect()
-            }
-        }
+    /// form of the response's time-domain part: de-meaned per sample
+    /// ([`likelihood::demeaned_residuals`]) or de-meaned block means
+    /// ([`likelihood::block_mean_residuals`]).
+    fn time_residuals(&self, x: &[f64], m: &[f64]) -> Result<Vec<f64>> {
+        Ok(match self.block_len {
+            Some(len) => likelihood::block_mean_residuals(x, m, len)?,
+            None => likelihood::demeaned_residuals(x, m)?,
+        })
     }
 }
 
