@@ -38,6 +38,10 @@ use serde::{Deserialize, Serialize};
 /// ±1.2/1.3 %); at 1e-2 and 3e-2 the stick–slip comb's jumps enter and B's moves by 40 %.
 pub const FISHER_STEP_U: f64 = 3e-3;
 
+/// Half-span, in the whitened coordinates of `F⁻¹` (1 = the bowl's 1σ along an axis), of the
+/// points whose Jacobians the sandwich averages ([`RecordingLikelihood::smoothed_jacobian`]).
+pub const SANDWICH_SPAN_SIGMA: f64 = 0.5;
+
 /// One band's measured side: its likelihood and its ordinates.
 struct BandTerm {
     lik: WelchLikelihood,
@@ -413,6 +417,61 @@ impl RecordingLikelihood {
         Ok(Jacobian { columns })
     }
 
+    /// The response's linearisation over the central part of the likelihood's bowl: the mean of
+    /// the Jacobian `j` at `u` and of the Jacobians at `u ± r·L eᵢ`, with `r` =
+    /// [`SANDWICH_SPAN_SIGMA`], `L` the Cholesky factor of `F⁻¹ = (jᵀWj)⁻¹` (`w`: the weights
+    /// `W`) and `eᵢ` the axes; points outside the box are moved onto it, and a displaced Jacobian
+    /// whose response lost samples is left out. `j` itself where `F` is singular. Returns the mean
+    /// and the number of simulations it took (`2k` per displaced point). A displaced point whose
+    /// simulation fails is left out too.
+    ///
+    /// Why: the stick–slip response is rough below the bowl's scale, so a Jacobian by central
+    /// differences at one point moves with the point: on the main job's blade2dof fit, at points
+    /// 0.05–0.15 of `F`'s 1σ apart, the sandwich's 1σ of A moved by up to 31 % with one Jacobian.
+    /// The estimate itself scatters over about `±0.5σ` of `F` (the sandwich's 1σ is 0.5–0.7 of
+    /// `F`'s), so the linearisation that describes its spread is the response's mean slope over
+    /// that region, not its slope at the point where one fit happened to end.
+    fn smoothed_jacobian(
+        &self,
+        problem: &SpectralProblem,
+        u: &[f64],
+        j: Jacobian,
+        w: &[f64],
+    ) -> Result<(Jacobian, usize)> {
+        let k = u.len();
+        let (sigma, corr) = covariance(&j.fisher(w));
+        if sigma.iter().any(|s| !s.is_finite()) {
+            return Ok((j, 0));
+        }
+        let cov = DMatrix::from_fn(k, k, |a, b| corr[a][b] * sigma[a] * sigma[b]);
+        let Some(ch) = cov.cholesky() else {
+            return Ok((j, 0));
+        };
+        let l = ch.l();
+        let (mut sum, mut n, mut sims) = (j.columns, 1.0, 0);
+        for i in 0..k {
+            for sign in [1.0, -1.0] {
+                let at: Vec<f64> = (0..k)
+                    .map(|a| (u[a] + sign * SANDWICH_SPAN_SIGMA * l[(a, i)]).clamp(0.0, 1.0))
+                    .collect();
+                sims += 2 * k;
+                let Ok(ji) = self.jacobian(problem, &at, FISHER_STEP_U) else {
+                    continue;
+                };
+                if ji.columns[0].len() != sum[0].len() {
+                    continue;
+                }
+                for (s, c) in sum.iter_mut().zip(&ji.columns) {
+                    s.iter_mut().zip(c).for_each(|(x, y)| *x += y);
+                }
+                n += 1.0;
+            }
+        }
+        sum.iter_mut()
+            .for_each(|s| s.iter_mut().for_each(|x| *x /= n));
+        Ok((Jacobian { columns: sum }, sims))
+    }
+
     /// The variability matrix `V = Var(∇NLL)` at the fit `sim` (normalised coordinates, `k × k`,
     /// positive semi-definite): the sample covariance, over [`NOISE_REPLICATES`] recordings made of
     /// the fit's signal plus fresh white tracking noise of the recording's `σ`, of the NLL's
@@ -617,6 +676,51 @@ pub struct LocalFit {
 /// [`crate::Error::Fit`] with the reason when a recording has no likelihood (a target job); the
 /// simulations', the replicates' and the likelihood's errors.
 pub fn at_fit(problem: &SpectralProblem, u: &[f64]) -> Result<LocalFit> {
+    local_fit(problem, u, Spread::AtPoint)
+}
+
+/// [`at_fit`] with `F` and `V` from the response's Jacobian averaged over the central part of the
+/// likelihood's bowl ([`RecordingLikelihood::smoothed_jacobian`]): the spread the chosen model's
+/// intervals report. Costs `2k` more Jacobians (`4k²` simulations) per recording.
+///
+/// # Errors
+/// As [`at_fit`].
+pub fn at_fit_smoothed(problem: &SpectralProblem, u: &[f64]) -> Result<LocalFit> {
+    local_fit(problem, u, Spread::Smoothed)
+}
+
+/// [`at_fit`] and [`at_fit_smoothed`].
+fn local_fit(problem: &SpectralProblem, u: &[f64], spread: Spread) -> Result<LocalFit> {
+    let (nll, info, var) = information(problem, u, spread)?;
+    let (sigma_u, corr) = sandwich_covariance(&info, &var.expect("asked for"));
+    let (curvature_sigma_u, curvature_corr) = covariance(&info);
+    Ok(LocalFit {
+        nll,
+        sigma_u,
+        corr,
+        curvature_sigma_u,
+        curvature_corr,
+    })
+}
+
+/// The 1σ and correlations of the inverse Fisher information `F⁻¹` at `u` (as
+/// [`LocalFit::curvature_sigma_u`] and [`LocalFit::curvature_corr`]), without the variability:
+/// `1 + 2k` simulations per recording and no noise replicates.
+///
+/// # Errors
+/// As [`at_fit`].
+pub fn curvature_at(problem: &SpectralProblem, u: &[f64]) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
+    let (_, info, _) = information(problem, u, Spread::CurvatureOnly)?;
+    Ok(covariance(&info))
+}
+
+/// The NLL, the Fisher information and (with `variability`) the variability of `problem`'s
+/// recordings at `u`, summed over a joint fit's recordings ([`at_fit`]).
+fn information(
+    problem: &SpectralProblem,
+    u: &[f64],
+    spread: Spread,
+) -> Result<(NllParts, DMatrix<f64>, Option<DMatrix<f64>>)> {
     let mut nll: Option<NllParts> = None;
     let mut info = DMatrix::<f64>::zeros(u.len(), u.len());
     let mut var = DMatrix::<f64>::zeros(u.len(), u.len());
@@ -628,11 +732,23 @@ pub fn at_fit(problem: &SpectralProblem, u: &[f64]) -> Result<LocalFit> {
         let sim = p.simulate(&p.params_at(u))?;
         let parts = lik.nll(p, &sim)?;
         let j = lik.jacobian(p, u, FISHER_STEP_U)?;
-        info += j.fisher(&lik.weights(&parts, j.n_time(lik)));
-        var += lik.variability(p, &sim, &parts, &j)?;
+        let w = lik.weights(&parts, j.n_time(lik));
+        let mut sims = 1 + 2 * u.len();
+        let j = match spread {
+            Spread::Smoothed => {
+                let (j, more) = lik.smoothed_jacobian(p, u, j, &w)?;
+                sims += more;
+                j
+            }
+            Spread::CurvatureOnly | Spread::AtPoint => j,
+        };
+        info += j.fisher(&w);
+        if spread != Spread::CurvatureOnly {
+            var += lik.variability(p, &sim, &parts, &j)?;
+        }
         problem
             .evaluations
-            .fetch_add(1 + 2 * u.len(), std::sync::atomic::Ordering::Relaxed);
+            .fetch_add(sims, std::sync::atomic::Ordering::Relaxed);
         nll = Some(match nll {
             None => parts,
             Some(mut acc) => {
@@ -648,142 +764,215 @@ pub fn at_fit(problem: &SpectralProblem, u: &[f64]) -> Result<LocalFit> {
             }
         });
     }
-    let (sigma_u, corr) = sandwich_covariance(&info, &var);
-    let (curvature_sigma_u, curvature_corr) = covariance(&info);
-    Ok(LocalFit {
-        nll: nll.expect("the main recording is always there"),
-        sigma_u,
-        corr,
-        curvature_sigma_u,
-        curvature_corr,
-    })
+    Ok((
+        nll.expect("the main recording is always there"),
+        info,
+        (spread != Spread::CurvatureOnly).then_some(var),
+    ))
 }
 
-/// Newton steps of [`settle`].
-pub const SETTLE_STEPS: usize = 6;
-
-/// A Newton step of [`settle`] shorter than this, in every coordinate's 1σ, is not taken and ends
-/// the settling: it is the size of the step's own noise. The ripples of the cost (about 0.05 nats)
-/// seen through the ±σ/2 stencil tilt the gradient by about 0.05 nats/σ, which moves a Newton step
-/// by about 0.1σ; on the main job's blade2dof fit, after a first step of 0.12–0.24σ the next five
-/// alternated in sign at 0.02–0.15σ. A step of 0.1σ moves an interval's ends by 2.5 % of its width.
-pub const SETTLE_STOP_SIGMA: f64 = 0.1;
-
-/// Whether every coordinate of `step` is under [`SETTLE_STOP_SIGMA`] of its `sigma`.
-fn within_noise(step: &[f64], sigma: &[f64]) -> bool {
-    step.iter()
-        .zip(sigma)
-        .all(|(d, s)| d.abs() < SETTLE_STOP_SIGMA * s)
+/// What [`information`] linearises the response with, and whether it estimates the variability.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Spread {
+    /// `F` from the Jacobian at the point; no variability.
+    CurvatureOnly,
+    /// `F` and `V` from the Jacobian at the point.
+    AtPoint,
+    /// `F` and `V` from the Jacobian averaged over the bowl's centre
+    /// ([`RecordingLikelihood::smoothed_jacobian`]).
+    Smoothed,
 }
 
-/// Half-span of [`settle`]'s gradient stencil, in each coordinate's 1σ.
-pub const SETTLE_SPAN_SIGMA: f64 = 0.5;
+/// Rounds of [`settle`]: each fits a quadratic to the cost over a design around the last round's
+/// minimum and moves to the quadratic's minimum.
+pub const SETTLE_ROUNDS: usize = 3;
+
+/// Sizes of [`settle`]'s design ([`surface_design`]), in the whitened coordinates of `F⁻¹` (1 =
+/// one standard deviation of the bowl along that direction): the cube's half-side and the axial
+/// points' radius.
+pub const SETTLE_DESIGN_RADII: [f64; 2] = [0.5, 1.0];
 
 /// The most [`settle`] may raise the cost above the search's end, nats: the rise of a quadratic
 /// NLL at 1σ.
 pub const SETTLE_MAX_RISE_NATS: f64 = 0.5;
 
-/// The likelihood's optimum at the scale of its own intervals, from a search's end `u0` of cost
-/// `cost0`: up to [`SETTLE_STEPS`] Newton steps `δ = −F⁻¹ g` with the Gauss–Newton Fisher
-/// information `F` of [`at_fit`] as the Hessian and the gradient `g` from central differences of
-/// the cost over `±` [`SETTLE_SPAN_SIGMA`]`·σ` per coordinate, each step clamped to `±1σ`, the
-/// whole move to `±1σ` (σ at `u0`) and the box. Returns the point, its cost and [`at_fit`] there;
-/// `u0` itself (and its [`at_fit`]) when the settled point's cost exceeds `cost0` by more than
-/// [`SETTLE_MAX_RISE_NATS`] (then the bowl is not quadratic over its interval).
-///
-/// Why: the stick–slip likelihood is rough at a scale far below its intervals. On the main job's
-/// fit its cost jitters by about 0.05 nats between points σ/50 apart, while its bowl rises by
-/// tenths of a nat to nats at ±σ/2, so a Nelder–Mead polish stops in whichever ripple it meets,
-/// and two swarm seeds ended up to 0.4 of an interval's width apart (docs/fit.md, "Uncertainty"). A
-/// gradient over a stencil of ±σ/2 sees the bowl, not the ripples (implicit filtering: Kelley 2011,
-/// *Implicit Filtering*, SIAM, ch. 1), and the Laplace interval assumes that bowl. Steps stop where
-/// a coordinate is uninformed (infinite σ), where the stencil would leave the box, where a
-/// stencil's simulation fails, or where the step is within its noise ([`SETTLE_STOP_SIGMA`]). Costs up to `SETTLE_STEPS · 4k + 2 + 2k` simulations for k
-/// coordinates.
+/// The most simulations [`settle`] takes for `k` coordinates: `F` at the start, every round's
+/// design, the settled point's cost and [`at_fit`] there.
+pub fn settle_evaluations(k: usize) -> usize {
+    (1 + 2 * k) + SETTLE_ROUNDS * surface_design(k).len() + 1 + (1 + 2 * k)
+}
+
+/// [`settle_point`] and [`at_fit`] at the settled point: the point, its cost and its local fit.
 ///
 /// # Errors
-/// Those of [`at_fit`] at `u0` and at each new point.
+/// Those of [`settle_point`] and [`at_fit`].
 pub fn settle(
     problem: &SpectralProblem,
     u0: &[f64],
     cost0: f64,
 ) -> Result<(Vec<f64>, f64, LocalFit)> {
+    let (u, cost) = settle_point(problem, u0, cost0)?;
+    let local = at_fit(problem, &u)?;
+    Ok((u, cost, local))
+}
+
+/// The likelihood's optimum at the scale of its own intervals, from a search's end `u0` of cost
+/// `cost0`: [`SETTLE_ROUNDS`] rounds of a quadratic response surface ([`surface_step`]), each
+/// fitted by least squares to the cost at a design of points around the last round's minimum
+/// (radii [`SETTLE_DESIGN_RADII`] in the whitened coordinates of the Fisher information `F` at
+/// `u0`, [`curvature_at`]) and moving to its minimum, clamped to the design's radius and the box.
+/// Returns the point and its cost; `u0` and `cost0` when no round can be taken (a coordinate the
+/// likelihood does not inform, a design that would leave the box, a failed simulation in it) or
+/// when the settled point's cost exceeds `cost0` by more than [`SETTLE_MAX_RISE_NATS`] (then the
+/// bowl is not quadratic over its interval).
+///
+/// Why: the stick–slip likelihood is rough at a scale far below its intervals. On the main job's
+/// fit its cost jitters by about 0.05 nats between points σ/50 apart, while its bowl rises by
+/// tenths of a nat to nats at ±σ/2, so a Nelder–Mead polish stops in whichever ripple it meets,
+/// and two swarm seeds ended up to 0.4 of an interval's width apart (docs/fit.md, "Uncertainty"). A
+/// quadratic fitted over a design one standard deviation wide sees the bowl, not the ripples
+/// (response-surface methodology: Box & Wilson 1951, *J. R. Stat. Soc. B* 13:1; as a filter of a
+/// rough objective, Kelley 2011, *Implicit Filtering*, SIAM, ch. 1), and the Laplace interval
+/// assumes that bowl. The surface's own Hessian is used, not `F`: the likelihood is misspecified,
+/// so its curvature is not the Fisher information's, and Newton steps with `F` crawl along the
+/// correlated valleys (A–B, C–k1) instead of reaching their floor. `F` only shapes the design.
+/// Costs `1 + 2k` simulations for `F`, the design's points per round ([`surface_design`]: 25 for
+/// k = 4 coordinates, 45 for 6) and one for the settled point's cost.
+///
+/// # Errors
+/// Those of [`curvature_at`] at `u0`.
+pub fn settle_point(problem: &SpectralProblem, u0: &[f64], cost0: f64) -> Result<(Vec<f64>, f64)> {
     use rayon::prelude::*;
-    let start = at_fit(problem, u0)?;
-    let (mut u, mut local) = (u0.to_vec(), start.clone());
-    for _ in 0..SETTLE_STEPS {
-        let costs = |points: &[Vec<f64>]| -> Vec<f64> {
-            points.par_iter().map(|p| problem.cost_at(p)).collect()
-        };
-        let Some(step) = newton_step(&u, &local.curvature_sigma_u, &local.curvature_corr, costs)
-        else {
+    let (sigma, corr) = curvature_at(problem, u0)?;
+    let costs = |points: &[Vec<f64>]| -> Vec<f64> {
+        points.par_iter().map(|p| problem.cost_at(p)).collect()
+    };
+    let mut u = u0.to_vec();
+    for _ in 0..SETTLE_ROUNDS {
+        let Some(next) = surface_step(&u, &sigma, &corr, costs) else {
             break;
         };
-        if within_noise(&step, &local.curvature_sigma_u) {
-            break;
-        }
-        for ((x, d), (x0, s0)) in u
-            .iter_mut()
-            .zip(&step)
-            .zip(u0.iter().zip(&start.curvature_sigma_u))
-        {
-            *x = (*x + d).clamp(x0 - s0, x0 + s0).clamp(0.0, 1.0);
-        }
-        local = at_fit(problem, &u)?;
+        u = next;
     }
     if u == u0 {
-        return Ok((u, cost0, start));
+        return Ok((u, cost0));
     }
     let cost = problem.cost_at(&u);
     if cost.is_finite() && cost <= cost0 + SETTLE_MAX_RISE_NATS {
-        Ok((u, cost, local))
+        Ok((u, cost))
     } else {
-        Ok((u0.to_vec(), cost0, start))
+        Ok((u0.to_vec(), cost0))
     }
 }
 
-/// One step of [`settle`] at `u` with the 1σ `sigma` and correlations `corr` of the inverse Fisher
-/// information; `costs` evaluates the stencil's points. `None` when no step can be taken.
-fn newton_step(
+/// The design of [`surface_step`] in whitened coordinates, a central composite design (Box &
+/// Wilson 1951): the centre, the corners `(±a, …, ±a)` of a cube of half-side
+/// `a` = [`SETTLE_DESIGN_RADII`]`[0]` (all `2^k` for `k ≤ 4`; for more coordinates the half
+/// whose last sign is the product of the others, a resolution-`k` fraction that still separates
+/// every linear, square and cross term), and `±α` on every axis, `α` = [`SETTLE_DESIGN_RADII`]`[1]`.
+/// With `α = 2a` it is rotatable for `k = 4`. `1 + 2k + 2^k` points (`2^(k−1)` for `k ≥ 5`): 25
+/// for four coordinates, 45 for six.
+fn surface_design(k: usize) -> Vec<Vec<f64>> {
+    let [side, axial] = SETTLE_DESIGN_RADII;
+    let mut d = vec![vec![0.0; k]];
+    let free = if k <= 4 { k } else { k - 1 };
+    for bits in 0..(1usize << free) {
+        let mut z: Vec<f64> = (0..free)
+            .map(|i| if bits >> i & 1 == 1 { side } else { -side })
+            .collect();
+        if free < k {
+            let sign: f64 = z.iter().map(|x| x.signum()).product();
+            z.push(sign * side);
+        }
+        d.push(z);
+    }
+    for i in 0..k {
+        for sign in [1.0, -1.0] {
+            let mut z = vec![0.0; k];
+            z[i] = sign * axial;
+            d.push(z);
+        }
+    }
+    d
+}
+
+/// One round of [`settle`] from `u`, with the 1σ `sigma` and correlations `corr` of `F⁻¹`: the
+/// cost (`costs` evaluates a list of points) at [`surface_design`] mapped by `u + L z` (`L` the
+/// Cholesky factor of `F⁻¹`), a quadratic `c + gᵀz + ½ zᵀHz` fitted by least squares, and the
+/// point of its minimum `z = −H⁻¹g`, each coordinate clamped to the design's outer radius (or
+/// `z = −g` clamped so, a step in `F`'s metric, where the fitted `H` is not positive definite),
+/// then to the box. `None` when no round can be taken.
+fn surface_step(
     u: &[f64],
     sigma: &[f64],
     corr: &[Vec<f64>],
     costs: impl Fn(&[Vec<f64>]) -> Vec<f64>,
 ) -> Option<Vec<f64>> {
-    let n = u.len();
-    if sigma.iter().any(|s| !s.is_finite() || *s <= 0.0) {
+    let k = u.len();
+    if k == 0 || sigma.iter().any(|s| !s.is_finite() || *s <= 0.0) {
         return None;
     }
-    let h: Vec<f64> = sigma.iter().map(|s| SETTLE_SPAN_SIGMA * s).collect();
-    if u.iter().zip(&h).any(|(x, h)| x - h < 0.0 || x + h > 1.0) {
+    let cov = DMatrix::from_fn(k, k, |i, j| corr[i][j] * sigma[i] * sigma[j]);
+    let l = cov.cholesky()?.l();
+    let to_u = |z: &[f64]| -> Vec<f64> {
+        (0..k)
+            .map(|i| u[i] + (0..=i).map(|j| l[(i, j)] * z[j]).sum::<f64>())
+            .collect()
+    };
+    let design = surface_design(k);
+    let points: Vec<Vec<f64>> = design.iter().map(|z| to_u(z)).collect();
+    if points.iter().flatten().any(|x| !(0.0..=1.0).contains(x)) {
         return None;
     }
-    let points: Vec<Vec<f64>> = (0..2 * n)
-        .map(|k| {
-            let mut p = u.to_vec();
-            p[k / 2] += if k % 2 == 0 { h[k / 2] } else { -h[k / 2] };
-            p
-        })
-        .collect();
     let c = costs(&points);
     if c.iter()
         .any(|c| !c.is_finite() || *c >= super::problem::FAILED_COST)
     {
         return None;
     }
-    let g: Vec<f64> = (0..n)
-        .map(|i| (c[2 * i] - c[2 * i + 1]) / (2.0 * h[i]))
-        .collect();
-    Some(
-        (0..n)
-            .map(|i| {
-                let d: f64 = -(0..n)
-                    .map(|j| corr[i][j] * sigma[i] * sigma[j] * g[j])
-                    .sum::<f64>();
-                d.clamp(-sigma[i], sigma[i]).clamp(-u[i], 1.0 - u[i])
-            })
-            .collect(),
-    )
+    let (g, h) = fit_quadratic(&design, &c)?;
+    let z = match h.clone().cholesky() {
+        Some(ch) => ch.solve(&(-&g)),
+        None => -&g,
+    };
+    let outer = SETTLE_DESIGN_RADII[1];
+    let z: Vec<f64> = z.iter().map(|x| x.clamp(-outer, outer)).collect();
+    Some(to_u(&z).into_iter().map(|x| x.clamp(0.0, 1.0)).collect())
+}
+
+/// Least-squares quadratic `c + gᵀz + ½ zᵀHz` through the values `y` at the points `z`: its
+/// gradient `g` and Hessian `H` at the origin. `None` when the design does not determine them.
+fn fit_quadratic(z: &[Vec<f64>], y: &[f64]) -> Option<(nalgebra::DVector<f64>, DMatrix<f64>)> {
+    let k = z.first()?.len();
+    let pairs: Vec<(usize, usize)> = (0..k).flat_map(|i| (i..k).map(move |j| (i, j))).collect();
+    let p = 1 + k + pairs.len();
+    if z.len() < p {
+        return None;
+    }
+    let x = DMatrix::from_fn(z.len(), p, |r, col| match col {
+        0 => 1.0,
+        c if c <= k => z[r][c - 1],
+        c => {
+            let (i, j) = pairs[c - 1 - k];
+            z[r][i] * z[r][j]
+        }
+    });
+    let beta = x
+        .svd(true, true)
+        .solve(&nalgebra::DVector::from_column_slice(y), 1e-12)
+        .ok()?;
+    let g = nalgebra::DVector::from_fn(k, |i, _| beta[1 + i]);
+    let mut h = DMatrix::<f64>::zeros(k, k);
+    for (n, &(i, j)) in pairs.iter().enumerate() {
+        let b = beta[1 + k + n];
+        if i == j {
+            h[(i, i)] = 2.0 * b;
+        } else {
+            h[(i, j)] = b;
+            h[(j, i)] = b;
+        }
+    }
+    Some((g, h))
 }
 
 /// Covariance of the normalised coordinates from a Fisher information `f` (its pseudo-inverse over
@@ -920,61 +1109,111 @@ mod tests {
         assert!(corr[0][1].is_nan());
     }
 
-    #[test]
-    fn a_newton_step_lands_on_a_quadratic_bowls_centre_through_its_ripples() {
-        // Cost 0.5 (u − m)ᵀ Σ⁻¹ (u − m) + a ripple of amplitude 0.05 and period σ/7 in each
-        // coordinate, Σ with σ = (0.01, 0.02) and correlation 0.5. Central differences are exact for
-        // the quadratic; the ripple's error in g is at most 0.05/h per coordinate (h = σ/2), which
-        // moves the step by at most Σ·|g error| ≤ 2·0.05·(1 + 0.5)/σ_i·σ_i² = 0.15σ_i from m.
+    /// A bowl `0.5 (u − m)ᵀ Σ⁻¹ (u − m)` with σ = (0.01, 0.02) and correlation 0.5, plus (with
+    /// `ripple`) `0.05 (sin(2π·7 u₀/σ₀) + cos(2π·7 u₁/σ₁))`: ripples of 0.05 nats at σ/7, the
+    /// main job's likelihood's scale (docs/fit.md, "Uncertainty").
+    fn rippled_bowl(ripple: f64) -> impl Fn(&[Vec<f64>]) -> Vec<f64> {
         let (m, sigma, rho) = ([0.4, 0.6], [0.01, 0.02], 0.5);
-        let corr = vec![vec![1.0, rho], vec![rho, 1.0]];
-        let det = 1.0 - rho * rho;
-        let cost = |p: &[f64]| {
-            let z = [(p[0] - m[0]) / sigma[0], (p[1] - m[1]) / sigma[1]];
-            let q = (z[0] * z[0] - 2.0 * rho * z[0] * z[1] + z[1] * z[1]) / (2.0 * det);
-            let tau = 2.0 * std::f64::consts::PI * 7.0;
-            q + 0.05 * ((tau * p[0] / sigma[0]).sin() + (tau * p[1] / sigma[1]).cos())
-        };
-        let costs = |pts: &[Vec<f64>]| pts.iter().map(|p| cost(p)).collect::<Vec<_>>();
-        // From 0.8σ off in both coordinates, inside the ±1σ clamp.
-        let u = [m[0] + 0.8 * sigma[0], m[1] - 0.8 * sigma[1]];
-        let step = newton_step(&u, &sigma, &corr, costs).unwrap();
-        for i in 0..2 {
-            let off = (u[i] + step[i] - m[i]).abs() / sigma[i];
-            assert!(off <= 0.15, "coordinate {i}: {off:.3}σ from the centre");
-        }
-        // Without the ripple the step is exact.
-        let smooth = |pts: &[Vec<f64>]| {
+        move |pts: &[Vec<f64>]| {
             pts.iter()
                 .map(|p| {
-                    cost(p)
-                        - 0.05
-                            * ((2.0 * std::f64::consts::PI * 7.0 * p[0] / sigma[0]).sin()
-                                + (2.0 * std::f64::consts::PI * 7.0 * p[1] / sigma[1]).cos())
+                    let z = [(p[0] - m[0]) / sigma[0], (p[1] - m[1]) / sigma[1]];
+                    let q = (z[0] * z[0] - 2.0 * rho * z[0] * z[1] + z[1] * z[1])
+                        / (2.0 * (1.0 - rho * rho));
+                    let tau = 2.0 * std::f64::consts::PI * 7.0;
+                    q + ripple * ((tau * p[0] / sigma[0]).sin() + (tau * p[1] / sigma[1]).cos())
                 })
-                .collect::<Vec<_>>()
-        };
-        let step = newton_step(&u, &sigma, &corr, smooth).unwrap();
-        for i in 0..2 {
-            assert!((u[i] + step[i] - m[i]).abs() < 1e-9 * sigma[i] + 1e-12);
+                .collect()
         }
     }
 
     #[test]
-    fn no_newton_step_for_an_uninformed_coordinate_or_at_the_box_edge() {
-        let corr = vec![vec![1.0, 0.0], vec![0.0, 1.0]];
-        let costs = |pts: &[Vec<f64>]| vec![0.0; pts.len()];
-        assert!(newton_step(&[0.5, 0.5], &[0.01, f64::INFINITY], &corr, costs).is_none());
-        assert!(newton_step(&[0.004, 0.5], &[0.01, 0.01], &corr, costs).is_none());
-        assert!(newton_step(&[0.5, 0.5], &[0.01, 0.01], &corr, costs).is_some());
+    fn a_quadratic_surface_lands_on_a_bowls_centre_and_its_ripples_move_it_little() {
+        let (m, sigma) = ([0.4, 0.6], [0.01, 0.02]);
+        let corr = vec![vec![1.0, 0.5], vec![0.5, 1.0]];
+        // From (+0.5σ, −0.5σ): whitened (0.5, −0.87), inside the design's radius of 1.
+        let u = [m[0] + 0.5 * sigma[0], m[1] - 0.5 * sigma[1]];
+        // A quadratic is fitted exactly, so without ripples the round lands on the centre.
+        let next = surface_step(&u, &sigma, &corr, rippled_bowl(0.0)).unwrap();
+        for i in 0..2 {
+            assert!(
+                (next[i] - m[i]).abs() < 1e-9 * sigma[i],
+                "coordinate {i}: {next:?}"
+            );
+        }
+        // With them: a central difference over ±σ/2 would be off by up to 0.05/(σ/2) per
+        // coordinate, 0.15σ in the step (the Newton step settling took before); a least-squares fit
+        // over the 9 points' spread must do better than that.
+        let next = surface_step(&u, &sigma, &corr, rippled_bowl(0.05)).unwrap();
+        for i in 0..2 {
+            let off = (next[i] - m[i]).abs() / sigma[i];
+            assert!(off < 0.15, "coordinate {i}: {off:.3}σ from the centre");
+        }
     }
 
     #[test]
-    fn a_step_under_a_tenth_of_sigma_in_every_coordinate_is_within_noise() {
-        let sigma = [0.01, 0.02];
-        assert!(within_noise(&[0.0009, -0.0019], &sigma));
-        // One coordinate at 0.1σ or more is a step worth taking.
-        assert!(!within_noise(&[0.0009, -0.002], &sigma));
-        assert!(!within_noise(&[-0.0011, 0.0], &sigma));
+    fn no_surface_step_for_an_uninformed_coordinate_or_where_the_design_leaves_the_box() {
+        let corr = vec![vec![1.0, 0.0], vec![0.0, 1.0]];
+        let costs = |pts: &[Vec<f64>]| vec![0.0; pts.len()];
+        assert!(surface_step(&[0.5, 0.5], &[0.01, f64::INFINITY], &corr, costs).is_none());
+        assert!(surface_step(&[0.009, 0.5], &[0.01, 0.01], &corr, costs).is_none());
+        assert!(surface_step(&[0.5, 0.5], &[0.01, 0.01], &corr, costs).is_some());
+        let failed = |pts: &[Vec<f64>]| vec![f64::NAN; pts.len()];
+        assert!(surface_step(&[0.5, 0.5], &[0.01, 0.01], &corr, failed).is_none());
+    }
+
+    #[test]
+    fn the_half_fraction_design_separates_every_term_of_a_quadratic_in_six_coordinates() {
+        // y = Σ (i + 1) zᵢ + ½ zᵀHz, H_ii = 2 + i and H_ij = 0.1 (1 + i + j)/(1 + |i − j|): every
+        // one of the 28 coefficients nonzero, recovered exactly from the 45 points.
+        let k = 6;
+        let design = surface_design(k);
+        assert_eq!(design.len(), 1 + 2 * k + (1 << (k - 1)));
+        let h = DMatrix::from_fn(k, k, |i, j| {
+            if i == j {
+                2.0 + i as f64
+            } else {
+                0.1 * (1 + i + j) as f64 / (1 + i.abs_diff(j)) as f64
+            }
+        });
+        let y: Vec<f64> = design
+            .iter()
+            .map(|z| {
+                let zv = nalgebra::DVector::from_column_slice(z);
+                (0..k).map(|i| (i + 1) as f64 * z[i]).sum::<f64>()
+                    + 0.5 * (zv.transpose() * &h * &zv)[(0, 0)]
+            })
+            .collect();
+        let (gf, hf) = fit_quadratic(&design, &y).unwrap();
+        for i in 0..k {
+            assert!((gf[i] - (i + 1) as f64).abs() < 1e-9, "g[{i}] = {}", gf[i]);
+            for j in 0..k {
+                assert!((hf[(i, j)] - h[(i, j)]).abs() < 1e-9, "H[{i}][{j}]");
+            }
+        }
+    }
+
+    #[test]
+    fn a_quadratic_is_fitted_exactly_from_the_design() {
+        // y = 2 + (1, −2, 0.5)·z + ½ zᵀHz with H = [[3, 1, 0], [1, 2, −0.5], [0, −0.5, 1]].
+        let h = DMatrix::from_row_slice(3, 3, &[3.0, 1.0, 0.0, 1.0, 2.0, -0.5, 0.0, -0.5, 1.0]);
+        let g = [1.0, -2.0, 0.5];
+        let design = surface_design(3);
+        assert_eq!(design.len(), 1 + 2 * 3 + 8);
+        let y: Vec<f64> = design
+            .iter()
+            .map(|z| {
+                let zv = nalgebra::DVector::from_column_slice(z);
+                2.0 + g.iter().zip(z).map(|(a, b)| a * b).sum::<f64>()
+                    + 0.5 * (zv.transpose() * &h * &zv)[(0, 0)]
+            })
+            .collect();
+        let (gf, hf) = fit_quadratic(&design, &y).unwrap();
+        for i in 0..3 {
+            assert!((gf[i] - g[i]).abs() < 1e-10);
+            for j in 0..3 {
+                assert!((hf[(i, j)] - h[(i, j)]).abs() < 1e-10);
+            }
+        }
     }
 }

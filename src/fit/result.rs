@@ -97,6 +97,10 @@ pub enum IntervalMethod {
         /// alone).
         #[serde(default)]
         noise_replicates: usize,
+        /// Half-span, in the whitened coordinates of `F⁻¹`, of the points whose Jacobians `F` and
+        /// `V` average (0 in results written before they did: the Jacobian at the fit alone).
+        #[serde(default)]
+        span_sigma: f64,
     },
 }
 
@@ -108,6 +112,7 @@ impl std::fmt::Display for IntervalMethod {
             IntervalMethod::Laplace {
                 fisher_step_u,
                 noise_replicates: 0,
+                ..
             } => write!(
                 f,
                 "Laplace: ±1σ of the inverse Fisher information of the recording's likelihood alone (Gauss–Newton, central differences of {fisher_step_u} in the normalised coordinates)"
@@ -115,10 +120,23 @@ impl std::fmt::Display for IntervalMethod {
             IntervalMethod::Laplace {
                 fisher_step_u,
                 noise_replicates,
-            } => write!(
-                f,
-                "Laplace: ±1σ of the sandwich F⁻¹VF⁻¹ (F the Gauss–Newton Fisher information of the recording's likelihood, central differences of {fisher_step_u} in the normalised coordinates; V the variance of its gradient over {noise_replicates} replicates of the recording's tracking noise)"
-            ),
+                span_sigma,
+            } => {
+                write!(
+                    f,
+                    "Laplace: ±1σ of the sandwich F⁻¹VF⁻¹ (F the Gauss–Newton Fisher information of the recording's likelihood, central differences of {fisher_step_u} in the normalised coordinates"
+                )?;
+                if *span_sigma > 0.0 {
+                    write!(
+                        f,
+                        ", averaged with those at the 2k points u ± {span_sigma}·L eᵢ, L the Cholesky factor of F⁻¹"
+                    )?;
+                }
+                write!(
+                    f,
+                    "; V the variance of its gradient over {noise_replicates} replicates of the recording's tracking noise)"
+                )
+            }
             IntervalMethod::Bootstrap {
                 replicates,
                 noise_sigma_m,

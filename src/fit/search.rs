@@ -175,6 +175,25 @@ pub(super) struct CandidateFit {
     pub(super) search_note: Option<String>,
 }
 
+impl CandidateFit {
+    /// The spread of the chosen candidate's estimate from the sandwich with the response's
+    /// Jacobian averaged over the bowl's centre ([`super::evidence::at_fit_smoothed`]): the 1σ
+    /// and correlations its intervals and result report. Unchanged where the fit has no
+    /// likelihood, was interrupted, or the smoothed spread fails.
+    pub(super) fn with_smoothed_spread(mut self) -> Self {
+        if self.evidence.is_err() || interrupt::stop_requested() {
+            return self;
+        }
+        if let Ok(l) = super::evidence::at_fit_smoothed(&self.problem, &self.best_u) {
+            self.sigma_u = l.sigma_u;
+            self.corr = l.corr;
+            self.fisher_sigma_u = Some(l.curvature_sigma_u);
+            self.evidence = Ok(l.nll);
+        }
+        self
+    }
+}
+
 /// How often a fit whose stderr is not a terminal prints a one-line progress message: 5 s, or
 /// `WIPERLAB_PROGRESS_INTERVAL_S` seconds when set (tests use 0).
 pub(super) fn piped_interval() -> std::time::Duration {
@@ -198,7 +217,7 @@ pub(super) fn progress_bar(job: &LoadedJob, candidates: &[Candidate]) -> indicat
         let n = job.free.len() + if c.shoulder { 2 } else { 0 };
         // The curvature's stencil, or the likelihood's settling steps and its Fisher information.
         let hess_evals = (1 + 2 * n + 2 * n * n.saturating_sub(1))
-            .max(super::evidence::SETTLE_STEPS * 4 * n + 2 + 2 * n) as u64;
+            .max(super::evidence::settle_evaluations(n)) as u64;
         let nested = candidates[..i]
             .iter()
             .any(|f| c.shoulder && f.kind == c.kind && !f.shoulder);

@@ -78,6 +78,7 @@ pub fn laplace_intervals(free: &[FreeParam], best_u: &[f64], sigma_u: &[f64]) ->
                 method: IntervalMethod::Laplace {
                     fisher_step_u: super::evidence::FISHER_STEP_U,
                     noise_replicates: super::evidence::NOISE_REPLICATES,
+                    span_sigma: super::evidence::SANDWICH_SPAN_SIGMA,
                 },
             }
         })
@@ -227,7 +228,7 @@ pub fn bootstrap_intervals(
             };
             // The estimator's last stage, as in the fit (`search::fit_candidate`).
             let u = if rep.cost_is_nll() {
-                super::evidence::settle(&rep, &u, cost)?.0
+                super::evidence::settle_point(&rep, &u, cost)?.0
             } else {
                 u
             };
