@@ -293,7 +293,8 @@ crate::names::named_enum! {
     /// How the fit gives each parameter an interval.
     pub enum UncertaintyMethod: "uncertainty method" {
         /// Laplace's approximation: ±1σ of the sandwich `F⁻¹ V F⁻¹` of the recording's
-        /// likelihood at the fit (2k simulations and replicates of the recording's noise).
+        /// likelihood at the fit, with the response's Jacobian averaged over the bowl's centre
+        /// (`(2k + 1)·2k` simulations and replicates of the recording's noise).
         Laplace => "laplace",
         /// Basic parametric bootstrap: `bootstrap` replicates, each re-fitted.
         Bootstrap => "bootstrap",

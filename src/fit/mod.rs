@@ -86,7 +86,12 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let mut fits = fit_candidates(job, &meas, &candidates, &pb)?;
     let mut selection = select::choose(&fits, &job.job.spectrum.bands, !fit.models.is_empty());
     let absorbing = select::absorbing_warnings(&fits, selection.chosen, &job.job.spectrum.bands);
-    let cf = fits.swap_remove(selection.chosen).with_smoothed_spread();
+    // Laplace intervals read the sandwich over the bowl's centre; a bootstrap's come from its
+    // replicates, so its 1σ and correlations keep the sandwich at the fit.
+    let mut cf = fits.swap_remove(selection.chosen);
+    if fit.uncertainty.method() == job::UncertaintyMethod::Laplace {
+        cf = cf.with_smoothed_spread();
+    }
     let best = BestModel::of(&cf)?;
     let mut parameters = fitted_parameters(job, &cf);
     let peaks = peak_comparisons(&cf, &best.features)?;
