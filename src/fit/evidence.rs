@@ -440,14 +440,9 @@ impl RecordingLikelihood {
     ) -> Result<(Jacobian, usize)> {
         let k = u.len();
         let (sigma, corr) = covariance(&j.fisher(w));
-        if sigma.iter().any(|s| !s.is_finite()) {
-            return Ok((j, 0));
-        }
-        let cov = DMatrix::from_fn(k, k, |a, b| corr[a][b] * sigma[a] * sigma[b]);
-        let Some(ch) = cov.cholesky() else {
+        let Some(l) = cholesky_of_covariance(&sigma, &corr) else {
             return Ok((j, 0));
         };
-        let l = ch.l();
         let (mut sum, mut n, mut sims) = (j.columns, 1.0, 0);
         for i in 0..k {
             for sign in [1.0, -1.0] {
@@ -714,8 +709,9 @@ pub fn curvature_at(problem: &SpectralProblem, u: &[f64]) -> Result<(Vec<f64>, V
     Ok(covariance(&info))
 }
 
-/// The NLL, the Fisher information and (with `variability`) the variability of `problem`'s
-/// recordings at `u`, summed over a joint fit's recordings ([`at_fit`]).
+/// The NLL, the Fisher information and (unless `spread` is [`Spread::CurvatureOnly`]) the
+/// variability of `problem`'s recordings at `u`, summed over a joint fit's recordings
+/// ([`at_fit`]).
 fn information(
     problem: &SpectralProblem,
     u: &[f64],
@@ -909,11 +905,10 @@ fn surface_step(
     costs: impl Fn(&[Vec<f64>]) -> Vec<f64>,
 ) -> Option<Vec<f64>> {
     let k = u.len();
-    if k == 0 || sigma.iter().any(|s| !s.is_finite() || *s <= 0.0) {
+    if k == 0 || sigma.iter().any(|s| *s <= 0.0) {
         return None;
     }
-    let cov = DMatrix::from_fn(k, k, |i, j| corr[i][j] * sigma[i] * sigma[j]);
-    let l = cov.cholesky()?.l();
+    let l = cholesky_of_covariance(sigma, corr)?;
     let to_u = |z: &[f64]| -> Vec<f64> {
         (0..k)
             .map(|i| u[i] + (0..=i).map(|j| l[(i, j)] * z[j]).sum::<f64>())
@@ -938,6 +933,18 @@ fn surface_step(
     let outer = SETTLE_DESIGN_RADII[1];
     let z: Vec<f64> = z.iter().map(|x| x.clamp(-outer, outer)).collect();
     Some(to_u(&z).into_iter().map(|x| x.clamp(0.0, 1.0)).collect())
+}
+
+/// The lower Cholesky factor `L` of the covariance with 1σ `sigma` and correlations `corr`
+/// (`LLᵀ = Σ`; `u + L z` maps whitened coordinates `z` to normalised ones). `None` where a 1σ is
+/// not finite (a coordinate without information) or the covariance is not positive definite.
+fn cholesky_of_covariance(sigma: &[f64], corr: &[Vec<f64>]) -> Option<DMatrix<f64>> {
+    if sigma.iter().any(|s| !s.is_finite()) {
+        return None;
+    }
+    let k = sigma.len();
+    let cov = DMatrix::from_fn(k, k, |i, j| corr[i][j] * sigma[i] * sigma[j]);
+    Some(cov.cholesky()?.l())
 }
 
 /// Least-squares quadratic `c + gᵀz + ½ zᵀHz` through the values `y` at the points `z`: its
