@@ -292,6 +292,23 @@ fn likelihood_at_the_truth() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// Writes every scene's recording, blade, truth and job to `target/model_choice_scenes/` (seconds,
+/// no fits), so one row of the table can be re-run alone with the CLI:
+/// `cargo test --release --test model_choice write_the_scenes -- --ignored --nocapture`, then
+/// `target/release/wiperlab fit target/model_choice_scenes/scene4.toml`.
+#[test]
+#[ignore = "writes the table's scenes for the CLI"]
+fn write_the_scenes() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/model_choice_scenes");
+    std::fs::create_dir_all(&dir).unwrap();
+    for (i, s) in SCENES.iter().enumerate() {
+        let (job, switches) = write_scene(&dir, i, s).unwrap();
+        // (The job's figures and report go to its own directory's reports/.)
+        assert!(LoadedJob::load(&job).is_ok(), "{}", job.display());
+        println!("{}: {} ({switches} switches)", s.name, job.display());
+    }
+}
+
 #[test]
 #[ignore = "about 20 minutes on 2 cores: cargo test --release --test model_choice -- --ignored"]
 fn likelihood_choice_confusion_table() {
