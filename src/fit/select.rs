@@ -54,32 +54,7 @@ fn evidences(fits: &[CandidateFit]) -> Option<Vec<Option<Evidence>>> {
 /// was the only one).
 pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) -> Selection {
     let evidence = evidences(fits);
-    let aics: Vec<f64> = fits
-        .iter()
-        .enumerate()
-        .map(|(i, f)| match &evidence {
-            Some(e) => e[i].map_or(f64::INFINITY, |e| e.aic()),
-            None if f.cost < FAILED_COST => aic(f.cost, f.free.len()),
-            None => f64::INFINITY,
-        })
-        .collect();
-    let capable: Vec<bool> = fits
-        .iter()
-        .map(|f| match &evidence {
-            Some(_) => !f.candidate.imposes_a_band(bands),
-            None => f.candidate.cannot_produce(bands).is_none(),
-        })
-        .collect();
-    let any_capable = capable.contains(&true);
-    let scores: Vec<f64> = (0..fits.len())
-        .map(|i| {
-            if capable[i] || !any_capable {
-                aics[i]
-            } else {
-                f64::INFINITY
-            }
-        })
-        .collect();
+    let (aics, scores) = criteria(fits, bands, evidence.as_deref());
     let chosen = (0..fits.len())
         .min_by(|&a, &b| scores[a].total_cmp(&scores[b]))
         .unwrap_or(0);
@@ -108,6 +83,54 @@ pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) ->
         })
         .collect();
     Selection { chosen, trials }
+}
+
+/// How far each candidate's score (the AIC [`choose`] chooses by) lies above the chosen one's, as
+/// the fits stand: 0 for the chosen, +∞ for one that cannot be chosen (it imposes a band, or has
+/// no AIC).
+pub(super) fn score_gaps(fits: &[CandidateFit], bands: &[BandSpec]) -> Vec<f64> {
+    let evidence = evidences(fits);
+    let (_, scores) = criteria(fits, bands, evidence.as_deref());
+    let best = scores.iter().copied().fold(f64::INFINITY, f64::min);
+    scores
+        .iter()
+        .map(|&s| if s == best { 0.0 } else { s - best })
+        .collect()
+}
+
+/// Every candidate's AIC, and its score: the AIC where [`choose`] may choose it, else +∞.
+fn criteria(
+    fits: &[CandidateFit],
+    bands: &[BandSpec],
+    evidence: Option<&[Option<Evidence>]>,
+) -> (Vec<f64>, Vec<f64>) {
+    let aics: Vec<f64> = fits
+        .iter()
+        .enumerate()
+        .map(|(i, f)| match evidence {
+            Some(e) => e[i].map_or(f64::INFINITY, |e| e.aic()),
+            None if f.cost < FAILED_COST => aic(f.cost, f.free.len()),
+            None => f64::INFINITY,
+        })
+        .collect();
+    let capable: Vec<bool> = fits
+        .iter()
+        .map(|f| match evidence {
+            Some(_) => !f.candidate.imposes_a_band(bands),
+            None => f.candidate.cannot_produce(bands).is_none(),
+        })
+        .collect();
+    let any_capable = capable.contains(&true);
+    let scores: Vec<f64> = (0..fits.len())
+        .map(|i| {
+            if capable[i] || !any_capable {
+                aics[i]
+            } else {
+                f64::INFINITY
+            }
+        })
+        .collect();
+    (aics, scores)
 }
 
 /// The candidates' criteria, for the reasons.

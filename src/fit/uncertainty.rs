@@ -5,7 +5,7 @@ use super::features::{features, noise_floor};
 use super::job::{self, UncertaintyMethod};
 use super::problem::{FreeParam, SpectralProblem};
 use super::result::{FittedParam, Interval, IntervalMethod};
-use super::search::{CandidateFit, optimise, polish};
+use super::search::{CandidateFit, Confirmation, optimise, polish};
 use crate::Result;
 use crate::simulate::blade::BladeSimulation;
 use crate::spectrum::stats::quantile_sorted;
@@ -219,9 +219,9 @@ pub fn bootstrap_intervals(
             }
             let rep = Arc::new(rep);
             let (u, cost) = if settings.full_refit {
-                let (u, _, _, cost) =
-                    optimise(&rep, fit, fit.seed.wrapping_add(1 + r as u64), &[], None)?;
-                (u, cost)
+                let seed = fit.seed.wrapping_add(1 + r as u64);
+                let found = optimise(&rep, fit, seed, &[], None, Confirmation::Now)?;
+                (found.u, found.cost)
             } else {
                 let (u, _, cost) = polish(&rep, best_u, 0.05, settings.polish_iterations, None)?;
                 (u, cost)
