@@ -271,7 +271,8 @@ crate::names::named_enum! {
     /// model the scene needs").
     pub enum NestedSearch: "nested search" {
         /// Nelder–Mead polishes from `X`'s optimum (θ_c at its bound, the median and the 90th
-        /// percentile of |θ|) first; the global search (`restarts` swarms) follows only when they
+        /// percentile of |θ|; and X's k1 as the contact stiffness with θ_c at the 10th) first; the
+        /// global search (`restarts` swarms) follows only when they
         /// lower the recording's NLL by more than
         /// [`crate::fit::NESTED_GLOBAL_GAIN_NATS`]. With the features objective, or a target job
         /// (no likelihood), always the global search.

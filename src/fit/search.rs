@@ -269,8 +269,9 @@ pub(super) fn progress_bar(job: &LoadedJob, candidates: &[Candidate]) -> indicat
     pb
 }
 
-/// How many warm points a nested candidate's search starts from ([`nested_warm_points`]).
-const NESTED_WARM_POINTS: u64 = 3;
+/// How many warm points a nested candidate's search starts from ([`nested_warm_points`]): its
+/// local search polishes from each, and restarts 0–3 of its global search start a particle at one.
+const NESTED_WARM_POINTS: u64 = 4;
 
 /// Model runs of one Nelder–Mead polish over `n` parameters: its simplex and two per iteration.
 fn polish_budget(fit: &job::FitSection, n: usize) -> u64 {
@@ -827,11 +828,17 @@ fn nested_search(
 /// the shoulder changes no moment. The first point has θ_c on its upper bound and the smaller
 /// model's own normalised coordinates (bitwise its parameters and, while the neck stays below θ_c,
 /// its simulation); it is also the point [`optimise`] keeps if no restart ends below it. The
-/// others put θ_c at the median and the 90th percentile of |θ| in the smaller model's simulation
+/// next two put θ_c at the median and the 90th percentile of |θ| in the smaller model's simulation
 /// (inside the contact-angle bounds): the same motion, but a polish from there feels k1_contact at
 /// once, while from the first it must first bring θ_c into the range the neck visits. On the
 /// confusion table's often-crossed shoulder (docs/fit.md) the search from the first point alone
-/// never left blade2dof's optimum.
+/// never left blade2dof's optimum. The last reads X's stiffness as that of a neck resting on the
+/// shoulder: k1_contact = X's k1, θ_c at the 10th percentile of |θ|, and the free k1 halfway (log
+/// scale) between its lower bound and X's k1 (along the resting neck's ridge, where only
+/// `(k1_contact − k1)·θ_c` matters, any free k1 moves the neck alike while θ_c is small). On the
+/// confusion table's neck resting on a shoulder at 0.025 rad, without it the global search ended
+/// 2.5 nats below the truth's likelihood and blade2dof was chosen (k1 +229 %); with it the search
+/// reached within 0.13 nats of the truth's and the shoulder model was chosen.
 fn nested_warm_points(smaller: &CandidateFit, free: &[FreeParam]) -> Vec<Vec<f64>> {
     let params = smaller.problem.params_at(&smaller.best_u);
     let first: Vec<f64> = free
@@ -879,6 +886,19 @@ fn nested_warm_points(smaller: &CandidateFit, free: &[FreeParam]) -> Vec<Vec<f64
     for q in [0.5, 0.9] {
         let mut p = first.clone();
         p[i] = free[i].u_of(crate::spectrum::stats::quantile_sorted(&abs_theta, q));
+        points.push(p);
+    }
+    // X's stiffness read as the contact stiffness of a neck resting on the shoulder: θ_c at the
+    // 10th percentile of |θ|, k1_contact = X's k1, the free k1 halfway (log scale) between its
+    // lower bound and X's k1.
+    if let (Some(j), Some(c)) = (
+        free.iter().position(|fp| fp.name == ParamId::K1),
+        free.iter().position(|fp| fp.name == ParamId::K1c),
+    ) {
+        let mut p = first.clone();
+        p[i] = free[i].u_of(crate::spectrum::stats::quantile_sorted(&abs_theta, 0.1));
+        p[c] = free[c].u_of(params.k1_nm_per_rad);
+        p[j] = free[j].u_of((free[j].lower * params.k1_nm_per_rad).sqrt());
         points.push(p);
     }
     points
