@@ -65,6 +65,21 @@ fn main_job_finds_the_truth_for_nine_of_ten_seeds() {
             .iter()
             .map(|e| format!("{:+.2} %", 100.0 * e))
             .collect();
+        // Each interval, so the ends' differences between seeds can be traced to their source
+        // (the estimate or the width).
+        for n in names {
+            if let Some(p) = r.parameters.iter().find(|p| p.name == n)
+                && let Some(iv) = &p.interval
+            {
+                println!(
+                    "    {n}: {:.6e} [{:.6e}, {:.6e}] width {:.4e}",
+                    p.value,
+                    iv.lo,
+                    iv.hi,
+                    iv.hi - iv.lo
+                );
+            }
+        }
         println!(
             "seed {seed}: {} cost {:.4}, A {} B {} C {} k1 {}, {} evaluations, {:.1} s",
             r.model, r.cost, pct[0], pct[1], pct[2], pct[3], r.model_evaluations, r.wall_time_s
