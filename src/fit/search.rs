@@ -506,10 +506,65 @@ pub(super) fn fit_candidate(
         reporting: reporting.clone(),
     });
     let mut fit = finish(candidate, free, problem, found, &reporting, pb)?;
+    let mut search_note = search_note;
+    if let (Some(smaller), Some(w)) = (nested, warm.first()) {
+        fit = keep_the_smaller_optimum(fit, smaller, w, &reporting, pb, &mut search_note)?;
+    }
     fit.search_note = search_note;
     fit.unconfirmed = unconfirmed;
     fit.wall_time_s = started.elapsed().as_secs_f64();
     Ok(fit)
+}
+
+/// A nested candidate (`X+shoulder`) whose settled optimum is less likely than `X`'s: it takes
+/// `X`'s settled optimum instead, its first warm point `warm` (the same parameters, and while the
+/// neck stays below θ_c the same simulation), with its local fit there and no settling. Both
+/// settled points are centres of bowls at the intervals' scale, not maxima, so the larger
+/// model's can land a few hundredths of a nat below the smaller one's; but the larger model
+/// contains the smaller one's optimum, so its maximum likelihood is never below it, as the
+/// likelihood-ratio test and AIC of nested models assume. Unchanged otherwise.
+fn keep_the_smaller_optimum(
+    fit: CandidateFit,
+    smaller: &CandidateFit,
+    warm: &[f64],
+    reporting: &Reporting,
+    pb: &Option<indicatif::ProgressBar>,
+    note: &mut Option<String>,
+) -> Result<CandidateFit> {
+    if !fit.problem.cost_is_nll() || fit.cost <= smaller.cost || interrupt::stop_requested() {
+        return Ok(fit);
+    }
+    let at_warm = fit.problem.cost_at(warm);
+    if !at_warm.is_finite() || at_warm >= fit.cost {
+        return Ok(fit);
+    }
+    let found = Optimised {
+        u: warm.to_vec(),
+        swarm_iters: fit.swarm_iters,
+        polish_iters: fit.polish_iters,
+        cost: at_warm,
+        unconfirmed_ends: None,
+    };
+    let kept = format!(
+        "its settled optimum ({:.3} nats) was less likely than the model without shoulder's, so \
+         it keeps that model's optimum ({at_warm:.3} nats)",
+        fit.cost
+    );
+    *note = Some(match note.take() {
+        Some(n) => format!("{n}; {kept}"),
+        None => kept,
+    });
+    let mut kept_fit = finish_at(
+        fit.candidate,
+        fit.free.clone(),
+        fit.problem.clone(),
+        found,
+        reporting,
+        pb,
+        false,
+    )?;
+    kept_fit.search_cost = fit.search_cost;
+    Ok(kept_fit)
 }
 
 /// The last stage of a candidate's fit, from its search's best end: settling and the sandwich
@@ -522,6 +577,20 @@ fn finish(
     found: Optimised,
     reporting: &Reporting,
     pb: &Option<indicatif::ProgressBar>,
+) -> Result<CandidateFit> {
+    finish_at(candidate, free, problem, found, reporting, pb, true)
+}
+
+/// [`finish`], settling the likelihood's optimum or (`settle = false`) taking the local fit at
+/// the search's end as it is.
+fn finish_at(
+    candidate: Candidate,
+    free: Vec<FreeParam>,
+    problem: Arc<SpectralProblem>,
+    found: Optimised,
+    reporting: &Reporting,
+    pb: &Option<indicatif::ProgressBar>,
+    settle: bool,
 ) -> Result<CandidateFit> {
     let Optimised {
         u: mut best_u,
@@ -547,7 +616,7 @@ fn finish(
     } else {
         // With the likelihood as the cost, the estimate is its optimum at the intervals' scale
         // ([`super::evidence::settle`]), not the ripple the polish stopped in.
-        let local = if problem.cost_is_nll() {
+        let local = if settle && problem.cost_is_nll() {
             super::evidence::settle(&problem, &best_u, cost).map(|(u, c, l)| {
                 (best_u, cost) = (u, c);
                 l
@@ -1172,7 +1241,21 @@ pub(super) fn warm_population(
         .collect()
 }
 
-/// Nelder–Mead from `start` with an initial simplex of edge `step` (normalised units).
+/// When a polish of the likelihood stops: the standard deviation of the cost over the simplex's
+/// vertices below 0.05 nats (or `polish_iterations`). That is the depth of the ripples the
+/// stick–slip likelihood has at a scale far below its intervals (on the main job's fit the cost
+/// jitters by about 0.05 nats between points σ/50 apart; docs/fit.md, "Uncertainty"), so a
+/// simplex that small only walks from ripple to ripple; the settling that follows fits the bowl
+/// over ±1σ ([`super::evidence::settle`]). A one-restart blade2dof fit of the shipped recording
+/// then stops its polish after 42 iterations instead of running all 60.
+pub const POLISH_SD_NATS: f64 = 0.05;
+
+/// When a polish of any other cost (the feature cost, a target job's) stops: the standard
+/// deviation of its values over the simplex's vertices below 1e-3.
+const POLISH_SD_OTHER: f64 = 1e-3;
+
+/// Nelder–Mead from `start` with an initial simplex of edge `step` (normalised units), stopping at
+/// [`POLISH_SD_NATS`] with the likelihood, [`POLISH_SD_OTHER`] otherwise, or after `iterations`.
 pub(super) fn polish(
     problem: &Arc<SpectralProblem>,
     start: &[f64],
@@ -1192,8 +1275,13 @@ pub(super) fn polish(
         };
         simplex.push(v);
     }
+    let sd = if problem.cost_is_nll() {
+        POLISH_SD_NATS
+    } else {
+        POLISH_SD_OTHER
+    };
     let nm = NelderMead::new(simplex)
-        .with_sd_tolerance(1e-3)
+        .with_sd_tolerance(sd)
         .map_err(fit_err)?;
     let run_evals = observer
         .as_ref()
