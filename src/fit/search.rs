@@ -505,7 +505,14 @@ pub(super) fn fit_candidate(
         ends,
         reporting: reporting.clone(),
     });
-    let mut fit = finish(candidate, free, problem, found, &reporting, pb)?;
+    let mut fit = finish(
+        candidate,
+        free,
+        problem,
+        found,
+        (&reporting, pb),
+        Settling::Settle,
+    )?;
     let mut search_note = search_note;
     if let (Some(smaller), Some(w)) = (nested, warm.first()) {
         fit = keep_the_smaller_optimum(fit, smaller, w, &reporting, pb, &mut search_note)?;
@@ -554,43 +561,37 @@ fn keep_the_smaller_optimum(
         Some(n) => format!("{n}; {kept}"),
         None => kept,
     });
-    let mut kept_fit = finish_at(
+    let mut kept_fit = finish(
         fit.candidate,
         fit.free.clone(),
         fit.problem.clone(),
         found,
-        reporting,
-        pb,
-        false,
+        (reporting, pb),
+        Settling::AsFound,
     )?;
     kept_fit.search_cost = fit.search_cost;
     Ok(kept_fit)
 }
 
-/// The last stage of a candidate's fit, from its search's best end: settling and the sandwich
-/// with a likelihood ([`super::evidence::settle`]), else the cost's curvature; and the search's
-/// history (its wall time and search note are the caller's).
+/// Whether [`finish`] settles the likelihood's optimum or takes the search's end as it is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Settling {
+    /// [`super::evidence::settle`]: the optimum at the intervals' scale.
+    Settle,
+    /// The local fit at the search's end (a point already settled once).
+    AsFound,
+}
+
+/// The last stage of a candidate's fit, from its search's best end: settling (`settling`) and
+/// the sandwich with a likelihood ([`super::evidence::settle`]), else the cost's curvature; and
+/// the search's history (its wall time and search note are the caller's).
 fn finish(
     candidate: Candidate,
     free: Vec<FreeParam>,
     problem: Arc<SpectralProblem>,
     found: Optimised,
-    reporting: &Reporting,
-    pb: &Option<indicatif::ProgressBar>,
-) -> Result<CandidateFit> {
-    finish_at(candidate, free, problem, found, reporting, pb, true)
-}
-
-/// [`finish`], settling the likelihood's optimum or (`settle = false`) taking the local fit at
-/// the search's end as it is.
-fn finish_at(
-    candidate: Candidate,
-    free: Vec<FreeParam>,
-    problem: Arc<SpectralProblem>,
-    found: Optimised,
-    reporting: &Reporting,
-    pb: &Option<indicatif::ProgressBar>,
-    settle: bool,
+    (reporting, pb): (&Reporting, &Option<indicatif::ProgressBar>),
+    settling: Settling,
 ) -> Result<CandidateFit> {
     let Optimised {
         u: mut best_u,
@@ -616,7 +617,7 @@ fn finish_at(
     } else {
         // With the likelihood as the cost, the estimate is its optimum at the intervals' scale
         // ([`super::evidence::settle`]), not the ripple the polish stopped in.
-        let local = if settle && problem.cost_is_nll() {
+        let local = if settling == Settling::Settle && problem.cost_is_nll() {
             super::evidence::settle(&problem, &best_u, cost).map(|(u, c, l)| {
                 (best_u, cost) = (u, c);
                 l
@@ -759,8 +760,8 @@ pub(super) fn confirm_deferred(
                     f.free.clone(),
                     f.problem.clone(),
                     found,
-                    &reporting,
-                    pb,
+                    (&reporting, pb),
+                    Settling::Settle,
                 )?;
                 f.search_note = note;
             }
