@@ -390,11 +390,13 @@ fn likelihood_choice_confusion_table() {
             .iter()
             .filter(|w| w.contains("absorbs structure"))
             .collect();
-        // Which parameters' Laplace intervals miss the truth, and each interval's half-width.
+        // Which parameters' Laplace intervals miss the truth, and each interval's half-width
+        // (printed under the scene's line).
         let mut outside = Vec::new();
+        let mut interval_lines = Vec::new();
         for p in &r.parameters {
             if let (Some(iv), Some(t)) = (&p.interval, p.true_value) {
-                println!(
+                interval_lines.push(format!(
                     "    {}: {:.5} [{:.5}, {:.5}] truth {t:.5} (half-width {:.1} %){}",
                     p.name,
                     p.value,
@@ -402,7 +404,7 @@ fn likelihood_choice_confusion_table() {
                     iv.hi,
                     50.0 * (iv.hi - iv.lo) / p.value,
                     if p.determined { "" } else { ", undetermined" }
-                );
+                ));
                 if t < iv.lo || t > iv.hi {
                     outside.push(p.name.to_string());
                 }
@@ -427,6 +429,9 @@ fn likelihood_choice_confusion_table() {
         );
         for t in &r.model_trials {
             println!("    {}: {}", t.model, t.reason);
+        }
+        for line in &interval_lines {
+            println!("{line}");
         }
         let _ = writeln!(
             md,
