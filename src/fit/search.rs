@@ -908,7 +908,7 @@ fn nested_search(
 /// `(k1_contact − k1)·θ_c` matters, any free k1 moves the neck alike while θ_c is small). On the
 /// confusion table's neck resting on a shoulder at 0.025 rad, without it the global search ended
 /// 2.5 nats below the truth's likelihood and blade2dof was chosen (k1 +229 %); with it the search
-/// reached within 0.13 nats of the truth's and the shoulder model was chosen.
+/// ends within 0.2 nats of the truth's likelihood and the shoulder model is chosen.
 fn nested_warm_points(smaller: &CandidateFit, free: &[FreeParam]) -> Vec<Vec<f64>> {
     let params = smaller.problem.params_at(&smaller.best_u);
     let first: Vec<f64> = free
