@@ -192,8 +192,8 @@ fn laplace_intervals_cover_the_full_model_at_their_rate() {
     }
     let out = root.join("reports/coverage");
     std::fs::create_dir_all(&out).unwrap();
-    std::fs::write(out.join("table.md"), &md).unwrap();
-    std::fs::write(out.join("table.csv"), &csv).unwrap();
+    wiperlab::io::write_atomic(&out.join("table.md"), md.as_bytes()).unwrap();
+    wiperlab::io::write_atomic(&out.join("table.csv"), csv.as_bytes()).unwrap();
     println!("{md}");
     for ((id, _), tl) in truths.iter().zip(&tally) {
         assert_eq!(

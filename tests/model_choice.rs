@@ -337,8 +337,8 @@ fn likelihood_choice_confusion_table() {
     std::fs::create_dir_all(&out).unwrap();
     // The rows so far, written after every scene so that a run stopped partway keeps them.
     let write_table = |md: &str, csv: &str| {
-        std::fs::write(out.join("table.md"), md).unwrap();
-        std::fs::write(out.join("table.csv"), csv).unwrap();
+        wiperlab::io::write_atomic(&out.join("table.md"), md.as_bytes()).unwrap();
+        wiperlab::io::write_atomic(&out.join("table.csv"), csv.as_bytes()).unwrap();
     };
     for (i, s) in SCENES.iter().enumerate() {
         let fitted = write_scene(&dir, i, s).and_then(|(job, switches)| {

@@ -65,8 +65,12 @@ fn main_job_finds_the_truth_for_nine_of_ten_seeds() {
             .iter()
             .map(|e| format!("{:+.2} %", 100.0 * e))
             .collect();
-        // Each interval, so the ends' differences between seeds can be traced to their source
-        // (the estimate or the width).
+        println!(
+            "seed {seed}: {} cost {:.4}, A {} B {} C {} k1 {}, {} evaluations, {:.1} s",
+            r.model, r.cost, pct[0], pct[1], pct[2], pct[3], r.model_evaluations, r.wall_time_s
+        );
+        // Each interval, under the seed's line, so the ends' differences between seeds can be
+        // traced to their source (the estimate or the width).
         for n in names {
             if let Some(p) = r.parameters.iter().find(|p| p.name == n)
                 && let Some(iv) = &p.interval
@@ -80,10 +84,6 @@ fn main_job_finds_the_truth_for_nine_of_ten_seeds() {
                 );
             }
         }
-        println!(
-            "seed {seed}: {} cost {:.4}, A {} B {} C {} k1 {}, {} evaluations, {:.1} s",
-            r.model, r.cost, pct[0], pct[1], pct[2], pct[3], r.model_evaluations, r.wall_time_s
-        );
         let _ = writeln!(
             md,
             "| {seed} | {} | {:.4} | {} | {} | {} | {} | {} | {} | {:.1} s |",
@@ -127,8 +127,8 @@ fn main_job_finds_the_truth_for_nine_of_ten_seeds() {
     }
     let out = root.join("reports/seeds");
     std::fs::create_dir_all(&out).unwrap();
-    std::fs::write(out.join("table.md"), &md).unwrap();
-    std::fs::write(out.join("table.csv"), &csv).unwrap();
+    wiperlab::io::write_atomic(&out.join("table.md"), md.as_bytes()).unwrap();
+    wiperlab::io::write_atomic(&out.join("table.csv"), csv.as_bytes()).unwrap();
     println!("{md}");
     assert!(
         within >= 9,
