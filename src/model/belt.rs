@@ -34,7 +34,7 @@ impl StickSlipModel<2> for Belt {
         match mode.phase.slip_dir() {
             Some(s) => {
                 let v_slip = y[1] - self.v_belt_m_per_s;
-                let f = -s * self.law.mu_slip(v_slip) * self.normal_n;
+                let f = -s * self.law.mu_slip_along(s, v_slip) * self.normal_n;
                 dy[1] = (spring + f) / self.mass_kg;
                 Ok(Contact {
                     normal: self.normal_n,

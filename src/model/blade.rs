@@ -449,7 +449,7 @@ impl Blade {
             tip_velocity,
             ..
         } = self.rows_with_kinematics(t, y, touching);
-        let mu = self.params.friction.mu_slip(tip_velocity);
+        let mu = self.params.friction.mu_slip_along(s, tip_velocity);
         // f = −s μ N: fold into the N column.
         let mut a = a0;
         for i in 0..3 {
@@ -786,7 +786,7 @@ impl LockedBlade {
                     .blade
                     .params
                     .friction
-                    .mu_slip(self.slip_velocity_of(t, th, thd));
+                    .mu_slip_along(s, self.slip_velocity_of(t, th, thd));
                 // [s_th, s_n − s μ s_f; n_th, 1] [θ̈, N] = [s_b, n_b]
                 let c = s_n - s * mu * s_f;
                 let det0 = s_th - s_n * n_th;

@@ -37,6 +37,32 @@ impl FrictionLaw {
         }
     }
 
+    /// Dynamic coefficient in the slip phase of direction `s` (±1) at slip velocity
+    /// `v_m_per_s`: `μ_d(s·v)`, with the law continued smoothly to `s·v < 0`.
+    ///
+    /// For `s·v ≥ 0` this is [`FrictionLaw::mu_slip`]. The continuation is read only at an
+    /// integrator's trial states just past the end of slip (`s·v = 0`, the event that ends the
+    /// phase, is located on the dense output and the solution is cut there). With `μ_d(|v|)`
+    /// instead, a step that crosses the event sees a kink in the right-hand side, and the error
+    /// estimate rejects it until the step no longer crosses: the step size collapses geometrically
+    /// onto every slip-to-stick transition (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.6,
+    /// "discontinuous right-hand sides"). The seed's law continues analytically
+    /// (`A·exp(−B·s·v) + C`), Coulomb's is constant, and Leine's `μ_s/(1 + δ·s·v)` is continued
+    /// analytically down to `s·v = −1/(2δ)` (where it is `2μ_s`) and held there, far from any
+    /// trial state.
+    #[inline]
+    pub fn mu_slip_along(&self, s: f64, v_m_per_s: f64) -> f64 {
+        let u = s * v_m_per_s;
+        match *self {
+            FrictionLaw::Exponential { a, b_s_per_m, c } => a * (-b_s_per_m * u).exp() + c,
+            FrictionLaw::Coulomb { mu_k, .. } => mu_k,
+            FrictionLaw::Leine {
+                mu_s,
+                delta_s_per_m,
+            } => mu_s / (1.0 + delta_s_per_m * u).max(0.5),
+        }
+    }
+
     /// Derivative `dμ_d/d|v|` at slip speed `speed_m_per_s` (s/m); `−A·B` at 0⁺ for the seed's law.
     #[inline]
     pub fn mu_slip_slope(&self, speed_m_per_s: f64) -> f64 {
@@ -105,6 +131,56 @@ impl FrictionLaw {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The continued law is the slip law on its side of zero, and past zero it continues with
+    /// the value and the slope of the law at `0⁺` (one-sided difference quotients; the slope at 0
+    /// is `−A·B` for the seed's law, `−μ_s·δ` for Leine's, physics.md §2.2, §3.3).
+    #[test]
+    fn continued_slip_law_is_smooth_through_zero_slip_speed() {
+        let laws = [
+            FrictionLaw::Exponential {
+                a: 0.8,
+                b_s_per_m: 10.0,
+                c: 0.2,
+            },
+            FrictionLaw::Coulomb {
+                mu_s: 0.6,
+                mu_k: 0.4,
+            },
+            FrictionLaw::Leine {
+                mu_s: 1.0,
+                delta_s_per_m: 3.0,
+            },
+        ];
+        for law in laws {
+            for s in [1.0, -1.0] {
+                for v in [0.0, 1e-3, 0.05, 0.3] {
+                    assert_eq!(law.mu_slip_along(s, s * v), law.mu_slip(v), "{law:?}");
+                }
+                let d = 1e-7;
+                let at0 = law.mu_slip_along(s, 0.0);
+                let below = (at0 - law.mu_slip_along(s, -s * d)) / d;
+                let above = (law.mu_slip_along(s, s * d) - at0) / d;
+                let slope = law.mu_slip_slope(0.0);
+                assert!(
+                    (below - slope).abs() < 1e-4 * slope.abs().max(1.0),
+                    "{law:?}"
+                );
+                assert!(
+                    (above - slope).abs() < 1e-4 * slope.abs().max(1.0),
+                    "{law:?}"
+                );
+                // The kinked law this replaces has the opposite slope past zero.
+                if slope != 0.0 {
+                    let kinked = (at0 - law.mu_slip(d)) / d;
+                    assert!((kinked + slope).abs() < 1e-4 * slope.abs(), "{law:?}");
+                }
+            }
+        }
+        // Leine's continuation is held at 2·μ_s from s·v = −1/(2δ) on, finite everywhere.
+        let leine = laws[2];
+        assert_eq!(leine.mu_slip_along(1.0, -10.0), 2.0);
+    }
 
     /// Values from physics.md §2.2 for the candidate wet law A = 0.8, B = 10 s/m, C = 0.2:
     /// μ(0) = 1.00, μ(0.05) = 0.69, μ(0.1) = 0.49, μ(0.3) = 0.24 (two decimals), slope −A·B = −8.

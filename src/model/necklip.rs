@@ -490,7 +490,11 @@ impl NeckLip {
             / self.blade.params.l1_m.max(self.blade.params.l2_m);
         match mode.phase.slip_dir() {
             Some(s) => {
-                let mu = self.blade.params.friction.mu_slip(rows.tip_velocity);
+                let mu = self
+                    .blade
+                    .params
+                    .friction
+                    .mu_slip_along(s, rows.tip_velocity);
                 let build = |mu_s: f64| {
                     Matrix3::new(
                         a3[(0, 0)],
