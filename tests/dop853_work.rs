@@ -4,7 +4,7 @@
 //!   `wiperlab simulate` runs it (outputs at 10 kHz): 11 per attempt, 4 more per accepted step (its
 //!   end's derivative and the three stages of the 7th-order dense output), one per phase start;
 //!   and that it needs fewer evaluations than DOPRI5 (docs/validation.md, "DOP853 against
-//!   DOPRI5", explains why the ratio is 0.73 and not 0.5);
+//!   DOPRI5", explains why the ratio is 0.69 and not 0.5);
 //! - the transitions of 20 ms of stick–slip from the blade's first stick onset at rtol 1e-10: the
 //!   same sequence with both methods, at the same times within a bound set by the tolerance.
 
@@ -57,7 +57,7 @@ fn dop853_evaluations_on_the_whole_window_add_up_and_undercut_dopri5() {
         6 * (s5.steps + s5.rejected) + 1 + d5.transitions.len(),
         "DOPRI5 {s5:?}"
     );
-    // Fewer evaluations than DOPRI5 (measured 0.73; 0.8 leaves room for the first stick onset,
+    // Fewer evaluations than DOPRI5 (measured 0.69; 0.8 leaves room for the first stick onset,
     // which moves with the integration error and changes the burst's length by a few cycles).
     let ratio = s8.rhs_evals as f64 / s5.rhs_evals as f64;
     assert!(ratio < 0.8, "DOP853/DOPRI5 evaluations {ratio:.3}");

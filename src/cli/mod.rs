@@ -219,8 +219,9 @@ pub enum Command {
         rtol: f64,
         #[arg(long, default_value_t = 1e-12)]
         atol: f64,
-        /// Integrator of the smooth phases: dop853 (the default: at rtol 1e-10 it needs 0.73× the
-        /// right-hand-side evaluations of dopri5 and about half the time, docs/model.md) or dopri5.
+        /// Integrator of the smooth phases: dop853 (the default: at rtol 1e-10 it needs 0.69× the
+        /// right-hand-side evaluations of dopri5 and half its model solves, docs/validation.md) or
+        /// dopri5.
         #[arg(long, value_enum, default_value_t = Method::Dop853)]
         method: Method,
         /// Stick-phase form: reduced (drift-free) or baumgarte.
