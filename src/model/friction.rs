@@ -26,15 +26,7 @@ impl FrictionLaw {
     /// direction's). At `speed = 0` this is the limit from the slip side, `μ_d(0⁺)`.
     #[inline]
     pub fn mu_slip(&self, speed_m_per_s: f64) -> f64 {
-        let v = speed_m_per_s.abs();
-        match *self {
-            FrictionLaw::Exponential { a, b_s_per_m, c } => a * (-b_s_per_m * v).exp() + c,
-            FrictionLaw::Coulomb { mu_k, .. } => mu_k,
-            FrictionLaw::Leine {
-                mu_s,
-                delta_s_per_m,
-            } => mu_s / (1.0 + delta_s_per_m * v),
-        }
+        self.mu_slip_along(1.0, speed_m_per_s.abs())
     }
 
     /// Dynamic coefficient in the slip phase of direction `s` (±1) at slip velocity
