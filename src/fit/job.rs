@@ -231,6 +231,11 @@ pub struct FitSection {
     /// when the local one finds the likelihood worth it).
     #[serde(default = "d_nested_search")]
     pub nested_search: NestedSearch,
+    /// Fresh Nelder–Mead polishes from the chosen model's settled optimum, each kept while it
+    /// lowers the likelihood's cost by more than 0.1 nats (default 0: none; see
+    /// `search::descend_chosen` and docs/fit.md, "Down the valley").
+    #[serde(default)]
+    pub valley_polishes: usize,
     /// Confidence intervals: Laplace (from the likelihood's Fisher information) or parametric
     /// bootstrap (see [`crate::fit::bootstrap_intervals`]).
     #[serde(default)]

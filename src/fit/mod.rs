@@ -50,7 +50,7 @@ use job::LoadedJob;
 use std::sync::atomic::Ordering;
 
 use measure::measure;
-use search::{CandidateFit, confirm_deferred, fit_candidates, progress_bar};
+use search::{CandidateFit, confirm_deferred, descend_chosen, fit_candidates, progress_bar};
 
 /// The result plus what the report draws.
 pub struct FitOutcome {
@@ -86,7 +86,11 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let mut fits = fit_candidates(job, &meas, &candidates, &pb)?;
     let gaps = select::score_gaps(&fits, &job.job.spectrum.bands);
     confirm_deferred(job, &mut fits, &gaps, &pb)?;
-    let mut selection = select::choose(&fits, &job.job.spectrum.bands, !fit.models.is_empty());
+    let explicit = !fit.models.is_empty();
+    let mut selection = select::choose(&fits, &job.job.spectrum.bands, explicit);
+    if descend_chosen(job, &mut fits, selection.chosen, &pb)? {
+        selection = select::choose(&fits, &job.job.spectrum.bands, explicit);
+    }
     let absorbing = select::absorbing_warnings(&fits, selection.chosen, &job.job.spectrum.bands);
     // Laplace intervals read the sandwich over the bowl's centre; a bootstrap's come from its
     // replicates, so its 1σ and correlations keep the sandwich at the fit.
