@@ -1589,9 +1589,9 @@ mod tests {
         );
     }
 
-    /// At the main job's settled optimum (`fits/reversal.result.toml`, the fit the README's command
-    /// writes) a fresh polish gains less than [`VALLEY_GAIN_NATS`], so the end stays as it was, bit
-    /// for bit (the main job's result does not move).
+    /// At the main job's settled optimum (`fits/reversal.result.toml`, written by `wiperlab fit
+    /// fits/reversal.toml`) a fresh polish gains less than [`VALLEY_GAIN_NATS`], so the end stays
+    /// as it was, bit for bit (the main job's result does not move).
     #[test]
     fn at_the_main_jobs_optimum_the_end_is_kept() {
         let (job, candidate, problem) = main_job_problem();
