@@ -618,16 +618,7 @@ pub(super) fn descend_chosen(
     let wall_time_s = f.wall_time_s;
     let moved = found.cost < f.cost && !interrupt::stop_requested();
     if moved {
-        let note = f.search_note.take();
-        *f = finish(
-            f.candidate,
-            f.free.clone(),
-            f.problem.clone(),
-            found,
-            (&reporting, pb),
-            Settling::Settle,
-        )?;
-        f.search_note = note;
+        settle_anew(f, found, &reporting, pb)?;
     } else {
         f.polish_iters = found.polish_iters;
         f.history = reporting.sorted_history();
@@ -637,6 +628,27 @@ pub(super) fn descend_chosen(
         keep_nested_above(fits, chosen, pb)?;
     }
     Ok(moved)
+}
+
+/// The candidate `f` settled anew ([`finish`] with [`Settling::Settle`]) from a better search end
+/// `found`, keeping its search note (its wall time is the caller's).
+fn settle_anew(
+    f: &mut CandidateFit,
+    found: Optimised,
+    reporting: &Reporting,
+    pb: &Option<indicatif::ProgressBar>,
+) -> Result<()> {
+    let note = f.search_note.take();
+    *f = finish(
+        f.candidate,
+        f.free.clone(),
+        f.problem.clone(),
+        found,
+        (reporting, pb),
+        Settling::Settle,
+    )?;
+    f.search_note = note;
+    Ok(())
 }
 
 /// Every candidate nested on `fits[smaller]` (`X+shoulder` on `X`) that is less likely than it
@@ -901,16 +913,7 @@ pub(super) fn confirm_deferred(
                     cost: run.cost,
                     unconfirmed_ends: None,
                 };
-                let note = f.search_note.take();
-                *f = finish(
-                    f.candidate,
-                    f.free.clone(),
-                    f.problem.clone(),
-                    found,
-                    (&reporting, pb),
-                    Settling::Settle,
-                )?;
-                f.search_note = note;
+                settle_anew(f, found, &reporting, pb)?;
             }
             _ => {
                 f.swarm_iters += swarm_iters;
