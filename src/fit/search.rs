@@ -1545,6 +1545,26 @@ mod tests {
             .collect()
     }
 
+    /// A file of the repository, as text.
+    fn repository_file(path: &str) -> String {
+        std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path))
+            .expect(path)
+    }
+
+    /// [`descend_the_valley`] from `end` with the main job's settings and 4 valley polishes.
+    fn descend_four(
+        job: &LoadedJob,
+        candidate: Candidate,
+        problem: &Arc<SpectralProblem>,
+        end: Optimised,
+    ) -> Optimised {
+        let fit = job::FitSection {
+            valley_polishes: 4,
+            ..job.job.fit.clone()
+        };
+        descend_the_valley(problem, &fit, end, &Reporting::new(&None, candidate)).expect("descent")
+    }
+
     /// A search end at `u`, its cost read there.
     fn end_at(problem: &SpectralProblem, u: Vec<f64>) -> Optimised {
         let cost = problem.cost_at(&u);
@@ -1564,11 +1584,8 @@ mod tests {
     #[test]
     fn fresh_polishes_go_on_down_the_valley() {
         let (job, candidate, problem) = main_job_problem();
-        let text = std::fs::read_to_string(
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/reversal/truth.json"),
-        )
-        .expect("truth");
-        let truth: serde_json::Value = serde_json::from_str(&text).expect("truth json");
+        let truth: serde_json::Value =
+            serde_json::from_str(&repository_file("data/reversal/truth.json")).expect("truth json");
         let start = coordinates(&problem, |name| {
             let v = truth["params"][name].as_f64().expect("true value");
             v * match name {
@@ -1578,13 +1595,7 @@ mod tests {
             }
         });
         let (u, _, cost) = polish(&problem, &start, 0.05, 10, None).expect("polish");
-        let reporting = Reporting::new(&None, candidate);
-        let short = end_at(&problem, u);
-        let fit = job::FitSection {
-            valley_polishes: 4,
-            ..job.job.fit.clone()
-        };
-        let down = descend_the_valley(&problem, &fit, short, &reporting).expect("descent");
+        let down = descend_four(&job, candidate, &problem, end_at(&problem, u));
         assert!(
             down.cost < cost - VALLEY_GAIN_NATS,
             "the short polish ended at {cost:.3} nats, the valley's polishes at {:.3}",
@@ -1598,11 +1609,8 @@ mod tests {
     #[test]
     fn at_the_main_jobs_optimum_the_end_is_kept() {
         let (job, candidate, problem) = main_job_problem();
-        let text = std::fs::read_to_string(
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fits/reversal.result.toml"),
-        )
-        .expect("shipped result");
-        let result: toml::Value = toml::from_str(&text).expect("result toml");
+        let result: toml::Value =
+            toml::from_str(&repository_file("fits/reversal.result.toml")).expect("result toml");
         let fitted = result["parameters"].as_array().expect("parameters").clone();
         let start = coordinates(&problem, |name| {
             fitted
@@ -1613,12 +1621,7 @@ mod tests {
         });
         let at_fit = end_at(&problem, start.clone());
         let cost = at_fit.cost;
-        let reporting = Reporting::new(&None, candidate);
-        let fit = job::FitSection {
-            valley_polishes: 4,
-            ..job.job.fit.clone()
-        };
-        let kept = descend_the_valley(&problem, &fit, at_fit, &reporting).expect("descent");
+        let kept = descend_four(&job, candidate, &problem, at_fit);
         assert_eq!(
             kept.u, start,
             "no gain beyond {VALLEY_GAIN_NATS} nats: the end stays"
