@@ -232,10 +232,11 @@ pub struct FitSection {
     #[serde(default = "d_nested_search")]
     pub nested_search: NestedSearch,
     /// Fresh Nelder–Mead polishes from the chosen model's settled optimum, each kept while it
-    /// lowers the likelihood's cost by more than 0.1 nats (default 0: none; see
-    /// `search::descend_chosen` and docs/fit.md, "Down the valley").
+    /// lowers the likelihood's cost by more than 0.1 nats (see `search::descend_chosen` and
+    /// docs/fit.md, "Down the valley"). Default (`None`): [`SHOULDER_VALLEY_POLISHES`] when the
+    /// chosen candidate has a shoulder, none otherwise ([`FitSection::valley_polishes_for`]).
     #[serde(default)]
-    pub valley_polishes: usize,
+    pub valley_polishes: Option<usize>,
     /// Confidence intervals: Laplace (from the likelihood's Fisher information) or parametric
     /// bootstrap (see [`crate::fit::bootstrap_intervals`]).
     #[serde(default)]
@@ -284,6 +285,24 @@ crate::names::named_enum! {
         Adaptive => "adaptive",
         /// Always the global search, warm-started from `X`'s optimum.
         Global => "global",
+    }
+}
+
+/// Valley polishes a candidate with a shoulder gets by default. While the neck rests on the
+/// shoulder its moment is `k1c·θ − (k1c − k1)·θ_c`, so the likelihood has a long, shallow valley
+/// along `(k1c − k1)·θ_c` constant that a polish can stop on the slope of (docs/fit.md, "Down the
+/// valley", and "Why the free k1 of a resting neck is not recovered").
+pub const SHOULDER_VALLEY_POLISHES: usize = 4;
+
+impl FitSection {
+    /// The valley polishes (`[fit] valley_polishes`) for the chosen `candidate`: the job's count,
+    /// or by default [`SHOULDER_VALLEY_POLISHES`] for a candidate with a shoulder and 0 otherwise.
+    pub fn valley_polishes_for(&self, candidate: Candidate) -> usize {
+        self.valley_polishes.unwrap_or(if candidate.shoulder {
+            SHOULDER_VALLEY_POLISHES
+        } else {
+            0
+        })
     }
 }
 
@@ -957,5 +976,25 @@ mod tests {
         }
         let e = "head1dof+shoulder".parse::<Candidate>().unwrap_err();
         assert!(e.to_string().contains("known: head1dof, necklip"), "{e}");
+    }
+
+    #[test]
+    fn valley_polishes_default_to_the_shoulder_candidates_only() {
+        let fit = |extra: &str| -> FitSection {
+            toml::from_str(&format!("{extra}\n[parameters]\nA = [0.2, 1.5]\n")).unwrap()
+        };
+        let plain: Candidate = "blade2dof".parse().unwrap();
+        let shoulder: Candidate = "blade2dof+shoulder".parse().unwrap();
+        let default = fit("");
+        assert_eq!(default.valley_polishes_for(plain), 0);
+        assert_eq!(
+            default.valley_polishes_for(shoulder),
+            SHOULDER_VALLEY_POLISHES
+        );
+        let set = fit("valley_polishes = 2");
+        assert_eq!(set.valley_polishes_for(plain), 2);
+        assert_eq!(set.valley_polishes_for(shoulder), 2);
+        let off = fit("valley_polishes = 0");
+        assert_eq!(off.valley_polishes_for(shoulder), 0);
     }
 }

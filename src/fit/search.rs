@@ -529,7 +529,7 @@ pub(super) fn fit_candidate(
 pub const VALLEY_GAIN_NATS: f64 = 0.1;
 
 /// Fresh Nelder–Mead polishes from the search's best end, with the likelihood as the cost, kept
-/// while each lowers it by more than [`VALLEY_GAIN_NATS`] (at most `[fit] valley_polishes`). A polish
+/// while each lowers it by more than [`VALLEY_GAIN_NATS`] (at most `polishes`). A polish
 /// stops when its simplex has shrunk to the ripples' depth ([`POLISH_SD_NATS`]); in a long shallow
 /// valley of the likelihood that can happen on the valley's slope, and a new simplex of the first
 /// one's size, started where the last one stopped, goes on down the valley (restarting Nelder–Mead
@@ -537,18 +537,21 @@ pub const VALLEY_GAIN_NATS: f64 = 0.1;
 /// is already at a valley's floor, one polish confirms it and the end is kept as the search left
 /// it. Each polish costs up to `polish_iterations` Nelder–Mead iterations, one model run after
 /// another: on the main job's recording the one polish took 30 iterations (53 model runs, about
-/// 1.7 s), which is why the default is none.
+/// 1.7 s) and gained nothing, which is why only a candidate with a shoulder, whose contact moment
+/// makes a valley, gets them by default ([`job::FitSection::valley_polishes_for`]).
 fn descend_the_valley(
     problem: &Arc<SpectralProblem>,
     fit: &job::FitSection,
+    polishes: usize,
     mut found: Optimised,
     reporting: &Reporting,
-) -> Result<Optimised> {
+) -> Result<(Optimised, usize)> {
     if !problem.cost_is_nll() || !found.cost.is_finite() {
-        return Ok(found);
+        return Ok((found, 0));
     }
     let n = problem.free.len();
-    for k in 0..fit.valley_polishes {
+    let mut kept = 0;
+    for k in 0..polishes {
         if interrupt::stop_requested() {
             break;
         }
@@ -579,8 +582,9 @@ fn descend_the_valley(
             break;
         }
         (found.u, found.cost) = (u, cost);
+        kept += 1;
     }
-    Ok(found)
+    Ok((found, kept))
 }
 
 /// [`descend_the_valley`] from the settled optimum of the chosen candidate `fits[chosen]` (its
@@ -589,7 +593,8 @@ fn descend_the_valley(
 /// (`X+shoulder` on `X`) left less likely than it takes its optimum
 /// ([`keep_the_smaller_optimum`]), so the larger model stays at least as likely as the smaller,
 /// as the likelihood-ratio test assumes. The chosen candidate's score only falls, so the choice
-/// stands. Returns whether the chosen candidate moved.
+/// stands. The candidate's search note says how many polishes were kept and what they gained.
+/// Returns whether the chosen candidate moved.
 pub(super) fn descend_chosen(
     job: &LoadedJob,
     fits: &mut Vec<CandidateFit>,
@@ -597,7 +602,8 @@ pub(super) fn descend_chosen(
     pb: &Option<indicatif::ProgressBar>,
 ) -> Result<bool> {
     let f = &fits[chosen];
-    if job.job.fit.valley_polishes == 0 || !f.problem.cost_is_nll() || interrupt::stop_requested() {
+    let polishes = job.job.fit.valley_polishes_for(f.candidate);
+    if polishes == 0 || !f.problem.cost_is_nll() || interrupt::stop_requested() {
         return Ok(false);
     }
     let started = std::time::Instant::now();
@@ -613,10 +619,15 @@ pub(super) fn descend_chosen(
         cost: f.cost,
         unconfirmed_ends: None,
     };
-    let found = descend_the_valley(&f.problem, &job.job.fit, at_fit, &reporting)?;
+    let (found, kept) = descend_the_valley(&f.problem, &job.job.fit, polishes, at_fit, &reporting)?;
     let f = &mut fits[chosen];
     let wall_time_s = f.wall_time_s;
     let moved = found.cost < f.cost && !interrupt::stop_requested();
+    let note = valley_note(kept, polishes, f.cost - found.cost);
+    f.search_note = Some(match f.search_note.take() {
+        Some(n) => format!("{n}; {note}"),
+        None => note,
+    });
     if moved {
         settle_anew(f, found, &reporting, pb)?;
     } else {
@@ -628,6 +639,18 @@ pub(super) fn descend_chosen(
         keep_nested_above(fits, chosen, pb)?;
     }
     Ok(moved)
+}
+
+/// What [`descend_chosen`] did, for the candidate's search note: `kept` of at most `polishes`
+/// valley polishes kept, lowering the cost by `gain_nats`.
+fn valley_note(kept: usize, polishes: usize, gain_nats: f64) -> String {
+    if kept == 0 {
+        format!(
+            "valley polishes: none of up to {polishes} gained more than {VALLEY_GAIN_NATS} nats, the optimum kept"
+        )
+    } else {
+        format!("valley polishes: {kept} of up to {polishes} kept, {gain_nats:.3} nats lower")
+    }
 }
 
 /// The candidate `f` settled anew ([`finish`] with [`Settling::Settle`]) from a better search end
@@ -1558,11 +1581,15 @@ mod tests {
         problem: &Arc<SpectralProblem>,
         end: Optimised,
     ) -> Optimised {
-        let fit = job::FitSection {
-            valley_polishes: 4,
-            ..job.job.fit.clone()
-        };
-        descend_the_valley(problem, &fit, end, &Reporting::new(&None, candidate)).expect("descent")
+        descend_the_valley(
+            problem,
+            &job.job.fit,
+            4,
+            end,
+            &Reporting::new(&None, candidate),
+        )
+        .expect("descent")
+        .0
     }
 
     /// A search end at `u`, its cost read there.
