@@ -623,11 +623,7 @@ pub(super) fn descend_chosen(
     let f = &mut fits[chosen];
     let wall_time_s = f.wall_time_s;
     let moved = found.cost < f.cost && !interrupt::stop_requested();
-    let note = valley_note(kept, polishes, f.cost - found.cost);
-    f.search_note = Some(match f.search_note.take() {
-        Some(n) => format!("{n}; {note}"),
-        None => note,
-    });
+    add_note(f, valley_note(kept, polishes, f.cost - found.cost));
     if moved {
         settle_anew(f, found, &reporting, pb)?;
     } else {
@@ -639,6 +635,14 @@ pub(super) fn descend_chosen(
         keep_nested_above(fits, chosen, pb)?;
     }
     Ok(moved)
+}
+
+/// `note` appended to the candidate's search note (the trial's `reason` in the result).
+fn add_note(f: &mut CandidateFit, note: String) {
+    f.search_note = Some(match f.search_note.take() {
+        Some(n) => format!("{n}; {note}"),
+        None => note,
+    });
 }
 
 /// What [`descend_chosen`] did, for the candidate's search note: `kept` of at most `polishes`
@@ -906,10 +910,7 @@ pub(super) fn confirm_deferred(
             break;
         }
         if let Some(note) = confirmation_skipped(&unconfirmed.ends, gap) {
-            f.search_note = Some(match f.search_note.take() {
-                Some(n) => format!("{n}; {note}"),
-                None => note,
-            });
+            add_note(f, note);
             continue;
         }
         let started = std::time::Instant::now();
