@@ -623,7 +623,10 @@ pub(super) fn descend_chosen(
     let f = &mut fits[chosen];
     let wall_time_s = f.wall_time_s;
     let moved = found.cost < f.cost && !interrupt::stop_requested();
-    add_note(f, valley_note(kept, polishes, f.cost - found.cost));
+    add_note(
+        &mut f.search_note,
+        valley_note(kept, polishes, f.cost - found.cost),
+    );
     if moved {
         settle_anew(f, found, &reporting, pb)?;
     } else {
@@ -637,11 +640,11 @@ pub(super) fn descend_chosen(
     Ok(moved)
 }
 
-/// `note` appended to the candidate's search note (the trial's `reason` in the result).
-fn add_note(f: &mut CandidateFit, note: String) {
-    f.search_note = Some(match f.search_note.take() {
-        Some(n) => format!("{n}; {note}"),
-        None => note,
+/// `text` appended to a candidate's search note (the trial's `reason` in the result).
+fn add_note(note: &mut Option<String>, text: String) {
+    *note = Some(match note.take() {
+        Some(n) => format!("{n}; {text}"),
+        None => text,
     });
 }
 
@@ -743,10 +746,7 @@ fn keep_the_smaller_optimum(
          it keeps that model's optimum ({at_warm:.3} nats)",
         fit.cost
     );
-    *note = Some(match note.take() {
-        Some(n) => format!("{n}; {kept}"),
-        None => kept,
-    });
+    add_note(note, kept);
     let mut kept_fit = finish(
         fit.candidate,
         fit.free.clone(),
@@ -910,7 +910,7 @@ pub(super) fn confirm_deferred(
             break;
         }
         if let Some(note) = confirmation_skipped(&unconfirmed.ends, gap) {
-            add_note(f, note);
+            add_note(&mut f.search_note, note);
             continue;
         }
         let started = std::time::Instant::now();
