@@ -183,6 +183,16 @@ fn every_column_the_pandas_example_reads_exists() {
                 assert!(p0.contains_key(&k), "result parameters have no key {k:?}");
                 checked += 1;
             }
+            // The result's own keys (`result["goodness_of_fit"]`) and those of its tables.
+            for k in subscripts(&code, "result") {
+                assert!(r.get(&k).is_some(), "the result has no key {k:?}");
+                checked += 1;
+            }
+            let gof = r["goodness_of_fit"].as_table().expect("[goodness_of_fit]");
+            for k in subscripts(&code, "gof") {
+                assert!(gof.contains_key(&k), "goodness_of_fit has no key {k:?}");
+                checked += 1;
+            }
         }
         None => println!("skipped fits/reversal.result.toml: the main job writes it"),
     }

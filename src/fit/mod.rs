@@ -110,6 +110,8 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     if let Some(pb) = &pb {
         pb.finish_and_clear();
     }
+    let goodness_of_fit = goodness_of_fit(&cf, &best.sim);
+    warnings.extend(goodness_of_fit.and_then(|g| misfit_warning(&g)));
     warnings.extend(absorbing);
     warnings.extend(line_warnings(&peaks));
     warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
@@ -136,6 +138,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
             input_sha256,
             modes,
             interrupted,
+            goodness_of_fit,
         },
     );
     Ok(FitOutcome {
@@ -147,6 +150,33 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         model: best.features,
         best_sim: best.sim,
         best_params: best.params,
+    })
+}
+
+/// The chosen fit's goodness of fit to the recording's spectra
+/// ([`evidence::RecordingLikelihood::goodness_of_fit`]); `None` without a likelihood, for a joint
+/// fit (whose other recordings the test does not read), when interrupted, or when the test fails
+/// to run.
+fn goodness_of_fit(cf: &CandidateFit, sim: &BladeSimulation) -> Option<likelihood::GoodnessOfFit> {
+    let p = &cf.problem;
+    if !p.cost_is_nll() || !p.others.is_empty() || interrupt::stop_requested() {
+        return None;
+    }
+    p.likelihood.as_ref().ok()?.goodness_of_fit(p, sim).ok()
+}
+
+/// The warning of a fit whose spectra are less likely than its own noise makes likely.
+fn misfit_warning(g: &likelihood::GoodnessOfFit) -> Option<String> {
+    (!g.fits()).then(|| {
+        format!(
+            "the chosen model does not explain the recording's spectra to their noise: excess NLL {:.1} nats against {:.1} ± {:.1} for {} noise replicates of the fit (p = {:.3}, {:.1}σ); the recording holds structure no candidate reproduces, or the search missed a candidate's basin, and the fitted parameters may be bent to absorb it",
+            g.excess_nll_nats,
+            g.replicate_mean_nats,
+            g.replicate_sd_nats,
+            g.replicates,
+            g.p_value,
+            g.z()
+        )
     })
 }
 
@@ -367,6 +397,7 @@ struct Assembled {
     input_sha256: String,
     modes: Vec<crate::model::modes::BladeMode>,
     interrupted: bool,
+    goodness_of_fit: Option<likelihood::GoodnessOfFit>,
 }
 
 /// The result of the chosen fit, with the job's provenance (the recording's hash and the effective
@@ -418,6 +449,7 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         data_files: Vec::new(),
         modes: a.modes,
         interrupted: a.interrupted,
+        goodness_of_fit: a.goodness_of_fit,
         history: cf.history.clone(),
     }
 }

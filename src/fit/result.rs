@@ -361,6 +361,12 @@ pub struct FitResult {
     /// search had reached, `model_evaluations` says how far it got.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub interrupted: bool,
+    /// Whether the chosen model explains the recording's spectra to the recording's own noise: the
+    /// parametric-bootstrap test of [`crate::fit::evidence::RecordingLikelihood::goodness_of_fit`];
+    /// `None` without a likelihood (a target job, a joint fit), when interrupted, and in results
+    /// written before this field.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub goodness_of_fit: Option<crate::fit::likelihood::GoodnessOfFit>,
     pub history: Vec<HistoryPoint>,
 }
 
@@ -522,6 +528,13 @@ mod tests {
             data_files: vec!["psd_low.csv".into()],
             modes: vec![],
             interrupted: false,
+            goodness_of_fit: Some(crate::fit::likelihood::GoodnessOfFit {
+                excess_nll_nats: 78.3,
+                replicate_mean_nats: 75.7,
+                replicate_sd_nats: 7.8,
+                replicates: 999,
+                p_value: 0.354,
+            }),
             history: vec![HistoryPoint {
                 stage: SearchStage::Swarm,
                 restart: 1,

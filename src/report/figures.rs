@@ -741,6 +741,21 @@ pub fn fit_summary(r: &FitResult) -> String {
             100.0 * pk.rel_diff
         );
     }
+    if let Some(g) = &r.goodness_of_fit {
+        let _ = writeln!(
+            s,
+            "  goodness of fit: excess NLL {:.2} nats, noise replicates of the fit {:.2} ± {:.2} (p = {:.3}: {})",
+            g.excess_nll_nats,
+            g.replicate_mean_nats,
+            g.replicate_sd_nats,
+            g.p_value,
+            if g.fits() {
+                "the model explains the spectra to their noise"
+            } else {
+                "the spectra hold more than the model and noise"
+            }
+        );
+    }
     if !r.undetermined.is_empty() {
         let _ = writeln!(
             s,

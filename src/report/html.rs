@@ -355,6 +355,23 @@ fn mode_rows(r: &FitResult) -> Vec<ModeView> {
         .collect()
 }
 
+/// The goodness-of-fit test in a sentence.
+fn goodness_of_fit_words(g: &crate::fit::likelihood::GoodnessOfFit) -> String {
+    let verdict = if g.fits() {
+        "the model explains the recording's spectra to their noise"
+    } else {
+        "the spectra hold more than the model and noise: structure no candidate reproduces, or a basin the search missed, possibly absorbed by the fitted parameters"
+    };
+    format!(
+        "Goodness of fit: the recording's excess NLL at the fit is {} nats, against {} ± {} for {} replicates of the fitted model plus the recording's tracking noise (p = {}): {verdict}.",
+        num(g.excess_nll_nats, 4),
+        num(g.replicate_mean_nats, 4),
+        num(g.replicate_sd_nats, 2),
+        g.replicates,
+        num(g.p_value, 2),
+    )
+}
+
 fn trial_rows(r: &FitResult) -> Vec<TrialView> {
     r.model_trials
         .iter()
@@ -483,6 +500,8 @@ struct PageView<'a> {
     interval_methods: Vec<String>,
     peaks: Vec<PeakView>,
     trials: Vec<TrialView>,
+    /// The chosen model's goodness of fit in words, when the result has one.
+    goodness_of_fit: Option<String>,
     modes: Vec<ModeView>,
     correlation: Vec<CorrelationRow>,
     warnings: &'a [String],
@@ -573,6 +592,7 @@ fn page_view<'a>(
         interval_methods,
         peaks: peak_rows(r),
         trials: trial_rows(r),
+        goodness_of_fit: r.goodness_of_fit.as_ref().map(goodness_of_fit_words),
         modes: mode_rows(r),
         correlation: if pd { correlation_rows(r) } else { Vec::new() },
         warnings,
@@ -898,6 +918,7 @@ pub(super) mod tests {
             data_files: vec![],
             modes: vec![],
             interrupted: false,
+            goodness_of_fit: None,
             history: vec![],
         }
     }
