@@ -645,7 +645,8 @@ impl RecordingLikelihood {
 pub const NOISE_REPLICATES: usize = 256;
 
 /// Noise replicates of a goodness-of-fit test ([`RecordingLikelihood::goodness_of_fit`]): 999
-/// resolve a p-value of 0.001 (Davison & Hinkley 1997, §4.2.5, on choosing R); about 0.5 s on
+/// resolve a p-value of 0.001 (Davison & Hinkley 1997, §4.2, on the
+/// number of simulations); about 0.5 s on
 /// the main job's two bands and two threads.
 pub const GOODNESS_OF_FIT_REPLICATES: usize = 999;
 

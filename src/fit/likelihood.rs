@@ -744,7 +744,7 @@ impl GoodnessOfFit {
 
 /// The Monte Carlo p-value of an `observed` statistic against `replicates` of it under the null
 /// hypothesis, large values counting against it: `(1 + #{r ≥ observed}) / (1 + R)` (Davison &
-/// Hinkley 1997, eq. 4.11), never 0; with `R = 999` it resolves 0.001.
+/// Hinkley 1997, §4.2), never 0; with `R = 999` it resolves 0.001.
 pub fn monte_carlo_p_value(observed: f64, replicates: &[f64]) -> f64 {
     let at_least = replicates.iter().filter(|&&r| r >= observed).count();
     (1 + at_least) as f64 / (1 + replicates.len()) as f64
