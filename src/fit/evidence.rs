@@ -489,54 +489,79 @@ impl RecordingLikelihood {
         parts: &NllParts,
         j: &Jacobian,
     ) -> Result<DMatrix<f64>> {
-        use rand::SeedableRng;
-        use rand_distr::Distribution;
         use rayon::prelude::*;
-        let sim_psd: Vec<Vec<f64>> = problem
-            .model_features(sim)?
-            .bands
-            .into_iter()
-            .map(|b| b.psd)
-            .collect();
-        let m = self.model_x(problem, sim)?;
+        let base = self.replicate_base(problem, sim)?;
         let w = self.weights(parts, j.n_time(self));
-        let normal = rand_distr::Normal::new(0.0, self.sigma_m).map_err(|_| {
-            likelihood::LikelihoodError::InvalidSigma {
-                sigma: self.sigma_m,
-            }
-        })?;
         let scores: Vec<Vec<f64>> = (0..NOISE_REPLICATES)
             .into_par_iter()
             .map(|r| {
-                let mut rng = rand::rngs::StdRng::seed_from_u64(NOISE_SEED + r as u64);
-                let x: Vec<f64> = m.iter().map(|v| v + normal.sample(&mut rng)).collect();
-                Ok(j.score(&w, &self.replicate_residuals(problem, &x, &m, &sim_psd)?))
+                let x = base.signal(r);
+                Ok(j.score(&w, &self.replicate_residuals(problem, &x, &base)?))
             })
             .collect::<Result<_>>()?;
         Ok(sample_covariance(&scores))
     }
 
-    /// One noise replicate's residuals in the response's order: per spectral ordinate
-    /// `1 − P̂_k/S_k` with `S_k` the simulation's ordinate `sim_psd` plus the noise density of the
-    /// replicate's own `σ̂`; per time-domain sample or block mean the negated noise, de-meaned.
-    /// `x`: the replicate's signal, `m`: the model's.
-    fn replicate_residuals(
+    /// What the noise replicates of the simulation `sim` are drawn around
+    /// ([`ReplicateBase`]).
+    ///
+    /// # Errors
+    /// The simulation's features' errors; [`likelihood::LikelihoodError::InvalidSigma`] for a
+    /// recording's σ that is no normal distribution's.
+    fn replicate_base(
+        &self,
+        problem: &SpectralProblem,
+        sim: &BladeSimulation,
+    ) -> Result<ReplicateBase> {
+        let sim_psd = problem
+            .model_features(sim)?
+            .bands
+            .into_iter()
+            .map(|b| b.psd)
+            .collect();
+        let noise = rand_distr::Normal::new(0.0, self.sigma_m).map_err(|_| {
+            likelihood::LikelihoodError::InvalidSigma {
+                sigma: self.sigma_m,
+            }
+        })?;
+        Ok(ReplicateBase {
+            m: self.model_x(problem, sim)?,
+            sim_psd,
+            noise,
+        })
+    }
+
+    /// A replicate's Welch ordinates through the measurement's estimator, and per band the noise
+    /// density of the replicate's own `σ̂` (as the fit estimates the recording's).
+    fn replicate_spectra(
         &self,
         problem: &SpectralProblem,
         x: &[f64],
-        m: &[f64],
-        sim_psd: &[Vec<f64>],
-    ) -> Result<Vec<f64>> {
+    ) -> Result<(crate::spectrum::features::Features, Vec<f64>)> {
         let sigma = likelihood::tracking_noise_sigma(x)?;
-        let noise_scale = (sigma / self.sigma_m).powi(2);
+        let scale = (sigma / self.sigma_m).powi(2);
         let f = crate::spectrum::features::features(
             x,
             problem.fs_hz,
             &problem.bands,
             problem.max_fill,
         )?;
-        let mut res = Vec::with_capacity(m.len());
-        for ((fb, s), b) in f.bands.iter().zip(sim_psd).zip(&self.bands) {
+        Ok((f, self.bands.iter().map(|b| b.noise_psd * scale).collect()))
+    }
+
+    /// One noise replicate's residuals in the response's order: per spectral ordinate
+    /// `1 − P̂_k/S_k` with `S_k` the simulation's ordinate `sim_psd` plus the noise density of the
+    /// replicate's own `σ̂`; per time-domain sample or block mean the negated noise, de-meaned.
+    /// `x`: the replicate's signal, drawn around `base`.
+    fn replicate_residuals(
+        &self,
+        problem: &SpectralProblem,
+        x: &[f64],
+        base: &ReplicateBase,
+    ) -> Result<Vec<f64>> {
+        let (f, noise) = self.replicate_spectra(problem, x)?;
+        let mut res = Vec::with_capacity(base.m.len());
+        for ((fb, s), noise) in f.bands.iter().zip(&base.sim_psd).zip(noise) {
             if fb.psd.len() != s.len() {
                 return Err(likelihood::LikelihoodError::LengthMismatch {
                     measured: fb.psd.len(),
@@ -544,11 +569,10 @@ impl RecordingLikelihood {
                 }
                 .into());
             }
-            let noise = b.noise_psd * noise_scale;
             res.extend(fb.psd.iter().zip(s).map(|(p, s)| 1.0 - p / (s + noise)));
         }
         if self.time_domain {
-            res.extend(self.time_residuals(x, m)?.into_iter().map(|e| -e));
+            res.extend(self.time_residuals(x, &base.m)?.into_iter().map(|e| -e));
         }
         Ok(res)
     }
@@ -588,36 +612,21 @@ impl RecordingLikelihood {
         sim: &BladeSimulation,
         replicates: usize,
     ) -> Result<Vec<f64>> {
-        use rand::SeedableRng;
-        use rand_distr::Distribution;
         use rayon::prelude::*;
-        let sim_psd: Vec<Vec<f64>> = problem
-            .model_features(sim)?
-            .bands
-            .into_iter()
-            .map(|b| b.psd)
-            .collect();
-        let m = self.model_x(problem, sim)?;
-        let normal = rand_distr::Normal::new(0.0, self.sigma_m).map_err(|_| {
-            likelihood::LikelihoodError::InvalidSigma {
-                sigma: self.sigma_m,
-            }
-        })?;
+        let base = self.replicate_base(problem, sim)?;
         (0..replicates)
             .into_par_iter()
             .map(|r| {
-                let mut rng = rand::rngs::StdRng::seed_from_u64(NOISE_SEED + r as u64);
-                let x: Vec<f64> = m.iter().map(|v| v + normal.sample(&mut rng)).collect();
-                let sigma = likelihood::tracking_noise_sigma(&x)?;
-                let f = crate::spectrum::features::features(
-                    &x,
-                    problem.fs_hz,
-                    &problem.bands,
-                    problem.max_fill,
-                )?;
+                let x = base.signal(r);
+                let (f, noise) = self.replicate_spectra(problem, &x)?;
                 let mut excess = 0.0;
-                for ((fb, s), b) in f.bands.iter().zip(&sim_psd).zip(&self.bands) {
-                    let noise = b.noise_psd * (sigma / self.sigma_m).powi(2);
+                for (((fb, s), noise), b) in f
+                    .bands
+                    .iter()
+                    .zip(&base.sim_psd)
+                    .zip(noise)
+                    .zip(&self.bands)
+                {
                     let expected: Vec<f64> = s.iter().map(|v| v + noise).collect();
                     excess += b.lik.nll(&fb.psd, &expected)? - b.lik.nll(&fb.psd, &fb.psd)?;
                 }
@@ -643,6 +652,28 @@ impl RecordingLikelihood {
 /// about `1/√(2R)`, 4.4 % for R = 256; each replicate costs one Welch estimate per band and no
 /// simulation.
 pub const NOISE_REPLICATES: usize = 256;
+
+/// What noise replicates of a simulation are drawn around: the model's signal at the recording's
+/// samples (NaN where the recording is), its Welch ordinates per band, and white noise of the
+/// recording's `σ`.
+struct ReplicateBase {
+    m: Vec<f64>,
+    sim_psd: Vec<Vec<f64>>,
+    noise: rand_distr::Normal<f64>,
+}
+
+impl ReplicateBase {
+    /// Replicate `r`'s signal: `m` plus white noise drawn from seed [`NOISE_SEED`]` + r`.
+    fn signal(&self, r: usize) -> Vec<f64> {
+        use rand::SeedableRng;
+        use rand_distr::Distribution;
+        let mut rng = rand::rngs::StdRng::seed_from_u64(NOISE_SEED + r as u64);
+        self.m
+            .iter()
+            .map(|v| v + self.noise.sample(&mut rng))
+            .collect()
+    }
+}
 
 /// Noise replicates of a goodness-of-fit test ([`RecordingLikelihood::goodness_of_fit`]): 999
 /// resolve a p-value of 0.001 (Davison & Hinkley 1997, §4.2, on the
