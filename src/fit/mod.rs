@@ -110,8 +110,11 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     if let Some(pb) = &pb {
         pb.finish_and_clear();
     }
-    let goodness_of_fit = goodness_of_fit(&cf, &best.sim);
-    warnings.extend(goodness_of_fit.and_then(|g| misfit_warning(&g)));
+    let goodness_of_fit = goodness_of_fit(&cf, &best.sim).unwrap_or_else(|e| {
+        warnings.push(format!("no goodness-of-fit test: {e}"));
+        None
+    });
+    warnings.extend(goodness_of_fit.as_ref().and_then(misfit_warning));
     warnings.extend(absorbing);
     warnings.extend(line_warnings(&peaks));
     warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
@@ -155,14 +158,24 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
 
 /// The chosen fit's goodness of fit to the recording's spectra
 /// ([`evidence::RecordingLikelihood::goodness_of_fit`]); `None` without a likelihood, for a joint
-/// fit (whose other recordings the test does not read), when interrupted, or when the test fails
-/// to run.
-fn goodness_of_fit(cf: &CandidateFit, sim: &BladeSimulation) -> Option<likelihood::GoodnessOfFit> {
+/// fit (whose other recordings the test does not read) and when interrupted.
+///
+/// # Errors
+/// Why the test could not run (a replicate's spectra or noise estimate failed), for a warning.
+fn goodness_of_fit(
+    cf: &CandidateFit,
+    sim: &BladeSimulation,
+) -> std::result::Result<Option<likelihood::GoodnessOfFit>, String> {
     let p = &cf.problem;
+    let Ok(lik) = p.likelihood.as_ref() else {
+        return Ok(None);
+    };
     if !p.cost_is_nll() || !p.others.is_empty() || interrupt::stop_requested() {
-        return None;
+        return Ok(None);
     }
-    p.likelihood.as_ref().ok()?.goodness_of_fit(p, sim).ok()
+    lik.goodness_of_fit(p, sim)
+        .map(Some)
+        .map_err(|e| e.to_string())
 }
 
 /// The warning of a fit whose spectra are less likely than its own noise makes likely.
@@ -470,6 +483,18 @@ mod tests {
 
     fn band(name: &str, lo: f64, hi: f64) -> BandSpec {
         BandSpec::new(name, [lo, hi], 1024)
+    }
+
+    /// The misfit warning fires only when the recording's statistic is beyond all but 1 % of its
+    /// replicates', and quotes the numbers.
+    #[test]
+    fn misfit_warning_fires_below_the_level_only() {
+        let replicates: Vec<f64> = (0..999).map(|i| 60.0 + 0.04 * f64::from(i)).collect();
+        let above_all = likelihood::GoodnessOfFit::of(171.0, &replicates).unwrap();
+        let w = misfit_warning(&above_all).expect("p = 0.001 is below the level");
+        assert!(w.contains("171.0 nats") && w.contains("p = 0.001"), "{w}");
+        let typical = likelihood::GoodnessOfFit::of(80.0, &replicates).unwrap();
+        assert_eq!(misfit_warning(&typical), None);
     }
 
     /// The default chain: the head model for low bands only, the full blade as soon as a band
