@@ -364,11 +364,11 @@ fn goodness_of_fit_words(g: &crate::fit::likelihood::GoodnessOfFit) -> String {
     };
     format!(
         "Goodness of fit: the recording's excess NLL at the fit is {} nats, against {} ± {} for {} replicates of the fitted model plus the recording's tracking noise (p = {}): {verdict}.",
-        num(g.excess_nll_nats, 4),
+        num(g.excess_nll_nats, 5),
         num(g.replicate_mean_nats, 4),
         num(g.replicate_sd_nats, 2),
         g.replicates,
-        num(g.p_value, 2),
+        format!("{:.3}", g.p_value),
     )
 }
 
@@ -973,6 +973,8 @@ pub(super) mod tests {
         )));
         assert!(html.contains("Only one model (blade2dof) was fitted"));
         assert!(html.contains("The result does not record the job's settings."));
+        // No test in the result: no goodness-of-fit paragraph.
+        assert!(!html.contains("id=\"goodness-of-fit\""));
 
         // Unchanged recording, all figures present, nothing failed: no warnings at all.
         std::fs::write(&rec, "the recording at fit time").unwrap();
@@ -982,6 +984,14 @@ pub(super) mod tests {
         let mut r = r;
         r.parameters[1].determined = true;
         r.failed_evaluations = 0;
+        // A fit its recording contradicts: the paragraph says so in words, with its numbers.
+        r.goodness_of_fit = Some(crate::fit::likelihood::GoodnessOfFit {
+            excess_nll_nats: 170.96,
+            replicate_mean_nats: 78.37,
+            replicate_sd_nats: 7.96,
+            replicates: 999,
+            p_value: 0.001,
+        });
         let s = write_report(
             &r,
             &ReportPaths {
@@ -993,11 +1003,10 @@ pub(super) mod tests {
         )
         .unwrap();
         assert!(s.warnings.is_empty(), "{:?}", s.warnings);
-        assert!(
-            std::fs::read_to_string(&s.path)
-                .unwrap()
-                .contains("<p id=\"warning-list\">None.</p>")
-        );
+        let html = std::fs::read_to_string(&s.path).unwrap();
+        assert!(html.contains("<p id=\"warning-list\">None.</p>"));
+        assert!(html.contains("<p id=\"goodness-of-fit\">Goodness of fit: the recording&#x27;s excess NLL at the fit is 170.96 nats, against 78.37 ± 8.0 for 999 replicates"), "{html}");
+        assert!(html.contains("(p = 0.001): the spectra hold more than the model and noise"));
         std::fs::remove_dir_all(&dir).ok();
     }
 
