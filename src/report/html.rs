@@ -363,12 +363,12 @@ fn goodness_of_fit_words(g: &crate::fit::likelihood::GoodnessOfFit) -> String {
         "the spectra hold more than the model and noise: structure no candidate reproduces, or a basin the search missed, possibly absorbed by the fitted parameters"
     };
     format!(
-        "Goodness of fit: the recording's excess NLL at the fit is {} nats, against {} ± {} for {} replicates of the fitted model plus the recording's tracking noise (p = {}): {verdict}.",
+        "Goodness of fit: the recording's excess NLL at the fit is {} nats, against {} ± {} for {} replicates of the fitted model plus the recording's tracking noise (p = {:.3}): {verdict}.",
         num(g.excess_nll_nats, 5),
         num(g.replicate_mean_nats, 4),
         num(g.replicate_sd_nats, 2),
         g.replicates,
-        format!("{:.3}", g.p_value),
+        g.p_value,
     )
 }
 
