@@ -247,8 +247,7 @@ impl RecordingLikelihood {
     /// Those of [`RecordingLikelihood::nll`].
     pub fn excess_nll(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<f64> {
         // The fit's cost: the residuals are only formed when the time-domain term needs them.
-        let (spectral_nats, _) = self.spectral_terms(problem, sim)?;
-        let mut excess = spectral_nats.iter().sum::<f64>() - self.saturated_spectral_nats;
+        let mut excess = self.spectral_excess_nll(problem, sim)?;
         if self.time_domain {
             excess += match self.block_len {
                 Some(len) => self.block_term(&self.model_x(problem, sim)?, len)?.0,
@@ -260,6 +259,14 @@ impl RecordingLikelihood {
             };
         }
         Ok(excess)
+    }
+
+    /// The bands' Whittle NLL above the saturated model's, nats: the spectral part of
+    /// [`RecordingLikelihood::excess_nll`] and the statistic of
+    /// [`RecordingLikelihood::goodness_of_fit`].
+    fn spectral_excess_nll(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<f64> {
+        let (spectral_nats, _) = self.spectral_terms(problem, sim)?;
+        Ok(spectral_nats.iter().sum::<f64>() - self.saturated_spectral_nats)
     }
 
     /// The Whittle NLL of every band, nats, and the bands' effectively independent bins.
@@ -591,8 +598,7 @@ impl RecordingLikelihood {
         problem: &SpectralProblem,
         sim: &BladeSimulation,
     ) -> Result<likelihood::GoodnessOfFit> {
-        let (spectral, _) = self.spectral_terms(problem, sim)?;
-        let observed = spectral.iter().sum::<f64>() - self.saturated_spectral_nats;
+        let observed = self.spectral_excess_nll(problem, sim)?;
         let replicates = self.replicate_excess_nll(problem, sim, GOODNESS_OF_FIT_REPLICATES)?;
         Ok(likelihood::GoodnessOfFit::of(observed, &replicates)?)
     }

@@ -718,13 +718,12 @@ impl GoodnessOfFit {
                 });
             }
         }
-        let n = replicates.len() as f64;
-        let mean = replicates.iter().sum::<f64>() / n;
-        let var = replicates.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        use statrs::statistics::Statistics;
         Ok(GoodnessOfFit {
             excess_nll_nats: observed,
-            replicate_mean_nats: mean,
-            replicate_sd_nats: var.sqrt(),
+            replicate_mean_nats: replicates.mean(),
+            // The sample standard deviation (divisor R − 1).
+            replicate_sd_nats: replicates.std_dev(),
             replicates: replicates.len(),
             p_value: monte_carlo_p_value(observed, replicates),
         })
