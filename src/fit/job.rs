@@ -323,6 +323,10 @@ crate::names::named_enum! {
         Laplace => "laplace",
         /// Basic parametric bootstrap: `bootstrap` replicates, each re-fitted.
         Bootstrap => "bootstrap",
+        /// Profile likelihood: each parameter walked out from the fit, the others re-polished at
+        /// every step, to where the likelihood has dropped by the sandwich-calibrated 68.27 %
+        /// threshold (a few conditional polishes per side).
+        Profile => "profile",
     }
 }
 

@@ -39,7 +39,10 @@ pub use result::{
 };
 pub use search::{NESTED_GLOBAL_GAIN_NATS, problem_for};
 pub use select::aic;
-pub use uncertainty::{bootstrap_intervals, identifiability_warnings, laplace_intervals};
+pub use uncertainty::{
+    ProfileStart, bootstrap_intervals, identifiability_warnings, laplace_intervals,
+    profile_intervals_at,
+};
 
 use crate::Result;
 use crate::model::BladeParams;
@@ -92,10 +95,10 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         selection = select::choose(&fits, &job.job.spectrum.bands, explicit);
     }
     let absorbing = select::absorbing_warnings(&fits, selection.chosen, &job.job.spectrum.bands);
-    // Laplace intervals read the sandwich over the bowl's centre; a bootstrap's come from its
-    // replicates, so its 1σ and correlations keep the sandwich at the fit.
+    // Laplace and profile intervals read the sandwich over the bowl's centre; a bootstrap's come
+    // from its replicates, so its 1σ and correlations keep the sandwich at the fit.
     let mut cf = fits.swap_remove(selection.chosen);
-    if fit.uncertainty.method() == job::UncertaintyMethod::Laplace {
+    if fit.uncertainty.method() != job::UncertaintyMethod::Bootstrap {
         cf = cf.with_smoothed_spread();
     }
     let best = BestModel::of(&cf)?;
@@ -222,7 +225,7 @@ fn chosen_intervals(
     let (intervals, mut warnings) = if interrupt::stop_requested() {
         (None, Vec::new())
     } else {
-        match uncertainty::intervals(cf, &best.sim, fit) {
+        match uncertainty::intervals(cf, &best.sim, fit, pb) {
             Err(_) if interrupt::stop_requested() => (None, Vec::new()),
             other => other?,
         }

@@ -317,6 +317,34 @@ impl CostFunction for Shared {
     }
 }
 
+/// [`Shared`] with one normalised coordinate held: the cost as a function of the others (a
+/// profile likelihood's inner minimisation, [`super::uncertainty::profile_intervals`]).
+#[derive(Clone)]
+pub(super) struct Pinned {
+    pub(super) shared: Shared,
+    /// The held coordinate's index in the full vector.
+    pub(super) index: usize,
+    /// Its value, normalised.
+    pub(super) u: f64,
+}
+
+impl Pinned {
+    /// The full coordinates: `others` with the held one inserted at its index.
+    pub(super) fn full(&self, others: &[f64]) -> Vec<f64> {
+        let mut u = others.to_vec();
+        u.insert(self.index, self.u);
+        u
+    }
+}
+
+impl CostFunction for Pinned {
+    type Param = Vec<f64>;
+    type Output = f64;
+    fn cost(&self, others: &Self::Param) -> std::result::Result<f64, argmin::core::Error> {
+        self.shared.cost(&self.full(others))
+    }
+}
+
 /// Cost of a target job: per band, `(ln f_m/f_edge / 0.01)²` when the model's peak `f_m` lies outside
 /// the target range (`f_edge` the nearest edge; 0 inside), 100 when the model has no peak in the band.
 pub fn target_cost(targets: &[[f64; 2]], model: &Features) -> f64 {

@@ -73,8 +73,14 @@ pub struct Interval {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum IntervalMethod {
-    /// Where the cost's profile crosses its threshold.
-    Profile,
+    /// Profile likelihood ([`crate::fit::profile_intervals_at`]): where the NLL, minimised over
+    /// the other parameters, has risen by `rise_limit_nats` from the fit.
+    Profile {
+        /// The rise at the interval's ends, nats: 0.5·σ²_sandwich/σ²_Fisher of the parameter (0 in
+        /// results that did not record it).
+        #[serde(default)]
+        rise_limit_nats: f64,
+    },
     /// Basic parametric bootstrap ([`crate::fit::bootstrap_intervals`]).
     Bootstrap {
         replicates: usize,
@@ -107,7 +113,12 @@ pub enum IntervalMethod {
 impl std::fmt::Display for IntervalMethod {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            IntervalMethod::Profile => f.write_str("profile"),
+            IntervalMethod::Profile { rise_limit_nats } if *rise_limit_nats > 0.0 => write!(
+                f,
+                "profile likelihood: where the NLL, minimised over the other parameters, has risen \
+                 {rise_limit_nats:.3} nats from the fit (0.5·σ²_sandwich/σ²_Fisher)"
+            ),
+            IntervalMethod::Profile { .. } => f.write_str("profile likelihood"),
             IntervalMethod::Curvature => f.write_str("curvature"),
             IntervalMethod::Laplace {
                 fisher_step_u,
@@ -444,7 +455,9 @@ mod tests {
                 lo: 0.028,
                 hi: 0.032,
                 level: 0.68,
-                method: IntervalMethod::Profile,
+                method: IntervalMethod::Profile {
+                    rise_limit_nats: 0.125,
+                },
             }),
         }
     }

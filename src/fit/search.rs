@@ -7,7 +7,7 @@ use super::evidence::RecordingLikelihood;
 use super::interrupt;
 use super::job::{self, LoadedJob};
 use super::measure::{Measurement, measure, measure_recording, necklip_view};
-use super::problem::{FreeParam, Shared, SpectralProblem};
+use super::problem::{FreeParam, Pinned, Shared, SpectralProblem};
 use super::result::{HistoryPoint, SearchStage};
 use crate::Result;
 use crate::model::BladeParams;
@@ -44,7 +44,7 @@ pub(super) struct Reporting {
 impl Reporting {
     /// The reporting of `candidate`'s search on the progress bar `pb` (from its position now), with
     /// one-line messages instead when stderr is not a terminal.
-    fn new(pb: &Option<indicatif::ProgressBar>, candidate: Candidate) -> Reporting {
+    pub(super) fn new(pb: &Option<indicatif::ProgressBar>, candidate: Candidate) -> Reporting {
         let last_line = pb
             .as_ref()
             .filter(|_| !std::io::IsTerminal::is_terminal(&std::io::stderr()))
@@ -82,8 +82,28 @@ impl Reporting {
         history
     }
 
+    /// Moves the progress bar to `evaluations` model runs from this reporting's base and, when
+    /// stderr is not a terminal, prints a one-line message at most every [`piped_interval`].
+    fn advance(&self, evaluations: usize) {
+        let Some(pb) = &self.progress else { return };
+        pb.set_position(self.base + evaluations as u64);
+        if let Some(last) = &self.last_line {
+            let mut last = last.lock().unwrap_or_else(|e| e.into_inner());
+            if last.elapsed() >= piped_interval() {
+                *last = std::time::Instant::now();
+                eprintln!(
+                    "progress: {}: {}/{} model runs, {:.0} s",
+                    pb.message(),
+                    pb.position(),
+                    pb.length().unwrap_or(0),
+                    pb.elapsed().as_secs_f64()
+                );
+            }
+        }
+    }
+
     /// Names the stage on the progress bar.
-    fn stage(&self, what: std::fmt::Arguments) {
+    pub(super) fn stage(&self, what: std::fmt::Arguments) {
         if let Some(pb) = &self.progress {
             pb.set_message(format!("{} {what}", self.candidate));
         }
@@ -142,22 +162,7 @@ where
                 best_cost: state.get_best_cost(),
                 evaluations: self.run_evals.load(Ordering::Relaxed),
             });
-        if let Some(pb) = &self.reporting.progress {
-            pb.set_position(self.reporting.base + evaluations as u64);
-            if let Some(last) = &self.reporting.last_line {
-                let mut last = last.lock().unwrap_or_else(|e| e.into_inner());
-                if last.elapsed() >= piped_interval() {
-                    *last = std::time::Instant::now();
-                    eprintln!(
-                        "progress: {}: {}/{} model runs, {:.0} s",
-                        pb.message(),
-                        pb.position(),
-                        pb.length().unwrap_or(0),
-                        pb.elapsed().as_secs_f64()
-                    );
-                }
-            }
-        }
+        self.reporting.advance(evaluations);
         let cost = state.get_best_cost();
         if let Some(p) = state.get_best_param() {
             let mut best = self
@@ -169,6 +174,22 @@ where
                 *best = Some((p.point().to_vec(), cost));
             }
         }
+        Ok(())
+    }
+}
+
+/// An argmin observer that only moves the progress bar (no history, no best point): the polishes
+/// after the search ([`super::uncertainty::profile_intervals_at`]). `evals` counts the model runs
+/// of all of them.
+#[derive(Clone)]
+pub(super) struct ProgressObserver {
+    pub(super) reporting: Reporting,
+    pub(super) evals: Arc<AtomicUsize>,
+}
+
+impl<I: State> Observe<I> for ProgressObserver {
+    fn observe_iter(&mut self, _: &I, _: &KV) -> std::result::Result<(), argmin::core::Error> {
+        self.reporting.advance(self.evals.load(Ordering::Relaxed));
         Ok(())
     }
 }
@@ -1439,24 +1460,8 @@ pub(super) fn polish(
     observer: Option<SearchObserver>,
 ) -> Result<(Vec<f64>, u64, f64)> {
     let fit_err = FitError::Optimiser;
-    let n = start.len();
-    let mut simplex = vec![start.to_vec()];
-    for i in 0..n {
-        let mut v = start.to_vec();
-        v[i] = if v[i] + step <= 1.0 {
-            v[i] + step
-        } else {
-            v[i] - step
-        };
-        simplex.push(v);
-    }
-    let sd = if problem.cost_is_nll() {
-        POLISH_SD_NATS
-    } else {
-        POLISH_SD_OTHER
-    };
-    let nm = NelderMead::new(simplex)
-        .with_sd_tolerance(sd)
+    let nm = NelderMead::new(initial_simplex(start, step))
+        .with_sd_tolerance(polish_sd(problem))
         .map_err(fit_err)?;
     let run_evals = observer
         .as_ref()
@@ -1476,6 +1481,72 @@ pub(super) fn polish(
         .map(|u| u.clamp(0.0, 1.0))
         .collect();
     Ok((u, res.state().get_iter(), res.state().get_best_cost()))
+}
+
+/// Where [`polish`] starts: `start` and, for each coordinate, `start` moved by `step` (back by
+/// `step` where forward would leave the unit box).
+fn initial_simplex(start: &[f64], step: f64) -> Vec<Vec<f64>> {
+    let mut simplex = vec![start.to_vec()];
+    for i in 0..start.len() {
+        let mut v = start.to_vec();
+        v[i] = if v[i] + step <= 1.0 {
+            v[i] + step
+        } else {
+            v[i] - step
+        };
+        simplex.push(v);
+    }
+    simplex
+}
+
+/// The spread of the simplex's costs at which [`polish`] stops.
+fn polish_sd(problem: &SpectralProblem) -> f64 {
+    if problem.cost_is_nll() {
+        POLISH_SD_NATS
+    } else {
+        POLISH_SD_OTHER
+    }
+}
+
+/// [`polish`] of every coordinate but `index`, which is held at `u_held`: the minimum of the cost
+/// over the others from `start` (full coordinates; its `index` entry is replaced). Returns the full
+/// coordinates of the best point and its cost.
+pub(super) fn polish_pinned(
+    problem: &Arc<SpectralProblem>,
+    start: &[f64],
+    (index, u_held): (usize, f64),
+    step: f64,
+    iterations: u64,
+    progress: Option<ProgressObserver>,
+) -> Result<(Vec<f64>, f64)> {
+    let fit_err = FitError::Optimiser;
+    let mut others = start.to_vec();
+    others.remove(index);
+    let counter = progress
+        .as_ref()
+        .map_or_else(|| Arc::new(AtomicUsize::new(0)), |o| o.evals.clone());
+    let pinned = Pinned {
+        shared: Shared(problem.clone(), SearchStage::Polish, counter),
+        index,
+        u: u_held,
+    };
+    let nm = NelderMead::new(initial_simplex(&others, step))
+        .with_sd_tolerance(polish_sd(problem))
+        .map_err(fit_err)?;
+    let mut ex = Executor::new(pinned.clone(), nm).configure(|s| s.max_iters(iterations));
+    if let Some(o) = progress {
+        ex = ex.add_observer(o, ObserverMode::Always);
+    }
+    let res = ex.run().map_err(fit_err)?;
+    let best: Vec<f64> = res
+        .state()
+        .get_best_param()
+        .cloned()
+        .unwrap_or(others)
+        .iter()
+        .map(|u| u.clamp(0.0, 1.0))
+        .collect();
+    Ok((pinned.full(&best), res.state().get_best_cost()))
 }
 
 /// Finite-difference curvature of the cost at `u0` (step 0.03 in normalised units, stencil kept

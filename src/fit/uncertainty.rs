@@ -5,16 +5,20 @@ use super::features::{features, noise_floor};
 use super::job::{self, UncertaintyMethod};
 use super::problem::{FreeParam, SpectralProblem};
 use super::result::{FittedParam, Interval, IntervalMethod};
-use super::search::{CandidateFit, Confirmation, optimise, polish};
+use super::search::{
+    CandidateFit, Confirmation, ProgressObserver, Reporting, optimise, polish, polish_pinned,
+};
 use crate::Result;
 use crate::simulate::blade::BladeSimulation;
 use crate::spectrum::stats::quantile_sorted;
 use rand::SeedableRng;
+use std::sync::atomic::AtomicUsize;
 use std::sync::{Arc, Mutex};
 
 /// The uncertainty stage: an interval for every freed parameter of the chosen fit, by the job's
 /// method (`[fit.uncertainty] method`): Laplace's from the likelihood's Fisher information
-/// ([`laplace_intervals`], no further fits) or the parametric bootstrap ([`bootstrap_intervals`]).
+/// ([`laplace_intervals`], no further fits), the profile likelihood ([`profile_intervals`], a few
+/// conditional polishes per parameter) or the parametric bootstrap ([`bootstrap_intervals`]).
 /// A target job gets a warning instead: its targets carry no measurement noise. Returns the
 /// intervals (in the order of the freed parameters) and warnings.
 ///
@@ -24,6 +28,7 @@ pub(super) fn intervals(
     cf: &CandidateFit,
     best_sim: &BladeSimulation,
     fit: &job::FitSection,
+    pb: &Option<indicatif::ProgressBar>,
 ) -> Result<(Option<Vec<Interval>>, Vec<String>)> {
     if cf.problem.targets.is_some() {
         return Ok((
@@ -39,6 +44,16 @@ pub(super) fn intervals(
                 Ok((Some(intervals), warnings))
             }
             Err(why) => Ok((None, vec![format!("no Laplace intervals: {why}")])),
+        },
+        UncertaintyMethod::Profile => match &cf.evidence {
+            Ok(_) => {
+                let (intervals, warnings) = profile_intervals(cf, fit, pb)?;
+                Ok((Some(intervals), warnings))
+            }
+            Err(why) => Ok((
+                None,
+                vec![format!("no profile-likelihood intervals: {why}")],
+            )),
         },
         UncertaintyMethod::Bootstrap if fit.uncertainty.bootstrap == 0 => Ok((
             None,
@@ -83,6 +98,262 @@ pub fn laplace_intervals(free: &[FreeParam], best_u: &[f64], sigma_u: &[f64]) ->
             }
         })
         .collect()
+}
+
+/// Conditional polishes per side of a profile at the most: the walk doubles its step each time,
+/// so 8 reach 255 initial steps from the fit (or the search box's bound first).
+pub const PROFILE_MAX_STEPS: usize = 8;
+
+/// The profile walk's first step, normalised units, at least: a parameter whose 1σ is smaller
+/// still starts here (ripples of the likelihood are finer than that, docs/fit.md, "Uncertainty").
+pub const PROFILE_MIN_STEP_U: f64 = 0.005;
+
+/// The profile walk's first step, normalised units, at the most (an undetermined parameter's 1σ
+/// is infinite).
+pub const PROFILE_MAX_STEP_U: f64 = 0.1;
+
+/// The NLL rise at a 68.27 % profile-likelihood bound of a parameter whose sandwich and Fisher
+/// 1σ are `sigma_sandwich` and `sigma_fisher`: the likelihood is a composite (Whittle-type)
+/// likelihood, so twice its rise is distributed as `μ·χ²₁` with `μ = σ²_sandwich/σ²_Fisher`, not as
+/// `χ²₁` (Kent 1982, *Biometrika* 69:1, Theorem 3.1; Varin, Reid & Firth 2011, *Statistica Sinica*
+/// 21:5, §2.3), and the bound is at `μ·`[`PROFILE_68_NATS`]. On a quadratic likelihood the
+/// profile interval is then the Laplace one. `μ = 1` where either 1σ is not finite and positive.
+pub fn profile_rise_limit(sigma_sandwich: f64, sigma_fisher: f64) -> f64 {
+    let mu = (sigma_sandwich / sigma_fisher).powi(2);
+    if mu.is_finite() && mu > 0.0 {
+        PROFILE_68_NATS * mu
+    } else {
+        PROFILE_68_NATS
+    }
+}
+
+/// Nelder–Mead iterations a profile step's polish typically makes before it stops at the
+/// likelihood's ripples: only the progress bar's length estimate.
+const PROFILE_POLISH_ITERATIONS_TYPICAL: u64 = 10;
+
+/// One end of a parameter's profile-likelihood interval ([`profile_end`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProfileEnd {
+    /// The end, normalised coordinate of the profiled parameter.
+    pub u: f64,
+    /// The profile crossed the rise limit (else the end is the search box's bound or the last
+    /// point of the walk).
+    pub closed: bool,
+    /// The end is the search box's bound, reached with the profile still below the limit.
+    pub at_bound: bool,
+    /// The lowest rise met along the walk, nats (negative: a point more likely than the fit).
+    pub lowest_rise_nats: f64,
+    /// Where that lowest rise was met, normalised coordinate.
+    pub lowest_u: f64,
+}
+
+/// Walks a parameter's profile from the fit at `u0` in direction `side` (±1): steps of
+/// `first_step`, 2·`first_step`, 4·`first_step`, … (at most [`PROFILE_MAX_STEPS`]), each point's
+/// `rise(u)` (the minimum of the NLL over the other parameters with this one held at `u`, minus
+/// the fit's), until the rise exceeds `limit`; the end is interpolated between the last two points
+/// linearly in √rise (exact for a quadratic profile). Stops at the unit box's bound if the
+/// profile stays below the limit up to it.
+pub fn profile_end(
+    u0: f64,
+    first_step: f64,
+    side: f64,
+    limit: f64,
+    mut rise: impl FnMut(f64) -> f64,
+) -> ProfileEnd {
+    let (mut d_in, mut r_in) = (0.0_f64, 0.0_f64);
+    let mut end = ProfileEnd {
+        u: u0,
+        closed: false,
+        at_bound: false,
+        lowest_rise_nats: 0.0,
+        lowest_u: u0,
+    };
+    for j in 0..PROFILE_MAX_STEPS {
+        let x = (u0 + side * first_step * f64::from(1u32 << j)).clamp(0.0, 1.0);
+        let d = (x - u0).abs();
+        if d <= d_in {
+            end.at_bound = true;
+            return end;
+        }
+        let r = rise(x);
+        if r < end.lowest_rise_nats {
+            (end.lowest_rise_nats, end.lowest_u) = (r, x);
+        }
+        if r > limit {
+            let (a, b) = (r_in.max(0.0).sqrt(), r.sqrt());
+            let t = ((limit.sqrt() - a) / (b - a)).clamp(0.0, 1.0);
+            end.u = u0 + side * (d_in + t * (d - d_in));
+            end.closed = true;
+            return end;
+        }
+        (d_in, r_in) = (d, r);
+        end.u = x;
+        if x == 0.0 || x == 1.0 {
+            end.at_bound = true;
+            return end;
+        }
+    }
+    end
+}
+
+/// [`profile_intervals_at`] of the chosen fit, with its sandwich and Fisher 1σ and `[fit]
+/// polish_iterations`, on the progress bar `pb`.
+///
+/// # Errors
+/// As [`profile_intervals_at`].
+fn profile_intervals(
+    cf: &CandidateFit,
+    fit: &job::FitSection,
+    pb: &Option<indicatif::ProgressBar>,
+) -> Result<(Vec<Interval>, Vec<String>)> {
+    let fisher = cf.fisher_sigma_u.as_deref().unwrap_or(&cf.sigma_u);
+    let at = ProfileStart {
+        u: &cf.best_u,
+        cost_nats: cf.cost,
+        sigma_u: &cf.sigma_u,
+        fisher_sigma_u: fisher,
+    };
+    let progress = pb.as_ref().map(|bar| {
+        // The bar's estimate: two steps a side, each polish its simplex and ten iterations (on
+        // the main job's fit they stop at the ripples' depth after 6–12).
+        let k = cf.free.len() as u64;
+        bar.inc_length(4 * k * (k + 2 * PROFILE_POLISH_ITERATIONS_TYPICAL));
+        let reporting = Reporting::new(pb, cf.candidate);
+        reporting.stage(format_args!("profile likelihood"));
+        ProgressObserver {
+            reporting,
+            evals: Arc::new(AtomicUsize::new(0)),
+        }
+    });
+    profile_with(&cf.problem, at, fit.polish_iterations, progress)
+}
+
+/// Where [`profile_intervals_at`] starts: a fit and its spread, normalised coordinates.
+#[derive(Debug, Clone, Copy)]
+pub struct ProfileStart<'a> {
+    /// The fit.
+    pub u: &'a [f64],
+    /// The problem's cost there (the recording's NLL), nats.
+    pub cost_nats: f64,
+    /// 1σ of each coordinate from the sandwich `F⁻¹ V F⁻¹` ([`super::evidence::at_fit_smoothed`]).
+    pub sigma_u: &'a [f64],
+    /// 1σ of each coordinate from the Fisher information `F⁻¹` alone.
+    pub fisher_sigma_u: &'a [f64],
+}
+
+/// Profile-likelihood intervals (68.27 %) from a fit (Pawitan 2001, *In All Likelihood*, §2.6;
+/// Raue et al. 2009, *Bioinformatics* 25:15, for models of this kind): for each freed parameter
+/// and each side, [`profile_end`] with the other parameters re-polished by Nelder–Mead
+/// (`polish_iterations`, initial simplex 0.05) at every step, each polish starting where the
+/// previous one ended, and the limit [`profile_rise_limit`] from the parameter's sandwich and
+/// Fisher 1σ. Where the likelihood is quadratic this gives the Laplace interval; where it is flat
+/// or bent (a ridge, a valley) the interval follows the likelihood instead of its curvature at the
+/// fit. The 2k walks run in parallel; each costs one polish per step, typically two or three. A
+/// failed simulation counts as an infinite rise. Warnings name a parameter whose profile reaches
+/// its search bound, and a walk that met a point more likely than the fit by more than
+/// [`super::search::CONFIRM_NATS`] (the search ended short of the optimum). The problem's
+/// evaluation and failure counters include the polishes.
+///
+/// # Errors
+/// [`super::FitError::Optimiser`] when argmin fails during an interrupt (otherwise a polish that
+/// fails counts as an infinite rise).
+pub fn profile_intervals_at(
+    problem: &Arc<SpectralProblem>,
+    at: ProfileStart,
+    polish_iterations: u64,
+) -> Result<(Vec<Interval>, Vec<String>)> {
+    profile_with(problem, at, polish_iterations, None)
+}
+
+/// [`profile_intervals_at`], each polish reported to `progress`.
+fn profile_with(
+    problem: &Arc<SpectralProblem>,
+    at: ProfileStart,
+    polish_iterations: u64,
+    progress: Option<ProgressObserver>,
+) -> Result<(Vec<Interval>, Vec<String>)> {
+    use rayon::prelude::*;
+    let n = at.u.len();
+    let limit = |i: usize| profile_rise_limit(at.sigma_u[i], at.fisher_sigma_u[i]);
+    let walk = |(i, side): (usize, f64)| -> Result<ProfileEnd> {
+        let first = at.sigma_u[i].clamp(PROFILE_MIN_STEP_U, PROFILE_MAX_STEP_U);
+        let first = if first.is_nan() {
+            PROFILE_MAX_STEP_U
+        } else {
+            first
+        };
+        let mut start = at.u.to_vec();
+        let mut failure = None;
+        let end = profile_end(at.u[i], first, side, limit(i), |x| {
+            let observer = progress.clone();
+            match polish_pinned(problem, &start, (i, x), 0.05, polish_iterations, observer) {
+                Ok((u, cost)) => {
+                    start = u;
+                    cost - at.cost_nats
+                }
+                Err(e) => {
+                    failure.get_or_insert(e);
+                    f64::INFINITY
+                }
+            }
+        });
+        match failure {
+            Some(e) if super::interrupt::stop_requested() => Err(e),
+            _ => Ok(end),
+        }
+    };
+    let sides: Vec<(usize, f64)> = (0..n).flat_map(|i| [(i, -1.0), (i, 1.0)]).collect();
+    let ends: Vec<ProfileEnd> = sides.par_iter().map(|s| walk(*s)).collect::<Result<_>>()?;
+    let mut warnings = Vec::new();
+    let mut intervals = Vec::with_capacity(n);
+    for (i, fp) in problem.free.iter().enumerate() {
+        let (lo, hi) = (ends[2 * i], ends[2 * i + 1]);
+        intervals.push(Interval {
+            lo: fp.value(lo.u),
+            hi: fp.value(hi.u),
+            level: 0.6827,
+            method: IntervalMethod::Profile {
+                rise_limit_nats: limit(i),
+            },
+        });
+        warnings.extend(profile_warnings(fp, limit(i), lo, hi));
+    }
+    Ok((intervals, warnings))
+}
+
+/// [`profile_intervals_at`]'s warnings for one parameter: a side that reached the search box's
+/// bound, and a point more likely than the fit.
+fn profile_warnings(fp: &FreeParam, limit: f64, lo: ProfileEnd, hi: ProfileEnd) -> Vec<String> {
+    let mut warnings = Vec::new();
+    let bounds: Vec<&str> = [(lo, "lower"), (hi, "upper")]
+        .iter()
+        .filter(|(e, _)| e.at_bound)
+        .map(|(_, s)| *s)
+        .collect();
+    if !bounds.is_empty() {
+        warnings.push(format!(
+            "{}'s profile likelihood stays within {limit:.3} nats of the fit up to its search \
+             box's {} bound: the recording does not bound it there",
+            fp.name,
+            bounds.join(" and ")
+        ));
+    }
+    let lowest = if lo.lowest_rise_nats <= hi.lowest_rise_nats {
+        lo
+    } else {
+        hi
+    };
+    if lowest.lowest_rise_nats < -super::search::CONFIRM_NATS {
+        warnings.push(format!(
+            "{}'s profile met a point {:.2} nats more likely than the fit ({} = {:.4e}): the \
+             search ended short of the likelihood's maximum",
+            fp.name,
+            -lowest.lowest_rise_nats,
+            fp.name,
+            fp.value(lowest.lowest_u)
+        ));
+    }
+    warnings
 }
 
 /// How far [`along_contact_ridge`] looks: the free neck stiffness times each factor.
@@ -403,6 +674,75 @@ pub fn identifiability_warnings(
 mod tests {
     use super::*;
     use crate::model::ParamId;
+
+    /// The NLL rise of a quadratic profile with 1σ `sigma` in a composite likelihood whose rise is
+    /// `μ` times the exact one: `μ·(x − u0)²/(2σ²)`.
+    fn quadratic_rise(u0: f64, sigma: f64, mu: f64) -> impl FnMut(f64) -> f64 {
+        move |x| mu * (x - u0).powi(2) / (2.0 * sigma * sigma)
+    }
+
+    #[test]
+    fn a_quadratic_profile_ends_at_one_sigma() {
+        // Closed form: a quadratic log-likelihood's 68.27 % profile interval is the estimate ± 1σ,
+        // and with the rise scaled by μ = σ²_sandwich/σ²_Fisher the calibrated limit μ/2 gives
+        // the same ends (the walk interpolates in √rise, exact for a quadratic).
+        for (u0, sigma, first, mu) in [
+            (0.4, 0.02, 0.02, 1.0),
+            (0.4, 0.02, 0.005, 0.3),
+            (0.7, 0.013, 0.1, 0.5),
+        ] {
+            for side in [-1.0, 1.0] {
+                let limit = PROFILE_68_NATS * mu;
+                let end = profile_end(u0, first, side, limit, quadratic_rise(u0, sigma, mu));
+                assert!(end.closed && !end.at_bound, "{end:?}");
+                assert!(
+                    (end.u - (u0 + side * sigma)).abs() < 1e-12,
+                    "u0 {u0} σ {sigma} side {side}: end {}",
+                    end.u
+                );
+            }
+        }
+        // The calibrated limit: μ = (σ_sandwich/σ_Fisher)².
+        assert!((profile_rise_limit(0.5, 1.0) - 0.125).abs() < 1e-15);
+        assert_eq!(profile_rise_limit(1.0, f64::INFINITY), PROFILE_68_NATS);
+        assert_eq!(profile_rise_limit(f64::NAN, 1.0), PROFILE_68_NATS);
+    }
+
+    #[test]
+    fn a_flat_profile_reaches_the_bound_and_a_dip_is_reported() {
+        // Flat: the walk doubles its step (0.01, 0.02, …) to the box's bound (0.45 + 0.64 > 1).
+        let end = profile_end(0.45, 0.01, 1.0, 0.5, |_| 0.1);
+        assert!(end.at_bound && !end.closed, "{end:?}");
+        assert_eq!(end.u, 1.0);
+        // An estimate on the bound: nothing to walk.
+        let end = profile_end(0.0, 0.01, -1.0, 0.5, |_| panic!("no step beyond the bound"));
+        assert!(end.at_bound && end.u == 0.0);
+        // A point more likely than the fit on the way out is kept.
+        let end = profile_end(0.5, 0.01, 1.0, 0.5, |x| {
+            if (x - 0.52).abs() < 1e-12 {
+                -2.0
+            } else {
+                10.0 * (x - 0.5)
+            }
+        });
+        assert_eq!((end.lowest_rise_nats, end.lowest_u), (-2.0, 0.52));
+        assert!(end.closed);
+        // Eight doublings and still below the limit: open, at the walk's last point.
+        let end = profile_end(0.5, 1e-4, 1.0, 0.5, |_| 0.0);
+        assert!(!end.closed && !end.at_bound);
+        assert!((end.u - (0.5 + 1e-4 * 128.0)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_failed_step_closes_the_interval_at_the_last_good_point() {
+        // Steps 0.01, 0.02, 0.04 from 0.5. A simulation that fails beyond 0.53 is an infinite
+        // rise: the end is the last point the model could simulate (0.52), not beyond it.
+        let end = profile_end(0.5, 0.01, 1.0, 0.5, |x| {
+            if x > 0.53 { f64::INFINITY } else { 0.1 }
+        });
+        assert!(end.closed);
+        assert!((end.u - 0.52).abs() < 1e-12, "{}", end.u);
+    }
 
     #[test]
     fn a_ridge_point_keeps_the_moment_at_contact() {

@@ -878,7 +878,9 @@ pub(super) mod tests {
                         lo: 0.028,
                         hi: 0.032,
                         level: 0.68,
-                        method: crate::fit::IntervalMethod::Profile,
+                        method: crate::fit::IntervalMethod::Profile {
+                            rise_limit_nats: 0.125,
+                        },
                     }),
                 ),
                 p("B", false, None),
@@ -963,7 +965,10 @@ pub(super) mod tests {
         assert_eq!(s.warnings.len(), 4, "{:?}", s.warnings);
         let html = std::fs::read_to_string(&s.path).unwrap();
         assert!(html.contains("<td>[0.02800, 0.03200] (68 %)<sup>1</sup></td>"));
-        assert!(html.contains("<sup>1</sup> Interval method: profile</p>"));
+        assert!(html.contains(
+            "<sup>1</sup> Interval method: profile likelihood: where the NLL, minimised over the \
+             other parameters, has risen 0.125 nats from the fit"
+        ));
         assert!(html.contains("<td>+3.45 %</td>")); // 0.03/0.029 − 1
         assert!(html.contains("<span class=\"warn\">NO</span>"));
         assert!(html.contains("<td>-0.900</td>"));
