@@ -15,7 +15,7 @@ use crate::model::ParamId;
 use crate::simulate::SolverOptions;
 use crate::simulate::blade::ModelKind;
 use argmin::core::observers::{Observe, ObserverMode};
-use argmin::core::{Executor, KV, State};
+use argmin::core::{CostFunction, Executor, IterState, KV, State};
 use argmin::solver::neldermead::NelderMead;
 use argmin::solver::particleswarm::ParticleSwarm;
 use rand::SeedableRng;
@@ -1459,15 +1459,33 @@ pub(super) fn polish(
     iterations: u64,
     observer: Option<SearchObserver>,
 ) -> Result<(Vec<f64>, u64, f64)> {
-    let fit_err = FitError::Optimiser;
-    let nm = NelderMead::new(initial_simplex(start, step))
-        .with_sd_tolerance(polish_sd(problem))
-        .map_err(fit_err)?;
     let run_evals = observer
         .as_ref()
         .map_or_else(|| Arc::new(AtomicUsize::new(0)), |o| o.run_evals.clone());
-    let mut ex = Executor::new(Shared(problem.clone(), SearchStage::Polish, run_evals), nm)
-        .configure(|s| s.max_iters(iterations));
+    let cost = Shared(problem.clone(), SearchStage::Polish, run_evals);
+    nelder_mead(cost, start, step, polish_sd(problem), iterations, observer)
+}
+
+/// Nelder–Mead on `cost` from `start` with an initial simplex of edge `step`, stopping when the
+/// simplex's costs spread by less than `sd` or after `iterations`: the best point (clamped to the
+/// unit box), the iterations made and the best cost.
+fn nelder_mead<C, O>(
+    cost: C,
+    start: &[f64],
+    step: f64,
+    sd: f64,
+    iterations: u64,
+    observer: Option<O>,
+) -> Result<(Vec<f64>, u64, f64)>
+where
+    C: CostFunction<Param = Vec<f64>, Output = f64>,
+    O: Observe<IterState<Vec<f64>, (), (), (), (), f64>> + 'static,
+{
+    let fit_err = FitError::Optimiser;
+    let nm = NelderMead::new(initial_simplex(start, step))
+        .with_sd_tolerance(sd)
+        .map_err(fit_err)?;
+    let mut ex = Executor::new(cost, nm).configure(|s| s.max_iters(iterations));
     if let Some(o) = observer {
         ex = ex.add_observer(o, ObserverMode::Always);
     }
@@ -1519,7 +1537,6 @@ pub(super) fn polish_pinned(
     iterations: u64,
     progress: Option<ProgressObserver>,
 ) -> Result<(Vec<f64>, f64)> {
-    let fit_err = FitError::Optimiser;
     let mut others = start.to_vec();
     others.remove(index);
     let counter = progress
@@ -1530,23 +1547,9 @@ pub(super) fn polish_pinned(
         index,
         u: u_held,
     };
-    let nm = NelderMead::new(initial_simplex(&others, step))
-        .with_sd_tolerance(polish_sd(problem))
-        .map_err(fit_err)?;
-    let mut ex = Executor::new(pinned.clone(), nm).configure(|s| s.max_iters(iterations));
-    if let Some(o) = progress {
-        ex = ex.add_observer(o, ObserverMode::Always);
-    }
-    let res = ex.run().map_err(fit_err)?;
-    let best: Vec<f64> = res
-        .state()
-        .get_best_param()
-        .cloned()
-        .unwrap_or(others)
-        .iter()
-        .map(|u| u.clamp(0.0, 1.0))
-        .collect();
-    Ok((pinned.full(&best), res.state().get_best_cost()))
+    let sd = polish_sd(problem);
+    let (best, _, cost) = nelder_mead(pinned.clone(), &others, step, sd, iterations, progress)?;
+    Ok((pinned.full(&best), cost))
 }
 
 /// Finite-difference curvature of the cost at `u0` (step 0.03 in normalised units, stencil kept
