@@ -745,6 +745,36 @@ mod tests {
     }
 
     #[test]
+    fn profile_warnings_name_an_open_side_and_a_more_likely_point() {
+        let k1 = FreeParam::new(ParamId::K1, 0.005, 0.15);
+        let end = |u: f64, at_bound: bool, lowest_rise_nats: f64| ProfileEnd {
+            u,
+            closed: !at_bound,
+            at_bound,
+            lowest_rise_nats,
+            lowest_u: 0.6,
+        };
+        // Both sides closed, nothing below the fit by more than CONFIRM_NATS: no warning.
+        assert!(profile_warnings(&k1, 0.2, end(0.4, false, -0.3), end(0.6, false, 0.0)).is_empty());
+        let w = profile_warnings(&k1, 0.2, end(0.0, true, 0.0), end(0.6, false, -1.25));
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert!(
+            w[0].contains("k1's profile likelihood stays within 0.200 nats"),
+            "{}",
+            w[0]
+        );
+        assert!(w[0].contains("box's lower bound"), "{}", w[0]);
+        assert!(
+            w[1].contains("a point 1.25 nats more likely than the fit"),
+            "{}",
+            w[1]
+        );
+        // The point's value: u = 0.6 on k1's log axis, 0.005·30^0.6.
+        let v = 0.005 * 30f64.powf(0.6);
+        assert!(w[1].contains(&format!("k1 = {v:.4e}")), "{}", w[1]);
+    }
+
+    #[test]
     fn a_ridge_point_keeps_the_moment_at_contact() {
         // (k1c − k1)·θ_c = (0.1 − 0.03)·0.05 = 3.5e-3 N·m at every point of the ridge.
         for k1_r in [0.015, 0.0212, 0.0424, 0.06] {
