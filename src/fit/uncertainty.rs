@@ -250,7 +250,8 @@ pub struct ProfileStart<'a> {
 /// or bent (a ridge, a valley) the interval follows the likelihood instead of its curvature at the
 /// fit. The 2k walks run in parallel; each costs one polish per step, typically two or three. A
 /// failed simulation counts as an infinite rise. Warnings name a parameter whose profile reaches
-/// its search bound, and a walk that met a point more likely than the fit by more than
+/// its search bound or runs out of steps below the limit, and a walk that met a point more likely
+/// than the fit by more than
 /// [`super::search::CONFIRM_NATS`] (the search ended short of the optimum). The problem's
 /// evaluation and failure counters include the polishes.
 ///
@@ -337,6 +338,17 @@ fn profile_warnings(fp: &FreeParam, limit: f64, lo: ProfileEnd, hi: ProfileEnd) 
             fp.name,
             bounds.join(" and ")
         ));
+    }
+    for (e, side) in [(lo, "lower"), (hi, "upper")] {
+        if !e.closed && !e.at_bound {
+            warnings.push(format!(
+                "{}'s profile likelihood stays within {limit:.3} nats of the fit over the walk's \
+                 {PROFILE_MAX_STEPS} steps: its {side} end ({:.4e}) is the last step, not where \
+                 the likelihood bounds it",
+                fp.name,
+                fp.value(e.u)
+            ));
+        }
     }
     let lowest = if lo.lowest_rise_nats <= hi.lowest_rise_nats {
         lo
@@ -764,6 +776,14 @@ mod tests {
             w[0]
         );
         assert!(w[0].contains("box's lower bound"), "{}", w[0]);
+        // A walk that ran out of steps under the limit, away from the bound.
+        let open = ProfileEnd {
+            closed: false,
+            ..end(0.6, false, 0.0)
+        };
+        let w_open = profile_warnings(&k1, 0.2, end(0.4, false, 0.0), open);
+        assert_eq!(w_open.len(), 1, "{w_open:?}");
+        assert!(w_open[0].contains("its upper end"), "{}", w_open[0]);
         assert!(
             w[1].contains("a point 1.25 nats more likely than the fit"),
             "{}",
