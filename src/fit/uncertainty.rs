@@ -100,8 +100,9 @@ pub fn laplace_intervals(free: &[FreeParam], best_u: &[f64], sigma_u: &[f64]) ->
         .collect()
 }
 
-/// Conditional polishes per side of a profile at the most: the walk doubles its step each time,
-/// so 8 reach 255 initial steps from the fit (or the search box's bound first).
+/// Conditional polishes per side of a profile at the most: the walk doubles its distance from the
+/// fit each time, so the eighth point lies 128 first steps from it (or the search box's bound is
+/// met first).
 pub const PROFILE_MAX_STEPS: usize = 8;
 
 /// The profile walk's first step, normalised units, at least: a parameter whose 1σ is smaller
