@@ -590,7 +590,7 @@ fn descend_the_valley(
         let (u, iters, cost) = match polish(
             problem,
             &found.u,
-            0.05,
+            POLISH_STEP_U,
             fit.polish_iterations,
             Some(observer),
         ) {
@@ -1043,7 +1043,15 @@ fn nested_search(
     let runs: Vec<Result<(Vec<f64>, u64, f64)>> = warm
         .par_iter()
         .enumerate()
-        .map(|(r, w)| polish(problem, w, 0.05, fit.polish_iterations, Some(observer(r))))
+        .map(|(r, w)| {
+            polish(
+                problem,
+                w,
+                POLISH_STEP_U,
+                fit.polish_iterations,
+                Some(observer(r)),
+            )
+        })
         .collect();
     let mut local: Option<(Vec<f64>, f64)> = warm.first().map(|w| (w.clone(), at_warm));
     let mut polish_iters = 0;
@@ -1391,7 +1399,7 @@ fn restart(
     let (u, polish_iters, cost) = match polish(
         problem,
         &swarm_best,
-        0.05,
+        POLISH_STEP_U,
         fit.polish_iterations,
         observer(SearchStage::Polish),
     ) {
@@ -1445,6 +1453,10 @@ pub(super) fn warm_population(
 /// over ±1σ ([`super::evidence::settle`]). A one-restart blade2dof fit of the shipped recording
 /// then stops its polish after 42 iterations instead of running all 60.
 pub const POLISH_SD_NATS: f64 = 0.05;
+
+/// The edge of a polish's initial simplex, normalised units: every polish of the fit (after a
+/// swarm, from a warm point, down a valley), of a bootstrap replicate and of a profile step.
+pub(super) const POLISH_STEP_U: f64 = 0.05;
 
 /// When a polish of any other cost (the feature cost, a target job's) stops: the standard
 /// deviation of its values over the simplex's vertices below 1e-3.

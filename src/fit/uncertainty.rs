@@ -6,7 +6,8 @@ use super::job::{self, UncertaintyMethod};
 use super::problem::{FreeParam, SpectralProblem};
 use super::result::{FittedParam, Interval, IntervalMethod};
 use super::search::{
-    CandidateFit, Confirmation, ProgressObserver, Reporting, optimise, polish, polish_pinned,
+    CandidateFit, Confirmation, POLISH_STEP_U, ProgressObserver, Reporting, optimise, polish,
+    polish_pinned,
 };
 use crate::Result;
 use crate::simulate::blade::BladeSimulation;
@@ -245,7 +246,7 @@ pub struct ProfileStart<'a> {
 /// Profile-likelihood intervals (68.27 %) from a fit (Pawitan 2001, *In All Likelihood*, §2.6;
 /// Raue et al. 2009, *Bioinformatics* 25:15, for models of this kind): for each freed parameter
 /// and each side, [`profile_end`] with the other parameters re-polished by Nelder–Mead
-/// (`polish_iterations`, initial simplex 0.05) at every step, each polish starting where the
+/// (`polish_iterations`, initial simplex [`POLISH_STEP_U`]) at every step, each polish starting where the
 /// previous one ended, and the limit [`profile_rise_limit`] from the parameter's sandwich and
 /// Fisher 1σ. Where the likelihood is quadratic this gives the Laplace interval; where it is flat
 /// or bent (a ridge, a valley) the interval follows the likelihood instead of its curvature at the
@@ -288,7 +289,14 @@ fn profile_with(
         let mut failure = None;
         let end = profile_end(at.u[i], first, side, limit(i), |x| {
             let observer = progress.clone();
-            match polish_pinned(problem, &start, (i, x), 0.05, polish_iterations, observer) {
+            match polish_pinned(
+                problem,
+                &start,
+                (i, x),
+                POLISH_STEP_U,
+                polish_iterations,
+                observer,
+            ) {
                 Ok((u, cost)) => {
                     start = u;
                     cost - at.cost_nats
@@ -507,7 +515,13 @@ pub fn bootstrap_intervals(
                 let found = optimise(&rep, fit, seed, &[], None, Confirmation::Now)?;
                 (found.u, found.cost)
             } else {
-                let (u, _, cost) = polish(&rep, best_u, 0.05, settings.polish_iterations, None)?;
+                let (u, _, cost) = polish(
+                    &rep,
+                    best_u,
+                    POLISH_STEP_U,
+                    settings.polish_iterations,
+                    None,
+                )?;
                 (u, cost)
             };
             // The estimator's last stage, as in the fit (`search::fit_candidate`).
