@@ -117,7 +117,12 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         warnings.push(format!("no goodness-of-fit test: {e}"));
         None
     });
-    warnings.extend(goodness_of_fit.as_ref().and_then(misfit_warning));
+    let shoulder_listed = candidates.iter().any(|c| c.shoulder);
+    warnings.extend(
+        goodness_of_fit
+            .as_ref()
+            .and_then(|g| misfit_warning(g, shoulder_listed)),
+    );
     warnings.extend(absorbing);
     warnings.extend(line_warnings(&peaks));
     warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
@@ -182,10 +187,17 @@ fn goodness_of_fit(
 }
 
 /// The warning of a fit whose spectra are less likely than its own noise makes likely.
-fn misfit_warning(g: &likelihood::GoodnessOfFit) -> Option<String> {
+/// `shoulder_listed`: the job lists a `+shoulder` candidate; the warning then says how a known
+/// contact angle helps the search (docs/fit.md, "Shoulder contact").
+fn misfit_warning(g: &likelihood::GoodnessOfFit, shoulder_listed: bool) -> Option<String> {
     (!g.fits()).then(|| {
+        let hint = if shoulder_listed {
+            "; a shoulder the neck touches only at the peaks of its swing has a basin a few per cent wide in theta_c that the search can miss: bounding [fit.shoulder] theta_c to a contact angle known from the blade's drawing lets it find one (docs/fit.md, \"Shoulder contact\")"
+        } else {
+            ""
+        };
         format!(
-            "the chosen model does not explain the recording's spectra to their noise: excess NLL {:.1} nats against {:.1} ± {:.1} for {} noise replicates of the fit (p = {:.3}, {:.1}σ); the recording holds structure no candidate reproduces, or the search missed a candidate's basin, and the fitted parameters may be bent to absorb it",
+            "the chosen model does not explain the recording's spectra to their noise: excess NLL {:.1} nats against {:.1} ± {:.1} for {} noise replicates of the fit (p = {:.3}, {:.1}σ); the recording holds structure no candidate reproduces, or the search missed a candidate's basin, and the fitted parameters may be bent to absorb it{hint}",
             g.excess_nll_nats,
             g.replicate_mean_nats,
             g.replicate_sd_nats,
@@ -494,10 +506,17 @@ mod tests {
     fn misfit_warning_fires_below_the_level_only() {
         let replicates: Vec<f64> = (0..999).map(|i| 60.0 + 0.04 * f64::from(i)).collect();
         let above_all = likelihood::GoodnessOfFit::of(171.0, &replicates).unwrap();
-        let w = misfit_warning(&above_all).expect("p = 0.001 is below the level");
+        let w = misfit_warning(&above_all, false).expect("p = 0.001 is below the level");
         assert!(w.contains("171.0 nats") && w.contains("p = 0.001"), "{w}");
+        assert!(!w.contains("theta_c"), "{w}");
+        let with_shoulder = misfit_warning(&above_all, true).expect("the same test");
+        assert!(
+            with_shoulder.contains("[fit.shoulder] theta_c"),
+            "{with_shoulder}"
+        );
         let typical = likelihood::GoodnessOfFit::of(80.0, &replicates).unwrap();
-        assert_eq!(misfit_warning(&typical), None);
+        assert_eq!(misfit_warning(&typical, false), None);
+        assert_eq!(misfit_warning(&typical, true), None);
     }
 
     /// The default chain: the head model for low bands only, the full blade as soon as a band
