@@ -231,6 +231,10 @@ pub struct FitSection {
     /// when the local one finds the likelihood worth it).
     #[serde(default = "d_nested_search")]
     pub nested_search: NestedSearch,
+    /// Whether a `+shoulder` candidate is searched again slice by slice in θ_c when the chosen
+    /// model fails its goodness-of-fit test (default `on-misfit`; [`crate::fit::scan`]).
+    #[serde(default)]
+    pub contact_angle_scan: ContactAngleScan,
     /// Fresh Nelder–Mead polishes from the chosen model's settled optimum, each kept while it
     /// lowers the likelihood's cost by more than 0.1 nats (see `search::descend_chosen` and
     /// docs/fit.md, "Down the valley"). Default (`None`): [`SHOULDER_VALLEY_POLISHES`] when the
@@ -303,6 +307,20 @@ impl FitSection {
         } else {
             0
         })
+    }
+}
+
+crate::names::named_enum! {
+    /// When the contact-angle scan ([`crate::fit::scan`]) runs.
+    #[derive(Default)]
+    pub enum ContactAngleScan: "contact-angle scan" {
+        /// When the chosen model's spectra fail the goodness-of-fit test (p ≤ 0.01): the search
+        /// may have missed a shoulder's narrow basin. Each `+shoulder` candidate is then searched
+        /// again once per slice of θ_c (up to four whole searches of it).
+        #[default]
+        OnMisfit => "on-misfit",
+        /// Never.
+        Never => "never",
     }
 }
 

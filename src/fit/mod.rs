@@ -24,6 +24,7 @@ mod measure;
 mod problem;
 pub mod reach;
 pub mod result;
+pub mod scan;
 mod search;
 mod select;
 pub mod template;
@@ -90,9 +91,28 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let gaps = select::score_gaps(&fits, &job.job.spectrum.bands);
     confirm_deferred(job, &mut fits, &gaps, &pb)?;
     let explicit = !fit.models.is_empty();
-    let mut selection = select::choose(&fits, &job.job.spectrum.bands, explicit);
-    if descend_chosen(job, &mut fits, selection.chosen, &pb)? {
-        selection = select::choose(&fits, &job.job.spectrum.bands, explicit);
+    let choose = |fits: &mut Vec<CandidateFit>| -> Result<select::Selection> {
+        let selection = select::choose(fits, &job.job.spectrum.bands, explicit);
+        Ok(if descend_chosen(job, fits, selection.chosen, &pb)? {
+            select::choose(fits, &job.job.spectrum.bands, explicit)
+        } else {
+            selection
+        })
+    };
+    let mut selection = choose(&mut fits)?;
+    let (mut best, mut gof) = chosen_goodness(&fits[selection.chosen])?;
+    let chosen_name = fits[selection.chosen].candidate.to_string();
+    if let Some(why) = scan::scan_reason(fit.contact_angle_scan, &chosen_name, gof_ref(&gof))
+        && !interrupt::stop_requested()
+    {
+        // The scan's notes reach the trials' reasons through a new choice either way; the valley
+        // polishes run again only from a moved optimum.
+        if scan::scan_contact_angle(job, &meas, &mut fits, &pb, &why)? {
+            selection = choose(&mut fits)?;
+            (best, gof) = chosen_goodness(&fits[selection.chosen])?;
+        } else {
+            selection = select::choose(&fits, &job.job.spectrum.bands, explicit);
+        }
     }
     let absorbing = select::absorbing_warnings(&fits, selection.chosen, &job.job.spectrum.bands);
     // Laplace and profile intervals read the sandwich over the bowl's centre; a bootstrap's come
@@ -101,7 +121,6 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     if fit.uncertainty.method() != job::UncertaintyMethod::Bootstrap {
         cf = cf.with_smoothed_spread();
     }
-    let best = BestModel::of(&cf)?;
     let mut parameters = fitted_parameters(job, &cf);
     let peaks = peak_comparisons(&cf, &best.features)?;
     let (intervals, mut warnings, interrupted) = chosen_intervals(&cf, &best, fit, &pb)?;
@@ -113,7 +132,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     if let Some(pb) = &pb {
         pb.finish_and_clear();
     }
-    let goodness_of_fit = goodness_of_fit(&cf, &best.sim).unwrap_or_else(|e| {
+    let goodness_of_fit = gof.unwrap_or_else(|e| {
         warnings.push(format!("no goodness-of-fit test: {e}"));
         None
     });
@@ -184,6 +203,24 @@ fn goodness_of_fit(
     lik.goodness_of_fit(p, sim)
         .map(Some)
         .map_err(|e| e.to_string())
+}
+
+/// The chosen fit's simulation at its optimum and its [`goodness_of_fit`] (or why there is none).
+///
+/// # Errors
+/// A best-fit model that cannot be simulated again.
+fn chosen_goodness(cf: &CandidateFit) -> Result<(BestModel, GoodnessOutcome)> {
+    let best = BestModel::of(cf)?;
+    let gof = goodness_of_fit(cf, &best.sim);
+    Ok((best, gof))
+}
+
+/// A goodness-of-fit test, `None` when there is none, or why it could not run.
+type GoodnessOutcome = std::result::Result<Option<likelihood::GoodnessOfFit>, String>;
+
+/// The test in `gof`, when it ran.
+fn gof_ref(gof: &GoodnessOutcome) -> Option<&likelihood::GoodnessOfFit> {
+    gof.as_ref().ok().and_then(Option::as_ref)
 }
 
 /// The warning of a fit whose spectra are less likely than its own noise makes likely.

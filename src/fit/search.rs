@@ -62,7 +62,7 @@ impl Reporting {
     /// The same reporting (history, best point) continued later in the job, after the candidate's
     /// first `evaluations` model runs: the bar's base moved so that its runs count on from the
     /// bar's position now.
-    fn resumed(&self, evaluations: usize) -> Reporting {
+    pub(super) fn resumed(&self, evaluations: usize) -> Reporting {
         let mut r = self.clone();
         if let Some(pb) = &self.progress {
             r.base = pb.position().saturating_sub(evaluations as u64);
@@ -292,10 +292,10 @@ pub(super) fn progress_bar(job: &LoadedJob, candidates: &[Candidate]) -> indicat
 
 /// How many warm points a nested candidate's search starts from ([`nested_warm_points`]): its
 /// local search polishes from each, and restarts 0–3 of its global search start a particle at one.
-const NESTED_WARM_POINTS: u64 = 4;
+pub(super) const NESTED_WARM_POINTS: u64 = 4;
 
 /// Model runs of one Nelder–Mead polish over `n` parameters: its simplex and two per iteration.
-fn polish_budget(fit: &job::FitSection, n: usize) -> u64 {
+pub(super) fn polish_budget(fit: &job::FitSection, n: usize) -> u64 {
     n as u64 + 1 + 2 * fit.polish_iterations
 }
 
@@ -662,7 +662,7 @@ pub(super) fn descend_chosen(
 }
 
 /// `text` appended to a candidate's search note (the trial's `reason` in the result).
-fn add_note(note: &mut Option<String>, text: String) {
+pub(super) fn add_note(note: &mut Option<String>, text: String) {
     *note = Some(match note.take() {
         Some(n) => format!("{n}; {text}"),
         None => text,
@@ -683,7 +683,7 @@ fn valley_note(kept: usize, polishes: usize, gain_nats: f64) -> String {
 
 /// The candidate `f` settled anew ([`finish`] with [`Settling::Settle`]) from a better search end
 /// `found`, keeping its search note (its wall time is the caller's).
-fn settle_anew(
+pub(super) fn settle_anew(
     f: &mut CandidateFit,
     found: Optimised,
     reporting: &Reporting,
