@@ -22,7 +22,7 @@ use super::likelihood::GoodnessOfFit;
 use super::measure::Measurement;
 use super::search::{
     CandidateFit, Confirmation, NESTED_WARM_POINTS, Optimised, Reporting, VALLEY_GAIN_NATS,
-    add_note, fit_candidate, polish_budget, settle_anew,
+    add_note, fit_candidate, polish_budget, settle_anew, sorted_abs_theta,
 };
 use crate::Result;
 use crate::model::ParamId;
@@ -124,15 +124,7 @@ pub(super) fn scan_contact_angle(
 /// simulated.
 fn scan_range(smaller: &CandidateFit, larger: &CandidateFit) -> Option<(f64, f64)> {
     let fp = larger.free.iter().find(|fp| fp.name == ParamId::ThetaC)?;
-    let params = smaller.problem.params_at(&smaller.best_u);
-    let sim = smaller.problem.simulate(&params).ok()?;
-    let mut abs_theta: Vec<f64> = sim
-        .theta_rad
-        .iter()
-        .filter(|t| t.is_finite())
-        .map(|t| t.abs())
-        .collect();
-    abs_theta.sort_by(f64::total_cmp);
+    let abs_theta = sorted_abs_theta(smaller)?;
     let q = |p: f64| crate::spectrum::stats::quantile_sorted(&abs_theta, p);
     let (lo, hi) = (
         q(RANGE_QUANTILES.0).max(fp.lower),

@@ -1140,22 +1140,12 @@ fn nested_warm_points(smaller: &CandidateFit, free: &[FreeParam]) -> Vec<Vec<f64
         })
         .collect();
     let mut points = vec![first.clone()];
-    let (Some(i), Ok(sim)) = (
+    let (Some(i), Some(abs_theta)) = (
         free.iter().position(|fp| fp.name == ParamId::ThetaC),
-        smaller.problem.simulate(&params),
+        sorted_abs_theta(smaller),
     ) else {
         return points;
     };
-    let mut abs_theta: Vec<f64> = sim
-        .theta_rad
-        .iter()
-        .filter(|t| t.is_finite())
-        .map(|t| t.abs())
-        .collect();
-    if abs_theta.is_empty() {
-        return points;
-    }
-    abs_theta.sort_by(f64::total_cmp);
     for q in [0.5, 0.9] {
         let mut p = first.clone();
         p[i] = free[i].u_of(crate::spectrum::stats::quantile_sorted(&abs_theta, q));
@@ -1175,6 +1165,24 @@ fn nested_warm_points(smaller: &CandidateFit, free: &[FreeParam]) -> Vec<Vec<f64
         points.push(p);
     }
     points
+}
+
+/// |θ| of the neck in `fit`'s simulation at its optimum, finite samples in ascending order: where
+/// a shoulder's contact angle would act on that motion. `None` when it cannot be simulated or has
+/// no finite sample.
+pub(super) fn sorted_abs_theta(fit: &CandidateFit) -> Option<Vec<f64>> {
+    let sim = fit
+        .problem
+        .simulate(&fit.problem.params_at(&fit.best_u))
+        .ok()?;
+    let mut abs_theta: Vec<f64> = sim
+        .theta_rad
+        .iter()
+        .filter(|t| t.is_finite())
+        .map(|t| t.abs())
+        .collect();
+    abs_theta.sort_by(f64::total_cmp);
+    (!abs_theta.is_empty()).then_some(abs_theta)
 }
 
 /// The estimator: `restarts` independent runs of a particle swarm over `[0, 1]^n` (`particles`,
