@@ -1,8 +1,9 @@
 //! The contact-angle scan ([`super::job::ContactAngleScan`]): when the chosen model fails its
 //! goodness-of-fit test, each `+shoulder` candidate is searched again, once per slice of the
-//! contact angle θ_c, by its whole search (restarts, warm points, valley polishes) with θ_c bounded
-//! to the slice; the best slice's end, settled in the full box, replaces the candidate's optimum
-//! when it is more likely.
+//! contact angle θ_c, by its whole search (local polishes from the smaller model's optimum, the
+//! global restarts and their second batch) with θ_c bounded to the slice; the best slice's end,
+//! settled in the full box, replaces the candidate's optimum when it is more likely, and the
+//! valley polishes of the new choice start from there.
 //!
 //! A shoulder that the neck touches only at the peaks of its swing stiffens it while
 //! |θ| > θ_c, for a fraction of each swing that changes steeply with θ_c: the likelihood's basin is
