@@ -28,7 +28,6 @@ use super::search::{
 use crate::Result;
 use crate::model::ParamId;
 use std::sync::atomic::Ordering;
-use std::sync::{Arc, Mutex};
 
 /// The width of one slice of θ_c on the log scale: 0.2 (±10 % about its centre), the widest
 /// bounds with which the search reached the often-crossed shoulder's basin (docs/fit.md, "Shoulder
@@ -231,11 +230,7 @@ fn keep_if_better(
             .zip(best.free.iter().zip(&best.best_u))
             .map(|(full, (sliced, u))| full.u_of(sliced.value(*u)))
             .collect();
-        let reporting = Reporting {
-            history: Arc::new(Mutex::new(f.history.clone())),
-            ..Reporting::new(pb, f.candidate)
-        }
-        .resumed(f.problem.evaluations.load(Ordering::Relaxed));
+        let reporting = Reporting::continuing(f, pb);
         let found = Optimised {
             cost: f.problem.cost_at(&u),
             u,

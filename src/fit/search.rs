@@ -59,10 +59,21 @@ impl Reporting {
         }
     }
 
+    /// The reporting of a fitted candidate `f`'s later work (valley polishes, a scan, taking the
+    /// smaller model's optimum): its history continued, its model runs counting on from the
+    /// progress bar's position now.
+    pub(super) fn continuing(f: &CandidateFit, pb: &Option<indicatif::ProgressBar>) -> Reporting {
+        Reporting {
+            history: Arc::new(Mutex::new(f.history.clone())),
+            ..Reporting::new(pb, f.candidate)
+        }
+        .resumed(f.problem.evaluations.load(Ordering::Relaxed))
+    }
+
     /// The same reporting (history, best point) continued later in the job, after the candidate's
     /// first `evaluations` model runs: the bar's base moved so that its runs count on from the
     /// bar's position now.
-    pub(super) fn resumed(&self, evaluations: usize) -> Reporting {
+    fn resumed(&self, evaluations: usize) -> Reporting {
         let mut r = self.clone();
         if let Some(pb) = &self.progress {
             r.base = pb.position().saturating_sub(evaluations as u64);
@@ -628,11 +639,7 @@ pub(super) fn descend_chosen(
         return Ok(false);
     }
     let started = std::time::Instant::now();
-    let reporting = Reporting {
-        history: Arc::new(Mutex::new(f.history.clone())),
-        ..Reporting::new(pb, f.candidate)
-    }
-    .resumed(f.problem.evaluations.load(Ordering::Relaxed));
+    let reporting = Reporting::continuing(f, pb);
     let at_fit = Optimised {
         u: f.best_u.clone(),
         swarm_iters: f.swarm_iters,
@@ -720,11 +727,7 @@ fn keep_nested_above(
             fits.insert(i, larger);
             continue;
         };
-        let reporting = Reporting {
-            history: Arc::new(Mutex::new(larger.history.clone())),
-            ..Reporting::new(pb, larger.candidate)
-        }
-        .resumed(larger.problem.evaluations.load(Ordering::Relaxed));
+        let reporting = Reporting::continuing(&larger, pb);
         let (mut note, wall_time_s) = (larger.search_note.clone(), larger.wall_time_s);
         let mut kept = keep_the_smaller_optimum(larger, small, &warm, &reporting, pb, &mut note)?;
         (kept.search_note, kept.wall_time_s) = (note, wall_time_s);
