@@ -28,6 +28,7 @@ pub mod scan;
 mod search;
 mod select;
 pub mod template;
+pub mod tolerance;
 mod uncertainty;
 
 pub use candidate::{Candidate, NECK_BAND_MIN_HZ, smallest_capable_model};
@@ -145,8 +146,16 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     warnings.extend(absorbing);
     warnings.extend(line_warnings(&peaks));
     warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
+    let tolerance_check = (!interrupted && !interrupt::stop_requested())
+        .then(|| {
+            let at_job = (best.cost, best.sim.transitions.len());
+            tolerance::ToleranceCheck::run(&cf.problem, &cf.best_u, at_job)
+        })
+        .flatten();
+    warnings.extend(tolerance_check.as_ref().and_then(|t| t.warning()));
     warnings.extend(failure_warning(&cf.problem));
-    // The chosen model's counts include its bootstrap replicates (they share its counters).
+    // The chosen model's counts include its bootstrap replicates and the tolerance check's
+    // simulations (they share its counters).
     let chosen = &mut selection.trials[selection.chosen];
     chosen.model_evaluations = cf.problem.evaluations.load(Ordering::Relaxed);
     chosen.failed_evaluations = failures(&cf.problem).0;
@@ -169,6 +178,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
             modes,
             interrupted,
             goodness_of_fit,
+            tolerance_check,
         },
     );
     Ok(FitOutcome {
@@ -463,6 +473,7 @@ struct Assembled {
     modes: Vec<crate::model::modes::BladeMode>,
     interrupted: bool,
     goodness_of_fit: Option<likelihood::GoodnessOfFit>,
+    tolerance_check: Option<tolerance::ToleranceCheck>,
 }
 
 /// The result of the chosen fit, with the job's provenance (the recording's hash and the effective
@@ -515,6 +526,7 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         modes: a.modes,
         interrupted: a.interrupted,
         goodness_of_fit: a.goodness_of_fit,
+        tolerance_check: a.tolerance_check,
         history: cf.history.clone(),
     }
 }

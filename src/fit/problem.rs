@@ -256,6 +256,23 @@ impl SpectralProblem {
         self.objective == Objective::Likelihood && self.targets.is_none() && self.likelihood.is_ok()
     }
 
+    /// The cost ([`SpectralProblem::total_cost`]) at normalised coordinates `u` simulated with
+    /// `solver` instead of the job's, and the simulation's number of transitions; counted as a model
+    /// evaluation (and a failed one on error). This recording only (a joint fit's others are not
+    /// run).
+    ///
+    /// # Errors
+    /// The simulation's and the cost's.
+    pub fn cost_with_solver(&self, u: &[f64], solver: &SolverOptions) -> Result<(f64, usize)> {
+        self.evaluations.fetch_add(1, Ordering::Relaxed);
+        let p = self.params_at(u);
+        self.simulate_with(&p, solver)
+            .and_then(|s| Ok((self.total_cost(&s)?, s.transitions.len())))
+            .inspect_err(|_| {
+                self.failures.fetch_add(1, Ordering::Relaxed);
+            })
+    }
+
     /// Cost at normalised coordinates, with a quadratic penalty outside the box.
     pub fn cost_at(&self, u: &[f64]) -> f64 {
         self.cost_at_stage(u, SearchStage::Polish)

@@ -378,6 +378,12 @@ pub struct FitResult {
     /// written before this field.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub goodness_of_fit: Option<crate::fit::likelihood::GoodnessOfFit>,
+    /// The chosen optimum's cost again at tenfold and hundredfold tighter solver tolerances
+    /// ([`crate::fit::tolerance::ToleranceCheck`]): whether the integrator resolves the likelihood
+    /// there. `None` without a likelihood, for a joint fit, when interrupted, and in results written
+    /// before this field.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance_check: Option<crate::fit::tolerance::ToleranceCheck>,
     pub history: Vec<HistoryPoint>,
 }
 
@@ -548,6 +554,15 @@ mod tests {
                 replicates: 999,
                 p_value: 0.354,
             }),
+            tolerance_check: Some(crate::fit::tolerance::ToleranceCheck::of(
+                vec![crate::fit::tolerance::TolerancePoint {
+                    rtol: 1e-8,
+                    atol: 1e-10,
+                    cost_nats: 78.3,
+                    transitions: 160,
+                }],
+                vec!["rtol 1e-10: too many steps".into()],
+            )),
             history: vec![HistoryPoint {
                 stage: SearchStage::Swarm,
                 restart: 1,

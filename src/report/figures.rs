@@ -756,6 +756,26 @@ pub fn fit_summary(r: &FitResult) -> String {
             }
         );
     }
+    if let Some(t) = &r.tolerance_check {
+        let costs: Vec<String> = t
+            .points
+            .iter()
+            .map(|p| format!("{:.2}", p.cost_nats))
+            .collect();
+        let rtols: Vec<String> = t.points.iter().map(|p| format!("{:e}", p.rtol)).collect();
+        let _ = writeln!(
+            s,
+            "  tolerance check: cost {} nats at rtol {} ({:.2} nats apart: {})",
+            costs.join(", "),
+            rtols.join(", "),
+            t.spread_nats,
+            if t.resolved() {
+                "resolved by the integrator"
+            } else {
+                "not resolved, see the warning"
+            }
+        );
+    }
     if !r.undetermined.is_empty() {
         let _ = writeln!(
             s,

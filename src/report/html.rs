@@ -372,6 +372,25 @@ fn goodness_of_fit_words(g: &crate::fit::likelihood::GoodnessOfFit) -> String {
     )
 }
 
+/// The tolerance check in a sentence.
+fn tolerance_check_words(t: &crate::fit::tolerance::ToleranceCheck) -> String {
+    let at: Vec<String> = t
+        .points
+        .iter()
+        .map(|p| format!("{} nats at rtol {:e}", num(p.cost_nats, 5), p.rtol))
+        .collect();
+    let verdict = if t.resolved() {
+        "the integrator resolves the likelihood at the optimum"
+    } else {
+        "the integrator does not resolve the likelihood at the optimum: the cost surface is rough at that depth and the intervals understate the uncertainty"
+    };
+    format!(
+        "Tolerance check: the optimum's cost is {} ({} nats apart): {verdict}.",
+        crate::names::join(&at, ", "),
+        num(t.spread_nats, 2),
+    )
+}
+
 fn trial_rows(r: &FitResult) -> Vec<TrialView> {
     r.model_trials
         .iter()
@@ -502,6 +521,7 @@ struct PageView<'a> {
     trials: Vec<TrialView>,
     /// The chosen model's goodness of fit in words, when the result has one.
     goodness_of_fit: Option<String>,
+    tolerance_check: Option<String>,
     modes: Vec<ModeView>,
     correlation: Vec<CorrelationRow>,
     warnings: &'a [String],
@@ -593,6 +613,7 @@ fn page_view<'a>(
         peaks: peak_rows(r),
         trials: trial_rows(r),
         goodness_of_fit: r.goodness_of_fit.as_ref().map(goodness_of_fit_words),
+        tolerance_check: r.tolerance_check.as_ref().map(tolerance_check_words),
         modes: mode_rows(r),
         correlation: if pd { correlation_rows(r) } else { Vec::new() },
         warnings,
@@ -921,6 +942,7 @@ pub(super) mod tests {
             modes: vec![],
             interrupted: false,
             goodness_of_fit: None,
+            tolerance_check: None,
             history: vec![],
         }
     }

@@ -1,0 +1,193 @@
+//! Whether a fit's optimum is resolved by its integrator: the likelihood at the chosen optimum
+//! again at tenfold and hundredfold tighter solver tolerances ([`ToleranceCheck`]).
+//!
+//! A smooth trajectory converges as the tolerance tightens, and so does the cost: on the shipped
+//! recording the main job's optimum costs the same to 0.01 nats from rtol 1e-8 to 1e-10. A motion
+//! whose stick–slip sequence hangs on grazing events (a stick the lip's slip speed only just
+//! reaches, a shoulder the neck only just touches) does not: an event that appears at one
+//! tolerance and not at the next changes the rest of the window, and with it the spectra. On the
+//! confusion table's often-crossed 0.12 rad shoulder (docs/fit.md, "What the search misses") the
+//! fitted optimum's cost moved from 66.8 to 69.0 nats between rtol 1e-8 and 1e-10 (168 and 170
+//! transitions). The cost surface is then rough at that depth: a search that keeps its lowest
+//! evaluation keeps a ripple the integrator's rounding happened to put low, cost differences
+//! smaller than the spread do not tell parameter sets apart, and intervals read from the local
+//! curvature at the 0.5-nat scale understate the uncertainty. The check costs two simulations.
+
+use super::SpectralProblem;
+use serde::{Deserialize, Serialize};
+
+/// Factors by which the probes divide the job's `rtol` and `atol`.
+pub const PROBE_DIVISORS: [f64; 2] = [10.0, 100.0];
+
+/// Tightest relative tolerance a probe uses: below it a Runge–Kutta pair in double precision
+/// (unit roundoff 1.1e-16) spends its steps on rounding (Hairer, Nørsett & Wanner, *Solving
+/// Ordinary Differential Equations I*, 2nd ed., §II.4).
+pub const MIN_PROBE_RTOL: f64 = 1e-13;
+
+/// Factor on the job's `max_steps` for a probe: a fifth-order pair takes `100^(1/5)` ≈ 2.5 times
+/// the steps at a hundredfold tighter tolerance.
+const PROBE_MAX_STEPS_FACTOR: usize = 4;
+
+/// The spread above which a fit is not resolved by its integrator, nats: 0.5, the rise of a
+/// quadratic negative log-likelihood at one standard deviation, the scale its intervals are read
+/// at.
+pub const SPREAD_WARN_NATS: f64 = 0.5;
+
+/// The cost of one simulation of the optimum at one tolerance.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TolerancePoint {
+    pub rtol: f64,
+    pub atol: f64,
+    /// The fit's cost there: the recording's NLL above the saturated model's, nats.
+    pub cost_nats: f64,
+    /// Stick–slip and contact transitions of the simulation.
+    pub transitions: usize,
+}
+
+/// The chosen optimum's cost at the job's tolerance and at each probe's.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ToleranceCheck {
+    /// The job's tolerance first, then each probe that ran, tightest last.
+    pub points: Vec<TolerancePoint>,
+    /// Largest minus smallest cost over `points`, nats.
+    pub spread_nats: f64,
+    /// Probes whose simulation failed, and why.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub failed: Vec<String>,
+}
+
+impl ToleranceCheck {
+    /// The check at normalised coordinates `u` of `problem`, whose cost there at the job's
+    /// tolerance is `cost_nats` with `transitions` transitions. `None` when the cost is not the
+    /// recording's NLL (a target job, the features objective) or the fit is joint (its other
+    /// recordings' costs are not re-run). Each probe counts as a model evaluation of `problem`,
+    /// and a failed one as a failed evaluation.
+    pub fn run(
+        problem: &SpectralProblem,
+        u: &[f64],
+        (cost_nats, transitions): (f64, usize),
+    ) -> Option<ToleranceCheck> {
+        if !problem.cost_is_nll() || !problem.others.is_empty() {
+            return None;
+        }
+        let job = problem.solver;
+        let mut points = vec![TolerancePoint {
+            rtol: job.rtol,
+            atol: job.atol,
+            cost_nats,
+            transitions,
+        }];
+        let mut failed = Vec::new();
+        for divisor in PROBE_DIVISORS {
+            let rtol = job.rtol / divisor;
+            if rtol < MIN_PROBE_RTOL {
+                break;
+            }
+            let solver = crate::simulate::SolverOptions {
+                rtol,
+                atol: job.atol / divisor,
+                max_steps: job.max_steps.saturating_mul(PROBE_MAX_STEPS_FACTOR),
+                ..job
+            };
+            match problem.cost_with_solver(u, &solver) {
+                Ok((cost_nats, transitions)) => points.push(TolerancePoint {
+                    rtol,
+                    atol: solver.atol,
+                    cost_nats,
+                    transitions,
+                }),
+                Err(e) => failed.push(format!("rtol {rtol:e}: {e}")),
+            }
+        }
+        Some(ToleranceCheck::of(points, failed))
+    }
+
+    /// The check of `points` (the job's tolerance first) with the probes that `failed`.
+    pub fn of(points: Vec<TolerancePoint>, failed: Vec<String>) -> ToleranceCheck {
+        let (lo, hi) = points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.cost_nats), hi.max(p.cost_nats))
+            });
+        let spread_nats = if points.len() > 1 { hi - lo } else { 0.0 };
+        ToleranceCheck {
+            points,
+            spread_nats,
+            failed,
+        }
+    }
+
+    /// Whether the cost agrees across tolerances to within [`SPREAD_WARN_NATS`].
+    pub fn resolved(&self) -> bool {
+        self.spread_nats <= SPREAD_WARN_NATS
+    }
+
+    /// The warning of an optimum the integrator does not resolve, `None` when it does.
+    pub fn warning(&self) -> Option<String> {
+        if self.resolved() {
+            return None;
+        }
+        let at = |p: &TolerancePoint| {
+            format!(
+                "{:.3} nats at rtol {:e} ({} transitions)",
+                p.cost_nats, p.rtol, p.transitions
+            )
+        };
+        let points: Vec<String> = self.points.iter().map(at).collect();
+        Some(format!(
+            "the likelihood at the optimum is not resolved by the integrator: {} ({:.2} nats apart, more than the {SPREAD_WARN_NATS} nats of a 1σ interval); the stick–slip sequence hangs on grazing events, so the cost surface is rough at that depth, cost differences below it do not tell parameter sets apart and the intervals understate the uncertainty (docs/fit.md, \"Tolerance check\")",
+            crate::names::join(&points, ", "),
+            self.spread_nats
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(rtol: f64, cost_nats: f64, transitions: usize) -> TolerancePoint {
+        TolerancePoint {
+            rtol,
+            atol: rtol * 1e-2,
+            cost_nats,
+            transitions,
+        }
+    }
+
+    #[test]
+    fn the_spread_is_the_range_of_the_costs_and_warns_above_half_a_nat() {
+        let close = ToleranceCheck::of(
+            vec![
+                point(1e-8, 78.317, 160),
+                point(1e-9, 78.318, 160),
+                point(1e-10, 78.320, 160),
+            ],
+            vec![],
+        );
+        assert!((close.spread_nats - 0.003).abs() < 1e-9);
+        assert!(close.resolved() && close.warning().is_none());
+        let apart = ToleranceCheck::of(
+            vec![
+                point(1e-8, 66.83, 168),
+                point(1e-9, 67.03, 170),
+                point(1e-10, 69.03, 170),
+            ],
+            vec![],
+        );
+        assert!((apart.spread_nats - 2.2).abs() < 1e-9);
+        let w = apart.warning().expect("a 2.2-nat spread warns");
+        assert!(
+            w.contains("66.830 nats at rtol 1e-8 (168 transitions)"),
+            "{w}"
+        );
+        assert!(w.contains("2.20 nats apart"), "{w}");
+    }
+
+    #[test]
+    fn a_single_point_has_no_spread() {
+        let alone = ToleranceCheck::of(vec![point(1e-13, 5.0, 3)], vec!["x".into()]);
+        assert_eq!(alone.spread_nats, 0.0);
+        assert!(alone.resolved());
+    }
+}
