@@ -328,10 +328,10 @@ fn likelihood_choice_confusion_table() {
     let dir = std::env::temp_dir().join(format!("wiperlab_model_choice_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let mut md = String::from(
-        "| recording | shoulder switches | true model | chosen | ΔAIC of the true model | A | B | C | k1 | k1c | warnings | truth outside the 68 % interval | ln L of the true model's fit − at the truth | goodness of fit p |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| recording | shoulder switches | true model | chosen | ΔAIC of the true model | A | B | C | k1 | k1c | warnings | truth outside the 68 % interval | ln L of the true model's fit − at the truth | goodness of fit p | tolerance check spread [nats] |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut csv = String::from(
-        "recording,switches,true_model,chosen_model,delta_aic_true,err_A,err_B,err_C,err_k1,err_k1c,wall_time_s,outside_interval,lnl_fit_minus_truth,goodness_of_fit_p\n",
+        "recording,switches,true_model,chosen_model,delta_aic_true,err_A,err_B,err_C,err_k1,err_k1c,wall_time_s,outside_interval,lnl_fit_minus_truth,goodness_of_fit_p,tolerance_spread_nats\n",
     );
     let mut failures = Vec::new();
     let out = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/model_choice");
@@ -355,7 +355,7 @@ fn likelihood_choice_confusion_table() {
                 println!("{}: {e}", s.name);
                 let _ = writeln!(
                     md,
-                    "| {} | — | {} | ({e}) | | | | | | | | | | |",
+                    "| {} | — | {} | ({e}) | | | | | | | | | | | |",
                     s.name, s.truth_model
                 );
                 failures.push(format!("{}: {e}", s.name));
@@ -415,6 +415,12 @@ fn likelihood_choice_confusion_table() {
         let gof_p = r
             .goodness_of_fit
             .map_or("—".to_string(), |g| format!("{:.3}", g.p_value));
+        // The chosen optimum's cost spread over rtol, rtol/10, rtol/100 (docs/fit.md, "Tolerance
+        // check").
+        let spread = r
+            .tolerance_check
+            .as_ref()
+            .map_or("—".to_string(), |t| format!("{:.2}", t.spread_nats));
         let outside = if outside.is_empty() {
             "none".to_string()
         } else {
@@ -440,7 +446,7 @@ fn likelihood_choice_confusion_table() {
         }
         let _ = writeln!(
             md,
-            "| {} | {switches} | {} | {chosen} | {d_true:+.2} | {} | {} | {} | {} | {} | {} | {outside} | {above_truth:+.2} | {gof_p} |",
+            "| {} | {switches} | {} | {chosen} | {d_true:+.2} | {} | {} | {} | {} | {} | {} | {outside} | {above_truth:+.2} | {gof_p} | {spread} |",
             s.name,
             s.truth_model,
             pct(err("A")),
@@ -453,7 +459,7 @@ fn likelihood_choice_confusion_table() {
         let num = |e: Option<f64>| e.map_or(String::new(), |e| format!("{e}"));
         let _ = writeln!(
             csv,
-            "\"{}\",{switches},{},{chosen},{d_true},{},{},{},{},{},{},\"{outside}\",{above_truth},{gof_p}",
+            "\"{}\",{switches},{},{chosen},{d_true},{},{},{},{},{},{},\"{outside}\",{above_truth},{gof_p},{spread}",
             s.name,
             s.truth_model,
             num(err("A")),

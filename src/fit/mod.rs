@@ -153,6 +153,12 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         })
         .flatten();
     warnings.extend(tolerance_check.as_ref().and_then(|t| t.warning()));
+    warnings.extend(
+        tolerance_check
+            .as_ref()
+            .zip(runner_up(&selection.trials))
+            .and_then(|(t, (chosen, runner, gap))| t.choice_warning(&chosen, &runner, gap)),
+    );
     warnings.extend(failure_warning(&cf.problem));
     // The chosen model's counts include its bootstrap replicates and the tolerance check's
     // simulations (they share its counters).
@@ -191,6 +197,21 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         best_sim: best.sim,
         best_params: best.params,
     })
+}
+
+/// The chosen trial's name, the name of the trial with the AIC nearest to it among the others, and
+/// that AIC's distance above the chosen one's (`None` without two trials in likelihood units).
+fn runner_up(trials: &[result::ModelTrial]) -> Option<(String, String, f64)> {
+    let aic = |t: &result::ModelTrial| t.evidence.as_ref().map(|e| e.aic);
+    let chosen = trials.iter().find(|t| t.chosen)?;
+    let chosen_aic = aic(chosen)?;
+    trials
+        .iter()
+        .filter(|t| !t.chosen)
+        .filter_map(|t| Some((t, aic(t)? - chosen_aic)))
+        .filter(|(_, gap)| gap.is_finite())
+        .min_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+        .map(|(t, gap)| (chosen.model.to_string(), t.model.to_string(), gap))
 }
 
 /// The chosen fit's goodness of fit to the recording's spectra

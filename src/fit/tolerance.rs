@@ -140,6 +140,20 @@ impl ToleranceCheck {
             self.spread_nats
         ))
     }
+
+    /// The warning of a model choice the integrator does not resolve: `chosen` over `runner_up`,
+    /// whose AIC is `aic_gap` above the chosen one's (`aic_gap / 2` nats of log-likelihood once
+    /// the penalties are counted), when the optimum's cost spreads by more than that; `None`
+    /// otherwise.
+    pub fn choice_warning(&self, chosen: &str, runner_up: &str, aic_gap: f64) -> Option<String> {
+        let gap_nats = aic_gap.abs() / 2.0;
+        (aic_gap.is_finite() && self.spread_nats > gap_nats).then(|| {
+            format!(
+                "the choice of {chosen} over {runner_up} (ΔAIC {aic_gap:.2}, {gap_nats:.2} nats) is smaller than the {:.2} nats the chosen optimum's cost moves between solver tolerances: the integrator does not resolve it (docs/fit.md, \"Tolerance check\")",
+                self.spread_nats
+            )
+        })
+    }
 }
 
 #[cfg(test)]
@@ -182,6 +196,22 @@ mod tests {
             "{w}"
         );
         assert!(w.contains("2.20 nats apart"), "{w}");
+    }
+
+    #[test]
+    fn a_choice_closer_than_the_spread_warns() {
+        let apart =
+            ToleranceCheck::of(vec![point(1e-8, 66.8, 168), point(1e-9, 68.0, 170)], vec![]);
+        // 1.2 nats of spread against ΔAIC 2.0 (1.0 nat): unresolved; against ΔAIC 3.0: resolved.
+        let w = apart
+            .choice_warning("blade2dof", "blade2dof+shoulder", 2.0)
+            .expect("1.2 nats > 1.0");
+        assert!(
+            w.contains("blade2dof over blade2dof+shoulder (ΔAIC 2.00, 1.00 nats)"),
+            "{w}"
+        );
+        assert!(apart.choice_warning("a", "b", 3.0).is_none());
+        assert!(apart.choice_warning("a", "b", f64::INFINITY).is_none());
     }
 
     #[test]
