@@ -493,6 +493,25 @@ fn likelihood_choice_confusion_table() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// Scene `i` written to a fresh directory named after `tag`, and its true model's problem: the scene,
+/// the directory (for the caller to remove) and the problem.
+fn scene_problem(
+    i: usize,
+    tag: &str,
+) -> (
+    &'static Scene,
+    std::path::PathBuf,
+    wiperlab::fit::SpectralProblem,
+) {
+    let s = &SCENES[i];
+    let dir = std::env::temp_dir().join(format!("wiperlab_{tag}_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (job, _) = write_scene(&dir, i, s).unwrap();
+    let job = LoadedJob::load(&job).unwrap();
+    let p = wiperlab::fit::problem_for(&job, s.truth_model.parse().unwrap()).unwrap();
+    (s, dir, p)
+}
+
 /// Why the free k1 of the shoulder scenes does not come back (issue 19, point 3): while the neck
 /// rests on the shoulder, its moment is `k1c·θ − (k1c − k1)·θ_c` (docs/model.md, "Shoulder
 /// contact"), so every (k1, θ_c) with the same `(k1c − k1)·θ_c` moves the blade the same way; only
@@ -503,14 +522,8 @@ fn likelihood_choice_confusion_table() {
 /// spectra see the moment at contact, not k1 and θ_c apart.
 #[test]
 fn the_spectra_do_not_tell_k1_from_theta_c_along_the_contact_moment_ridge() {
-    let i = 4;
-    let s = &SCENES[i];
+    let (s, dir, p) = scene_problem(4, "ridge");
     assert_eq!(s.shoulder, Some((0.025, 0.024375)));
-    let dir = std::env::temp_dir().join(format!("wiperlab_ridge_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let (job, _) = write_scene(&dir, i, s).unwrap();
-    let job = LoadedJob::load(&job).unwrap();
-    let p = wiperlab::fit::problem_for(&job, s.truth_model.parse().unwrap()).unwrap();
     let lik = p.likelihood.as_ref().unwrap().clone();
     let truth = truth_params(s);
     let spectral_nll = |k1: f64, theta_c: f64| -> f64 {
@@ -576,14 +589,8 @@ fn the_tolerance_check_flags_the_often_crossed_shoulders_unresolved_likelihood()
     assert_eq!(at_truth.points.len(), 3, "{at_truth:?}");
     assert!(at_truth.resolved(), "{at_truth:?}");
 
-    let i = 6;
-    let s = &SCENES[i];
+    let (s, dir, p) = scene_problem(6, "tolerance");
     assert_eq!(s.shoulder, Some((0.12, 0.09)));
-    let dir = std::env::temp_dir().join(format!("wiperlab_tolerance_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let (job, _) = write_scene(&dir, i, s).unwrap();
-    let job = LoadedJob::load(&job).unwrap();
-    let p = wiperlab::fit::problem_for(&job, s.truth_model.parse().unwrap()).unwrap();
     let truth = true_coordinates(&p, &truth_params(s));
     // The fit's end on this scene (its result's values; the truth's errors there are A −2.9 %,
     // B +3.5 %, C −5.6 %, k1 −7.2 %, k1c −1.3 %, θ_c +4.4 %).

@@ -169,26 +169,19 @@ mod tests {
         }
     }
 
+    /// The check of costs and transitions at rtol 1e-8, 1e-9 and 1e-10.
+    fn three(costs: [(f64, usize); 3]) -> ToleranceCheck {
+        let rtols = [1e-8, 1e-9, 1e-10];
+        let points = rtols.iter().zip(costs);
+        ToleranceCheck::of(points.map(|(r, (c, n))| point(*r, c, n)).collect(), vec![])
+    }
+
     #[test]
     fn the_spread_is_the_range_of_the_costs_and_warns_above_half_a_nat() {
-        let close = ToleranceCheck::of(
-            vec![
-                point(1e-8, 78.317, 160),
-                point(1e-9, 78.318, 160),
-                point(1e-10, 78.320, 160),
-            ],
-            vec![],
-        );
+        let close = three([(78.317, 160), (78.318, 160), (78.320, 160)]);
         assert!((close.spread_nats - 0.003).abs() < 1e-9);
         assert!(close.resolved() && close.warning().is_none());
-        let apart = ToleranceCheck::of(
-            vec![
-                point(1e-8, 66.83, 168),
-                point(1e-9, 67.03, 170),
-                point(1e-10, 69.03, 170),
-            ],
-            vec![],
-        );
+        let apart = three([(66.83, 168), (67.03, 170), (69.03, 170)]);
         assert!((apart.spread_nats - 2.2).abs() < 1e-9);
         let w = apart.warning().expect("a 2.2-nat spread warns");
         assert!(
