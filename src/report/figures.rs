@@ -771,6 +771,8 @@ pub fn fit_summary(r: &FitResult) -> String {
             t.spread_nats,
             if t.resolved() {
                 "resolved by the integrator"
+            } else if t.points.len() < 2 {
+                "no probe ran, see the warning"
             } else {
                 "not resolved, see the warning"
             }

@@ -381,6 +381,8 @@ fn tolerance_check_words(t: &crate::fit::tolerance::ToleranceCheck) -> String {
         .collect();
     let verdict = if t.resolved() {
         "the integrator resolves the likelihood at the optimum"
+    } else if t.points.len() < 2 {
+        "every tighter probe failed, so whether the integrator resolves the likelihood is not known"
     } else {
         "the integrator does not resolve the likelihood at the optimum: the cost surface is rough at that depth and the intervals understate the uncertainty"
     };
