@@ -264,13 +264,24 @@ impl SpectralProblem {
     /// # Errors
     /// The simulation's and the cost's.
     pub fn cost_with_solver(&self, u: &[f64], solver: &SolverOptions) -> Result<(f64, usize)> {
-        self.evaluations.fetch_add(1, Ordering::Relaxed);
         let p = self.params_at(u);
-        self.simulate_with(&p, solver)
-            .and_then(|s| Ok((self.total_cost(&s)?, s.transitions.len())))
-            .inspect_err(|_| {
-                self.failures.fetch_add(1, Ordering::Relaxed);
-            })
+        self.counted(|| {
+            let s = self.simulate_with(&p, solver)?;
+            Ok((self.total_cost(&s)?, s.transitions.len()))
+        })
+    }
+
+    /// `run`, one model evaluation: counted in `evaluations`, and on error in `failures` with
+    /// the first failure's message kept.
+    fn counted<T>(&self, run: impl FnOnce() -> Result<T>) -> Result<T> {
+        self.evaluations.fetch_add(1, Ordering::Relaxed);
+        run().inspect_err(|e| {
+            self.failures.fetch_add(1, Ordering::Relaxed);
+            let mut g = self.first_failure.lock().unwrap_or_else(|e| e.into_inner());
+            if g.is_none() {
+                *g = Some(e.to_string());
+            }
+        })
     }
 
     /// Cost at normalised coordinates, with a quadratic penalty outside the box.
@@ -293,21 +304,9 @@ impl SpectralProblem {
             return FAILED_COST;
         }
         let p = self.params_at(u);
-        self.evaluations.fetch_add(1, Ordering::Relaxed);
-        let c = match self
-            .simulate_with(&p, solver)
-            .and_then(|s| self.stage_cost(&s, stage))
-        {
-            Ok(c) => c,
-            Err(e) => {
-                self.failures.fetch_add(1, Ordering::Relaxed);
-                let mut g = self.first_failure.lock().unwrap_or_else(|e| e.into_inner());
-                if g.is_none() {
-                    *g = Some(e.to_string());
-                }
-                FAILED_COST
-            }
-        };
+        let c = self
+            .counted(|| self.stage_cost(&self.simulate_with(&p, solver)?, stage))
+            .unwrap_or(FAILED_COST);
         let joint: f64 = self.others.iter().map(|o| o.cost_at_stage(u, stage)).sum();
         c + joint + 1e4 * outside
     }

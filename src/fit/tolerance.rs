@@ -33,6 +33,17 @@ const PROBE_MAX_STEPS_FACTOR: usize = 4;
 /// at.
 pub const SPREAD_WARN_NATS: f64 = 0.5;
 
+/// What a [`ToleranceCheck`] found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verdict {
+    /// The costs agree to within [`SPREAD_WARN_NATS`].
+    Resolved,
+    /// They spread by more.
+    Unresolved,
+    /// Every probe failed: there is nothing to compare.
+    NotProbed,
+}
+
 /// The cost of one simulation of the optimum at one tolerance.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TolerancePoint {
@@ -118,22 +129,34 @@ impl ToleranceCheck {
         }
     }
 
+    /// What the check found.
+    pub fn verdict(&self) -> Verdict {
+        if self.points.len() < 2 {
+            Verdict::NotProbed
+        } else if self.spread_nats <= SPREAD_WARN_NATS {
+            Verdict::Resolved
+        } else {
+            Verdict::Unresolved
+        }
+    }
+
     /// Whether a probe ran and the cost agrees across tolerances to within [`SPREAD_WARN_NATS`].
     pub fn resolved(&self) -> bool {
-        self.points.len() > 1 && self.spread_nats <= SPREAD_WARN_NATS
+        self.verdict() == Verdict::Resolved
     }
 
     /// The warning of an optimum the integrator does not resolve, or whose probes all failed;
     /// `None` when it is resolved.
     pub fn warning(&self) -> Option<String> {
-        if self.resolved() {
-            return None;
-        }
-        if self.points.len() < 2 {
-            return Some(format!(
-                "the tolerance check did not run: every probe failed ({}), so it is not known whether the integrator resolves the likelihood at the optimum (docs/fit.md, \"Tolerance check\")",
-                self.failed.join("; ")
-            ));
+        match self.verdict() {
+            Verdict::Resolved => return None,
+            Verdict::NotProbed => {
+                return Some(format!(
+                    "the tolerance check did not run: every probe failed ({}), so it is not known whether the integrator resolves the likelihood at the optimum (docs/fit.md, \"Tolerance check\")",
+                    self.failed.join("; ")
+                ));
+            }
+            Verdict::Unresolved => {}
         }
         let at = |p: &TolerancePoint| {
             format!(

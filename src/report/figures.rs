@@ -757,6 +757,7 @@ pub fn fit_summary(r: &FitResult) -> String {
         );
     }
     if let Some(t) = &r.tolerance_check {
+        use crate::fit::tolerance::Verdict;
         let costs: Vec<String> = t
             .points
             .iter()
@@ -769,12 +770,10 @@ pub fn fit_summary(r: &FitResult) -> String {
             costs.join(", "),
             rtols.join(", "),
             t.spread_nats,
-            if t.resolved() {
-                "resolved by the integrator"
-            } else if t.points.len() < 2 {
-                "no probe ran, see the warning"
-            } else {
-                "not resolved, see the warning"
+            match t.verdict() {
+                Verdict::Resolved => "resolved by the integrator",
+                Verdict::NotProbed => "no probe ran, see the warning",
+                Verdict::Unresolved => "not resolved, see the warning",
             }
         );
     }

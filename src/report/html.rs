@@ -379,12 +379,15 @@ fn tolerance_check_words(t: &crate::fit::tolerance::ToleranceCheck) -> String {
         .iter()
         .map(|p| format!("{} nats at rtol {:e}", num(p.cost_nats, 5), p.rtol))
         .collect();
-    let verdict = if t.resolved() {
-        "the integrator resolves the likelihood at the optimum"
-    } else if t.points.len() < 2 {
-        "every tighter probe failed, so whether the integrator resolves the likelihood is not known"
-    } else {
-        "the integrator does not resolve the likelihood at the optimum: the cost surface is rough at that depth and the intervals understate the uncertainty"
+    use crate::fit::tolerance::Verdict;
+    let verdict = match t.verdict() {
+        Verdict::Resolved => "the integrator resolves the likelihood at the optimum",
+        Verdict::NotProbed => {
+            "every tighter probe failed, so whether the integrator resolves the likelihood is not known"
+        }
+        Verdict::Unresolved => {
+            "the integrator does not resolve the likelihood at the optimum: the cost surface is rough at that depth and the intervals understate the uncertainty"
+        }
     };
     format!(
         "Tolerance check: the optimum's cost is {} ({} nats apart): {verdict}.",
