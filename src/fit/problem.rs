@@ -114,6 +114,72 @@ pub struct SpectralProblem {
     /// Failed evaluations, shared like `evaluations` with the bootstrap's replicate problems.
     pub failures: Arc<AtomicUsize>,
     pub first_failure: Mutex<Option<String>>,
+    /// The polish-stage evaluations found about as likely as the best one
+    /// ([`EvaluatedNearBest`]), which the intervals read.
+    pub near_best: Mutex<EvaluatedNearBest>,
+}
+
+/// How far above the lowest cost seen (nats) [`EvaluatedNearBest`] keeps a point: above the
+/// profile rise limits the intervals use (0.5 nats times σ²_sandwich/σ²_Fisher,
+/// [`super::uncertainty::profile_rise_limit`]) for a sandwich up to twice the Fisher 1σ.
+pub const NEAR_BEST_MARGIN_NATS: f64 = 2.0;
+
+/// The points a problem's search evaluated at the polish's tolerance, inside the search box, with a
+/// cost within [`NEAR_BEST_MARGIN_NATS`] of the lowest seen: with the likelihood objective, points
+/// the recording's likelihood found about as likely as the best. Each simulation the search runs
+/// is a sample of the likelihood; those near the best one outline the region it leaves open, which
+/// a curvature at the fit can miss where the likelihood is flat or bent
+/// ([`super::uncertainty::widen_to_near_best`]).
+#[derive(Debug, Clone)]
+pub struct EvaluatedNearBest {
+    lowest: f64,
+    /// `(cost, u)`: cost in nats, `u` the problem's normalised coordinates.
+    points: Vec<(f64, Vec<f64>)>,
+    /// The number of points after the last pruning (pruned again when it doubles).
+    kept: usize,
+}
+
+impl Default for EvaluatedNearBest {
+    fn default() -> Self {
+        EvaluatedNearBest {
+            lowest: f64::INFINITY,
+            points: Vec::new(),
+            kept: 0,
+        }
+    }
+}
+
+impl EvaluatedNearBest {
+    /// Keeps `(u, cost)` when the cost is finite and within the margin of the lowest seen; the
+    /// points left behind by a lower one are dropped each time the list doubles.
+    pub fn record(&mut self, u: &[f64], cost: f64) {
+        if !cost.is_finite() {
+            return;
+        }
+        self.lowest = self.lowest.min(cost);
+        if cost > self.lowest + NEAR_BEST_MARGIN_NATS {
+            return;
+        }
+        self.points.push((cost, u.to_vec()));
+        if self.points.len() >= 2 * self.kept.max(64) {
+            let limit = self.lowest + NEAR_BEST_MARGIN_NATS;
+            self.points.retain(|p| p.0 <= limit);
+            self.kept = self.points.len();
+        }
+    }
+
+    /// The lowest cost recorded, nats (`+∞` when none).
+    pub fn lowest(&self) -> f64 {
+        self.lowest
+    }
+
+    /// The recorded points whose cost is at most `cost`, as `(cost, u)`.
+    pub fn at_most(&self, cost: f64) -> impl Iterator<Item = (f64, &[f64])> {
+        self.points
+            .iter()
+            .filter(move |p| p.0 <= cost)
+            .map(|p| (p.0, p.1.as_slice()))
+    }
 }
 
 impl SpectralProblem {
@@ -290,7 +356,24 @@ impl SpectralProblem {
     }
 
     /// [`SpectralProblem::cost_at`] with the simulations of `stage` (the swarm's may be coarser).
+    ///
+    /// With the likelihood as the cost, a polish-stage evaluation inside the box is kept in
+    /// [`SpectralProblem::near_best`] when it is near the lowest seen.
     pub(super) fn cost_at_stage(&self, u: &[f64], stage: SearchStage) -> f64 {
+        let c = self.unrecorded_cost_at_stage(u, stage);
+        let inside = u.iter().all(|x| (0.0..=1.0).contains(x));
+        if stage == SearchStage::Polish && inside && c < FAILED_COST && self.cost_is_nll() {
+            self.near_best
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .record(u, c);
+        }
+        c
+    }
+
+    /// [`SpectralProblem::cost_at_stage`] without keeping the point (a joint fit's other
+    /// recordings, whose cost is a part of the whole).
+    fn unrecorded_cost_at_stage(&self, u: &[f64], stage: SearchStage) -> f64 {
         let solver = match stage {
             SearchStage::Swarm => &self.swarm_solver,
             SearchStage::Polish => &self.solver,
@@ -307,7 +390,11 @@ impl SpectralProblem {
         let c = self
             .counted(|| self.stage_cost(&self.simulate_with(&p, solver)?, stage))
             .unwrap_or(FAILED_COST);
-        let joint: f64 = self.others.iter().map(|o| o.cost_at_stage(u, stage)).sum();
+        let joint: f64 = self
+            .others
+            .iter()
+            .map(|o| o.unrecorded_cost_at_stage(u, stage))
+            .sum();
         c + joint + 1e4 * outside
     }
 }

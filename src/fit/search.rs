@@ -474,6 +474,7 @@ fn problem_of(
         evaluations,
         failures: Arc::new(AtomicUsize::new(0)),
         first_failure: Mutex::new(None),
+        near_best: Mutex::new(Default::default()),
     };
     p.likelihood = if p.targets.is_some() {
         Err("a target job has no measurement noise".into())

@@ -41,14 +41,16 @@ pub(super) fn intervals(
         UncertaintyMethod::Laplace => match &cf.evidence {
             Ok(_) => {
                 let mut intervals = laplace_intervals(&cf.free, &cf.best_u, &cf.sigma_u);
-                let warnings = along_contact_ridge(cf, &mut intervals);
+                let mut warnings = along_contact_ridge(cf, &mut intervals);
+                warnings.extend(near_best_of(cf, &mut intervals));
                 Ok((Some(intervals), warnings))
             }
             Err(why) => Ok((None, vec![format!("no Laplace intervals: {why}")])),
         },
         UncertaintyMethod::Profile => match &cf.evidence {
             Ok(_) => {
-                let (intervals, warnings) = profile_intervals(cf, fit, pb)?;
+                let (mut intervals, mut warnings) = profile_intervals(cf, fit, pb)?;
+                warnings.extend(near_best_of(cf, &mut intervals));
                 Ok((Some(intervals), warnings))
             }
             Err(why) => Ok((
@@ -377,6 +379,78 @@ fn profile_warnings(fp: &FreeParam, limit: f64, lo: ProfileEnd, hi: ProfileEnd) 
     warnings
 }
 
+/// [`widen_to_near_best`] on the chosen fit, with the points its problem kept.
+fn near_best_of(cf: &CandidateFit, intervals: &mut [Interval]) -> Vec<String> {
+    let fisher = cf.fisher_sigma_u.as_deref().unwrap_or(&cf.sigma_u);
+    let at = ProfileStart {
+        u: &cf.best_u,
+        cost_nats: cf.cost,
+        sigma_u: &cf.sigma_u,
+        fisher_sigma_u: fisher,
+    };
+    let near = cf
+        .problem
+        .near_best
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    widen_to_near_best(&cf.free, at, &near, intervals)
+}
+
+/// Widens each interval to contain the points the search evaluated whose cost lies within the
+/// parameter's profile rise limit of the fit ([`profile_rise_limit`]). The profile likelihood at
+/// a point's value of a parameter is at most the point's cost (the others held there instead of
+/// re-optimised), so such a point lies inside that parameter's 68.27 % profile-likelihood region
+/// (Pawitan 2001, *In All Likelihood*, §2.6), and a profile interval would contain it. The search's
+/// own simulations (its polishes, settling, valley polishes, profile walks: every evaluation at the
+/// polish's tolerance, [`super::problem::EvaluatedNearBest`]) thereby sample the region a
+/// curvature at the fit can understate where the likelihood is flat or bent: a valley whose
+/// floor the polishes walked along, a resting neck's ridge. Costs no simulation.
+///
+/// Returns a warning for each parameter whose interval grew by more than a tenth of its width,
+/// naming the span the points reach, and one when a point was more likely than the fit by more
+/// than [`super::search::CONFIRM_NATS`] (the search ended short of its own best evaluation).
+pub fn widen_to_near_best(
+    free: &[FreeParam],
+    at: ProfileStart,
+    near: &super::problem::EvaluatedNearBest,
+    intervals: &mut [Interval],
+) -> Vec<String> {
+    let mut warnings = Vec::new();
+    for (i, fp) in free.iter().enumerate() {
+        let limit = profile_rise_limit(at.sigma_u[i], at.fisher_sigma_u[i]);
+        let (lo0, hi0) = (intervals[i].lo, intervals[i].hi);
+        let (mut lo, mut hi) = (lo0, hi0);
+        for (_, u) in near.at_most(at.cost_nats + limit) {
+            let v = fp.value(u[i]);
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+        intervals[i].lo = lo;
+        intervals[i].hi = hi;
+        let width = hi0 - lo0;
+        if (lo0 - lo) + (hi - hi0) > NEAR_BEST_WARN_WIDTH * width {
+            warnings.push(format!(
+                "{}: points the search evaluated within {limit:.2} nats of the fit reach \
+                 {lo:.4e} to {hi:.4e}, beyond the curvature's interval [{lo0:.4e}, {hi0:.4e}]: \
+                 the likelihood is flatter there than its curvature at the fit says, and the \
+                 interval spans them",
+                fp.name
+            ));
+        }
+    }
+    let gain = at.cost_nats - near.lowest();
+    if gain > super::search::CONFIRM_NATS {
+        warnings.push(format!(
+            "the search evaluated a point {gain:.2} nats more likely than the fit: it ended short \
+             of its own best evaluation"
+        ));
+    }
+    warnings
+}
+
+/// The growth of an interval (a fraction of its width) above which [`widen_to_near_best`] warns.
+pub const NEAR_BEST_WARN_WIDTH: f64 = 0.1;
+
 /// How far [`along_contact_ridge`] looks: the free neck stiffness times each factor.
 pub const RIDGE_K1_FACTORS: [f64; 4] = [
     0.5,
@@ -639,6 +713,7 @@ impl ReplicateSource {
             evaluations: problem.evaluations.clone(),
             failures: problem.failures.clone(),
             first_failure: Mutex::new(None),
+            near_best: Mutex::new(Default::default()),
         })
         .map(|mut rep| {
             // The replicate's own likelihood: its measured ordinates and noise, the recording's
@@ -857,5 +932,117 @@ mod tests {
         let mut iv = iv0.clone();
         assert!(widen_along_ridge(&free, &u, 0.0, bowl, &mut iv).is_none());
         assert_eq!(iv, iv0);
+    }
+
+    /// Evaluates `cost` at each point of a grid over a square of half-width `half` around `u0`
+    /// (21 × 21 points) and keeps them in a register, as the search's evaluations would be.
+    fn evaluated_grid(
+        u0: &[f64],
+        half: f64,
+        cost: impl Fn(&[f64]) -> f64,
+    ) -> super::super::problem::EvaluatedNearBest {
+        let mut near = super::super::problem::EvaluatedNearBest::default();
+        for i in 0..21 {
+            for j in 0..21 {
+                let u = [
+                    u0[0] + half * (i as f64 / 10.0 - 1.0),
+                    u0[1] + half * (j as f64 / 10.0 - 1.0),
+                ];
+                near.record(&u, cost(&u));
+            }
+        }
+        near
+    }
+
+    #[test]
+    fn near_best_keeps_what_lies_within_the_margin_of_the_lowest() {
+        let mut near = super::super::problem::EvaluatedNearBest::default();
+        near.record(&[0.5], 10.0);
+        near.record(&[0.6], 11.5);
+        near.record(&[0.7], f64::NAN);
+        // 2.5 nats above the lowest: never kept.
+        near.record(&[0.8], 12.5);
+        assert_eq!(near.at_most(f64::INFINITY).count(), 2);
+        // A lower point leaves the first two behind the margin; the next pruning drops them.
+        near.record(&[0.4], 8.0);
+        for k in 0..200 {
+            near.record(&[0.4 + 1e-4 * k as f64], 8.0 + 0.01 * k as f64);
+        }
+        assert_eq!(near.lowest(), 8.0);
+        assert!(
+            near.at_most(f64::INFINITY)
+                .all(|(c, _)| c <= 8.0 + super::super::problem::NEAR_BEST_MARGIN_NATS)
+        );
+        assert_eq!(near.at_most(8.0).count(), 2);
+    }
+
+    #[test]
+    fn intervals_widen_to_evaluated_points_where_the_likelihood_is_flatter_than_its_curvature() {
+        let free = vec![
+            FreeParam::new(ParamId::A, 0.2, 2.0),
+            FreeParam::new(ParamId::C, 0.3, 0.8),
+        ];
+        let u0 = [0.4, 0.6];
+        let sigma = [0.01, 0.01];
+        let at = ProfileStart {
+            u: &u0,
+            cost_nats: 0.0,
+            sigma_u: &sigma,
+            fisher_sigma_u: &sigma,
+        };
+        // Closed form: on the quadratic bowl of 1σ = 0.01 in each coordinate, a point within
+        // 0.5 nats has |Δu| ≤ 0.01 in each, so the Laplace intervals already hold every one.
+        let bowl = |u: &[f64]| {
+            ((u[0] - u0[0]) / sigma[0]).powi(2) / 2.0 + ((u[1] - u0[1]) / sigma[1]).powi(2) / 2.0
+        };
+        let iv0 = laplace_intervals(&free, &u0, &sigma);
+        let mut iv = iv0.clone();
+        let near = evaluated_grid(&u0, 0.05, bowl);
+        let w = widen_to_near_best(&free, at, &near, &mut iv);
+        for (a, b) in iv.iter().zip(&iv0) {
+            assert!(
+                (a.lo - b.lo).abs() < 1e-12 && (a.hi - b.hi).abs() < 1e-12,
+                "{a:?} {b:?}"
+            );
+        }
+        assert!(w.is_empty(), "{w:?}");
+        // A valley 100× flatter in A than the curvature at the fit says (1σ 0.1 instead of
+        // 0.01): the points within 0.5 nats reach Δu = ±0.05 (the grid's edge) in A, not in C.
+        let valley = |u: &[f64]| {
+            ((u[0] - u0[0]) / 0.1).powi(2) / 2.0 + ((u[1] - u0[1]) / sigma[1]).powi(2) / 2.0
+        };
+        let mut iv = iv0.clone();
+        let near = evaluated_grid(&u0, 0.05, valley);
+        let w = widen_to_near_best(&free, at, &near, &mut iv);
+        assert!(
+            (iv[0].lo - free[0].value(0.35)).abs() < 1e-12,
+            "{:?}",
+            iv[0]
+        );
+        assert!(
+            (iv[0].hi - free[0].value(0.45)).abs() < 1e-12,
+            "{:?}",
+            iv[0]
+        );
+        assert!((iv[1].lo - iv0[1].lo).abs() < 1e-12 && (iv[1].hi - iv0[1].hi).abs() < 1e-12);
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert!(
+            w[0].starts_with("A: points the search evaluated"),
+            "{}",
+            w[0]
+        );
+        // One point 1.125 nats below the bowl at Δu = (0.005, 0), where the bowl is 0.125: a
+        // point 1 nat more likely than the fit, which the search ended short of.
+        let dip = |u: &[f64]| {
+            let here = (u[0] - 0.405).abs() < 1e-9 && (u[1] - u0[1]).abs() < 1e-9;
+            bowl(u) - if here { 1.125 } else { 0.0 }
+        };
+        let mut iv = iv0.clone();
+        let near = evaluated_grid(&u0, 0.05, dip);
+        let w = widen_to_near_best(&free, at, &near, &mut iv);
+        assert!(
+            w.iter().any(|m| m.contains("1.00 nats more likely")),
+            "{w:?}"
+        );
     }
 }
