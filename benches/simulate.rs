@@ -125,6 +125,7 @@ fn cost(c: &mut Criterion) {
         evaluations: Arc::new(AtomicUsize::new(0)),
         failures: std::sync::Arc::new(AtomicUsize::new(0)),
         first_failure: Mutex::new(None),
+        near_best: Mutex::new(Default::default()),
     };
     problem.likelihood = Ok(Arc::new(
         RecordingLikelihood::new(&problem, &x, false).expect("likelihood"),

@@ -210,13 +210,7 @@ fn profile_intervals(
     fit: &job::FitSection,
     pb: &Option<indicatif::ProgressBar>,
 ) -> Result<(Vec<Interval>, Vec<String>)> {
-    let fisher = cf.fisher_sigma_u.as_deref().unwrap_or(&cf.sigma_u);
-    let at = ProfileStart {
-        u: &cf.best_u,
-        cost_nats: cf.cost,
-        sigma_u: &cf.sigma_u,
-        fisher_sigma_u: fisher,
-    };
+    let at = ProfileStart::of(cf);
     let progress = pb.as_ref().map(|bar| {
         // The bar's estimate: two steps a side, each polish its simplex and ten iterations (on
         // the main job's fit they stop at the ripples' depth after 6–12).
@@ -243,6 +237,19 @@ pub struct ProfileStart<'a> {
     pub sigma_u: &'a [f64],
     /// 1σ of each coordinate from the Fisher information `F⁻¹` alone.
     pub fisher_sigma_u: &'a [f64],
+}
+
+impl<'a> ProfileStart<'a> {
+    /// The chosen fit's optimum, cost and spread (the Fisher 1σ, or the sandwich's where the fit
+    /// has none).
+    fn of(cf: &'a CandidateFit) -> Self {
+        ProfileStart {
+            u: &cf.best_u,
+            cost_nats: cf.cost,
+            sigma_u: &cf.sigma_u,
+            fisher_sigma_u: cf.fisher_sigma_u.as_deref().unwrap_or(&cf.sigma_u),
+        }
+    }
 }
 
 /// Profile-likelihood intervals (68.27 %) from a fit (Pawitan 2001, *In All Likelihood*, §2.6;
@@ -381,13 +388,7 @@ fn profile_warnings(fp: &FreeParam, limit: f64, lo: ProfileEnd, hi: ProfileEnd) 
 
 /// [`widen_to_near_best`] on the chosen fit, with the points its problem kept.
 fn near_best_of(cf: &CandidateFit, intervals: &mut [Interval]) -> Vec<String> {
-    let fisher = cf.fisher_sigma_u.as_deref().unwrap_or(&cf.sigma_u);
-    let at = ProfileStart {
-        u: &cf.best_u,
-        cost_nats: cf.cost,
-        sigma_u: &cf.sigma_u,
-        fisher_sigma_u: fisher,
-    };
+    let at = ProfileStart::of(cf);
     let near = cf
         .problem
         .near_best
