@@ -43,7 +43,7 @@ pub use search::{NESTED_GLOBAL_GAIN_NATS, problem_for};
 pub use select::aic;
 pub use uncertainty::{
     ProfileStart, bootstrap_intervals, identifiability_warnings, laplace_intervals,
-    profile_intervals_at,
+    profile_intervals_at, widen_to_near_best,
 };
 
 use crate::Result;

@@ -67,6 +67,12 @@ pub struct Interval {
     pub level: f64,
     /// How it was obtained.
     pub method: IntervalMethod,
+    /// `[lo, hi]` of the method alone, when the interval was then widened to points the fit
+    /// evaluated inside the parameter's profile region (the search's own near-best points,
+    /// [`crate::fit::widen_to_near_best`], or the shoulder's contact-moment ridge); absent when
+    /// it was not widened.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub widened_from: Option<[f64; 2]>,
 }
 
 /// How a confidence interval was obtained.
@@ -464,6 +470,7 @@ mod tests {
                 method: IntervalMethod::Profile {
                     rise_limit_nats: 0.125,
                 },
+                widened_from: None,
             }),
         }
     }

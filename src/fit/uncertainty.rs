@@ -98,6 +98,7 @@ pub fn laplace_intervals(free: &[FreeParam], best_u: &[f64], sigma_u: &[f64]) ->
                     noise_replicates: super::evidence::NOISE_REPLICATES,
                     span_sigma: super::evidence::SANDWICH_SPAN_SIGMA,
                 },
+                widened_from: None,
             }
         })
         .collect()
@@ -334,6 +335,7 @@ fn profile_with(
             method: IntervalMethod::Profile {
                 rise_limit_nats: limit(i),
             },
+            widened_from: None,
         });
         warnings.extend(profile_warnings(fp, limit(i), lo, hi));
     }
@@ -420,21 +422,20 @@ pub fn widen_to_near_best(
     for (i, fp) in free.iter().enumerate() {
         let limit = profile_rise_limit(at.sigma_u[i], at.fisher_sigma_u[i]);
         let (lo0, hi0) = (intervals[i].lo, intervals[i].hi);
-        let (mut lo, mut hi) = (lo0, hi0);
+        let (mut p_lo, mut p_hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for (_, u) in near.at_most(at.cost_nats + limit) {
             let v = fp.value(u[i]);
-            lo = lo.min(v);
-            hi = hi.max(v);
+            p_lo = p_lo.min(v);
+            p_hi = p_hi.max(v);
         }
-        intervals[i].lo = lo;
-        intervals[i].hi = hi;
-        let width = hi0 - lo0;
-        if (lo0 - lo) + (hi - hi0) > NEAR_BEST_WARN_WIDTH * width {
+        widen(&mut intervals[i], p_lo, p_hi);
+        let (lo, hi) = (intervals[i].lo, intervals[i].hi);
+        if (lo0 - lo) + (hi - hi0) > NEAR_BEST_WARN_WIDTH * (hi0 - lo0) {
             warnings.push(format!(
-                "{}: points the search evaluated within {limit:.2} nats of the fit reach \
-                 {lo:.4e} to {hi:.4e}, beyond the curvature's interval [{lo0:.4e}, {hi0:.4e}]: \
-                 the likelihood is flatter there than its curvature at the fit says, and the \
-                 interval spans them",
+                "{}: points the search evaluated within {limit:.2} nats of the fit span \
+                 {p_lo:.4e} to {p_hi:.4e}, beyond the curvature's interval [{lo0:.4e}, \
+                 {hi0:.4e}]: the likelihood is flatter there than its curvature at the fit says, \
+                 so the interval is widened to [{lo:.4e}, {hi:.4e}]",
                 fp.name
             ));
         }
@@ -447,6 +448,19 @@ pub fn widen_to_near_best(
         ));
     }
     warnings
+}
+
+/// Widens `interval` to contain `[lo, hi]`, keeping its ends before the first widening in
+/// [`Interval::widened_from`].
+fn widen(interval: &mut Interval, lo: f64, hi: f64) {
+    if lo >= interval.lo && hi <= interval.hi {
+        return;
+    }
+    interval
+        .widened_from
+        .get_or_insert([interval.lo, interval.hi]);
+    interval.lo = interval.lo.min(lo);
+    interval.hi = interval.hi.max(hi);
 }
 
 /// The growth of an interval (a fraction of its width) above which [`widen_to_near_best`] warns.
@@ -527,8 +541,7 @@ fn widen_along_ridge(
             continue;
         }
         for (i, v) in [(i_k1, k1_r), (i_th, theta_r)] {
-            intervals[i].lo = intervals[i].lo.min(v);
-            intervals[i].hi = intervals[i].hi.max(v);
+            widen(&mut intervals[i], v, v);
         }
         let (lo, hi) = span.unwrap_or((k1, k1));
         span = Some((lo.min(k1_r), hi.max(k1_r)));
@@ -631,6 +644,7 @@ pub fn bootstrap_intervals(
                     noise_sigma_m: references.iter().map(|r| r.sigma).collect(),
                     full_refit: settings.full_refit,
                 },
+                widened_from: None,
             }
         })
         .collect())
@@ -925,6 +939,7 @@ mod tests {
         let span = widen_along_ridge(&free, &u, 0.0, ridge, &mut iv).unwrap();
         assert!((span.0 - 0.015).abs() < 1e-12 && (span.1 - 0.06).abs() < 1e-12);
         assert!(iv[0].lo <= 0.015 + 1e-12 && iv[0].hi >= 0.06 - 1e-12);
+        assert_eq!(iv[0].widened_from, Some([iv0[0].lo, iv0[0].hi]));
         // θ_c spans the ridge's angles: 3.5e-3/(0.1 − 0.015) to 3.5e-3/(0.1 − 0.06).
         assert!(iv[2].lo <= 3.5e-3 / 0.085 + 1e-12 && iv[2].hi >= 3.5e-3 / 0.04 - 1e-12);
         assert_eq!((iv[1].lo, iv[1].hi), (iv0[1].lo, iv0[1].hi));
@@ -1025,6 +1040,7 @@ mod tests {
             "{:?}",
             iv[0]
         );
+        assert_eq!(iv[0].widened_from, Some([iv0[0].lo, iv0[0].hi]));
         assert!((iv[1].lo - iv0[1].lo).abs() < 1e-12 && (iv[1].hi - iv0[1].hi).abs() < 1e-12);
         assert_eq!(w.len(), 1, "{w:?}");
         assert!(

@@ -907,6 +907,7 @@ pub(super) mod tests {
                         method: crate::fit::IntervalMethod::Profile {
                             rise_limit_nats: 0.125,
                         },
+                        widened_from: None,
                     }),
                 ),
                 p("B", false, None),
