@@ -197,6 +197,8 @@ fn signal_label(s: SignalKind) -> &'static str {
 struct IntervalView {
     lo: String,
     hi: String,
+    /// The method's own ends when the interval was widened to points the fit evaluated.
+    widened_from: Option<String>,
     level_pct: String,
     footnote: usize,
 }
@@ -230,6 +232,9 @@ fn parameter_rows(r: &FitResult) -> (Vec<ParamView>, Vec<String>) {
                 IntervalView {
                     lo: num(i.lo, 4),
                     hi: num(i.hi, 4),
+                    widened_from: i
+                        .widened_from
+                        .map(|[lo, hi]| format!("[{}, {}]", num(lo, 4), num(hi, 4))),
                     level_pct: format!("{:.0}", 100.0 * i.level),
                     footnote: methods.iter().position(|m| *m == method).unwrap_or(0) + 1,
                 }
@@ -993,6 +998,28 @@ pub(super) mod tests {
         assert_eq!(s.warnings.len(), 4, "{:?}", s.warnings);
         let html = std::fs::read_to_string(&s.path).unwrap();
         assert!(html.contains("<td>[0.02800, 0.03200] (68 %)<sup>1</sup></td>"));
+        // An interval widened to the fit's own points shows the method's ends under it.
+        let mut widened = result();
+        if let Some(iv) = widened.parameters[0].interval.as_mut() {
+            iv.widened_from = Some([0.029, 0.031]);
+        }
+        let s = write_report(
+            &widened,
+            &ReportPaths {
+                job: dir.join("job.toml"),
+                result: dir.join("unit.result.toml"),
+                recording: rec.clone(),
+                dir: figs.clone(),
+            },
+        )
+        .unwrap();
+        let html = std::fs::read_to_string(&s.path).unwrap();
+        assert!(
+            html.contains(
+                "<sup>1</sup><br><span class=\"note\">widened from [0.02900, 0.03100]</span>"
+            ),
+            "{html}"
+        );
         assert!(html.contains(
             "<sup>1</sup> Interval method: profile likelihood: where the NLL, minimised over the \
              other parameters, has risen 0.125 nats from the fit"
