@@ -998,28 +998,6 @@ pub(super) mod tests {
         assert_eq!(s.warnings.len(), 4, "{:?}", s.warnings);
         let html = std::fs::read_to_string(&s.path).unwrap();
         assert!(html.contains("<td>[0.02800, 0.03200] (68 %)<sup>1</sup></td>"));
-        // An interval widened to the fit's own points shows the method's ends under it.
-        let mut widened = result();
-        if let Some(iv) = widened.parameters[0].interval.as_mut() {
-            iv.widened_from = Some([0.029, 0.031]);
-        }
-        let s = write_report(
-            &widened,
-            &ReportPaths {
-                job: dir.join("job.toml"),
-                result: dir.join("unit.result.toml"),
-                recording: rec.clone(),
-                dir: figs.clone(),
-            },
-        )
-        .unwrap();
-        let html = std::fs::read_to_string(&s.path).unwrap();
-        assert!(
-            html.contains(
-                "<sup>1</sup><br><span class=\"note\">widened from [0.02900, 0.03100]</span>"
-            ),
-            "{html}"
-        );
         assert!(html.contains(
             "<sup>1</sup> Interval method: profile likelihood: where the NLL, minimised over the \
              other parameters, has risen 0.125 nats from the fit"
@@ -1067,6 +1045,32 @@ pub(super) mod tests {
         assert!(html.contains("<p id=\"warning-list\">None.</p>"));
         assert!(html.contains("<p id=\"goodness-of-fit\">Goodness of fit: the recording&#x27;s excess NLL at the fit is 170.96 nats, against 78.37 ± 8.0 for 999 replicates"), "{html}");
         assert!(html.contains("(p = 0.001): the spectra hold more than the model and noise"));
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn a_widened_interval_shows_the_methods_own_ends() {
+        let dir = std::env::temp_dir().join(format!("wiperlab_html_wide_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut r = result();
+        if let Some(iv) = r.parameters[0].interval.as_mut() {
+            iv.widened_from = Some([0.029, 0.031]);
+        }
+        let paths = ReportPaths {
+            job: dir.join("job.toml"),
+            result: dir.join("unit.result.toml"),
+            recording: dir.join("rec.csv"),
+            dir: dir.clone(),
+        };
+        let html = std::fs::read_to_string(write_report(&r, &paths).unwrap().path).unwrap();
+        assert!(
+            html.contains(
+                "<td>[0.02800, 0.03200] (68 %)<sup>1</sup><br><span class=\"note\">widened from \
+                 [0.02900, 0.03100]</span></td>"
+            ),
+            "{html}"
+        );
         std::fs::remove_dir_all(&dir).ok();
     }
 
