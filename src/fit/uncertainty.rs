@@ -433,9 +433,9 @@ pub fn widen_to_near_best(
         if (lo0 - lo) + (hi - hi0) > NEAR_BEST_WARN_WIDTH * (hi0 - lo0) {
             warnings.push(format!(
                 "{}: points the search evaluated within {limit:.2} nats of the fit span \
-                 {p_lo:.4e} to {p_hi:.4e}, beyond the curvature's interval [{lo0:.4e}, \
-                 {hi0:.4e}]: the likelihood is flatter there than its curvature at the fit says, \
-                 so the interval is widened to [{lo:.4e}, {hi:.4e}]",
+                 {p_lo:.4e} to {p_hi:.4e}, beyond the method's own interval [{lo0:.4e}, \
+                 {hi0:.4e}]: the likelihood is flatter there than that interval says, so it is \
+                 widened to [{lo:.4e}, {hi:.4e}]",
                 fp.name
             ));
         }
