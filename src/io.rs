@@ -9,6 +9,10 @@ use std::path::Path;
 /// (`tempfile`'s `persist`, an atomic rename on POSIX file systems). The directory must exist
 /// (see [`create_dir`]): a mistyped output path is an error, not a new directory tree.
 ///
+/// The file gets the mode `File::create` would give it: a new file 0666 without the process's
+/// umask bits (0644 under umask 022), a replaced file the mode it had. A results folder shared
+/// by a lab stays readable to it.
+///
 /// # Errors
 /// [`Error::Io`] naming the directory when it does not exist or is not writable, or `path` when the
 /// file cannot be written or renamed.
@@ -34,8 +38,7 @@ pub fn write_atomic_with(
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)
-        .map_err(|e| Error::io(dir, "cannot create a temporary file in", e))?;
+    let mut tmp = temp_file_for(path, dir)?;
     {
         let mut w = std::io::BufWriter::with_capacity(1 << 16, tmp.as_file_mut());
         write(&mut w)?;
@@ -44,6 +47,31 @@ pub fn write_atomic_with(
     tmp.persist(path)
         .map_err(|e| Error::io(path, "cannot rename into place", e.error))?;
     Ok(())
+}
+
+/// A temporary file in `dir` that will replace `path`, with the permissions `File::create` would
+/// give `path`. On Unix it is opened with mode 0666, which the kernel narrows by the umask as it
+/// does for any new file (no umask is read or changed, so threads cannot race), then given the
+/// existing file's permission bits when `path` is replaced.
+fn temp_file_for(path: &Path, dir: &Path) -> Result<tempfile::NamedTempFile> {
+    let mut builder = tempfile::Builder::new();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt as _;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let tmp = builder
+        .tempfile_in(dir)
+        .map_err(|e| Error::io(dir, "cannot create a temporary file in", e))?;
+    #[cfg(unix)]
+    if let Some(old) = std::fs::metadata(path).ok().filter(|m| m.is_file()) {
+        use std::os::unix::fs::PermissionsExt as _;
+        let mode = old.permissions().mode() & 0o777;
+        tmp.as_file()
+            .set_permissions(std::fs::Permissions::from_mode(mode))
+            .map_err(|e| Error::io(path, "cannot give the new file the old one's mode", e))?;
+    }
+    Ok(tmp)
 }
 
 /// True when `name` can be used as a file or directory name beside another file: not empty, not

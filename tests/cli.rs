@@ -798,3 +798,42 @@ fn sigint_stops_the_fit_and_keeps_the_previous_result() {
     assert!(r["model_evaluations"].as_integer().unwrap() > 0);
     assert!(r["parameters"].as_array().unwrap().len() == 4);
 }
+
+/// Outputs get the mode `File::create` gives (0666 without the umask bits), not the temporary
+/// file's 0600: under umask 022 a new file is 0644, under 077 it is 0600, and a replaced file
+/// keeps the mode it had. The binary runs under `sh -c 'umask …; exec …'` so the test process's
+/// own umask is never changed.
+#[cfg(unix)]
+#[test]
+fn outputs_get_the_mode_a_normal_write_gives() {
+    use std::os::unix::fs::PermissionsExt as _;
+    let dir = TempDir::new("modes");
+    let csv = dir.write(
+        "rec.csv",
+        "t_s,head_x_m,head_y_m\n0,0,0\n0.001,0.001,0\n0.002,0.002,0\n",
+    );
+    let import_under = |umask: &str, out: &Path| {
+        let o = Command::new("sh")
+            .arg("-c")
+            .arg(format!("umask {umask}; exec \"$0\" \"$@\""))
+            .arg(env!("CARGO_BIN_EXE_wiperlab"))
+            .args(["import", s(&csv), "--format", "canonical", "-o", s(out)])
+            .current_dir(root())
+            .output()
+            .expect("cannot start sh");
+        ok(&o, &format!("import under umask {umask}"));
+        std::fs::metadata(out).expect("output").permissions().mode() & 0o777
+    };
+    let out = dir.join("t022.csv");
+    assert_eq!(import_under("022", &out), 0o644);
+    let out = dir.join("t077.csv");
+    assert_eq!(import_under("077", &out), 0o600);
+    let kept = dir.join("kept.csv");
+    std::fs::write(&kept, "old").unwrap();
+    std::fs::set_permissions(&kept, std::fs::Permissions::from_mode(0o640)).unwrap();
+    assert_eq!(
+        import_under("022", &kept),
+        0o640,
+        "a replaced file keeps its mode"
+    );
+}
