@@ -696,13 +696,20 @@ fn fit_cases() -> Vec<Case> {
         case(
             "explore: a freed head mass that may be zero",
             j(&[("C = [0.1, 1.0]", "C = [0.1, 1.0]\nhead_mass = [0.0, 0.2]")]),
-            &["explore", "$D/job.toml", "-o", "$D/out"],
+            &["explore", "$D/job.toml", "--out-dir", "$D/out"],
             &["$D/job.toml:", "'head_mass'", "> 0"],
         ),
         case(
             "explore: no samples",
             j(&[]),
-            &["explore", "$D/job.toml", "--samples", "0", "-o", "$D/out"],
+            &[
+                "explore",
+                "$D/job.toml",
+                "--samples",
+                "0",
+                "--out-dir",
+                "$D/out",
+            ],
             &["--samples 0"],
         ),
         case(

@@ -30,7 +30,7 @@ fn explore_csv(job: &Path, samples: &str, seed: &str, out: &Path) -> (String, St
         samples,
         "--seed",
         seed,
-        "-o",
+        "--out-dir",
         out.to_str().unwrap(),
         "--quiet",
     ]);
@@ -231,7 +231,7 @@ fn assert_refused_at(dir: &Path, params: &str, key: &str, names: &str, samples: 
         path.to_str().unwrap(),
         "--samples",
         samples,
-        "-o",
+        "--out-dir",
         out.to_str().unwrap(),
     ]);
     let err = String::from_utf8_lossy(&o.stderr);
@@ -281,7 +281,7 @@ fn explore_refuses_a_bad_job_with_exit_2_and_the_line() {
             good.to_str().unwrap(),
             "--samples",
             n,
-            "-o",
+            "--out-dir",
             out.to_str().unwrap(),
         ]);
         let err = String::from_utf8_lossy(&o.stderr);

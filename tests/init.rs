@@ -59,6 +59,14 @@ fn without_settings_the_template_marks_what_a_fit_needs() {
     let o = wiperlab(&s.0, &["init", "rec_xypts.csv"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let job = s.0.join("rec_xypts.job.toml");
+    // The count names the settings marked, not the header that explains the marks: MISSING the
+    // blade, the frame rate and the scale; CHECK the roles guessed from the names, t0_s and the
+    // default bands (no frame rate).
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("(3 MISSING, 3 CHECK)"),
+        "{}",
+        text(&o)
+    );
     let t = std::fs::read_to_string(&job).expect("the template");
     // Detected format and the file's points.
     assert!(t.contains("format = \"dltdv\""), "{t}");
@@ -112,6 +120,12 @@ fn with_the_sample_settings_the_filled_in_template_loads_like_the_main_job() {
     );
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let job = s.0.join("jobs/sample.toml");
+    // Only the blade is MISSING; t0_s and the scaled bands are CHECK.
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("(1 MISSING, 2 CHECK)"),
+        "{}",
+        text(&o)
+    );
     let t = std::fs::read_to_string(&job).expect("the template");
     assert!(!t.contains("CHECK: guessed"), "roles were given: {t}");
     // The job lives elsewhere than the recording: the recording's path is absolute.

@@ -11,18 +11,23 @@ use std::path::PathBuf;
 #[derive(Debug, Subcommand)]
 pub enum CampaignCommand {
     /// List the campaign's recordings, their overrides and condition labels.
-    List { campaign: PathBuf },
+    List {
+        /// The campaign TOML (docs/campaigns.md).
+        campaign: PathBuf,
+    },
     /// Fit every recording on this machine, in parallel; skips recordings whose result is complete
     /// for unchanged inputs (rerun to continue after an interruption); a failed recording does not
     /// stop the others (the exit code is then 1).
     Run {
+        /// The campaign TOML (docs/campaigns.md).
         campaign: PathBuf,
-        /// Recordings fitted at once (each fit also uses the thread pool). Default: 1.
+        /// Recordings fitted at once (each fit also uses the thread pool).
         #[arg(long, default_value_t = 1)]
         jobs: usize,
     },
     /// Fit one recording (what each Slurm array task runs).
     Task {
+        /// The campaign TOML (docs/campaigns.md).
         campaign: PathBuf,
         /// Position of the recording in `campaign list` (0-based; Slurm's SLURM_ARRAY_TASK_ID).
         #[arg(long)]
@@ -30,6 +35,7 @@ pub enum CampaignCommand {
     },
     /// Write the Slurm job-array script (one task per recording) and, with --submit, submit it.
     Slurm {
+        /// The campaign TOML (docs/campaigns.md).
         campaign: PathBuf,
         #[command(flatten)]
         settings: SlurmArgs,
@@ -38,25 +44,33 @@ pub enum CampaignCommand {
         submit: bool,
     },
     /// State of each recording: done, failed, or the array task's queue state.
-    Status { campaign: PathBuf },
+    Status {
+        /// The campaign TOML (docs/campaigns.md).
+        campaign: PathBuf,
+    },
     /// Merge every result into <campaign dir>/<name>/campaign.csv and draw the campaign report
     /// page <campaign dir>/<name>/report/index.html.
-    Collect { campaign: PathBuf },
+    Collect {
+        /// The campaign TOML (docs/campaigns.md).
+        campaign: PathBuf,
+    },
 }
 
 /// Slurm settings from the command line (each overrides the campaign file's `[slurm]`).
 #[derive(Debug, Args)]
 pub struct SlurmArgs {
-    /// Partition (`sbatch --partition`).
+    /// Partition (`sbatch --partition`; default: the campaign file's, else the cluster's default).
     #[arg(long)]
     partition: Option<String>,
-    /// Time limit per task (`sbatch --time`), e.g. 00:30:00.
+    /// Time limit per task as HH:MM:SS (`sbatch --time`), e.g. 00:30:00 (default: the campaign
+    /// file's, else the partition's limit).
     #[arg(long)]
     time: Option<String>,
-    /// CPUs per task, also the fit's thread count. Default 2.
+    /// CPUs per task, also the fit's thread count (default: the campaign file's, else 2).
     #[arg(long)]
     cpus_per_task: Option<u32>,
-    /// Largest number of tasks running at once (`--array=0-N%K`).
+    /// Largest number of tasks running at once (`--array=0-N%K`; default: the campaign file's,
+    /// else no limit).
     #[arg(long)]
     max_parallel: Option<u32>,
 }

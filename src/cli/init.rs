@@ -43,8 +43,7 @@ pub(super) fn run(
         import: &spec,
         summary: &summary,
     })?;
-    let missing = text.lines().filter(|l| l.contains("MISSING")).count();
-    let check = text.lines().filter(|l| l.contains("CHECK")).count();
+    let (missing, check) = crate::fit::template::count_marks(&text);
     if stdout {
         // `-o -`: the job on stdout, the count on stderr.
         print!("{text}");

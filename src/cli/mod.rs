@@ -7,7 +7,6 @@
 
 use crate::Result;
 use crate::simulate::Method;
-use crate::simulate::blade::ModelKind;
 use clap::{Parser, Subcommand};
 pub use error::CliError;
 use std::path::{Path, PathBuf};
@@ -41,12 +40,12 @@ mod modes;
 mod simulate;
 mod spectrum;
 
-pub use simulate::{BAUMGARTE_OMEGA_PER_S, StickChoice};
+pub use simulate::{BAUMGARTE_OMEGA_PER_S, SimulatedModel, StickChoice};
 pub use spectrum::BandArg;
 
 /// wiperlab: a wiper blade's tracked motion beside a stick–slip model of it.
 #[derive(Parser, Debug)]
-#[command(name = "wiperlab", version, about)]
+#[command(name = "wiperlab", version, about, after_help = EXIT_CODES)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -57,22 +56,27 @@ pub struct Cli {
     pub quiet: bool,
 }
 
+/// The exit codes, listed under the top-level `--help`.
+const EXIT_CODES: &str = "Exit codes: 0 done, 1 computation failed (a simulation or fit that \
+    cannot go on), 2 bad input (a file, a flag or a setting; nothing is written), 130 interrupted \
+    (Ctrl-C or SIGTERM; a fit writes its best result so far to <job>.interrupted.result.toml).";
+
 /// Welch settings of `spectrum`, named and defaulted as `scipy.signal.welch`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct WelchArgs {
     /// Window of each segment.
     #[arg(long, value_enum, default_value_t = crate::spectrum::Window::Hann)]
     pub window: crate::spectrum::Window,
-    /// Samples shared by consecutive segments (default nperseg/2).
+    /// Samples shared by consecutive segments (default: nperseg/2).
     #[arg(long)]
     pub noverlap: Option<usize>,
-    /// FFT length, ≥ nperseg (default nperseg; longer zero-pads).
+    /// FFT length in samples, ≥ nperseg (default: nperseg; longer zero-pads).
     #[arg(long)]
     pub nfft: Option<usize>,
     /// What is subtracted from each segment.
     #[arg(long, value_enum, default_value_t = crate::spectrum::Detrend::Constant)]
     pub detrend: crate::spectrum::Detrend,
-    /// density (m²/Hz) or spectrum (m²).
+    /// density (PSD, m²/Hz) or spectrum (power, m²).
     #[arg(long, value_enum, default_value_t = crate::spectrum::Scaling::Density)]
     pub scaling: crate::spectrum::Scaling,
     /// How the segments' periodograms are combined (median with SciPy's bias correction).
@@ -83,20 +87,26 @@ pub struct WelchArgs {
 /// Import options shared by `import` and `spectrum`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct ImportArgs {
-    /// Sidecar TOML with the import settings (format, fps_hz, m_per_px, origin_px, points ...).
+    /// Sidecar TOML with the import settings (format, fps_hz, m_per_px, origin_px, points ...);
+    /// flags override it (default: none).
     #[arg(long)]
     pub spec: Option<PathBuf>,
     /// File layout (default: detect from the content).
     #[arg(long, value_parser = ["dltdv", "dltdv-sparse", "tracker", "kinovea-csv", "kinovea-txt",
         "kinovea-kinematics", "deeplabcut", "sleap", "trackmate", "generic", "canonical"])]
     pub format: Option<String>,
-    /// Frame rate, Hz (required for DLTdv).
+    /// Frame rate, Hz: required where the file has frame numbers only (DLTdv, DeepLabCut, SLEAP,
+    /// TrackMate without a time unit, a generic `frame` column); elsewhere a check of the time
+    /// column (default: none).
     #[arg(long)]
     pub fps: Option<f64>,
-    /// Image scale, metres per pixel (DLTdv).
+    /// Image scale, metres per pixel: required where the file is in pixels (DLTdv, DeepLabCut,
+    /// SLEAP, TrackMate or generic tables in pixels) unless --scale-points-px gives it; not for
+    /// Tracker, which is calibrated (default: none).
     #[arg(long)]
     pub m_per_px: Option<f64>,
-    /// Pixel coordinates X,Y of the physical origin (DLTdv).
+    /// Coordinates X,Y of the physical origin, subtracted before scaling: pixels for pixel files,
+    /// the file's unit otherwise; must be 0,0 for Tracker (default: 0,0).
     // No `num_args = 2`: clap checks num_args before splitting on the delimiter, so it would reject
     // the documented `--origin-px 200,300`; the count is checked in `import_spec`.
     #[arg(long, value_delimiter = ',')]
@@ -105,37 +115,44 @@ pub struct ImportArgs {
     /// --scale-distance-m).
     #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
     pub scale_points_px: Option<Vec<f64>>,
-    /// Distance in metres between the --scale-points-px.
+    /// Distance in metres between the --scale-points-px (default: none).
     #[arg(long)]
     pub scale_distance_m: Option<f64>,
-    /// Metres per calibrated unit of the file (cm: 0.01; Tracker, Kinovea, TrackMate, generic).
+    /// Metres per calibrated unit of the file (cm: 0.01; Tracker, Kinovea, TrackMate, generic;
+    /// default: the unit the file states, Tracker 1).
     #[arg(long)]
     pub units_to_m: Option<f64>,
-    /// Whether the file's y axis points down (default: the format's convention).
+    /// Whether the file's y axis points down (default: the format's convention: true for DLTdv,
+    /// DeepLabCut, SLEAP and TrackMate image rows, false otherwise).
     #[arg(long)]
     pub y_down: Option<bool>,
-    /// Rotate so x runs along the sweep: sweep direction in degrees from +x (counter-clockwise).
+    /// Rotate so x runs along the sweep: sweep direction in degrees from +x (counter-clockwise;
+    /// default: no rotation).
     #[arg(long, allow_negative_numbers = true)]
     pub sweep_angle_deg: Option<f64>,
-    /// Rotate so x runs along the head's own principal axis of motion (angle reported).
+    /// Rotate so x runs along the head's own principal axis of motion (angle reported; default:
+    /// off).
     #[arg(long)]
     pub sweep_from_head: bool,
-    /// Seconds per unit of the file's time column where the file does not say (ms: 0.001).
+    /// Seconds per unit of the file's time column where the file does not say (ms: 0.001;
+    /// default: the unit in the header, else s for generic tables).
     #[arg(long)]
     pub time_to_s: Option<f64>,
-    /// DeepLabCut/SLEAP: likelihood below which a point becomes a gap (default 0.6).
+    /// DeepLabCut/SLEAP: likelihood (0 to 1) below which a point becomes a gap (default: 0.6,
+    /// DeepLabCut's pcutoff; 0 keeps every point).
     #[arg(long)]
     pub min_likelihood: Option<f64>,
-    /// DLTdv: 1-based camera to read; DLTdv sparse: --n-cameras gives how many there are.
+    /// DLTdv: 1-based camera to read; DLTdv sparse: --n-cameras gives how many there are
+    /// (default: 1).
     #[arg(long)]
     pub camera: Option<usize>,
-    /// DLTdv sparse: number of cameras in the file (default 1).
+    /// DLTdv sparse: number of cameras in the file (default: 1).
     #[arg(long)]
     pub n_cameras: Option<usize>,
-    /// Name of the tracked point that is the head.
+    /// Name of the tracked point that is the head (default: none, the file's names are kept).
     #[arg(long)]
     pub head: Option<String>,
-    /// Name of the tracked point that is the lip tip.
+    /// Name of the tracked point that is the lip tip (default: none, the file's names are kept).
     #[arg(long)]
     pub tip: Option<String>,
 }
@@ -144,6 +161,8 @@ pub struct ImportArgs {
 pub enum Command {
     /// Import a tracking-tool export into the canonical trace CSV (t_s, head_x_m, head_y_m, tip_x_m, tip_y_m, ...).
     Import {
+        /// The tracking export (DLTdv, Tracker, Kinovea, DeepLabCut, SLEAP, TrackMate, a generic
+        /// table or a canonical trace CSV).
         file: PathBuf,
         #[command(flatten)]
         import: ImportArgs,
@@ -176,10 +195,11 @@ pub enum Command {
     },
     /// Welch PSD, peaks and spectrogram of every tracked coordinate (and tip − head).
     Spectrum {
+        /// The tracking export or trace CSV to analyse.
         file: PathBuf,
         #[command(flatten)]
         import: ImportArgs,
-        /// Welch segment length (samples); default: the largest power of two ≤ len/4. SciPy's
+        /// Welch segment length in samples; default: the largest power of two ≤ len/4. SciPy's
         /// default is 256 whatever the record; a long high-speed recording needs longer segments
         /// to resolve its low component (2.4 Hz bins at 10,000 frames/s need 4096).
         #[arg(long)]
@@ -199,7 +219,7 @@ pub enum Command {
         /// stem>/ beside the input file, wherever the command runs).
         #[arg(long)]
         out_dir: Option<PathBuf>,
-        /// Longest gap (samples) filled by linear interpolation; longer gaps split the record
+        /// Longest gap in samples filled by linear interpolation; longer gaps split the record
         /// into separate Welch runs.
         #[arg(long, default_value_t = crate::import::FILL_MAX_SAMPLES)]
         max_fill: usize,
@@ -213,11 +233,14 @@ pub enum Command {
         #[arg(long, value_delimiter = ',')]
         window: Option<Vec<f64>>,
         /// Output sampling rate, Hz.
-        #[arg(long, default_value_t = 10000.0)]
+        #[arg(long, default_value = "10000")]
         fps: f64,
-        #[arg(long, default_value_t = 1e-10)]
+        /// Relative error tolerance of each integrator step (dimensionless).
+        #[arg(long, default_value = "1e-10")]
         rtol: f64,
-        #[arg(long, default_value_t = 1e-12)]
+        /// Absolute error tolerance of each integrator step, in the state's units (the link
+        /// angles θ, φ in rad and their rates in rad/s).
+        #[arg(long, default_value = "1e-12")]
         atol: f64,
         /// Integrator of the smooth phases: dop853 (the default: at rtol 1e-10 it needs 0.69× the
         /// right-hand-side evaluations of dopri5 and half its model solves, docs/validation.md) or
@@ -227,10 +250,10 @@ pub enum Command {
         /// Stick-phase form: reduced (drift-free) or baumgarte.
         #[arg(long, value_enum, default_value_t = StickChoice::Reduced)]
         stick: StickChoice,
-        /// Model of the hierarchy: blade2dof (full head/neck/lip) or head1dof (neck and lip locked;
-        /// necklip needs a recorded head and runs only inside a fit).
-        #[arg(long, value_enum, default_value_t = ModelKind::Blade2dof)]
-        model: ModelKind,
+        /// Model of the hierarchy: blade2dof (full head/neck/lip) or head1dof (neck and lip
+        /// locked). The necklip model needs a recorded head and runs only inside a fit.
+        #[arg(long, value_enum, default_value_t = SimulatedModel::Blade2dof)]
+        model: SimulatedModel,
         /// Output directory (default: reports/simulate/<params stem>/ beside the parameter file,
         /// wherever the command runs).
         #[arg(long)]
@@ -253,6 +276,7 @@ pub enum Command {
     /// <name>.result.toml beside the job and the figures in <reports_dir>/<name>/ (the job's
     /// reports_dir, default reports/ beside the job; wherever the command runs).
     Fit {
+        /// The fit-job TOML (`wiperlab init` writes one).
         job: PathBuf,
         /// Print the result as one JSON object on stdout.
         #[arg(long)]
@@ -268,6 +292,7 @@ pub enum Command {
     /// the closest achievable pair and the constraint that keeps it from the targets
     /// (constraint.txt) and the reachability map (reachability.svg).
     Explore {
+        /// The fit-job TOML whose [fit.parameters] are sampled.
         job: PathBuf,
         /// Number of samples (1 to 65536).
         #[arg(long, default_value_t = crate::fit::explore::DEFAULT_SAMPLES)]
@@ -278,12 +303,13 @@ pub enum Command {
         /// Output directory (default: <reports_dir>/explore/<job name>/, the job's reports_dir,
         /// default reports/ beside the job; wherever the command runs); an exploration already
         /// there is replaced, with a note on stderr.
-        #[arg(short = 'o', long = "out-dir")]
+        #[arg(long)]
         out_dir: Option<PathBuf>,
     },
     /// Write the report page <reports_dir>/<name>/index.html from <name>.result.toml beside the
     /// job (with --refit: fit first; without a result and without --refit: exit 2).
     Report {
+        /// The fit-job TOML whose result the page shows.
         job: PathBuf,
         /// Run the fit again even if the result file exists.
         #[arg(long)]
@@ -450,5 +476,74 @@ pub fn run(cli: Cli) -> Result<()> {
             refit,
             out_dir,
         } => fit::report(&job, refit, cli.quiet, out_dir),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    /// Every command, subcommands included, with its path (`wiperlab campaign run`).
+    fn all_commands() -> Vec<(String, clap::Command)> {
+        fn walk(path: String, c: clap::Command, out: &mut Vec<(String, clap::Command)>) {
+            for sub in c.get_subcommands() {
+                walk(format!("{path} {}", sub.get_name()), sub.clone(), out);
+            }
+            out.push((path, c));
+        }
+        let mut out = Vec::new();
+        walk("wiperlab".into(), Cli::command(), &mut out);
+        out
+    }
+
+    /// clap's own consistency checks (conflicting names, defaults outside possible values ...).
+    #[test]
+    fn the_command_line_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    /// Every argument says what it is; a default shows as people write it (`1e-10`, not
+    /// `0.0000000001`); `-o` is only ever `--output`, a file.
+    #[test]
+    fn every_argument_has_help_and_readable_defaults() {
+        for (path, c) in all_commands() {
+            for a in c.get_arguments() {
+                let id = a.get_id().as_str();
+                if matches!(id, "help" | "version") {
+                    continue;
+                }
+                assert!(a.get_help().is_some(), "{path} {id}: no help text");
+                for d in a.get_default_values() {
+                    let d = d.to_string_lossy();
+                    assert!(!d.contains("0.0000"), "{path} {id}: default written {d}");
+                }
+                if a.get_short() == Some('o') {
+                    assert_eq!(id, "output", "{path}: -o names {id}, not a file");
+                }
+            }
+        }
+    }
+
+    /// The exit codes are in the top-level help.
+    #[test]
+    fn the_help_lists_the_exit_codes() {
+        let help = Cli::command().render_long_help().to_string();
+        for code in [
+            "0 done",
+            "1 computation failed",
+            "2 bad input",
+            "130 interrupted",
+        ] {
+            assert!(help.contains(code), "{code} missing from\n{help}");
+        }
+    }
+
+    /// `simulate --model` offers only models that run on their own.
+    #[test]
+    fn simulate_offers_no_necklip() {
+        let e = Cli::try_parse_from(["wiperlab", "simulate", "b.toml", "--model", "necklip"])
+            .expect_err("necklip is not simulated alone");
+        assert_eq!(e.kind(), clap::error::ErrorKind::InvalidValue, "{e}");
     }
 }

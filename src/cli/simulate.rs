@@ -19,6 +19,26 @@ named_enum! {
     }
 }
 
+named_enum! {
+    /// The models `simulate` runs on their own ([`ModelKind`] without the necklip model, which
+    /// needs a recorded head and runs only inside a fit).
+    pub enum SimulatedModel: "model" {
+        /// [`ModelKind::Blade2dof`].
+        Blade2dof => "blade2dof",
+        /// [`ModelKind::Head1dof`].
+        Head1dof => "head1dof",
+    }
+}
+
+impl From<SimulatedModel> for ModelKind {
+    fn from(m: SimulatedModel) -> ModelKind {
+        match m {
+            SimulatedModel::Blade2dof => ModelKind::Blade2dof,
+            SimulatedModel::Head1dof => ModelKind::Head1dof,
+        }
+    }
+}
+
 /// Baumgarte's ω_B for `--stick baumgarte`, 1/s: fast against the blade's highest mode
 /// (≈ 1.2 kHz in stick, 2π·1.2e3 ≈ 7.5e3 /s), so the constraint error decays within a period.
 pub const BAUMGARTE_OMEGA_PER_S: f64 = 1e4;
@@ -32,7 +52,7 @@ pub(super) struct SimulateArgs {
     pub atol: f64,
     pub method: Method,
     pub stick: StickChoice,
-    pub model: ModelKind,
+    pub model: SimulatedModel,
     pub out_dir: Option<PathBuf>,
 }
 
@@ -81,8 +101,8 @@ pub(super) fn run(a: SimulateArgs) -> Result<()> {
         ..SolverOptions::default()
     };
     let t = std::time::Instant::now();
-    let sim = simulate_model(a.model, &p, win, &times, &opts, form)?;
-    let forces = contact_forces(a.model, &p, form, &sim)?;
+    let sim = simulate_model(a.model.into(), &p, win, &times, &opts, form)?;
+    let forces = contact_forces(a.model.into(), &p, form, &sim)?;
     let wall = t.elapsed().as_secs_f64();
     let dir = a
         .out_dir

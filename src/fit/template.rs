@@ -163,6 +163,19 @@ pub fn job_template(input: &TemplateInput) -> Result<String> {
         .map_err(|e| super::FitError::Template(e).into())
 }
 
+/// How many settings a template still marks: `(missing, check)`, counting the comment lines
+/// that begin with `# MISSING` or `# CHECK` (one per setting; the header that explains the
+/// marks is not counted).
+pub fn count_marks(template: &str) -> (usize, usize) {
+    let starting = |mark: &str| {
+        template
+            .lines()
+            .filter(|l| l.trim_start().starts_with(mark))
+            .count()
+    };
+    (starting("# MISSING"), starting("# CHECK"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -197,5 +210,13 @@ mod tests {
         assert_eq!(bands_for(Some(1000.0), 300)[0].nperseg, 128);
         assert!(bands_for(None, 1000).is_empty());
         assert!(bands_for(Some(100.0), 1000).is_empty(), "Nyquist 50 Hz");
+    }
+
+    /// The header that explains the marks is not a mark; indented marks count.
+    #[test]
+    fn marks_are_counted_per_setting() {
+        let t = "# Lines marked MISSING must be filled in;\n# lines marked CHECK are guesses.\n\
+                 # MISSING: the blade\n  # CHECK: t0_s\n# CHECK: bands\nx = 1 # MISSING in a value\n";
+        assert_eq!(count_marks(t), (1, 2));
     }
 }
