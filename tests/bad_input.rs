@@ -490,12 +490,12 @@ fn spectrum_cases() -> Vec<Case> {
         s(
             "spectrum: inverted band",
             &["--band", "300:30"],
-            &["--band 300:30"],
+            &["--band 300:30", "swapped", "did you mean --band 30:300?"],
         ),
         s(
             "spectrum: band above Nyquist",
             &["--band", "100:6000"],
-            &["Nyquist"],
+            &["Nyquist", "<= 5000 Hz", "10000 Hz sample rate"],
         ),
         s(
             "spectrum: negative band",

@@ -729,6 +729,11 @@ fn import_describe_and_convert() {
     let mut args = SAMPLE_IMPORT.to_vec();
     args.extend(["pt2", "--describe"]);
     let desc = ok(&wiperlab(&args), "import --describe");
+    // Times to the digits that mean something: frames at 1/10000 s, the last at 1.8868 s.
+    assert!(
+        desc.contains("t = 0 … 1.8868 s, dt median 1e-4 s (10000 fps)"),
+        "{desc}"
+    );
     assert!(desc.contains(&format!("{n_frames} frames")), "{desc}");
     assert!(
         desc.contains(&format!(

@@ -40,7 +40,7 @@ fn describe_prints_format_points_time_units_gaps() {
     let (out, err) = text(&o);
     assert_eq!(o.status.code(), Some(0), "{out}{err}");
     assert!(out.starts_with("sleap: 3 frames"), "{out}");
-    assert!(out.contains("(50.000000 fps)"), "{out}");
+    assert!(out.contains("dt median 0.02 s (50 fps)"), "{out}");
     assert!(
         out.contains("m/head: 2 tracked, 1 NaN (33.33 %) in 1 gaps, longest 1 samples"),
         "{out}"
@@ -283,6 +283,13 @@ fn spectrum_welch_options_match_the_closed_form() {
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // The console names the quantity and its unit (power, m², with --scaling spectrum).
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let line = stdout
+        .lines()
+        .find(|l| l.trim_start().starts_with("tip_x band"))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    assert!(line.contains(", power ") && line.ends_with(" m²"), "{line}");
     let csv = std::fs::read_to_string(out.join("psd.csv")).unwrap();
     let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
     let col = header
@@ -332,8 +339,16 @@ fn spectrum_refuses_impossible_settings_naming_the_flag() {
     let cases: [(&[&str], &str); 4] = [
         (&["--nperseg", "4"], "--nperseg 4"),
         (&["--nperseg", "10000000"], "--nperseg 10000000"),
-        (&["--band", "300:30"], "--band 300:30"),
-        (&["--band", "100:6000"], "Nyquist"),
+        (
+            &["--band", "300:30"],
+            "--band 300:30: LO and HI are swapped: did you mean --band 30:300?",
+        ),
+        // The sample's 10,000 frames/s (data/reversal/README.md): Nyquist 5000 Hz.
+        (
+            &["--band", "100:6000"],
+            "--band 100:6000: expected 0 <= LO < HI <= 5000 Hz (the Nyquist frequency, half the \
+             10000 Hz sample rate)",
+        ),
     ];
     for (extra, key) in cases {
         let mut args = base.to_vec();

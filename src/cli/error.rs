@@ -1,6 +1,7 @@
 //! What can go wrong with the command line itself: [`CliError`], naming the flag as typed.
 
 use crate::model::modes::ModesError;
+use crate::names::significant;
 use crate::spectrum::SpectrumError;
 use std::path::PathBuf;
 
@@ -17,13 +18,17 @@ pub enum CliError {
         got: usize,
     },
     /// `--window T0,T1` not ordered or not finite.
-    #[error("--window {t0_s},{t1_s}: expected T0 < T1, both finite, in s")]
+    #[error(
+        "--window {},{}: expected T0 < T1, both finite, in s",
+        significant(*t0_s, 6),
+        significant(*t1_s, 6)
+    )]
     Window { t0_s: f64, t1_s: f64 },
     /// A rate that must be positive and finite.
-    #[error("{flag} must be > 0 (got {value})")]
+    #[error("{flag} must be > 0 (got {})", significant(*value, 6))]
     NotPositive { flag: &'static str, value: f64 },
     /// A tolerance that must be positive and finite.
-    #[error("{flag} {value}: expected a positive, finite tolerance")]
+    #[error("{flag} {}: expected a positive, finite tolerance", significant(*value, 6))]
     Tolerance { flag: &'static str, value: f64 },
     /// Welch settings given by `--noverlap`/`--nfft` that do not fit the segment.
     #[error("Welch settings (--noverlap, --nfft): {0}")]
@@ -35,12 +40,17 @@ pub enum CliError {
     /// `--nperseg` outside 8 ..= the record's samples.
     #[error("--nperseg {nperseg}: expected 8 <= nperseg <= the record's {samples} samples")]
     Nperseg { nperseg: usize, samples: usize },
-    /// A `--band` (as typed) outside [0, Nyquist] or not ordered.
+    /// A `--band` (as typed) outside [0, Nyquist] or empty; `fs_hz` is the record's sample rate.
     #[error(
-        "--band {text}: expected 0 <= LO < HI <= {} Hz (the Nyquist frequency at {fs_hz} Hz)",
-        fs_hz / 2.0
+        "--band {text}: expected 0 <= LO < HI <= {} Hz (the Nyquist frequency, half the {} Hz \
+         sample rate)",
+        significant(fs_hz / 2.0, 6),
+        significant(*fs_hz, 6)
     )]
     Band { text: String, fs_hz: f64 },
+    /// A `--band HI:LO` (as typed) whose ends are swapped; `swapped` is it the right way round.
+    #[error("--band {text}: LO and HI are swapped: did you mean --band {swapped}?")]
+    BandSwapped { text: String, swapped: String },
     /// `init -o` naming an existing file.
     #[error("-o {}: the file exists; init never overwrites a job (choose another -o)", path.display())]
     OutputExists { path: PathBuf },

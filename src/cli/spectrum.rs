@@ -2,6 +2,7 @@
 
 use super::{CliError, ImportArgs};
 use crate::Result;
+use crate::names::{quantity, significant};
 use crate::spectrum::features::{BandSpec, features};
 use crate::spectrum::signal::SignalExpr;
 use std::path::{Path, PathBuf};
@@ -84,17 +85,17 @@ pub(super) fn run(a: SpectrumArgs) -> Result<()> {
         .unwrap_or_else(|| super::default_report_dir(&a.file, "spectrum"));
     crate::io::create_dir(&dir)?;
     println!(
-        "{}: {} samples at {:.6} Hz (median frame rate), Welch nperseg {nperseg} ({} window, noverlap {}, nfft {}, detrend {}, {} scaling, {} average), bin {:.4} Hz",
+        "{}: {} samples at {} Hz (median frame rate), Welch nperseg {nperseg} ({} window, noverlap {}, nfft {}, detrend {}, {} scaling, {} average), bin {}",
         a.file.display(),
         n,
-        fs,
+        significant(fs, 6),
         cfg.window.scipy_name(),
         cfg.noverlap,
         cfg.nfft,
         cfg.detrend,
         cfg.scaling,
         cfg.average,
-        fs / cfg.nfft as f64
+        quantity(fs / cfg.nfft as f64, "Hz")
     );
     print_grid(&trace, &uniform, n, a.max_fill);
     let mut computed = Vec::new();
@@ -106,7 +107,7 @@ pub(super) fn run(a: SpectrumArgs) -> Result<()> {
                 continue;
             }
         };
-        print_peaks(name, x, &f);
+        print_peaks(name, x, &f, cfg.scaling);
         let sg = crate::spectrum::stft::overview_spectrogram(x, fs)?;
         crate::report::figures::spectrum_figures(&dir, name, &f, sg.as_ref())?;
         computed.push((name.to_string(), f));
@@ -161,6 +162,14 @@ fn check_settings(
     let nyquist = fs_hz / 2.0;
     for b in bands {
         let [lo, hi] = b.range_hz;
+        if lo > hi {
+            let swapped = match b.text.split_once(':') {
+                Some((l, h)) => format!("{h}:{l}"),
+                None => format!("{hi}:{lo}"),
+            };
+            let text = b.text.clone();
+            return Err(CliError::BandSwapped { text, swapped }.into());
+        }
         if !(lo >= 0.0 && lo < hi && hi <= nyquist) {
             return Err(CliError::Band {
                 text: b.text.clone(),
@@ -182,10 +191,13 @@ fn print_grid(
     let summary = crate::import::describe(trace);
     if uniform.resampled {
         println!(
-            "  resampled: {} frame times (step {} … {} s) → {n} uniform samples at \
-             {:.6} Hz by linear interpolation; gaps ≤ {max_fill} samples filled, longer \
+            "  resampled: {} frame times (step {} … {}) → {n} uniform samples at \
+             {} Hz by linear interpolation; gaps ≤ {max_fill} samples filled, longer \
              ones split the record",
-            summary.n_frames, summary.dt_min_s, summary.dt_max_s, uniform.fs_hz
+            summary.n_frames,
+            significant(summary.dt_min_s, 4),
+            quantity(summary.dt_max_s, "s"),
+            significant(uniform.fs_hz, 6)
         );
     } else {
         println!(
@@ -196,18 +208,28 @@ fn print_grid(
     }
 }
 
-/// One signal's missing samples and its peak per band.
-fn print_peaks(name: &str, x: &[f64], f: &crate::spectrum::features::Features) {
+/// One signal's missing samples and its peak per band: frequency to 5 significant digits (a
+/// fraction of a bin at the default segment lengths), period, and the PSD (or power) with its unit.
+fn print_peaks(
+    name: &str,
+    x: &[f64],
+    f: &crate::spectrum::features::Features,
+    scaling: crate::spectrum::Scaling,
+) {
+    let (what, unit) = match scaling {
+        crate::spectrum::Scaling::Density => ("PSD", "m²/Hz"),
+        crate::spectrum::Scaling::Spectrum => ("power", "m²"),
+    };
     let nan = x.iter().filter(|v| v.is_nan()).count();
     println!("  {name:>12}: {nan} missing samples, {} filled", f.filled);
     for b in &f.bands {
         match b.peak {
             Some(p) => println!(
-                "  {name:>12} band {:>10}: peak {:.6} Hz (period {:.6} s), PSD {:.4e}",
+                "  {name:>12} band {:>10}: peak {} Hz (period {}), {what} {}",
                 b.spec.name,
-                p.freq_hz,
-                1.0 / p.freq_hz,
-                p.level
+                significant(p.freq_hz, 5),
+                quantity(1.0 / p.freq_hz, "s"),
+                quantity(p.level, unit)
             ),
             None => println!("  {name:>12} band {:>10}: no peak", b.spec.name),
         }

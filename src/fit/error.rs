@@ -12,7 +12,9 @@ pub enum FitError {
     NoFrameRate { median_rate_hz: f64 },
     /// Frame times that are not uniform at `fs_hz`: one step is `step_s`.
     #[error(
-        "the recording's frame times are not uniform at {fs_hz} Hz (step {step_s} s found); resample it first"
+        "the recording's frame times are not uniform at {} Hz (step {} found); resample it first",
+        crate::names::significant(*fs_hz, 6),
+        crate::names::quantity(*step_s, "s")
     )]
     NonUniformFrames { fs_hz: f64, step_s: f64 },
     /// The neck/lip model without the recording's head and tip tracks; `reason` is why the

@@ -117,10 +117,12 @@ fn check_bands(job: &LoadedJob, path: &std::path::Path, n: usize, fs_hz: f64) ->
                 &at,
                 format!(
                     "[spectrum] band '{}': range_hz upper edge {} Hz is above the Nyquist frequency \
-                     {nyquist} Hz of the recording {} ({fs_hz} frames/s)",
+                     {} Hz of the recording {} ({} frames/s)",
                     b.name,
                     b.range_hz[1],
-                    path.display()
+                    crate::names::significant(nyquist, 6),
+                    path.display(),
+                    crate::names::significant(fs_hz, 6)
                 ),
             ));
         }

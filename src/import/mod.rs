@@ -73,6 +73,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
+use crate::names::significant;
 use crate::trace::{PointTrack, Trace};
 pub use error::ImportError;
 
@@ -681,7 +682,7 @@ fn check_plausible(path: &Path, trace: &Trace, unc: Uncalibrated) -> Result<()> 
                         p.name,
                         v[k],
                         k + 1,
-                        trace.t_s[k]
+                        significant(trace.t_s[k], 6)
                     ),
                 ));
             }
@@ -1112,29 +1113,31 @@ impl fmt::Display for ImportSummary {
         if let Some(format) = self.format {
             write!(f, "{format}: ")?;
         }
+        // Times to 6 significant digits (a 140 s record to the millisecond), steps to 4.
+        let (t, dt) = (|v| significant(v, 6), |v| significant(v, 4));
         if self.uncalibrated.frames {
             writeln!(
                 f,
                 "{} frames, frame {} … {} (no frame rate: times in frames), step median {}, min \
                  {}, max {} frames",
                 self.n_frames,
-                self.t_first_s,
-                self.t_last_s,
-                self.dt_median_s,
-                self.dt_min_s,
-                self.dt_max_s
+                t(self.t_first_s),
+                t(self.t_last_s),
+                dt(self.dt_median_s),
+                dt(self.dt_min_s),
+                dt(self.dt_max_s)
             )?;
         } else {
             writeln!(
                 f,
-                "{} frames, t = {} … {} s, dt median {} s ({:.6} fps), min {} s, max {} s",
+                "{} frames, t = {} … {} s, dt median {} s ({} fps), min {} s, max {} s",
                 self.n_frames,
-                self.t_first_s,
-                self.t_last_s,
-                self.dt_median_s,
-                self.fps_median_hz(),
-                self.dt_min_s,
-                self.dt_max_s
+                t(self.t_first_s),
+                t(self.t_last_s),
+                dt(self.dt_median_s),
+                significant(self.fps_median_hz(), 6),
+                dt(self.dt_min_s),
+                dt(self.dt_max_s)
             )?;
         }
         for (i, (name, nan)) in self.points.iter().enumerate() {

@@ -433,10 +433,11 @@ fn check_fps(path: &Path, t_s: &[f64], spec: &ImportSpec) -> Result<()> {
         return Err(Error::input(
             path,
             format!(
-                "the t column's median step {dt} s ({:.4} fps) disagrees with fps_hz = {fps} \
+                "the t column's median step {} s ({} fps) disagrees with fps_hz = {fps} \
                  by more than {} % (fps_hz is only a check for Tracker files; remove it to \
                  use the file's times)",
-                1.0 / dt,
+                crate::names::significant(dt, 4),
+                crate::names::significant(1.0 / dt, 6),
                 FPS_CHECK_REL_TOL * 100.0
             ),
         ));

@@ -368,7 +368,8 @@ fn time_base(
         ));
     };
     notes.push(format!(
-        "frame interval {dt} s from POSITION_T/FRAME (median over spots)"
+        "frame interval {} s from POSITION_T/FRAME (median over spots)",
+        crate::names::significant(dt, 6)
     ));
     Ok(RawTime::Seconds(
         (0..n).map(|k| (first + k as f64) * dt).collect(),

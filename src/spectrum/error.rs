@@ -46,7 +46,8 @@ pub enum SpectrumError {
     },
     /// The tracking noise of a trace cannot be estimated (too few samples, or a noise-free trace).
     #[error(
-        "stick detector: cannot estimate the tracking noise of the tip trace (σ̂ = {sigma_m} m from {samples} samples); it needs a noisy trace with at least 10 samples"
+        "stick detector: cannot estimate the tracking noise of the tip trace (σ̂ = {} from {samples} samples); it needs a noisy trace with at least 10 samples",
+        crate::names::quantity(*sigma_m, "m")
     )]
     NoNoiseEstimate { sigma_m: f64, samples: usize },
     /// Ridge settings out of range: the band must satisfy 0 ≤ low < high and `min_snr` ≥ 0.
@@ -77,8 +78,9 @@ pub enum SpectrumError {
     MissingPoint { role: String, present: Vec<String> },
     /// A feature band that holds no frequency bin of the spectrum.
     #[error(
-        "band '{band}' [{lo_hz}, {hi_hz}] Hz holds no frequency bin at fs = {fs_hz} Hz, nperseg = {nperseg} (Nyquist {} Hz)",
-        fs_hz / 2.0
+        "band '{band}' [{lo_hz}, {hi_hz}] Hz holds no frequency bin at fs = {} Hz, nperseg = {nperseg} (Nyquist {} Hz)",
+        crate::names::significant(*fs_hz, 6),
+        crate::names::significant(fs_hz / 2.0, 6)
     )]
     EmptyBand {
         band: String,
