@@ -1,4 +1,4 @@
-//! `wiperlab bench`: work–precision of the simulation methods (issue 5).
+//! `wiperlab bench`: work–precision of the simulation methods.
 //!
 //! Every method runs over a range of tolerances or steps on two problems, and is compared with a
 //! tight-tolerance event-driven reference (rtol 1e-13, checked against closed forms and an

@@ -134,12 +134,9 @@ impl PartialEq<&str> for Candidate {
 /// all bands lie below [`NECK_BAND_MIN_HZ`], else the full blade.
 ///
 /// The neck/lip model on a prescribed head is not in this default chain, although it models less:
-/// on a tracked recording it costs more, not less. On the shipped recording with the true blade one
-/// run takes 1.7 s against 0.066 s for the full blade (158 thousand steps against 22 thousand;
-/// the tracking noise in the prescribed head drives extra stick–slip transitions, 218 against 144).
-/// Fitting the high band alone (docs/fit.md, "Which model the scene needs"): 227 runs took 280 s and left
-/// k1 77 % off (the peak matched with the wrong parameters), where the full blade took 20 s for 824
-/// runs and came within 0.12 %. Name it in `[fit] models`
+/// on a tracked recording it costs more, not less: the tracking noise in the prescribed head drives
+/// extra stick–slip transitions and many more integrator steps per run, and fitted to the high band
+/// alone it can match the peak with the wrong parameters (docs/validation.md). Name it in `[fit] models`
 /// when the head's suspension (k0, c0, the head mass) is unknown: it takes the head's motion from
 /// the recording instead.
 pub fn smallest_capable_model(bands: &[BandSpec]) -> ModelKind {

@@ -33,9 +33,8 @@ use serde::{Deserialize, Serialize};
 /// Step of the central differences of the Fisher information, in normalised coordinates (the
 /// search box is `[0, 1]` per parameter; 1e-3 is 0.1 % of a linear range, 0.3 % of a decade).
 ///
-/// Measured on the shipped recording at the main job's fit, steps of
-/// 1e-3 and 3e-3 give the same 1σ within 13 % (A ±2.4/2.5 %, B ±2.9/2.9 %, C ±0.74/0.84 %, k1
-/// ±1.2/1.3 %); at 1e-2 and 3e-2 the stick–slip comb's jumps enter and B's moves by 40 %.
+/// At the main job's fit, steps of 1e-3 and 3e-3 give nearly the same 1σ; from 1e-2 on, the
+/// stick–slip comb's jumps enter the differences and the intervals move.
 pub const FISHER_STEP_U: f64 = 3e-3;
 
 /// Half-span, in the whitened coordinates of `F⁻¹` (1 = the bowl's 1σ along an axis), of the
@@ -683,8 +682,7 @@ impl ReplicateBase {
 
 /// Noise replicates of a goodness-of-fit test ([`RecordingLikelihood::goodness_of_fit`]): 999
 /// resolve a p-value of 0.001 (Davison & Hinkley 1997, §4.2, on the
-/// number of simulations); about 0.5 s on
-/// the main job's two bands and two threads.
+/// number of simulations); each costs a noise draw and its Welch estimate, no simulation.
 pub const GOODNESS_OF_FIT_REPLICATES: usize = 999;
 
 /// Seed of the first noise replicate ([`RecordingLikelihood::variability`]).

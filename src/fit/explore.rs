@@ -436,8 +436,9 @@ impl Exploration {
 
     /// Whether sample `s` reaches every band's target: its line within `rel_tol` of the target
     /// (of the range's edges for a range), at least [`crate::spectrum::harmonics::MIN_PROMINENCE`]
-    /// times its local floor, and not a harmonic of a stronger line (issue 17's criterion for the
-    /// paper's pairs takes 1 % for the low line and 2 % for the high one).
+    /// times its local floor, and not a harmonic of a stronger line (the criterion for the seed
+    /// paper's pairs, [`super::reach::band_tolerance`], takes 1 % for the low line and 2 % for the
+    /// high one).
     pub fn reaches(&self, s: &Sample, rel_tol: &[f64]) -> bool {
         let Some(lines) = s.outcome.lines() else {
             return false;

@@ -373,9 +373,8 @@ pub const LINE_FALSE_ALARM: f64 = 0.01;
 /// neighbouring bins correlate). A band whose motion raises its median only makes the test
 /// stricter. Without a distribution for the band (median average, no segments) it says yes.
 ///
-/// On the confusion table's head-only recording (docs/fit.md) the high band's largest ordinate is
-/// 1.4 times its median, against a threshold of about 1.5: tracking noise, whose maximum falls
-/// anywhere in 500–5000 Hz.
+/// A band of tracking noise alone (the confusion table's head-only recording, in 500–5000 Hz) has
+/// its largest ordinate anywhere, below the threshold.
 pub fn band_has_line(band: &crate::spectrum::features::BandFeatures) -> bool {
     let mut finite: Vec<f64> = band
         .psd

@@ -35,10 +35,9 @@ pub(super) fn sampling_rate(trace: &Trace, fps: Option<f64>) -> Result<f64> {
 
 /// Standard deviation of the Gaussian kernel that smooths a recorded head drop for the neck/lip
 /// model, s. Its gain `exp(−(2πfσ)²/2)` is 0.988 at the sample's 49 Hz low component and 0.02 at
-/// 900 Hz, where the heavy head hardly moves. A local quadratic fit's piecewise interpolant made the
-/// integrator cut its step at every sample; the kernel smooth is infinitely differentiable (measured
-/// on the shipped recording with the true blade: 4.3 thousand rejected steps instead of 157
-/// thousand).
+/// 900 Hz, where the heavy head hardly moves. A piecewise interpolant (local quadratic fits) would
+/// make the integrator cut its step at every sample, where its derivatives jump; the kernel smooth
+/// is infinitely differentiable, so the integrator takes long steps through it.
 pub const HEAD_KERNEL_SIGMA_S: f64 = 5e-4;
 
 /// The measured side of a fit, shared by every candidate.

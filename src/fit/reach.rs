@@ -1,10 +1,10 @@
-//! The closest achievable pair of an exploration and the constraint that keeps it from the targets
-//! (issue 17, point 5: "if no plausible set does, the map shows the closest achievable pair and the
-//! report names the constraint that prevents it").
+//! The closest achievable pair of an exploration and the constraint that keeps it from the targets:
+//! when no plausible parameter set reaches the targets, the map shows the closest achievable pair
+//! and the report names the constraint that prevents it.
 //!
 //! - **Distance** of a sample from the targets: per band with a target, the line's relative miss
 //!   (0 inside a range, (f − hi)/hi above it, (f − lo)/lo below) over the band's tolerance
-//!   ([`band_tolerance`]: 1 % for the first band, 2 % for the others, issue 17's criterion), and
+//!   ([`band_tolerance`]: 1 % for the first band, 2 % for the others, as for the seed paper's pairs), and
 //!   the largest of these. A sample with distance ≤ 1 whose lines are all their own and prominent
 //!   is one that [`super::explore::Exploration::reaches`] counts.
 //! - **Closest achievable pair**: the sample of smallest distance among those whose every band's
@@ -32,8 +32,8 @@ pub const EDGE_SHARE: f64 = 0.1;
 /// moves the line too little to count as a lever (the linear estimate means nothing that far).
 pub const MAX_LEVER_FACTOR: f64 = 10.0;
 
-/// The relative tolerance of band `b`: 1 % for the first band, 2 % for the others (issue 17's
-/// criterion for the paper's pairs, 78.4 Hz ± 1 % and 900 Hz ± 2 %).
+/// The relative tolerance of band `b`: 1 % for the first band, 2 % for the others (the criterion
+/// for the seed paper's pairs, 78.4 Hz ± 1 % and 900 Hz ± 2 %).
 pub fn band_tolerance(b: usize) -> f64 {
     if b == 0 { 0.01 } else { 0.02 }
 }

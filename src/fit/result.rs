@@ -1,8 +1,8 @@
 //! What a fit reports: [`FitResult`] and its parts, written as `fits/<job>.result.toml` by
 //! `wiperlab fit` (and as JSON with `--json`) and read back by `wiperlab report`.
 //!
-//! Every type here is `Serialize + Deserialize`. Fields added after the first release carry
-//! `#[serde(default)]`, so result files written before them still load (with the field empty).
+//! Every type here is `Serialize + Deserialize`. Optional fields carry `#[serde(default)]`, so a
+//! result file without them loads (with the field empty).
 
 use super::Candidate;
 use super::job::{FitSection, SpectrumSection};
@@ -105,12 +105,11 @@ pub enum IntervalMethod {
     Laplace {
         /// Central-difference step of the Fisher information, normalised coordinates.
         fisher_step_u: f64,
-        /// Noise replicates `V` was estimated from (0 in results written before `V` was: `F⁻¹`
-        /// alone).
+        /// Noise replicates `V` was estimated from (0 when the result has none: `F⁻¹` alone).
         #[serde(default)]
         noise_replicates: usize,
         /// Half-span, in the whitened coordinates of `F⁻¹`, of the points whose Jacobians `F` and
-        /// `V` average (0 in results written before they did: the Jacobian at the fit alone).
+        /// `V` average (0 when the result has none: the Jacobian at the fit alone).
         #[serde(default)]
         span_sigma: f64,
     },

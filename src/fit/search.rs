@@ -510,8 +510,8 @@ pub fn problem_for(job: &LoadedJob, candidate: Candidate) -> Result<SpectralProb
 /// fit is done. Its optimum, with k1_contact = k1 (so the shoulder changes no moment), seeds one
 /// particle of the first swarm and is itself kept if no restart ends below it (see `optimise`):
 /// the larger model then cannot end above the smaller one's cost, which the AIC comparison of
-/// nested models assumes. On the shipped recording without the warm particle, the shoulder
-/// candidate ended at 0.158 against 0.125 for the model it contains.
+/// nested models assumes. Without the warm particle a swarm can leave the larger candidate above
+/// the optimum of the model it contains.
 pub(super) fn fit_candidate(
     job: &LoadedJob,
     meas: &Measurement,
@@ -569,9 +569,9 @@ pub const VALLEY_GAIN_NATS: f64 = 0.1;
 /// at its claimed minimum: Press et al., *Numerical Recipes*, 3rd ed. 2007, §10.5). Where the end
 /// is already at a valley's floor, one polish confirms it and the end is kept as the search left
 /// it. Each polish costs up to `polish_iterations` Nelder–Mead iterations, one model run after
-/// another: on the main job's recording the one polish took 30 iterations (53 model runs, about
-/// 1.7 s) and gained nothing, which is why only a candidate with a shoulder, whose contact moment
-/// makes a valley, gets them by default ([`job::FitSection::valley_polishes_for`]).
+/// another, and gains nothing where the search already ended at the floor (as on the main job's
+/// recording), so only a candidate with a shoulder, whose contact moment makes a valley, gets
+/// them by default ([`job::FitSection::valley_polishes_for`]).
 fn descend_the_valley(
     problem: &Arc<SpectralProblem>,
     fit: &job::FitSection,
@@ -880,8 +880,8 @@ pub(super) struct Unconfirmed {
 /// unconfirmed best end must trail the chosen one for [`confirm_deferred`] to leave it: 5 nats, an
 /// AIC difference of 10, beyond which a model has "essentially no support" (Burnham & Anderson,
 /// *Model Selection and Multimodel Inference*, 2nd ed. 2002, §2.6). A basin as far below the best
-/// end as the ends spread above it would then still leave the candidate behind. On the shipped
-/// recording head1dof's five restarts end 530.9–587.4 nats, 450 nats behind blade2dof.
+/// end as the ends spread above it would then still leave the candidate behind: on the shipped
+/// recording head1dof trails blade2dof by far more than its ends spread.
 pub const DEFERRED_CONFIRM_MARGIN_NATS: f64 = 5.0;
 
 /// Why a candidate's deferred confirmation need not run ([`confirm_deferred`]), or `None` when it
@@ -1010,11 +1010,10 @@ fn search(
 /// ([`crate::fit::job::NestedSearch::Adaptive`]): 0.1 nats, a likelihood-ratio statistic 2Δ = 0.2,
 /// below the 10th percentile of χ²₂, the law the global search's statistic follows when the two
 /// shoulder parameters add nothing. A smaller local gain says they do nothing near the smaller
-/// model's optimum. The local gain is not a test of the shoulder: in the confusion table's scene with
-/// a shoulder at 0.06 rad it was 0.81 nats (2Δ = 1.62, p = 0.44), yet the global search found the
-/// shoulder there; without a shoulder it was 0.065 and 0.244 nats, and on the shipped recording
-/// the local search ends 0.068 nats above blade2dof's own search end (docs/fit.md, "Which model
-/// the scene needs").
+/// model's optimum. The local gain is not a test of the shoulder: a real shoulder away from the
+/// smaller model's optimum can give a local gain far from significant that the global search then
+/// finds (the confusion table, `reports/model_choice/`), so a gain above the threshold only
+/// decides whether the global search runs.
 pub const NESTED_GLOBAL_GAIN_NATS: f64 = 0.1;
 
 /// The adaptive search of a nested candidate: Nelder–Mead polishes from each of `warm` (in
@@ -1109,13 +1108,12 @@ fn nested_search(
 /// (inside the contact-angle bounds): the same motion, but a polish from there feels k1_contact at
 /// once, while from the first it must first bring θ_c into the range the neck visits. On the
 /// confusion table's often-crossed shoulder (docs/fit.md) the search from the first point alone
-/// never left blade2dof's optimum. The last reads X's stiffness as that of a neck resting on the
+/// does not leave blade2dof's optimum. The last reads X's stiffness as that of a neck resting on the
 /// shoulder: k1_contact = X's k1, θ_c at the 10th percentile of |θ|, and the free k1 halfway (log
 /// scale) between its lower bound and X's k1 (along the resting neck's ridge, where only
-/// `(k1_contact − k1)·θ_c` matters, any free k1 moves the neck alike while θ_c is small). On the
-/// confusion table's neck resting on a shoulder at 0.025 rad, without it the global search ended
-/// 2.5 nats below the truth's likelihood and blade2dof was chosen (k1 +229 %); with it the search
-/// ends within 0.2 nats of the truth's likelihood and the shoulder model is chosen.
+/// `(k1_contact − k1)·θ_c` matters, any free k1 moves the neck alike while θ_c is small). Without
+/// it the global search on the confusion table's neck resting on a shoulder (0.025 rad) stops
+/// short of the truth's likelihood and chooses blade2dof; with it the shoulder model is chosen.
 fn nested_warm_points(smaller: &CandidateFit, free: &[FreeParam]) -> Vec<Vec<f64>> {
     let params = smaller.problem.params_at(&smaller.best_u);
     let first: Vec<f64> = free
@@ -1195,9 +1193,9 @@ pub(super) fn sorted_abs_theta(fit: &CandidateFit) -> Option<Vec<f64>> {
 /// seeds its swarm with `seed ^ (r · 0x9E3779B97F4A7C15)`, so restart 0 is the single-run fit.
 ///
 /// Restarts because the cost surface is rough: the stick–slip comb's largest line jumps as the
-/// parameters move, so one swarm can settle in a nearby minimum. On the shipped recording, single
-/// swarms of 24 particles × 25 iterations ended in the truth's basin (cost 0.25) for some seeds and
-/// at 0.30 to 19.7 for others (docs/fit.md, "Restarts"; the seed-by-seed costs: CHANGELOG.md).
+/// parameters move, so one swarm can settle in a nearby minimum: on the shipped recording a single
+/// swarm ends in the truth's basin for some seeds and in a higher minimum for others
+/// (docs/validation.md, "Restarts").
 /// `warm`: points that one particle of restart `r`'s swarm starts at (`warm[r]`; the others at
 /// random); the first is also returned itself if no restart ends below its cost.
 /// With the likelihood as the cost and more than one restart, a best end that no second end
@@ -1459,11 +1457,10 @@ pub(super) fn warm_population(
 
 /// When a polish of the likelihood stops: the standard deviation of the cost over the simplex's
 /// vertices below 0.05 nats (or `polish_iterations`). That is the depth of the ripples the
-/// stick–slip likelihood has at a scale far below its intervals (on the main job's fit the cost
-/// jitters by about 0.05 nats between points σ/50 apart; docs/fit.md, "Uncertainty"), so a
+/// stick–slip likelihood has at a scale far below its intervals (between points σ/50 apart on the
+/// main job's fit; docs/validation.md), so a
 /// simplex that small only walks from ripple to ripple; the settling that follows fits the bowl
-/// over ±1σ ([`super::evidence::settle`]). A one-restart blade2dof fit of the shipped recording
-/// then stops its polish after 42 iterations instead of running all 60.
+/// over ±1σ ([`super::evidence::settle`]).
 pub const POLISH_SD_NATS: f64 = 0.05;
 
 /// The edge of a polish's initial simplex, normalised units: every polish of the fit (after a

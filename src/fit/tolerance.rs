@@ -1,14 +1,13 @@
 //! Whether a fit's optimum is resolved by its integrator: the likelihood at the chosen optimum
 //! again at tenfold and hundredfold tighter solver tolerances ([`ToleranceCheck`]).
 //!
-//! A smooth trajectory converges as the tolerance tightens, and so does the cost: on the shipped
-//! recording the main job's optimum costs the same to 0.03 nats from rtol 1e-8 to 1e-10. A motion
+//! A smooth trajectory converges as the tolerance tightens, and so does the cost (the main job's
+//! optimum on the shipped recording does). A motion
 //! whose stick–slip sequence hangs on grazing events (a stick the lip's slip speed only just
 //! reaches, a shoulder the neck only just touches) does not: an event that appears at one
-//! tolerance and not at the next changes the rest of the window, and with it the spectra. On the
-//! confusion table's often-crossed 0.12 rad shoulder (docs/fit.md, "What the search misses") the
-//! fitted optimum's cost moved from 66.8 to 68.4 nats between rtol 1e-8 and 1e-10 (168 and 170
-//! transitions). The cost surface is then rough at that depth: a search that keeps its lowest
+//! tolerance and not at the next changes the rest of the window, and with it the spectra (the
+//! confusion table's often-crossed 0.12 rad shoulder is such a motion). The cost surface is then
+//! rough at that depth: a search that keeps its lowest
 //! evaluation keeps a ripple the integrator's rounding happened to put low, cost differences
 //! smaller than the spread do not tell parameter sets apart, and intervals read from the local
 //! curvature at the 0.5-nat scale understate the uncertainty. The check costs two simulations.

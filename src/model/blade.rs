@@ -466,8 +466,8 @@ impl Blade {
                 mu,
             });
         }
-        // nalgebra's closed-form 3×3 inverse (cofactors) instead of LU with pivoting: it halved the
-        // slip right-hand side (criterion `blade rhs, slip`, 194 → 95 ns on this machine).
+        // nalgebra's closed-form 3×3 inverse (cofactors) rather than LU with pivoting: the slip
+        // right-hand side is the integrator's hot path (criterion bench `blade rhs, slip`).
         let z = a
             .try_inverse()
             .map(|inv| inv * b)

@@ -1,4 +1,4 @@
-//! Linearised modes of the blade in stick and in steady slip (issue 17.1).
+//! Linearised modes of the blade in stick and in steady slip.
 //!
 //! The right-hand side `ẋ = F(x)` of a phase is linearised numerically by central differences,
 //! `J_ij ≈ (F_i(x + h_j e_j) − F_i(x − h_j e_j)) / 2h_j`, around a quasi-static state; the complex

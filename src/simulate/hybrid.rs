@@ -960,7 +960,7 @@ mod tests {
     use super::golden_extremum;
 
     /// The bracket the dip search met in a neck/lip run near the flip (t ≈ 1.9906 s, 7.6e-14 s wide):
-    /// before the ulp floor the search cycled forever between two adjacent doubles.
+    /// without the ulp floor the search would cycle forever between two adjacent doubles.
     #[test]
     fn golden_search_ends_on_a_bracket_narrower_than_a_thousand_ulps() {
         let (a, b) = (1.990_639_444_323_852_6, 1.990_639_444_323_928_6);

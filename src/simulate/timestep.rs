@@ -1,4 +1,4 @@
-//! The two comparison methods of the work–precision study (issue 5): a Moreau–Jean-type
+//! The two comparison methods of the work–precision study (`wiperlab bench`): a Moreau–Jean-type
 //! semi-implicit time-stepping scheme and a smoothed-friction ODE, for the belt oscillator and the
 //! blade. The event-driven integrator ([`super::hybrid`]) is the method wiperlab uses; these exist to
 //! measure it against what users would otherwise write.

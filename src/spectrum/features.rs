@@ -80,13 +80,12 @@ impl BandSpec {
 
 /// The default bands of the fit: low 30–300 Hz (nperseg 4096) and high 500–5000 Hz (nperseg 512).
 ///
-/// The segment lengths were chosen on the shipped recording at 10 kfps: with 4096 samples (2.4 Hz
-/// bins) the low peak is resolved. In the high band the stick–slip comb (lines ~7 Hz apart, whose
-/// largest member changes with the integration tolerance) must merge into its envelope. 2048
-/// samples do that for one simulation (the peak moves by < 0.05 Hz between rtol 1e-7 and 1e-12),
-/// but still resolve bumps ~18 Hz apart on the envelope, and the largest one changes as the
-/// parameters move: the peak jumps by ~2 % (883 → 866 Hz) between neighbouring parameter sets and
-/// the cost surface gets steps of 3–4. With 512 samples (19.5 Hz bins) the envelope is one hump
+/// The segment lengths suit the shipped recording at 10 kfps: with 4096 samples (2.4 Hz bins) the
+/// low peak is resolved. In the high band the stick–slip comb (lines ~7 Hz apart, whose largest
+/// member changes with the integration tolerance) must merge into its envelope. 2048 samples do
+/// that for one simulation, but still resolve bumps ~18 Hz apart on the envelope, and the largest
+/// one changes as the parameters move: the peak jumps by ~2 % between neighbouring parameter sets
+/// and the cost surface gets steps. With 512 samples (19.5 Hz bins) the envelope is one hump
 /// and the cost has no steps (docs/fit.md, "Restarts"), and the model-made recordings of
 /// `tests/fit_recovery.rs`, `shoulder_fit.rs` and `joint_fit.rs` are recovered as well or better
 /// (docs/validation.md, "Spectra against tolerance"). A job that wants the finer estimate names its bands.
