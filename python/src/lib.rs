@@ -1,0 +1,18 @@
+//! `wiperlab._wiperlab`: the compiled half of the `wiperlab` Python package (PyO3 + NumPy).
+//!
+//! Each function converts its Python arguments, runs the wiperlab library with the GIL released
+//! and converts the result back; the library does all the work. Errors become the exceptions of
+//! `wiperlab.errors` ([`errors::to_py`]), and a panic inside the library becomes
+//! `wiperlab.WiperlabError` instead of reaching Python ([`errors::guard`]).
+
+use pyo3::prelude::*;
+
+mod errors;
+mod spectrum;
+
+/// The extension module.
+#[pymodule]
+fn _wiperlab(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(spectrum::welch, m)?)?;
+    Ok(())
+}
