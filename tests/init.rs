@@ -217,3 +217,22 @@ fn dash_o_dash_prints_the_job_on_stdout() {
     };
     assert_eq!(strip(&printed), strip(&written));
 }
+
+/// A recording with its own times: the template states their frame rate as people write it
+/// (times k/1000 s, so 1000 frames/s, not `1000.000000` or the median step's last bits).
+#[test]
+fn a_recording_with_times_states_its_frame_rate_rounded() {
+    let s = Scratch::new("timed");
+    let mut csv = String::from("t_s,head_x_m,head_y_m\n");
+    for k in 0..50 {
+        csv.push_str(&format!("{},{},0\n", k as f64 / 1000.0, 1e-4 * k as f64));
+    }
+    std::fs::write(s.0.join("timed.csv"), csv).expect("write");
+    let o = wiperlab(&s.0, &["init", "timed.csv", "--format", "canonical"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let t = std::fs::read_to_string(s.0.join("timed.job.toml")).expect("the template");
+    assert!(
+        t.contains("# The file's own times give 1000 frames/s;"),
+        "{t}"
+    );
+}

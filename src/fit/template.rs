@@ -138,7 +138,7 @@ pub fn job_template(input: &TemplateInput) -> Result<String> {
         n_frames => s.n_frames,
         points => s.points.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>().join(", "),
         fps_hz => spec.fps_hz,
-        fps_from_file => (!frames && spec.fps_hz.is_none()).then(|| format!("{:.6}", s.fps_median_hz())),
+        fps_from_file => (!frames && spec.fps_hz.is_none()).then(|| crate::names::significant(s.fps_median_hz(), 6)),
         needs_fps => frames && spec.fps_hz.is_none(),
         needs_scale => file_units,
         m_per_px => spec.m_per_px,
