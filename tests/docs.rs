@@ -190,3 +190,205 @@ fn no_source_cites_the_readme() {
         }
     }
 }
+
+// The job and blade references (`docs/job.md`, `docs/blade.md`) against the readers themselves.
+// The keys come from the readers' own "unknown field" and "unknown variant/name" errors (the lists
+// a user sees after a typo), so a key the code accepts and the reference lacks fails here, as
+// does a row for a key the code no longer accepts.
+
+/// The names a reader's error lists: `expected one of `a`, `b`` (serde) or `(known: a, b)`
+/// (wiperlab's named enums).
+fn listed(message: &str) -> Vec<String> {
+    if let Some((_, known)) = message.split_once("(known: ") {
+        let known = known.split(')').next().unwrap_or_default();
+        return known.split(", ").map(str::to_string).collect();
+    }
+    let Some((_, expected)) = message.split_once("expected") else {
+        panic!("the reader's error lists no names: {message}");
+    };
+    expected
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .map(str::to_string)
+        .collect()
+}
+
+/// What the job reader lists after reading `toml` (which must fail on an unknown name).
+fn job_lists(toml: &str) -> Vec<String> {
+    match toml::from_str::<wiperlab::fit::job::FitJob>(toml) {
+        Ok(_) => panic!("the job reader accepted {toml:?}"),
+        Err(e) => listed(e.message()),
+    }
+}
+
+/// What the blade reader lists after reading `toml` (which must fail on an unknown name).
+fn blade_lists(toml: &str) -> Vec<String> {
+    match toml::from_str::<wiperlab::model::BladeParams>(toml) {
+        Ok(_) => panic!("the blade reader accepted {toml:?}"),
+        Err(e) => listed(e.message()),
+    }
+}
+
+/// The reference rows under the heading `heading` (the text after the `#`s) of `doc`, up to the
+/// next heading: `(key, row)` for every table row whose first cell is a backticked key.
+fn reference_rows(doc: &str, heading: &str) -> Vec<(String, String)> {
+    let mut lines = doc
+        .lines()
+        .skip_while(|l| !(l.starts_with('#') && l.trim_start_matches('#').trim() == heading));
+    assert!(lines.next().is_some(), "no heading {heading:?}");
+    lines
+        .take_while(|l| !l.starts_with('#'))
+        .filter_map(|l| {
+            let rest = l.strip_prefix("| `")?;
+            let key = rest.split('`').next()?;
+            Some((key.to_string(), l.to_string()))
+        })
+        .collect()
+}
+
+/// The keys under `heading` are exactly `keys`.
+fn assert_documented(file: &str, doc: &str, heading: &str, keys: &[String]) {
+    let rows: Vec<String> = reference_rows(doc, heading)
+        .into_iter()
+        .map(|(k, _)| k)
+        .collect();
+    for key in keys {
+        assert!(
+            rows.contains(key),
+            "{file}, \"{heading}\": the reader accepts `{key}`, which the table does not list"
+        );
+    }
+    for row in &rows {
+        assert!(
+            keys.contains(row),
+            "{file}, \"{heading}\": the table lists `{row}`, which the reader does not accept \
+             (it accepts {keys:?})"
+        );
+    }
+}
+
+/// The row of `key` under `heading` names every value in `values` (in backticks or quotes).
+fn assert_values_documented(file: &str, doc: &str, heading: &str, key: &str, values: &[String]) {
+    let rows = reference_rows(doc, heading);
+    let (_, row) = rows
+        .iter()
+        .find(|(k, _)| k == key)
+        .unwrap_or_else(|| panic!("{file}, \"{heading}\": no row for `{key}`"));
+    for v in values {
+        assert!(
+            row.contains(&format!("`{v}`")) || row.contains(&format!("\"{v}\"")),
+            "{file}, \"{heading}\", `{key}`: the reader accepts {v:?}, which the row does not name"
+        );
+    }
+}
+
+#[test]
+fn the_job_reference_lists_every_key_the_job_reader_accepts() {
+    let doc = read(&root().join("docs/job.md"));
+    let unknown = "zz_not_a_key = 1";
+    for (heading, table) in [
+        ("Top level", ""),
+        ("`[recording]`", "[recording]"),
+        ("`[recording.import]`", "[recording.import]"),
+        ("`[recording.import.generic]`", "[recording.import.generic]"),
+        ("`[targets]`", "[targets]"),
+        ("`[[targets.peaks]]`", "[[targets.peaks]]"),
+        ("`[[more_recordings]]`", "[[more_recordings]]"),
+        ("`[spectrum]`", "[spectrum]"),
+        ("`[[spectrum.bands]]`", "[[spectrum.bands]]"),
+        ("`[solver]`", "[solver]"),
+        ("`[fit]`", "[fit]"),
+        ("`[fit.weights]`", "[fit.weights]"),
+        ("`[fit.shoulder]`", "[fit.shoulder]"),
+        ("`[fit.uncertainty]`", "[fit.uncertainty]"),
+        ("`[fit.likelihood]`", "[fit.likelihood]"),
+        ("`[truth]`", "[truth]"),
+    ] {
+        let keys = job_lists(&format!("{table}\n{unknown}\n"));
+        assert!(!keys.is_empty(), "{table}: no keys listed");
+        assert_documented("docs/job.md", &doc, heading, &keys);
+    }
+    // The parameters a fit may free are the keys of [fit.parameters].
+    let params = job_lists("[fit.parameters]\nzz_not_a_parameter = [0.0, 1.0]\n");
+    assert!(params.contains(&"k1".to_string()), "{params:?}");
+    assert_documented("docs/job.md", &doc, "`[fit.parameters]`", &params);
+    // Every value a named setting accepts.
+    for (heading, key, toml) in [
+        (
+            "`[recording.import]`",
+            "format",
+            "[recording.import]\nformat = \"zz\"",
+        ),
+        ("`[spectrum]`", "signal", "[spectrum]\nsignal = \"zz\""),
+        (
+            "`[[spectrum.bands]]`",
+            "window",
+            "[[spectrum.bands]]\nwindow = \"zz\"",
+        ),
+        (
+            "`[[spectrum.bands]]`",
+            "detrend",
+            "[[spectrum.bands]]\ndetrend = \"zz\"",
+        ),
+        (
+            "`[[spectrum.bands]]`",
+            "scaling",
+            "[[spectrum.bands]]\nscaling = \"zz\"",
+        ),
+        (
+            "`[[spectrum.bands]]`",
+            "average",
+            "[[spectrum.bands]]\naverage = \"zz\"",
+        ),
+        ("`[solver]`", "method", "[solver]\nmethod = \"zz\""),
+        ("`[fit]`", "objective", "[fit]\nobjective = \"zz\""),
+        ("`[fit]`", "models", "[fit]\nmodels = [\"zz\"]"),
+        ("`[fit]`", "nested_search", "[fit]\nnested_search = \"zz\""),
+        (
+            "`[fit]`",
+            "contact_angle_scan",
+            "[fit]\ncontact_angle_scan = \"zz\"",
+        ),
+        (
+            "`[fit.uncertainty]`",
+            "method",
+            "[fit.uncertainty]\nmethod = \"zz\"",
+        ),
+    ] {
+        let values = job_lists(toml);
+        assert!(values.len() >= 2, "{toml}: {values:?}");
+        assert_values_documented("docs/job.md", &doc, heading, key, &values);
+    }
+}
+
+#[test]
+fn the_blade_reference_lists_every_key_the_blade_reader_accepts() {
+    let doc = read(&root().join("docs/blade.md"));
+    let unknown = "zz_not_a_key = 1";
+    for (heading, table) in [("Top level", ""), ("`[shoulder]`", "[shoulder]")] {
+        let keys = blade_lists(&format!("{table}\n{unknown}\n"));
+        assert!(!keys.is_empty(), "{table}: no keys listed");
+        assert_documented("docs/blade.md", &doc, heading, &keys);
+    }
+    let laws = blade_lists("[friction]\nlaw = \"zz\"\n");
+    assert!(laws.contains(&"exponential".to_string()), "{laws:?}");
+    assert_values_documented("docs/blade.md", &doc, "`[friction]`", "law", &laws);
+    for law in &laws {
+        let keys = blade_lists(&format!("[friction]\nlaw = \"{law}\"\n{unknown}\n"));
+        let heading = format!("`[friction]` with `law = \"{law}\"`");
+        assert_documented("docs/blade.md", &doc, &heading, &keys);
+    }
+}
+
+/// `wiperlab init`'s template points to the two references.
+#[test]
+fn the_job_template_points_to_the_references() {
+    let template = read(&root().join("src/fit/templates/job.toml"));
+    for doc in ["docs/job.md", "docs/blade.md"] {
+        assert!(
+            template.contains(doc),
+            "the init template does not name {doc}"
+        );
+    }
+}
