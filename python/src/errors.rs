@@ -36,6 +36,12 @@ fn raise<'py>(py: Python<'py>, name: &str, args: impl PyCallArgs<'py>) -> PyErr 
 /// * an interrupt: `KeyboardInterrupt`;
 /// * anything else: `wiperlab.WiperlabError`.
 pub fn to_py(py: Python<'_>, e: Error) -> PyErr {
+    to_py_as(py, e, "InputError")
+}
+
+/// As [`to_py`], with `input_class` (a `wiperlab.errors` class) for other bad input: a reader of
+/// recordings says `RecordingError` for a file it cannot import.
+pub fn to_py_as(py: Python<'_>, e: Error, input_class: &str) -> PyErr {
     let message = e.to_string();
     match &e {
         Error::Io { path, source, .. } => {
@@ -80,10 +86,16 @@ pub fn to_py(py: Python<'_>, e: Error) -> PyErr {
             || e.stage_error::<wiperlab::spectrum::SpectrumError>()
                 .is_some() =>
         {
-            raise(py, "InputError", (message,))
+            raise(py, input_class, (message,))
         }
         _ => raise(py, "WiperlabError", (message,)),
     }
+}
+
+/// `wiperlab.InputError` with `message` (a bad value the binding itself finds, e.g. in a blade's
+/// parameters).
+pub fn input_error(py: Python<'_>, message: impl Into<String>) -> PyErr {
+    raise(py, "InputError", (message.into(),))
 }
 
 /// A bad argument of a Python call (an unknown option name, a wrong shape): `ValueError`.
@@ -98,10 +110,19 @@ where
     T: Send,
     F: FnOnce() -> wiperlab::Result<T> + Send,
 {
+    guard_as(py, "InputError", work)
+}
+
+/// As [`guard`], with [`to_py_as`]'s `input_class`.
+pub fn guard_as<T, F>(py: Python<'_>, input_class: &str, work: F) -> PyResult<T>
+where
+    T: Send,
+    F: FnOnce() -> wiperlab::Result<T> + Send,
+{
     let outcome = py.detach(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(work)));
     match outcome {
         Ok(Ok(v)) => Ok(v),
-        Ok(Err(e)) => Err(to_py(py, e)),
+        Ok(Err(e)) => Err(to_py_as(py, e, input_class)),
         Err(panic) => Err(panic_error(py, panic)),
     }
 }

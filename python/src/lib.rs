@@ -8,11 +8,22 @@
 use pyo3::prelude::*;
 
 mod errors;
+mod fit;
+mod model;
+mod recording;
 mod spectrum;
 
 /// The extension module.
 #[pymodule]
 fn _wiperlab(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(spectrum::welch, m)?)?;
+    m.add_function(wrap_pyfunction!(spectrum::find_peaks_in_band, m)?)?;
+    m.add_function(wrap_pyfunction!(recording::read_recording, m)?)?;
+    m.add_function(wrap_pyfunction!(model::blade_from_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(model::blade_check, m)?)?;
+    m.add_function(wrap_pyfunction!(model::blade_default_window, m)?)?;
+    m.add_function(wrap_pyfunction!(model::modes, m)?)?;
+    m.add_function(wrap_pyfunction!(model::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(fit::fit, m)?)?;
     Ok(())
 }

@@ -32,7 +32,7 @@ fn detrend_of(detrend: &Bound<'_, PyAny>) -> PyResult<Detrend> {
 /// Welch PSD as `scipy.signal.welch` (the docstring is in `wiperlab/__init__.py`).
 #[pyfunction]
 #[pyo3(signature = (x, fs=1.0, window="hann", nperseg=None, noverlap=None, nfft=None,
-    detrend=None, scaling="density", average="mean"))]
+    detrend=None, scaling="density", average="mean", max_fill=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn welch<'py>(
     py: Python<'py>,
@@ -45,6 +45,7 @@ pub fn welch<'py>(
     detrend: Option<Bound<'py, PyAny>>,
     scaling: &str,
     average: &str,
+    max_fill: Option<usize>,
 ) -> PyResult<ArrayPair<'py>> {
     let window = Window::from_scipy_name(window).ok_or_else(|| {
         value_error(format!(
@@ -90,9 +91,42 @@ pub fn welch<'py>(
     if let Some(n) = nfft {
         cfg.nfft = n;
     }
-    let psd = guard(py, || wiperlab::spectrum::welch(x, fs, &cfg))?;
+    let psd = guard(py, || match max_fill {
+        None => wiperlab::spectrum::welch(x, fs, &cfg),
+        Some(m) => wiperlab::spectrum::welch_gappy(x, fs, &cfg, m).map(|(psd, _)| psd),
+    })?;
     Ok((
         PyArray1::from_vec(py, psd.freq_hz),
         PyArray1::from_vec(py, psd.density),
     ))
+}
+
+/// The `n` largest local maxima of `pxx` in `band` (the docstring is
+/// `wiperlab.find_peaks_in_band`'s): `(freq_hz, level, bin, prominence)` each, largest first.
+#[pyfunction]
+#[pyo3(signature = (f, pxx, band, n=1))]
+pub fn find_peaks_in_band<'py>(
+    f: PyReadonlyArray1<'py, f64>,
+    pxx: PyReadonlyArray1<'py, f64>,
+    band: (f64, f64),
+    n: usize,
+) -> PyResult<Vec<(f64, f64, usize, f64)>> {
+    let (f, pxx) = (f.as_slice()?, pxx.as_slice()?);
+    if f.len() != pxx.len() {
+        return Err(value_error(format!(
+            "f has {} bins but Pxx {} (expected the pair welch returns)",
+            f.len(),
+            pxx.len()
+        )));
+    }
+    if band.0.is_nan() || band.1.is_nan() || band.0 > band.1 {
+        return Err(value_error(format!(
+            "band ({}, {}): expected low <= high in Hz",
+            band.0, band.1
+        )));
+    }
+    Ok(wiperlab::spectrum::top_peaks(f, pxx, band, n)
+        .into_iter()
+        .map(|p| (p.freq_hz, p.level, p.bin, p.prominence))
+        .collect())
 }

@@ -86,6 +86,11 @@ fn report_dir(job: &LoadedJob) -> PathBuf {
     job.reports_dir().join(&job.name)
 }
 
+/// Where `wiperlab fit` puts a job's figures by default: `<job dir>/<reports_dir>/<name>/`.
+pub fn default_fit_dir(job: &LoadedJob) -> PathBuf {
+    report_dir(job)
+}
+
 /// `<job dir>/<name>.interrupted.result.toml`: where an interrupted fit's result goes, so that a
 /// previous complete result stays in place.
 fn interrupted_path(job: &LoadedJob) -> PathBuf {
@@ -102,11 +107,23 @@ fn fit_and_write(
     report_dir: &Path,
     progress: bool,
 ) -> Result<(crate::fit::FitResult, PathBuf)> {
+    crate::fit::interrupt::install_signal_handler()?;
+    fit_files(job, report_dir, progress)
+}
+
+/// What `wiperlab fit` writes, without installing a signal handler: a caller that has its own
+/// (the Python package) stops the fit with [`crate::fit::interrupt::request_stop`], and gets
+/// [`Error::Interrupted`] naming the best-so-far result as the command does. `report_dir`:
+/// [`default_fit_dir`] unless the caller chooses another.
+pub fn fit_files(
+    job: &LoadedJob,
+    report_dir: &Path,
+    progress: bool,
+) -> Result<(crate::fit::FitResult, PathBuf)> {
     // Outputs that cannot be written are found now, not after the whole fit.
     crate::io::check_writable_file(&result_path(job))?;
     crate::io::check_writable_file(&interrupted_path(job))?;
     crate::io::check_creatable_dir(report_dir)?;
-    crate::fit::interrupt::install_signal_handler()?;
     let mut outcome = match crate::fit::run_fit(job, progress) {
         Err(_) if crate::fit::interrupt::stop_requested() => {
             return Err(Error::Interrupted { written: None });

@@ -40,6 +40,7 @@ mod modes;
 mod simulate;
 mod spectrum;
 
+pub use fit::{default_fit_dir, fit_files};
 pub use simulate::{BAUMGARTE_OMEGA_PER_S, SimulatedModel, StickChoice};
 pub use spectrum::BandArg;
 

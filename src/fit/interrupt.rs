@@ -11,6 +11,12 @@ pub fn request_stop() {
     STOP.store(true, Ordering::SeqCst);
 }
 
+/// Withdraws a stop request, so that the next fit in the same process runs (the Python package
+/// calls it before each fit; the command line runs one fit per process and never needs it).
+pub fn clear_stop() {
+    STOP.store(false, Ordering::SeqCst);
+}
+
 /// Whether a stop was requested.
 pub fn stop_requested() -> bool {
     STOP.load(Ordering::Relaxed)
