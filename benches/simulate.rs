@@ -124,6 +124,7 @@ fn cost(c: &mut Criterion) {
         likelihood: Err("built below".into()),
         evaluations: Arc::new(AtomicUsize::new(0)),
         failures: std::sync::Arc::new(AtomicUsize::new(0)),
+        failure_causes: Default::default(),
         first_failure: Mutex::new(None),
         near_best: Mutex::new(Default::default()),
     };

@@ -209,10 +209,15 @@ fn main_job_end_to_end() {
         .unwrap_or_else(|| panic!("no JSON object on stdout:\n{out}"));
     let r: serde_json::Value = serde_json::from_str(json_line).expect("stdout is JSON");
     assert_eq!(r["job"], "reversal");
-    // The result's warnings (here the harmonic ones) are printed once each on stderr.
+    // The result's warnings (here the harmonic ones) are printed once each on stderr, as
+    // `warning:` when they need attention and `note:` when they are for information.
     let warned: Vec<String> = stderr(&o)
         .lines()
-        .filter_map(|l| l.strip_prefix("warning: ").map(str::to_string))
+        .filter_map(|l| {
+            l.strip_prefix("warning: ")
+                .or_else(|| l.strip_prefix("note: "))
+                .map(str::to_string)
+        })
         .collect();
     let in_result: Vec<String> = r["warnings"]
         .as_array()

@@ -101,10 +101,11 @@ fn a_freed_head_mass_fits_with_the_head_frequency_held_and_reports_identifiabili
     assert_eq!(listed, !m.determined);
     if !m.determined {
         assert!(
-            out.result
-                .warnings
-                .iter()
-                .any(|w| w.starts_with("head_mass is not determined")),
+            out.result.warnings.iter().any(|w| matches!(
+                w,
+                wiperlab::fit::FitWarning::Undetermined { parameter }
+                    if *parameter == wiperlab::model::ParamId::HeadMass
+            )),
             "{:?}",
             out.result.warnings
         );

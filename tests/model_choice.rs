@@ -386,10 +386,10 @@ fn likelihood_choice_confusion_table() {
                 .and_then(|p| p.rel_error)
         };
         let pct = |e: Option<f64>| e.map_or("—".into(), |e| format!("{:+.2} %", 100.0 * e));
-        let absorbing: Vec<&String> = r
+        let absorbing: Vec<&wiperlab::fit::FitWarning> = r
             .warnings
             .iter()
-            .filter(|w| w.contains("absorbs structure"))
+            .filter(|w| matches!(w, wiperlab::fit::FitWarning::AbsorbsModelStructure { .. }))
             .collect();
         // Which parameters' Laplace intervals miss the truth, and each interval's half-width
         // (printed under the scene's line).

@@ -10,9 +10,10 @@ pub(super) fn fit(job: &Path, json: bool, quiet: bool, out_dir: Option<PathBuf>)
     let loaded = LoadedJob::load(job)?;
     let report_dir = out_dir.unwrap_or_else(|| report_dir(&loaded));
     let (result, result_path) = fit_and_write(&loaded, &report_dir, !quiet && !json)?;
-    // Each warning once, on stderr (also in the result file and on the report page).
+    // Each warning once, on stderr (also in the result file and on the report page): `warning:`
+    // when it needs attention, `note:` when it is normal on a good fit.
     for w in &result.warnings {
-        eprintln!("warning: {w}");
+        eprintln!("{}: {w}", severity_prefix(w.severity()));
     }
     if json {
         println!(
@@ -65,7 +66,7 @@ pub(super) fn report(job: &Path, refit: bool, quiet: bool, out_dir: Option<PathB
         },
     )?;
     for w in &summary.warnings {
-        eprintln!("warning: {w}");
+        eprintln!("{}: {w}", severity_prefix(w.severity()));
     }
     println!(
         "wrote {} ({} figures); open it in a browser",
@@ -73,6 +74,14 @@ pub(super) fn report(job: &Path, refit: bool, quiet: bool, out_dir: Option<PathB
         summary.figures.len()
     );
     Ok(())
+}
+
+/// How stderr marks a warning of `severity`.
+fn severity_prefix(severity: crate::fit::Severity) -> &'static str {
+    match severity {
+        crate::fit::Severity::Attention => "warning",
+        crate::fit::Severity::Information => "note",
+    }
 }
 
 /// `<job dir>/<name>.result.toml`.

@@ -30,6 +30,7 @@ mod select;
 pub mod template;
 pub mod tolerance;
 mod uncertainty;
+pub mod warning;
 
 pub use candidate::{Candidate, NECK_BAND_MIN_HZ, smallest_capable_model};
 pub use error::FitError;
@@ -45,6 +46,7 @@ pub use uncertainty::{
     ProfileStart, bootstrap_intervals, identifiability_warnings, laplace_intervals,
     profile_intervals_at, widen_to_near_best,
 };
+pub use warning::{FitWarning, Severity, Warnings};
 
 use crate::Result;
 use crate::model::BladeParams;
@@ -134,7 +136,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         pb.finish_and_clear();
     }
     let goodness_of_fit = gof.unwrap_or_else(|e| {
-        warnings.push(format!("no goodness-of-fit test: {e}"));
+        warnings.push(FitWarning::NoGoodnessOfFit { reason: e });
         None
     });
     let shoulder_listed = candidates.iter().any(|c| c.shoulder);
@@ -157,7 +159,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         tolerance_check
             .as_ref()
             .zip(runner_up(&selection.trials))
-            .and_then(|(t, (chosen, runner, gap))| t.choice_warning(&chosen, &runner, gap)),
+            .and_then(|(t, (chosen, runner, gap))| t.choice_warning(chosen, runner, gap)),
     );
     warnings.extend(failure_warning(&cf.problem));
     // The chosen model's counts include its bootstrap replicates and the tolerance check's
@@ -166,7 +168,9 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     chosen.model_evaluations = cf.problem.evaluations.load(Ordering::Relaxed);
     chosen.failed_evaluations = failures(&cf.problem).0;
     let modes = blade_modes(&best.params).unwrap_or_else(|e| {
-        warnings.push(format!("no blade modes at the fitted parameters: {e}"));
+        warnings.push(FitWarning::NoBladeModes {
+            reason: e.to_string(),
+        });
         Vec::new()
     });
     let result = assemble_result(
@@ -177,7 +181,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
             parameters,
             peaks,
             trials: selection.trials,
-            warnings,
+            warnings: warnings.into(),
             transitions: best.sim.transitions.len(),
             wall_time_s: started.elapsed().as_secs_f64(),
             input_sha256,
@@ -201,7 +205,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
 
 /// The chosen trial's name, the name of the trial with the AIC nearest to it among the others, and
 /// that AIC's distance above the chosen one's (`None` without two trials in likelihood units).
-fn runner_up(trials: &[result::ModelTrial]) -> Option<(String, String, f64)> {
+fn runner_up(trials: &[result::ModelTrial]) -> Option<(Candidate, Candidate, f64)> {
     let aic = |t: &result::ModelTrial| t.evidence.as_ref().map(|e| e.aic);
     let chosen = trials.iter().find(|t| t.chosen)?;
     let chosen_aic = aic(chosen)?;
@@ -211,7 +215,7 @@ fn runner_up(trials: &[result::ModelTrial]) -> Option<(String, String, f64)> {
         .filter_map(|t| Some((t, aic(t)? - chosen_aic)))
         .filter(|(_, gap)| gap.is_finite())
         .min_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
-        .map(|(t, gap)| (chosen.model.to_string(), t.model.to_string(), gap))
+        .map(|(t, gap)| (chosen.model, t.model, gap))
 }
 
 /// The chosen fit's goodness of fit to the recording's spectra
@@ -257,22 +261,10 @@ fn gof_ref(gof: &GoodnessOutcome) -> Option<&likelihood::GoodnessOfFit> {
 /// The warning of a fit whose spectra are less likely than its own noise makes likely.
 /// `shoulder_listed`: the job lists a `+shoulder` candidate; the warning then says how a known
 /// contact angle helps the search (docs/fit.md, "Shoulder contact").
-fn misfit_warning(g: &likelihood::GoodnessOfFit, shoulder_listed: bool) -> Option<String> {
-    (!g.fits()).then(|| {
-        let hint = if shoulder_listed {
-            "; a shoulder the neck touches only at the peaks of its swing has a basin a few per cent wide in theta_c that the search can miss: bounding [fit.shoulder] theta_c to a contact angle known from the blade's drawing lets it find one (docs/fit.md, \"Shoulder contact\")"
-        } else {
-            ""
-        };
-        format!(
-            "the chosen model does not explain the recording's spectra to their noise: excess NLL {:.1} nats against {:.1} ± {:.1} for {} noise replicates of the fit (p = {:.3}, {:.1}σ); the recording holds structure no candidate reproduces, or the search missed a candidate's basin, and the fitted parameters may be bent to absorb it{hint}",
-            g.excess_nll_nats,
-            g.replicate_mean_nats,
-            g.replicate_sd_nats,
-            g.replicates,
-            g.p_value,
-            g.z()
-        )
+fn misfit_warning(g: &likelihood::GoodnessOfFit, shoulder_listed: bool) -> Option<FitWarning> {
+    (!g.fits()).then_some(FitWarning::Misfit {
+        test: *g,
+        shoulder_listed,
     })
 }
 
@@ -295,7 +287,7 @@ fn chosen_intervals(
     best: &BestModel,
     fit: &job::FitSection,
     pb: &Option<indicatif::ProgressBar>,
-) -> Result<(Option<Vec<result::Interval>>, Vec<String>, bool)> {
+) -> Result<(Option<Vec<result::Interval>>, Vec<FitWarning>, bool)> {
     if let (Some(pb), true) = (
         pb,
         fit.uncertainty.method() == job::UncertaintyMethod::Bootstrap,
@@ -312,9 +304,7 @@ fn chosen_intervals(
     };
     let interrupted = interrupt::stop_requested();
     if interrupted {
-        warnings.push(
-            "interrupted: the best point the search had reached, without the remaining restarts, candidates, curvature or intervals".into(),
-        );
+        warnings.push(FitWarning::Interrupted);
     }
     Ok((intervals, warnings, interrupted))
 }
@@ -430,23 +420,37 @@ fn peak_comparison(
     }
 }
 
-/// Warnings for lines that are harmonics of stronger lines or lie more than 100× below their
-/// spectrum's dominant line ([`crate::spectrum::harmonics`]): the band then does not see the
-/// component it was meant for.
-fn line_warnings(peaks: &[PeakComparison]) -> Vec<String> {
+/// Warnings for lines that are harmonics of stronger lines, barely stand over their floor, or lie
+/// more than 100× below their spectrum's dominant line ([`crate::spectrum::harmonics`]): the band
+/// then may not see the component it was meant for. Each says whether the other spectrum's line in
+/// the band is the same harmonic (then the fit compares like with like).
+fn line_warnings(peaks: &[PeakComparison]) -> Vec<FitWarning> {
+    use warning::LineSource;
+    let order = |o: Option<crate::spectrum::harmonics::LineOrigin>| {
+        o.and_then(|o| o.harmonic_of).map(|h| h.order)
+    };
     let mut w = Vec::new();
     for p in peaks {
-        if let Some(c) = p
-            .measured_line
-            .and_then(|o| o.concern(&format!("the recording's line in band '{}'", p.band)))
-        {
-            w.push(c);
-        }
-        if let Some(c) = p
-            .model_line
-            .and_then(|o| o.concern(&format!("the model's line in band '{}'", p.band)))
-        {
-            w.push(c);
+        let same =
+            order(p.measured_line).is_some() && order(p.measured_line) == order(p.model_line);
+        for (source, line) in [
+            (LineSource::Recording, p.measured_line),
+            (LineSource::Model, p.model_line),
+        ] {
+            let Some(origin) = line else { continue };
+            let warning = FitWarning::Line {
+                band: p.band.clone(),
+                source,
+                origin,
+                same_harmonic_on_other_side: same,
+            };
+            let what = match source {
+                LineSource::Recording => "the recording's line",
+                LineSource::Model => "the model's line",
+            };
+            if origin.concern(what).is_some() {
+                w.push(warning);
+            }
         }
     }
     w
@@ -469,16 +473,33 @@ pub(crate) fn failures(problem: &SpectralProblem) -> (usize, Option<String>) {
     (failed, first)
 }
 
-/// A warning when more than a tenth of the chosen model's evaluations failed.
-fn failure_warning(problem: &SpectralProblem) -> Option<String> {
+/// A warning when more than [`warning::FAILED_WARN_FRACTION`] of the chosen model's evaluations
+/// failed, with the failures by cause.
+fn failure_warning(problem: &SpectralProblem) -> Option<FitWarning> {
     let evaluations = problem.evaluations.load(Ordering::Relaxed);
     let (failed, first) = failures(problem);
-    (failed * 10 > evaluations).then(|| {
-        format!(
-            "{failed} of {evaluations} model evaluations failed (first: {}); the bounds reach parameter sets the model cannot simulate",
-            first.unwrap_or_default()
-        )
+    (failed as f64 > warning::FAILED_WARN_FRACTION * evaluations as f64).then(|| {
+        FitWarning::FailedEvaluations {
+            failed,
+            evaluations,
+            causes: failure_causes(problem),
+            first,
+        }
     })
+}
+
+/// The chosen problem's failed evaluations by cause (its own and its joint recordings').
+fn failure_causes(
+    problem: &SpectralProblem,
+) -> std::collections::BTreeMap<explore::FailureCause, usize> {
+    let mut causes = std::collections::BTreeMap::new();
+    for p in std::iter::once(problem).chain(&problem.others) {
+        let by = p.failure_causes.lock().unwrap_or_else(|e| e.into_inner());
+        for (c, n) in by.iter() {
+            *causes.entry(*c).or_insert(0) += n;
+        }
+    }
+    causes
 }
 
 /// What the stages computed, for [`assemble_result`].
@@ -487,7 +508,7 @@ struct Assembled {
     parameters: Vec<FittedParam>,
     peaks: Vec<PeakComparison>,
     trials: Vec<ModelTrial>,
-    warnings: Vec<String>,
+    warnings: Warnings,
     transitions: usize,
     wall_time_s: f64,
     input_sha256: String,
@@ -577,9 +598,23 @@ mod tests {
         let replicates: Vec<f64> = (0..999).map(|i| 60.0 + 0.04 * f64::from(i)).collect();
         let above_all = likelihood::GoodnessOfFit::of(171.0, &replicates).unwrap();
         let w = misfit_warning(&above_all, false).expect("p = 0.001 is below the level");
-        assert!(w.contains("171.0 nats") && w.contains("p = 0.001"), "{w}");
-        assert!(!w.contains("theta_c"), "{w}");
-        let with_shoulder = misfit_warning(&above_all, true).expect("the same test");
+        assert_eq!(
+            w,
+            FitWarning::Misfit {
+                test: above_all,
+                shoulder_listed: false
+            }
+        );
+        assert_eq!(w.severity(), Severity::Attention);
+        let text = w.to_string();
+        assert!(
+            text.contains("171.0 nats") && text.contains("p = 0.001"),
+            "{text}"
+        );
+        assert!(!text.contains("theta_c"), "{text}");
+        let with_shoulder = misfit_warning(&above_all, true)
+            .expect("the same test")
+            .to_string();
         assert!(
             with_shoulder.contains("[fit.shoulder] theta_c"),
             "{with_shoulder}"

@@ -13,8 +13,11 @@ use crate::simulate::SolverOptions;
 use crate::simulate::blade::{BladeSimulation, ModelKind, simulate_model};
 use argmin::core::CostFunction;
 use serde::Serialize;
+use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
+
+use super::explore::FailureCause;
 
 /// Cost assigned to a parameter set whose simulation fails (contact loss, Painlevé, ...). Failures
 /// are counted and the first message is reported; they are never silent.
@@ -113,6 +116,8 @@ pub struct SpectralProblem {
     pub evaluations: Arc<AtomicUsize>,
     /// Failed evaluations, shared like `evaluations` with the bootstrap's replicate problems.
     pub failures: Arc<AtomicUsize>,
+    /// Failed evaluations by cause, shared like `failures`.
+    pub failure_causes: Arc<Mutex<BTreeMap<FailureCause, usize>>>,
     pub first_failure: Mutex<Option<String>>,
     /// The polish-stage evaluations found about as likely as the best one
     /// ([`EvaluatedNearBest`]), which the intervals read.
@@ -343,6 +348,12 @@ impl SpectralProblem {
         self.evaluations.fetch_add(1, Ordering::Relaxed);
         run().inspect_err(|e| {
             self.failures.fetch_add(1, Ordering::Relaxed);
+            *self
+                .failure_causes
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .entry(FailureCause::of(e))
+                .or_insert(0) += 1;
             let mut g = self.first_failure.lock().unwrap_or_else(|e| e.into_inner());
             if g.is_none() {
                 *g = Some(e.to_string());

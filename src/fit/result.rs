@@ -339,9 +339,11 @@ pub struct FitResult {
     /// Models tried, when the fit compared several (empty: only `model` was fitted).
     #[serde(default)]
     pub model_trials: Vec<ModelTrial>,
-    /// Warnings for the reader (undetermined parameters, bounds reached, ...), one sentence each.
-    #[serde(default)]
-    pub warnings: Vec<String>,
+    /// Warnings for the reader (undetermined parameters, bounds reached, ...): in the file,
+    /// `warnings` holds one sentence each and `warning_details` each one's severity, kind and
+    /// numbers ([`super::Warnings`]).
+    #[serde(flatten)]
+    pub warnings: crate::fit::Warnings,
     /// SHA-256 (lower-case hex) of the recording file the fit read; empty if not recorded.
     #[serde(default)]
     pub input_sha256: String,
@@ -541,7 +543,13 @@ mod tests {
             solver_atol: 1e-10,
             transitions_in_best_model: 10,
             model_trials: vec![sample_trial()],
-            warnings: vec!["w".into()],
+            warnings: vec![
+                crate::fit::FitWarning::Undetermined {
+                    parameter: ParamId::K1,
+                },
+                crate::fit::FitWarning::Text { text: "w".into() },
+            ]
+            .into(),
             input_sha256: "ab".into(),
             settings: "name = \"j\"\n".into(),
             target_job: true,
@@ -600,6 +608,7 @@ mod tests {
             "model",
             "model_trials",
             "warnings",
+            "warning_details",
             "input_sha256",
             "settings",
             "target_job",

@@ -473,6 +473,7 @@ fn problem_of(
         likelihood: Err("not built yet".into()),
         evaluations,
         failures: Arc::new(AtomicUsize::new(0)),
+        failure_causes: Default::default(),
         first_failure: Mutex::new(None),
         near_best: Mutex::new(Default::default()),
     };

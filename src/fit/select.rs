@@ -281,7 +281,7 @@ pub(super) fn absorbing_warnings(
     fits: &[CandidateFit],
     chosen: usize,
     bands: &[BandSpec],
-) -> Vec<String> {
+) -> Vec<super::FitWarning> {
     let c = &fits[chosen];
     if c.evidence.is_err() {
         return Vec::new();
@@ -304,13 +304,14 @@ pub(super) fn absorbing_warnings(
             let so = o.sigma_u[m] * o.free[m].slope(o.best_u[m]);
             let s = sc.max(so);
             if s.is_finite() && (vc - vo).abs() > s {
-                w.push(format!(
-                    "{} moves from {vc:.6} ({}) to {vo:.6} ({}), {:.1}σ: it absorbs structure one model has and the other has not, so its value depends on the model choice",
-                    fp.name,
-                    c.candidate,
-                    o.candidate,
-                    (vc - vo).abs() / s
-                ));
+                w.push(super::FitWarning::AbsorbsModelStructure {
+                    parameter: fp.name,
+                    chosen: c.candidate,
+                    value: vc,
+                    other: o.candidate,
+                    other_value: vo,
+                    sigmas: (vc - vo).abs() / s,
+                });
             }
         }
     }

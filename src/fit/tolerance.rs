@@ -12,7 +12,7 @@
 //! smaller than the spread do not tell parameter sets apart, and intervals read from the local
 //! curvature at the 0.5-nat scale understate the uncertainty. The check costs two simulations.
 
-use super::SpectralProblem;
+use super::{Candidate, FitWarning, SpectralProblem};
 use serde::{Deserialize, Serialize};
 
 /// Factors by which the probes divide the job's `rtol` and `atol`.
@@ -146,43 +146,38 @@ impl ToleranceCheck {
 
     /// The warning of an optimum the integrator does not resolve, or whose probes all failed;
     /// `None` when it is resolved.
-    pub fn warning(&self) -> Option<String> {
+    pub fn warning(&self) -> Option<FitWarning> {
         match self.verdict() {
-            Verdict::Resolved => return None,
-            Verdict::NotProbed => {
-                return Some(format!(
-                    "the tolerance check did not run: every probe failed ({}), so it is not known whether the integrator resolves the likelihood at the optimum (docs/fit.md, \"Tolerance check\")",
-                    self.failed.join("; ")
-                ));
-            }
-            Verdict::Unresolved => {}
+            Verdict::Resolved => None,
+            Verdict::NotProbed => Some(FitWarning::ToleranceNotProbed {
+                failures: self.failed.clone(),
+            }),
+            Verdict::Unresolved => Some(FitWarning::ToleranceUnresolved {
+                points: self.points.clone(),
+                spread_nats: self.spread_nats,
+            }),
         }
-        let at = |p: &TolerancePoint| {
-            format!(
-                "{:.3} nats at rtol {:e} ({} transitions)",
-                p.cost_nats, p.rtol, p.transitions
-            )
-        };
-        let points: Vec<String> = self.points.iter().map(at).collect();
-        Some(format!(
-            "the likelihood at the optimum is not resolved by the integrator: {} ({:.2} nats apart, more than the {SPREAD_WARN_NATS} nats of a 1σ interval); the stick–slip sequence hangs on grazing events, so the cost surface is rough at that depth, cost differences below it do not tell parameter sets apart and the intervals understate the uncertainty (docs/fit.md, \"Tolerance check\")",
-            crate::names::join(&points, ", "),
-            self.spread_nats
-        ))
     }
 
     /// The warning of a model choice the integrator does not resolve: `chosen` over `runner_up`,
     /// whose AIC is `aic_gap` above the chosen one's (`aic_gap / 2` nats of log-likelihood once
     /// the penalties are counted), when the optimum's cost spreads by more than that; `None`
     /// otherwise.
-    pub fn choice_warning(&self, chosen: &str, runner_up: &str, aic_gap: f64) -> Option<String> {
+    pub fn choice_warning(
+        &self,
+        chosen: Candidate,
+        runner_up: Candidate,
+        aic_gap: f64,
+    ) -> Option<FitWarning> {
         let gap_nats = aic_gap.abs() / 2.0;
-        (aic_gap.is_finite() && self.spread_nats > gap_nats).then(|| {
-            format!(
-                "the choice of {chosen} over {runner_up} (ΔAIC {aic_gap:.2}, {gap_nats:.2} nats) is smaller than the {:.2} nats the chosen optimum's cost moves between solver tolerances: the integrator does not resolve it (docs/fit.md, \"Tolerance check\")",
-                self.spread_nats
-            )
-        })
+        (aic_gap.is_finite() && self.spread_nats > gap_nats).then_some(
+            FitWarning::ChoiceUnresolved {
+                chosen,
+                runner_up,
+                aic_gap,
+                spread_nats: self.spread_nats,
+            },
+        )
     }
 }
 
@@ -215,10 +210,16 @@ mod tests {
         assert!((apart.spread_nats - 2.2).abs() < 1e-9);
         let w = apart.warning().expect("a 2.2-nat spread warns");
         assert!(
-            w.contains("66.830 nats at rtol 1e-8 (168 transitions)"),
-            "{w}"
+            matches!(&w, FitWarning::ToleranceUnresolved { points, spread_nats }
+                if points.len() == 3 && (spread_nats - 2.2).abs() < 1e-9),
+            "{w:?}"
         );
-        assert!(w.contains("2.20 nats apart"), "{w}");
+        let text = w.to_string();
+        assert!(
+            text.contains("66.830 nats at rtol 1e-8 (168 transitions)"),
+            "{text}"
+        );
+        assert!(text.contains("2.20 nats apart"), "{text}");
     }
 
     #[test]
@@ -226,15 +227,23 @@ mod tests {
         let apart =
             ToleranceCheck::of(vec![point(1e-8, 66.8, 168), point(1e-9, 68.0, 170)], vec![]);
         // 1.2 nats of spread against ΔAIC 2.0 (1.0 nat): unresolved; against ΔAIC 3.0: resolved.
-        let w = apart
-            .choice_warning("blade2dof", "blade2dof+shoulder", 2.0)
-            .expect("1.2 nats > 1.0");
+        let (a, b): (Candidate, Candidate) = (
+            "blade2dof".parse().unwrap(),
+            "blade2dof+shoulder".parse().unwrap(),
+        );
+        let w = apart.choice_warning(a, b, 2.0).expect("1.2 nats > 1.0");
         assert!(
-            w.contains("blade2dof over blade2dof+shoulder (ΔAIC 2.00, 1.00 nats)"),
+            matches!(w, FitWarning::ChoiceUnresolved { chosen, runner_up, .. }
+                if chosen == a && runner_up == b),
+            "{w:?}"
+        );
+        assert!(
+            w.to_string()
+                .contains("blade2dof over blade2dof+shoulder (ΔAIC 2.00, 1.00 nats)"),
             "{w}"
         );
-        assert!(apart.choice_warning("a", "b", 3.0).is_none());
-        assert!(apart.choice_warning("a", "b", f64::INFINITY).is_none());
+        assert!(apart.choice_warning(a, b, 3.0).is_none());
+        assert!(apart.choice_warning(a, b, f64::INFINITY).is_none());
     }
 
     #[test]
@@ -243,9 +252,12 @@ mod tests {
         assert_eq!(alone.spread_nats, 0.0);
         assert!(!alone.resolved());
         let w = alone.warning().expect("an unchecked optimum warns");
-        assert!(
-            w.contains("did not run") && w.contains("rtol 1e-9: x"),
-            "{w}"
+        assert_eq!(
+            w,
+            FitWarning::ToleranceNotProbed {
+                failures: vec!["rtol 1e-9: x".into()]
+            }
         );
+        assert!(w.to_string().contains("did not run"), "{w}");
     }
 }

@@ -9,6 +9,7 @@ use super::search::{
     CandidateFit, Confirmation, POLISH_STEP_U, ProgressObserver, Reporting, optimise, polish,
     polish_pinned,
 };
+use super::warning::{End, FitWarning};
 use crate::Result;
 use crate::simulate::blade::BladeSimulation;
 use crate::spectrum::stats::quantile_sorted;
@@ -30,12 +31,9 @@ pub(super) fn intervals(
     best_sim: &BladeSimulation,
     fit: &job::FitSection,
     pb: &Option<indicatif::ProgressBar>,
-) -> Result<(Option<Vec<Interval>>, Vec<String>)> {
+) -> Result<(Option<Vec<Interval>>, Vec<FitWarning>)> {
     if cf.problem.targets.is_some() {
-        return Ok((
-            None,
-            vec!["no intervals for a target job: targets carry no measurement noise".into()],
-        ));
+        return Ok((None, vec![FitWarning::TargetJobIntervals]));
     }
     match fit.uncertainty.method() {
         UncertaintyMethod::Laplace => match &cf.evidence {
@@ -45,7 +43,13 @@ pub(super) fn intervals(
                 warnings.extend(near_best_of(cf, &mut intervals));
                 Ok((Some(intervals), warnings))
             }
-            Err(why) => Ok((None, vec![format!("no Laplace intervals: {why}")])),
+            Err(why) => Ok((
+                None,
+                vec![FitWarning::NoIntervals {
+                    method: UncertaintyMethod::Laplace,
+                    reason: why.to_string(),
+                }],
+            )),
         },
         UncertaintyMethod::Profile => match &cf.evidence {
             Ok(_) => {
@@ -55,13 +59,15 @@ pub(super) fn intervals(
             }
             Err(why) => Ok((
                 None,
-                vec![format!("no profile-likelihood intervals: {why}")],
+                vec![FitWarning::NoIntervals {
+                    method: UncertaintyMethod::Profile,
+                    reason: why.to_string(),
+                }],
             )),
         },
-        UncertaintyMethod::Bootstrap if fit.uncertainty.bootstrap == 0 => Ok((
-            None,
-            vec!["no bootstrap intervals: [fit.uncertainty] bootstrap = 0 replicates".into()],
-        )),
+        UncertaintyMethod::Bootstrap if fit.uncertainty.bootstrap == 0 => {
+            Ok((None, vec![FitWarning::NoBootstrapReplicates]))
+        }
         UncertaintyMethod::Bootstrap => {
             let intervals = bootstrap_intervals(&cf.problem, &cf.best_u, best_sim, fit)?;
             Ok((Some(intervals), Vec::new()))
@@ -210,7 +216,7 @@ fn profile_intervals(
     cf: &CandidateFit,
     fit: &job::FitSection,
     pb: &Option<indicatif::ProgressBar>,
-) -> Result<(Vec<Interval>, Vec<String>)> {
+) -> Result<(Vec<Interval>, Vec<FitWarning>)> {
     let at = ProfileStart::of(cf);
     let progress = pb.as_ref().map(|bar| {
         // The bar's estimate: two steps a side, each polish its simplex and ten iterations (on
@@ -274,7 +280,7 @@ pub fn profile_intervals_at(
     problem: &Arc<SpectralProblem>,
     at: ProfileStart,
     polish_iterations: u64,
-) -> Result<(Vec<Interval>, Vec<String>)> {
+) -> Result<(Vec<Interval>, Vec<FitWarning>)> {
     profile_with(problem, at, polish_iterations, None)
 }
 
@@ -284,7 +290,7 @@ fn profile_with(
     at: ProfileStart,
     polish_iterations: u64,
     progress: Option<ProgressObserver>,
-) -> Result<(Vec<Interval>, Vec<String>)> {
+) -> Result<(Vec<Interval>, Vec<FitWarning>)> {
     use rayon::prelude::*;
     let n = at.u.len();
     let limit = |i: usize| profile_rise_limit(at.sigma_u[i], at.fisher_sigma_u[i]);
@@ -344,30 +350,28 @@ fn profile_with(
 
 /// [`profile_intervals_at`]'s warnings for one parameter: a side that reached the search box's
 /// bound, and a point more likely than the fit.
-fn profile_warnings(fp: &FreeParam, limit: f64, lo: ProfileEnd, hi: ProfileEnd) -> Vec<String> {
+fn profile_warnings(fp: &FreeParam, limit: f64, lo: ProfileEnd, hi: ProfileEnd) -> Vec<FitWarning> {
     let mut warnings = Vec::new();
-    let bounds: Vec<&str> = [(lo, "lower"), (hi, "upper")]
+    let bounds: Vec<End> = [(lo, End::Lower), (hi, End::Upper)]
         .iter()
         .filter(|(e, _)| e.at_bound)
         .map(|(_, s)| *s)
         .collect();
     if !bounds.is_empty() {
-        warnings.push(format!(
-            "{}'s profile likelihood stays within {limit:.3} nats of the fit up to its search \
-             box's {} bound: the recording does not bound it there",
-            fp.name,
-            bounds.join(" and ")
-        ));
+        warnings.push(FitWarning::ProfileAtBound {
+            parameter: fp.name,
+            rise_limit_nats: limit,
+            bounds,
+        });
     }
-    for (e, side) in [(lo, "lower"), (hi, "upper")] {
+    for (e, end) in [(lo, End::Lower), (hi, End::Upper)] {
         if !e.closed && !e.at_bound {
-            warnings.push(format!(
-                "{}'s profile likelihood stays within {limit:.3} nats of the fit over the walk's \
-                 {PROFILE_MAX_STEPS} steps: its {side} end ({:.4e}) is the last step, not where \
-                 the likelihood bounds it",
-                fp.name,
-                fp.value(e.u)
-            ));
+            warnings.push(FitWarning::ProfileOpen {
+                parameter: fp.name,
+                rise_limit_nats: limit,
+                end,
+                value: fp.value(e.u),
+            });
         }
     }
     let lowest = if lo.lowest_rise_nats <= hi.lowest_rise_nats {
@@ -376,20 +380,17 @@ fn profile_warnings(fp: &FreeParam, limit: f64, lo: ProfileEnd, hi: ProfileEnd) 
         hi
     };
     if lowest.lowest_rise_nats < -super::search::CONFIRM_NATS {
-        warnings.push(format!(
-            "{}'s profile met a point {:.2} nats more likely than the fit ({} = {:.4e}): the \
-             search ended short of the likelihood's maximum",
-            fp.name,
-            -lowest.lowest_rise_nats,
-            fp.name,
-            fp.value(lowest.lowest_u)
-        ));
+        warnings.push(FitWarning::ProfileMoreLikely {
+            parameter: fp.name,
+            gain_nats: -lowest.lowest_rise_nats,
+            value: fp.value(lowest.lowest_u),
+        });
     }
     warnings
 }
 
 /// [`widen_to_near_best`] on the chosen fit, with the points its problem kept.
-fn near_best_of(cf: &CandidateFit, intervals: &mut [Interval]) -> Vec<String> {
+fn near_best_of(cf: &CandidateFit, intervals: &mut [Interval]) -> Vec<FitWarning> {
     let at = ProfileStart::of(cf);
     let near = cf
         .problem
@@ -417,7 +418,7 @@ pub fn widen_to_near_best(
     at: ProfileStart,
     near: &super::problem::EvaluatedNearBest,
     intervals: &mut [Interval],
-) -> Vec<String> {
+) -> Vec<FitWarning> {
     let mut warnings = Vec::new();
     for (i, fp) in free.iter().enumerate() {
         let limit = profile_rise_limit(at.sigma_u[i], at.fisher_sigma_u[i]);
@@ -431,21 +432,18 @@ pub fn widen_to_near_best(
         widen(&mut intervals[i], p_lo, p_hi);
         let (lo, hi) = (intervals[i].lo, intervals[i].hi);
         if (lo0 - lo) + (hi - hi0) > NEAR_BEST_WARN_WIDTH * (hi0 - lo0) {
-            warnings.push(format!(
-                "{}: points the search evaluated within {limit:.2} nats of the fit span \
-                 {p_lo:.4e} to {p_hi:.4e}, beyond the method's own interval [{lo0:.4e}, \
-                 {hi0:.4e}]: the likelihood is flatter there than that interval says, so it is \
-                 widened to [{lo:.4e}, {hi:.4e}]",
-                fp.name
-            ));
+            warnings.push(FitWarning::WidenedInterval {
+                parameter: fp.name,
+                rise_limit_nats: limit,
+                points: [p_lo, p_hi],
+                method: [lo0, hi0],
+                widened: [lo, hi],
+            });
         }
     }
     let gain = at.cost_nats - near.lowest();
     if gain > super::search::CONFIRM_NATS {
-        warnings.push(format!(
-            "the search evaluated a point {gain:.2} nats more likely than the fit: it ended short \
-             of its own best evaluation"
-        ));
+        warnings.push(FitWarning::ShortOfBestEvaluation { gain_nats: gain });
     }
     warnings
 }
@@ -490,17 +488,12 @@ pub const PROFILE_68_NATS: f64 = 0.5;
 /// others only raises the cost), so the two intervals are widened to contain it. Returns a warning
 /// naming the span found; nothing when the fit frees no such triple or no point qualifies. Costs
 /// up to 4 simulations.
-fn along_contact_ridge(cf: &CandidateFit, intervals: &mut [Interval]) -> Vec<String> {
+fn along_contact_ridge(cf: &CandidateFit, intervals: &mut [Interval]) -> Vec<FitWarning> {
     let cost = |u: &[f64]| cf.problem.cost_at(u);
-    match widen_along_ridge(&cf.free, &cf.best_u, cf.cost, cost, intervals) {
-        Some((lo, hi)) => vec![format!(
-            "k1 and theta_c trade along the shoulder's contact-moment ridge ((k1c − k1)·θ_c held): \
-             k1 from {lo:.4e} to {hi:.4e} N·m/rad stays within {PROFILE_68_NATS} nats of the fit, so \
-             both intervals span it; the recording determines the moment at contact, not k1 and \
-             theta_c apart"
-        )],
-        None => Vec::new(),
-    }
+    widen_along_ridge(&cf.free, &cf.best_u, cf.cost, cost, intervals)
+        .map(|(k1_lo, k1_hi)| FitWarning::ContactRidge { k1_lo, k1_hi })
+        .into_iter()
+        .collect()
 }
 
 /// The point of the contact-moment ridge through `(k1, k1c, theta_c)` with free stiffness
@@ -727,6 +720,7 @@ impl ReplicateSource {
             likelihood: Err("not built yet".into()),
             evaluations: problem.evaluations.clone(),
             failures: problem.failures.clone(),
+            failure_causes: problem.failure_causes.clone(),
             first_failure: Mutex::new(None),
             near_best: Mutex::new(Default::default()),
         })
@@ -751,13 +745,10 @@ pub fn identifiability_warnings(
     params: &[FittedParam],
     corr: &[Vec<f64>],
     best_u: &[f64],
-) -> Vec<String> {
+) -> Vec<FitWarning> {
     let mut w = Vec::new();
     for p in params.iter().filter(|p| !p.determined) {
-        w.push(format!(
-            "{} is not determined by the data: its 1σ spans 10 % or more of its search range",
-            p.name
-        ));
+        w.push(FitWarning::Undetermined { parameter: p.name });
     }
     for i in 0..params.len() {
         for j in (i + 1)..params.len() {
@@ -767,21 +758,21 @@ pub fn identifiability_warnings(
                 .copied()
                 .unwrap_or(f64::NAN);
             if r.abs() > 0.95 {
-                w.push(format!(
-                    "{} and {} trade off (correlation {r:+.3}): the data pin down a combination of them, not each",
-                    params[i].name, params[j].name
-                ));
+                w.push(FitWarning::TradeOff {
+                    first: params[i].name,
+                    second: params[j].name,
+                    correlation: r,
+                });
             }
         }
     }
     for (p, u) in params.iter().zip(best_u) {
         if *u <= 0.005 || *u >= 0.995 {
-            w.push(format!(
-                "{} ended on its {} bound ({}); widen the bound or fix the parameter",
-                p.name,
-                if *u <= 0.005 { "lower" } else { "upper" },
-                p.value
-            ));
+            w.push(FitWarning::OnBound {
+                parameter: p.name,
+                bound: if *u <= 0.005 { End::Lower } else { End::Upper },
+                value: p.value,
+            });
         }
     }
     w
@@ -875,28 +866,44 @@ mod tests {
         assert!(profile_warnings(&k1, 0.2, end(0.4, false, -0.3), end(0.6, false, 0.0)).is_empty());
         let w = profile_warnings(&k1, 0.2, end(0.0, true, 0.0), end(0.6, false, -1.25));
         assert_eq!(w.len(), 2, "{w:?}");
-        assert!(
-            w[0].contains("k1's profile likelihood stays within 0.200 nats"),
-            "{}",
-            w[0]
+        assert_eq!(
+            w[0],
+            FitWarning::ProfileAtBound {
+                parameter: ParamId::K1,
+                rise_limit_nats: 0.2,
+                bounds: vec![End::Lower],
+            }
         );
-        assert!(w[0].contains("box's lower bound"), "{}", w[0]);
+        assert!(w[0].to_string().contains("box's lower bound"), "{}", w[0]);
         // A walk that ran out of steps under the limit, away from the bound.
         let open = ProfileEnd {
             closed: false,
             ..end(0.6, false, 0.0)
         };
         let w_open = profile_warnings(&k1, 0.2, end(0.4, false, 0.0), open);
-        assert_eq!(w_open.len(), 1, "{w_open:?}");
-        assert!(w_open[0].contains("its upper end"), "{}", w_open[0]);
         assert!(
-            w[1].contains("a point 1.25 nats more likely than the fit"),
-            "{}",
-            w[1]
+            matches!(
+                w_open[..],
+                [FitWarning::ProfileOpen {
+                    parameter: ParamId::K1,
+                    end: End::Upper,
+                    ..
+                }]
+            ),
+            "{w_open:?}"
         );
         // The point's value: u = 0.6 on k1's log axis, 0.005·30^0.6.
         let v = 0.005 * 30f64.powf(0.6);
-        assert!(w[1].contains(&format!("k1 = {v:.4e}")), "{}", w[1]);
+        let FitWarning::ProfileMoreLikely {
+            parameter: ParamId::K1,
+            gain_nats,
+            value,
+        } = w[1]
+        else {
+            panic!("{:?}", w[1]);
+        };
+        assert_eq!(gain_nats, 1.25);
+        assert!((value - v).abs() < 1e-12 * v, "{value} {v}");
     }
 
     #[test]
@@ -1043,10 +1050,15 @@ mod tests {
         assert_eq!(iv[0].widened_from, Some([iv0[0].lo, iv0[0].hi]));
         assert!((iv[1].lo - iv0[1].lo).abs() < 1e-12 && (iv[1].hi - iv0[1].hi).abs() < 1e-12);
         assert_eq!(w.len(), 1, "{w:?}");
-        assert!(
-            w[0].starts_with("A: points the search evaluated"),
-            "{}",
-            w[0]
+        assert_eq!(
+            w[0],
+            FitWarning::WidenedInterval {
+                parameter: ParamId::A,
+                rise_limit_nats: 0.5,
+                points: [iv[0].lo, iv[0].hi],
+                method: [iv0[0].lo, iv0[0].hi],
+                widened: [iv[0].lo, iv[0].hi],
+            }
         );
         // One point 1.125 nats below the bowl at Δu = (0.005, 0), where the bowl is 0.125: a
         // point 1 nat more likely than the fit, which the search ended short of.
@@ -1058,7 +1070,10 @@ mod tests {
         let near = evaluated_grid(&u0, 0.05, dip);
         let w = widen_to_near_best(&free, at, &near, &mut iv);
         assert!(
-            w.iter().any(|m| m.contains("1.00 nats more likely")),
+            w.iter().any(|m| matches!(
+                m,
+                FitWarning::ShortOfBestEvaluation { gain_nats } if (gain_nats - 1.0).abs() < 1e-9
+            )),
             "{w:?}"
         );
     }

@@ -25,6 +25,8 @@ use crate::fit::Candidate;
 use crate::fit::features::SignalKind;
 use crate::fit::job::FitSection;
 use crate::fit::result::{FitResult, sha256_file};
+use crate::fit::{FitWarning, Severity};
+pub use crate::report::warning::PageWarning;
 use crate::simulate::blade::ModelKind;
 use crate::{Error, Result};
 use serde::Serialize;
@@ -56,7 +58,7 @@ pub struct ReportSummary {
     /// Figures `wiperlab fit` writes for this result that are not in the directory.
     pub missing_figures: Vec<String>,
     /// Every warning shown on the page.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<PageWarning>,
 }
 
 /// The figures `wiperlab fit` always writes for a result (file name, caption), in page order; the
@@ -114,7 +116,7 @@ pub const OPTIONAL_FIGURES: &[(&str, &str)] = &[(
 
 /// A number with `sig` significant digits: plain for 1e-3 ≤ |x| < 1e5, else scientific; "—" for
 /// NaN, "±∞" spelled out.
-fn num(x: f64, sig: usize) -> String {
+pub(super) fn num(x: f64, sig: usize) -> String {
     if x.is_nan() {
         return "—".into();
     }
@@ -497,6 +499,25 @@ struct ProvenanceView<'a> {
     written_utc: &'a str,
 }
 
+/// One warning as the page lists it: its headline, and the full sentence folded under it.
+#[derive(Serialize)]
+struct WarningView {
+    headline: String,
+    details: Option<String>,
+}
+
+/// The warnings of one severity, in the order given.
+fn warning_views(warnings: &[PageWarning], severity: Severity) -> Vec<WarningView> {
+    warnings
+        .iter()
+        .filter(|w| w.severity() == severity)
+        .map(|w| WarningView {
+            headline: w.headline(),
+            details: w.details(),
+        })
+        .collect()
+}
+
 #[derive(Serialize)]
 struct FigureView<'a> {
     file: &'a str,
@@ -534,7 +555,9 @@ struct PageView<'a> {
     tolerance_check: Option<String>,
     modes: Vec<ModeView>,
     correlation: Vec<CorrelationRow>,
-    warnings: &'a [String],
+    /// Warnings that need the reader's attention, and those for information.
+    attention: Vec<WarningView>,
+    information: Vec<WarningView>,
     figures: Vec<FigureView<'a>>,
     /// A target job (no recording): the page has a reachability-map section.
     target_job: bool,
@@ -591,7 +614,7 @@ fn page_view<'a>(
     r: &'a FitResult,
     figures: &'a [Figure],
     map: Option<&'a Figure>,
-    warnings: &'a [String],
+    warnings: &[PageWarning],
     prov: &'a Provenance,
 ) -> PageView<'a> {
     let (parameters, interval_methods) = parameter_rows(r);
@@ -626,7 +649,8 @@ fn page_view<'a>(
         tolerance_check: r.tolerance_check.as_ref().map(tolerance_check_words),
         modes: mode_rows(r),
         correlation: if pd { correlation_rows(r) } else { Vec::new() },
-        warnings,
+        attention: warning_views(warnings, Severity::Attention),
+        information: warning_views(warnings, Severity::Information),
         figures: figures
             .iter()
             .map(|f| FigureView {
@@ -679,7 +703,7 @@ pub fn render_html(
     r: &FitResult,
     figures: &[Figure],
     map: Option<&Figure>,
-    warnings: &[String],
+    warnings: &[PageWarning],
     prov: &Provenance,
 ) -> std::result::Result<String, minijinja::Error> {
     let mut env = minijinja::Environment::new();
@@ -703,22 +727,21 @@ pub fn write_report(r: &FitResult, paths: &ReportPaths) -> Result<ReportSummary>
     let (figures, missing) = report_figures(r, dir)?;
     let mut warnings = result_warnings(r);
     if !missing.is_empty() {
-        warnings.push(format!(
-            "figures missing from {}: {} (run `wiperlab report --refit` to redraw them)",
-            dir.display(),
-            missing.join(", ")
-        ));
+        warnings.push(PageWarning::FiguresMissing {
+            dir: dir.clone(),
+            files: missing.clone(),
+        });
     }
     let now_hash = sha256_file(&paths.recording).map_err(|e| e.to_string());
     match &now_hash {
-        Ok(h) if !r.input_sha256.is_empty() && *h != r.input_sha256 => warnings.push(format!(
-            "the recording {} has changed since the fit (SHA-256 {} now, {} at fit time); refit \
-             with `wiperlab report --refit`",
-            paths.recording.display(),
-            h,
-            r.input_sha256
-        )),
-        Err(m) => warnings.push(format!("cannot hash the recording: {m}")),
+        Ok(h) if !r.input_sha256.is_empty() && *h != r.input_sha256 => {
+            warnings.push(PageWarning::RecordingChanged {
+                path: paths.recording.clone(),
+                sha256_now: h.clone(),
+                sha256_at_fit: r.input_sha256.clone(),
+            })
+        }
+        Err(m) => warnings.push(PageWarning::CannotHashRecording { reason: m.clone() }),
         _ => {}
     }
 
@@ -810,29 +833,35 @@ fn exploration_map(r: &FitResult, dir: &Path) -> Option<Figure> {
     })
 }
 
-/// The result's own warnings, one per undetermined parameter they do not already name, and one
-/// for failed model evaluations.
-fn result_warnings(r: &FitResult) -> Vec<String> {
-    let mut warnings = r.warnings.clone();
+/// The result's own warnings; one per undetermined parameter they do not already name; and, when
+/// model evaluations failed but the result does not warn about the chosen model's failures, one
+/// for the failures over all candidates.
+fn result_warnings(r: &FitResult) -> Vec<PageWarning> {
+    let names = |w: &FitWarning, p: crate::model::ParamId| match w {
+        FitWarning::Text { text } => text.contains(p.name()),
+        w => w.parameter() == Some(p),
+    };
+    let mut warnings: Vec<PageWarning> = r.warnings.iter().cloned().map(PageWarning::Fit).collect();
     for p in &r.parameters {
-        if !p.determined && !warnings.iter().any(|w| w.contains(p.name.name())) {
-            warnings.push(format!(
-                "the data leave {} undetermined (1σ {} over a search range [{}, {}]); read its \
-                 value with care and see the correlations",
-                p.name,
-                num(p.std_error, 3),
-                num(p.lower, 4),
-                num(p.upper, 4)
-            ));
+        if !p.determined && !r.warnings.iter().any(|w| names(w, p.name)) {
+            warnings.push(PageWarning::Undetermined {
+                parameter: p.name,
+                std_error: p.std_error,
+                lower: p.lower,
+                upper: p.upper,
+            });
         }
     }
-    if r.failed_evaluations > 0 {
-        warnings.push(format!(
-            "{} of {} model evaluations failed and were given the failure cost; first: {}",
-            r.failed_evaluations,
-            r.model_evaluations,
-            r.first_failure.as_deref().unwrap_or("(not recorded)")
-        ));
+    let fit_warned = r
+        .warnings
+        .iter()
+        .any(|w| matches!(w, FitWarning::FailedEvaluations { .. }));
+    if r.failed_evaluations > 0 && !fit_warned {
+        warnings.push(PageWarning::FailedEvaluations {
+            failed: r.failed_evaluations,
+            evaluations: r.model_evaluations,
+            first: r.first_failure.clone(),
+        });
     }
     warnings
 }
@@ -942,7 +971,7 @@ pub(super) mod tests {
             solver_atol: 1e-10,
             transitions_in_best_model: 10,
             model_trials: vec![],
-            warnings: vec![],
+            warnings: Default::default(),
             input_sha256: sha256_hex(b"the recording at fit time"),
             settings: String::new(),
             target_job: false,
@@ -990,12 +1019,47 @@ pub(super) mod tests {
             s.missing_figures,
             ["traces_tip.svg", "traces_head.svg", "friction_law.svg"]
         );
-        let has = |needle: &str| s.warnings.iter().any(|w| w.contains(needle));
-        assert!(has("leave B undetermined"), "{:?}", s.warnings);
-        assert!(has("2 of 30 model evaluations failed"), "{:?}", s.warnings);
-        assert!(has("figures missing"), "{:?}", s.warnings);
-        assert!(has("has changed since the fit"), "{:?}", s.warnings);
+        let has = |f: &dyn Fn(&PageWarning) -> bool| s.warnings.iter().any(f);
+        assert!(
+            has(&|w| matches!(w, PageWarning::Undetermined { parameter, .. }
+                if *parameter == crate::model::ParamId::B)),
+            "{:?}",
+            s.warnings
+        );
+        assert!(
+            has(&|w| matches!(
+                w,
+                PageWarning::FailedEvaluations {
+                    failed: 2,
+                    evaluations: 30,
+                    ..
+                }
+            )),
+            "{:?}",
+            s.warnings
+        );
+        assert!(
+            has(&|w| matches!(w, PageWarning::FiguresMissing { files, .. } if files.len() == 3)),
+            "{:?}",
+            s.warnings
+        );
+        assert!(
+            has(&|w| matches!(w, PageWarning::RecordingChanged { .. })),
+            "{:?}",
+            s.warnings
+        );
         assert_eq!(s.warnings.len(), 4, "{:?}", s.warnings);
+        // Failed evaluations below the fit's own threshold are for information; the rest need
+        // attention.
+        let severities: Vec<Severity> = s.warnings.iter().map(PageWarning::severity).collect();
+        assert_eq!(
+            severities
+                .iter()
+                .filter(|s| **s == Severity::Information)
+                .count(),
+            1,
+            "{severities:?}"
+        );
         let html = std::fs::read_to_string(&s.path).unwrap();
         assert!(html.contains("<td>[0.02800, 0.03200] (68 %)<sup>1</sup></td>"));
         assert!(html.contains(
@@ -1107,7 +1171,10 @@ pub(super) mod tests {
             recording_sha256_now: Err("gone & away".into()),
             written_utc: "now".into(),
         };
-        let html = render_html(&r, &figures, None, &["<i>w</i>".into()], &prov).unwrap();
+        let text = PageWarning::Fit(FitWarning::Text {
+            text: "<i>w</i>".into(),
+        });
+        let html = render_html(&r, &figures, None, &[text], &prov).unwrap();
         assert!(
             html.contains("<h1>Fit report: &lt;b&gt;job&lt;/b&gt;</h1>"),
             "{html}"

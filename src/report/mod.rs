@@ -3,6 +3,7 @@
 //! * [`plot`]: SVG line charts (traces, PSDs with peak markers) and spectrogram heat maps.
 //! * [`figures`]: which figures each command writes.
 //! * [`html`]: the report page `reports/<job>/index.html`.
+//! * [`warning`]: the page's warnings, by severity, with a headline and the full sentence.
 //! * [`campaign`]: a campaign's report page, `<campaign dir>/<name>/report/index.html`.
 
 pub mod campaign;
@@ -11,5 +12,6 @@ pub mod explore;
 pub mod figures;
 pub mod html;
 pub mod plot;
+pub mod warning;
 
 pub use error::{HeatmapProblem, ReportError};

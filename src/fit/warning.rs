@@ -1,0 +1,725 @@
+//! What a fit warns its reader about: [`FitWarning`], one variant per kind of warning carrying its
+//! numbers, with a [`Severity`] and the sentence it renders ([`std::fmt::Display`]).
+//!
+//! The result file keeps both: `warnings`, the sentences (what a reader, and a reader written for
+//! result files without kinds, reads), and `warning_details`, each warning's severity, kind and
+//! numbers ([`Warnings`]). A result written without `warning_details` loads each sentence as
+//! [`FitWarning::Text`].
+//!
+//! Severity, per kind (docs/report.md, "Warnings"): a warning **needs attention** when the result
+//! may be wrong or incomplete as it stands (a misfit, an interval open at a bound, a search that
+//! ended short of its own best point, an optimum the integrator does not resolve, ...); it is **for
+//! information** when it is normal on a good fit and the reported numbers already account for it
+//! (an interval widened to points the search evaluated, a band that sees the same harmonic in the
+//! recording and in the model, model evaluations that failed where the lip tip would leave the
+//! glass).
+
+use super::Candidate;
+use super::explore::FailureCause;
+use super::job::UncertaintyMethod;
+use super::likelihood::GoodnessOfFit;
+use super::tolerance::{SPREAD_WARN_NATS, TolerancePoint};
+use super::uncertainty::{PROFILE_68_NATS, PROFILE_MAX_STEPS};
+use crate::model::ParamId;
+use crate::names::named_enum;
+use crate::spectrum::harmonics::{LineOrigin, MIN_PROMINENCE};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::fmt;
+
+named_enum! {
+    /// How much a warning asks of its reader.
+    pub enum Severity: "severity" {
+        /// The result may be wrong or incomplete as it stands: act on it before using the numbers.
+        Attention => "attention",
+        /// Normal on a good fit; the reported numbers already account for it.
+        Information => "information",
+    }
+}
+
+named_enum! {
+    /// Which end of a parameter's search range or interval.
+    pub enum End: "end" {
+        Lower => "lower",
+        Upper => "upper",
+    }
+}
+
+named_enum! {
+    /// Whose spectrum a line belongs to.
+    pub enum LineSource: "line source" {
+        /// The recording's (or, for a target job, the target's).
+        Recording => "recording",
+        /// The fitted model's.
+        Model => "model",
+    }
+}
+
+/// Fraction of the model evaluations above which failures are worth a warning at all.
+pub const FAILED_WARN_FRACTION: f64 = 0.1;
+
+/// Fraction of the model evaluations above which failures need attention whatever their cause:
+/// the search then spends most of its budget where the model cannot go.
+pub const FAILED_ATTENTION_FRACTION: f64 = 0.5;
+
+/// One warning of a fit, with its numbers. Serialised (in `warning_details`) as a table tagged by
+/// `kind`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum FitWarning {
+    /// The fit was stopped by SIGINT or SIGTERM.
+    Interrupted,
+    /// The goodness-of-fit test could not run.
+    NoGoodnessOfFit { reason: String },
+    /// The chosen model does not explain the recording's spectra to their noise.
+    Misfit {
+        test: GoodnessOfFit,
+        /// The job lists a `+shoulder` candidate (the sentence then says how a known contact
+        /// angle helps the search).
+        shoulder_listed: bool,
+    },
+    /// A parameter moves between the chosen model and another capable one by more than the larger
+    /// of their 1σ.
+    AbsorbsModelStructure {
+        parameter: ParamId,
+        chosen: Candidate,
+        value: f64,
+        other: Candidate,
+        other_value: f64,
+        /// The move in units of the larger 1σ.
+        sigmas: f64,
+    },
+    /// A band's line is a harmonic of a stronger line, barely stands over its floor, or lies far
+    /// below the spectrum's dominant line.
+    Line {
+        band: String,
+        source: LineSource,
+        origin: LineOrigin,
+        /// The other spectrum's line in the band is the same harmonic (same order) of its own
+        /// fundamental: the fit compares like with like.
+        same_harmonic_on_other_side: bool,
+    },
+    /// A parameter's 1σ spans 10 % or more of its search range.
+    Undetermined { parameter: ParamId },
+    /// Two parameters correlated beyond ±0.95.
+    TradeOff {
+        first: ParamId,
+        second: ParamId,
+        correlation: f64,
+    },
+    /// A parameter ended on a bound of its search range.
+    OnBound {
+        parameter: ParamId,
+        bound: End,
+        value: f64,
+    },
+    /// A profile-likelihood walk reached the search box's bound below the rise limit.
+    ProfileAtBound {
+        parameter: ParamId,
+        rise_limit_nats: f64,
+        bounds: Vec<End>,
+    },
+    /// A profile-likelihood walk ran out of steps below the rise limit.
+    ProfileOpen {
+        parameter: ParamId,
+        rise_limit_nats: f64,
+        end: End,
+        /// The walk's last point, the parameter's unit.
+        value: f64,
+    },
+    /// A profile walk met a point more likely than the fit.
+    ProfileMoreLikely {
+        parameter: ParamId,
+        gain_nats: f64,
+        value: f64,
+    },
+    /// An interval widened to points the search evaluated inside the profile region.
+    WidenedInterval {
+        parameter: ParamId,
+        rise_limit_nats: f64,
+        /// The span of those points.
+        points: [f64; 2],
+        /// The method's own interval.
+        method: [f64; 2],
+        /// The interval reported.
+        widened: [f64; 2],
+    },
+    /// The search evaluated a point more likely than the fit.
+    ShortOfBestEvaluation { gain_nats: f64 },
+    /// k1 and theta_c trade along the shoulder's contact-moment ridge; both intervals span it.
+    ContactRidge { k1_lo: f64, k1_hi: f64 },
+    /// The job's interval method gave no intervals.
+    NoIntervals {
+        method: UncertaintyMethod,
+        reason: String,
+    },
+    /// A target job has no intervals: its targets carry no measurement noise.
+    TargetJobIntervals,
+    /// `[fit.uncertainty] bootstrap = 0` with the bootstrap method.
+    NoBootstrapReplicates,
+    /// Every probe of the tolerance check failed.
+    ToleranceNotProbed { failures: Vec<String> },
+    /// The optimum's cost moves between solver tolerances by more than [`SPREAD_WARN_NATS`].
+    ToleranceUnresolved {
+        points: Vec<TolerancePoint>,
+        spread_nats: f64,
+    },
+    /// The model choice's AIC gap is smaller than the tolerance spread.
+    ChoiceUnresolved {
+        chosen: Candidate,
+        runner_up: Candidate,
+        aic_gap: f64,
+        spread_nats: f64,
+    },
+    /// More than [`FAILED_WARN_FRACTION`] of the chosen model's evaluations failed.
+    FailedEvaluations {
+        failed: usize,
+        evaluations: usize,
+        /// Failures by cause (empty when not recorded).
+        #[serde(default)]
+        causes: BTreeMap<FailureCause, usize>,
+        first: Option<String>,
+    },
+    /// The blade's modes at the fitted parameters could not be computed.
+    NoBladeModes { reason: String },
+    /// A warning read from a result written before warnings had kinds: its sentence only.
+    Text { text: String },
+}
+
+impl FitWarning {
+    /// How much the warning asks of its reader (module docs; docs/report.md, "Warnings").
+    pub fn severity(&self) -> Severity {
+        use FitWarning::*;
+        match self {
+            WidenedInterval { .. }
+            | ContactRidge { .. }
+            | TradeOff { .. }
+            | TargetJobIntervals
+            | NoBootstrapReplicates
+            | NoBladeModes { .. } => Severity::Information,
+            Line {
+                origin,
+                same_harmonic_on_other_side,
+                ..
+            } => {
+                let weak = origin.prominence.is_nan() || origin.prominence < MIN_PROMINENCE;
+                let far_below = origin.below_dominant > 100.0;
+                let lone_harmonic = origin.harmonic_of.is_some() && !same_harmonic_on_other_side;
+                if weak || far_below || lone_harmonic {
+                    Severity::Attention
+                } else {
+                    Severity::Information
+                }
+            }
+            FailedEvaluations {
+                failed,
+                evaluations,
+                causes,
+                ..
+            } => {
+                let unreachable = |c: &FailureCause| {
+                    matches!(c, FailureCause::ContactLoss | FailureCause::Painleve)
+                };
+                let physical = !causes.is_empty()
+                    && causes.iter().all(|(c, n)| *n == 0 || unreachable(c))
+                    && causes.values().sum::<usize>() == *failed;
+                if physical && (*failed as f64) <= FAILED_ATTENTION_FRACTION * *evaluations as f64 {
+                    Severity::Information
+                } else {
+                    Severity::Attention
+                }
+            }
+            Interrupted
+            | NoGoodnessOfFit { .. }
+            | Misfit { .. }
+            | AbsorbsModelStructure { .. }
+            | Undetermined { .. }
+            | OnBound { .. }
+            | ProfileAtBound { .. }
+            | ProfileOpen { .. }
+            | ProfileMoreLikely { .. }
+            | ShortOfBestEvaluation { .. }
+            | NoIntervals { .. }
+            | ToleranceNotProbed { .. }
+            | ToleranceUnresolved { .. }
+            | ChoiceUnresolved { .. }
+            | Text { .. } => Severity::Attention,
+        }
+    }
+
+    /// The kind's name in the result file (`kind` of `warning_details`).
+    pub fn kind(&self) -> &'static str {
+        use FitWarning::*;
+        match self {
+            Interrupted => "interrupted",
+            NoGoodnessOfFit { .. } => "no_goodness_of_fit",
+            Misfit { .. } => "misfit",
+            AbsorbsModelStructure { .. } => "absorbs_model_structure",
+            Line { .. } => "line",
+            Undetermined { .. } => "undetermined",
+            TradeOff { .. } => "trade_off",
+            OnBound { .. } => "on_bound",
+            ProfileAtBound { .. } => "profile_at_bound",
+            ProfileOpen { .. } => "profile_open",
+            ProfileMoreLikely { .. } => "profile_more_likely",
+            WidenedInterval { .. } => "widened_interval",
+            ShortOfBestEvaluation { .. } => "short_of_best_evaluation",
+            ContactRidge { .. } => "contact_ridge",
+            NoIntervals { .. } => "no_intervals",
+            TargetJobIntervals => "target_job_intervals",
+            NoBootstrapReplicates => "no_bootstrap_replicates",
+            ToleranceNotProbed { .. } => "tolerance_not_probed",
+            ToleranceUnresolved { .. } => "tolerance_unresolved",
+            ChoiceUnresolved { .. } => "choice_unresolved",
+            FailedEvaluations { .. } => "failed_evaluations",
+            NoBladeModes { .. } => "no_blade_modes",
+            Text { .. } => "text",
+        }
+    }
+
+    /// The parameter the warning is about, when it is about one.
+    pub fn parameter(&self) -> Option<ParamId> {
+        use FitWarning::*;
+        match self {
+            AbsorbsModelStructure { parameter, .. }
+            | Undetermined { parameter }
+            | OnBound { parameter, .. }
+            | ProfileAtBound { parameter, .. }
+            | ProfileOpen { parameter, .. }
+            | ProfileMoreLikely { parameter, .. }
+            | WidenedInterval { parameter, .. } => Some(*parameter),
+            _ => None,
+        }
+    }
+}
+
+/// `name`'s line in `band` as the line warnings name it.
+fn line_name(source: LineSource, band: &str) -> String {
+    match source {
+        LineSource::Recording => format!("the recording's line in band '{band}'"),
+        LineSource::Model => format!("the model's line in band '{band}'"),
+    }
+}
+
+impl fmt::Display for FitWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        use FitWarning::*;
+        match self {
+            Interrupted => f.write_str(
+                "interrupted: the best point the search had reached, without the remaining \
+                 restarts, candidates, curvature or intervals",
+            ),
+            NoGoodnessOfFit { reason } => write!(f, "no goodness-of-fit test: {reason}"),
+            Misfit {
+                test: g,
+                shoulder_listed,
+            } => {
+                write!(
+                    f,
+                    "the chosen model does not explain the recording's spectra to their noise: \
+                     excess NLL {:.1} nats against {:.1} ± {:.1} for {} noise replicates of the \
+                     fit (p = {:.3}, {:.1}σ); the recording holds structure no candidate \
+                     reproduces, or the search missed a candidate's basin, and the fitted \
+                     parameters may be bent to absorb it",
+                    g.excess_nll_nats,
+                    g.replicate_mean_nats,
+                    g.replicate_sd_nats,
+                    g.replicates,
+                    g.p_value,
+                    g.z()
+                )?;
+                if *shoulder_listed {
+                    f.write_str(
+                        "; a shoulder the neck touches only at the peaks of its swing has a basin \
+                         a few per cent wide in theta_c that the search can miss: bounding \
+                         [fit.shoulder] theta_c to a contact angle known from the blade's drawing \
+                         lets it find one (docs/fit.md, \"Shoulder contact\")",
+                    )?;
+                }
+                Ok(())
+            }
+            AbsorbsModelStructure {
+                parameter,
+                chosen,
+                value,
+                other,
+                other_value,
+                sigmas,
+            } => write!(
+                f,
+                "{parameter} moves from {value:.6} ({chosen}) to {other_value:.6} ({other}), \
+                 {sigmas:.1}σ: it absorbs structure one model has and the other has not, so its \
+                 value depends on the model choice"
+            ),
+            Line {
+                band,
+                source,
+                origin,
+                ..
+            } => f.write_str(
+                &origin
+                    .concern(&line_name(*source, band))
+                    .unwrap_or_else(|| format!("{} needs no warning", line_name(*source, band))),
+            ),
+            Undetermined { parameter } => write!(
+                f,
+                "{parameter} is not determined by the data: its 1σ spans 10 % or more of its \
+                 search range"
+            ),
+            TradeOff {
+                first,
+                second,
+                correlation,
+            } => write!(
+                f,
+                "{first} and {second} trade off (correlation {correlation:+.3}): the data pin \
+                 down a combination of them, not each"
+            ),
+            OnBound {
+                parameter,
+                bound,
+                value,
+            } => write!(
+                f,
+                "{parameter} ended on its {bound} bound ({value}); widen the bound or fix the \
+                 parameter"
+            ),
+            ProfileAtBound {
+                parameter,
+                rise_limit_nats,
+                bounds,
+            } => write!(
+                f,
+                "{parameter}'s profile likelihood stays within {rise_limit_nats:.3} nats of the \
+                 fit up to its search box's {} bound: the recording does not bound it there",
+                bounds
+                    .iter()
+                    .map(|b| b.name())
+                    .collect::<Vec<_>>()
+                    .join(" and ")
+            ),
+            ProfileOpen {
+                parameter,
+                rise_limit_nats,
+                end,
+                value,
+            } => write!(
+                f,
+                "{parameter}'s profile likelihood stays within {rise_limit_nats:.3} nats of the \
+                 fit over the walk's {PROFILE_MAX_STEPS} steps: its {end} end ({value:.4e}) is \
+                 the last step, not where the likelihood bounds it"
+            ),
+            ProfileMoreLikely {
+                parameter,
+                gain_nats,
+                value,
+            } => write!(
+                f,
+                "{parameter}'s profile met a point {gain_nats:.2} nats more likely than the fit \
+                 ({parameter} = {value:.4e}): the search ended short of the likelihood's maximum"
+            ),
+            WidenedInterval {
+                parameter,
+                rise_limit_nats,
+                points: [p_lo, p_hi],
+                method: [lo0, hi0],
+                widened: [lo, hi],
+            } => write!(
+                f,
+                "{parameter}: points the search evaluated within {rise_limit_nats:.2} nats of the \
+                 fit span {p_lo:.4e} to {p_hi:.4e}, beyond the method's own interval \
+                 [{lo0:.4e}, {hi0:.4e}]: the likelihood is flatter there than that interval \
+                 says, so it is widened to [{lo:.4e}, {hi:.4e}]"
+            ),
+            ShortOfBestEvaluation { gain_nats } => write!(
+                f,
+                "the search evaluated a point {gain_nats:.2} nats more likely than the fit: it \
+                 ended short of its own best evaluation"
+            ),
+            ContactRidge { k1_lo, k1_hi } => write!(
+                f,
+                "k1 and theta_c trade along the shoulder's contact-moment ridge ((k1c − k1)·θ_c \
+                 held): k1 from {k1_lo:.4e} to {k1_hi:.4e} N·m/rad stays within \
+                 {PROFILE_68_NATS} nats of the fit, so both intervals span it; the recording \
+                 determines the moment at contact, not k1 and theta_c apart"
+            ),
+            NoIntervals { method, reason } => match method {
+                UncertaintyMethod::Laplace => write!(f, "no Laplace intervals: {reason}"),
+                UncertaintyMethod::Profile => {
+                    write!(f, "no profile-likelihood intervals: {reason}")
+                }
+                UncertaintyMethod::Bootstrap => write!(f, "no bootstrap intervals: {reason}"),
+            },
+            TargetJobIntervals => {
+                f.write_str("no intervals for a target job: targets carry no measurement noise")
+            }
+            NoBootstrapReplicates => {
+                f.write_str("no bootstrap intervals: [fit.uncertainty] bootstrap = 0 replicates")
+            }
+            ToleranceNotProbed { failures } => write!(
+                f,
+                "the tolerance check did not run: every probe failed ({}), so it is not known \
+                 whether the integrator resolves the likelihood at the optimum (docs/fit.md, \
+                 \"Tolerance check\")",
+                failures.join("; ")
+            ),
+            ToleranceUnresolved {
+                points,
+                spread_nats,
+            } => {
+                let at: Vec<String> = points
+                    .iter()
+                    .map(|p| {
+                        format!(
+                            "{:.3} nats at rtol {:e} ({} transitions)",
+                            p.cost_nats, p.rtol, p.transitions
+                        )
+                    })
+                    .collect();
+                write!(
+                    f,
+                    "the likelihood at the optimum is not resolved by the integrator: {} ({:.2} \
+                     nats apart, more than the {SPREAD_WARN_NATS} nats of a 1σ interval); the \
+                     stick–slip sequence hangs on grazing events, so the cost surface is rough \
+                     at that depth, cost differences below it do not tell parameter sets apart \
+                     and the intervals understate the uncertainty (docs/fit.md, \"Tolerance \
+                     check\")",
+                    crate::names::join(&at, ", "),
+                    spread_nats
+                )
+            }
+            ChoiceUnresolved {
+                chosen,
+                runner_up,
+                aic_gap,
+                spread_nats,
+            } => write!(
+                f,
+                "the choice of {chosen} over {runner_up} (ΔAIC {aic_gap:.2}, {:.2} nats) is \
+                 smaller than the {spread_nats:.2} nats the chosen optimum's cost moves between \
+                 solver tolerances: the integrator does not resolve it (docs/fit.md, \
+                 \"Tolerance check\")",
+                aic_gap.abs() / 2.0
+            ),
+            FailedEvaluations {
+                failed,
+                evaluations,
+                first,
+                ..
+            } => write!(
+                f,
+                "{failed} of {evaluations} model evaluations failed (first: {}); the bounds reach \
+                 parameter sets the model cannot simulate",
+                first.as_deref().unwrap_or_default()
+            ),
+            NoBladeModes { reason } => {
+                write!(f, "no blade modes at the fitted parameters: {reason}")
+            }
+            Text { text } => f.write_str(text),
+        }
+    }
+}
+
+/// A fit's warnings, in the order the fit found them. In the result file: `warnings`, their
+/// sentences, and `warning_details`, each one's severity and its kind with its numbers
+/// ([`WarningsFile`]).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(from = "WarningsFile", into = "WarningsFile")]
+pub struct Warnings(pub Vec<FitWarning>);
+
+impl std::ops::Deref for Warnings {
+    type Target = Vec<FitWarning>;
+    fn deref(&self) -> &Vec<FitWarning> {
+        &self.0
+    }
+}
+
+impl std::ops::DerefMut for Warnings {
+    fn deref_mut(&mut self) -> &mut Vec<FitWarning> {
+        &mut self.0
+    }
+}
+
+impl From<Vec<FitWarning>> for Warnings {
+    fn from(v: Vec<FitWarning>) -> Self {
+        Warnings(v)
+    }
+}
+
+impl<'a> IntoIterator for &'a Warnings {
+    type Item = &'a FitWarning;
+    type IntoIter = std::slice::Iter<'a, FitWarning>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.0.iter()
+    }
+}
+
+/// One entry of `warning_details`: the severity the fit gave the warning (for scripts; a reader
+/// recomputes it from the kind) and the warning.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct WarningDetail {
+    severity: Severity,
+    warning: FitWarning,
+}
+
+/// [`Warnings`] as the result file holds them.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+struct WarningsFile {
+    /// One sentence per warning.
+    #[serde(default)]
+    warnings: Vec<String>,
+    /// Each warning's severity, kind and numbers, in the order of `warnings`; absent in results
+    /// written before warnings had kinds.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    warning_details: Vec<WarningDetail>,
+}
+
+impl From<Warnings> for WarningsFile {
+    fn from(w: Warnings) -> Self {
+        WarningsFile {
+            warnings: w.0.iter().map(ToString::to_string).collect(),
+            warning_details: w
+                .0
+                .into_iter()
+                .map(|warning| WarningDetail {
+                    severity: warning.severity(),
+                    warning,
+                })
+                .collect(),
+        }
+    }
+}
+
+impl From<WarningsFile> for Warnings {
+    /// The details when there is one per sentence, else the sentences as [`FitWarning::Text`].
+    fn from(f: WarningsFile) -> Self {
+        if f.warning_details.len() == f.warnings.len() {
+            Warnings(f.warning_details.into_iter().map(|d| d.warning).collect())
+        } else {
+            Warnings(
+                f.warnings
+                    .into_iter()
+                    .map(|text| FitWarning::Text { text })
+                    .collect(),
+            )
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spectrum::harmonics::Fundamental;
+
+    fn harmonic_line(source: LineSource, matched: bool) -> FitWarning {
+        FitWarning::Line {
+            band: "low".into(),
+            source,
+            origin: LineOrigin {
+                freq_hz: 49.88,
+                prominence: 338.0,
+                harmonic_of: Some(Fundamental {
+                    freq_hz: 24.63,
+                    order: 2,
+                    level_ratio: 69.5,
+                }),
+                dominant_hz: 24.63,
+                below_dominant: 69.5,
+            },
+            same_harmonic_on_other_side: matched,
+        }
+    }
+
+    #[test]
+    fn a_harmonic_both_spectra_share_is_information_and_renders_the_concern() {
+        let w = harmonic_line(LineSource::Recording, true);
+        assert_eq!(w.severity(), Severity::Information);
+        assert_eq!(
+            w.to_string(),
+            "the recording's line in band 'low' at 49.88 Hz is harmonic 2 of a line at 24.63 Hz \
+             that is 69.5× stronger (a stick–slip comb: the band sees a harmonic, not the \
+             cycle's fundamental)"
+        );
+        // The model's line its own while the recording's is a harmonic: not like with like.
+        assert_eq!(
+            harmonic_line(LineSource::Recording, false).severity(),
+            Severity::Attention
+        );
+        // A weak line needs attention even when both sides agree.
+        let mut weak = harmonic_line(LineSource::Model, true);
+        if let FitWarning::Line { origin, .. } = &mut weak {
+            origin.prominence = f64::NAN;
+        }
+        assert_eq!(weak.severity(), Severity::Attention);
+    }
+
+    #[test]
+    fn failures_where_the_lip_would_leave_the_glass_are_information_up_to_half() {
+        let failed =
+            |failed: usize, causes: &[(FailureCause, usize)]| FitWarning::FailedEvaluations {
+                failed,
+                evaluations: 1000,
+                causes: causes.iter().copied().collect(),
+                first: Some("contact lost".into()),
+            };
+        let contact = failed(400, &[(FailureCause::ContactLoss, 400)]);
+        assert_eq!(contact.severity(), Severity::Information);
+        assert_eq!(
+            contact.to_string(),
+            "400 of 1000 model evaluations failed (first: contact lost); the bounds reach \
+             parameter sets the model cannot simulate"
+        );
+        let most = failed(600, &[(FailureCause::ContactLoss, 600)]);
+        assert_eq!(most.severity(), Severity::Attention);
+        let numeric = failed(
+            200,
+            &[
+                (FailureCause::ContactLoss, 150),
+                (FailureCause::StepBudget, 50),
+            ],
+        );
+        assert_eq!(numeric.severity(), Severity::Attention);
+        // Causes not recorded: not known to be harmless.
+        assert_eq!(failed(200, &[]).severity(), Severity::Attention);
+    }
+
+    #[test]
+    fn the_file_keeps_sentences_and_details_and_reads_sentences_alone() {
+        let w: Warnings = vec![
+            harmonic_line(LineSource::Model, true),
+            FitWarning::OnBound {
+                parameter: ParamId::K1,
+                bound: End::Upper,
+                value: 0.15,
+            },
+        ]
+        .into();
+        #[derive(Serialize, Deserialize)]
+        struct Holder {
+            #[serde(flatten)]
+            w: Warnings,
+        }
+        let text = toml::to_string(&Holder { w: w.clone() }).unwrap();
+        let t: toml::Table = toml::from_str(&text).unwrap();
+        let sentences = t["warnings"].as_array().unwrap();
+        assert_eq!(
+            sentences[1].as_str(),
+            Some("k1 ended on its upper bound (0.15); widen the bound or fix the parameter")
+        );
+        let details = t["warning_details"].as_array().unwrap();
+        assert_eq!(details[0]["severity"].as_str(), Some("information"));
+        assert_eq!(details[1]["warning"]["kind"].as_str(), Some("on_bound"));
+        let back: Holder = toml::from_str(&text).unwrap();
+        assert_eq!(back.w, w);
+        // A result without details: each sentence as text, needing attention.
+        let old: Holder = toml::from_str("warnings = [\"something odd\"]\n").unwrap();
+        assert_eq!(
+            old.w.0,
+            [FitWarning::Text {
+                text: "something odd".into()
+            }]
+        );
+        assert_eq!(old.w[0].severity(), Severity::Attention);
+        assert_eq!(old.w[0].kind(), "text");
+    }
+}

@@ -1,0 +1,406 @@
+//! The report page's warnings: the result's own ([`FitWarning`]) and what the page finds itself
+//! ([`PageWarning`]), each with a [`Severity`], a one-line headline that says what to do, and the
+//! full sentence ([`std::fmt::Display`]) the page folds under it.
+
+use super::html::num;
+use crate::fit::explore::FailureCause;
+use crate::fit::job::UncertaintyMethod;
+use crate::fit::warning::LineSource;
+use crate::fit::{FitWarning, Severity};
+use crate::model::ParamId;
+use crate::spectrum::harmonics::{LineOrigin, MIN_PROMINENCE};
+use std::fmt;
+use std::path::PathBuf;
+
+/// One warning on the report page.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PageWarning {
+    /// One of the result's own warnings.
+    Fit(FitWarning),
+    /// A parameter the result marks undetermined that none of its warnings names.
+    Undetermined {
+        parameter: ParamId,
+        std_error: f64,
+        lower: f64,
+        upper: f64,
+    },
+    /// Model evaluations over all candidates failed, and the result does not warn about the
+    /// chosen model's failures (fewer than a tenth of its evaluations).
+    FailedEvaluations {
+        failed: usize,
+        evaluations: usize,
+        first: Option<String>,
+    },
+    /// Figures the fit writes that are not in the report directory.
+    FiguresMissing { dir: PathBuf, files: Vec<String> },
+    /// The recording's SHA-256 differs from the one fitted.
+    RecordingChanged {
+        path: PathBuf,
+        sha256_now: String,
+        sha256_at_fit: String,
+    },
+    /// The recording could not be read to hash it.
+    CannotHashRecording { reason: String },
+}
+
+impl PageWarning {
+    /// How much the warning asks of its reader.
+    pub fn severity(&self) -> Severity {
+        match self {
+            PageWarning::Fit(w) => w.severity(),
+            PageWarning::FailedEvaluations { .. } => Severity::Information,
+            PageWarning::Undetermined { .. }
+            | PageWarning::FiguresMissing { .. }
+            | PageWarning::RecordingChanged { .. }
+            | PageWarning::CannotHashRecording { .. } => Severity::Attention,
+        }
+    }
+
+    /// One line for the page: what was found and, where the reader should act, what to do.
+    pub fn headline(&self) -> String {
+        match self {
+            PageWarning::Fit(w) => fit_headline(w),
+            PageWarning::Undetermined {
+                parameter,
+                std_error,
+                lower,
+                upper,
+            } => format!(
+                "The data leave {parameter} undetermined (1σ {} over a search range [{}, {}]): \
+                 read its value with care, or fix it from another measurement.",
+                num(*std_error, 3),
+                num(*lower, 4),
+                num(*upper, 4)
+            ),
+            PageWarning::FailedEvaluations {
+                failed,
+                evaluations,
+                ..
+            } => format!(
+                "{failed} of {evaluations} model evaluations over all candidates ({}) failed and \
+                 were given the failure cost, fewer than a tenth of the chosen model's: the \
+                 search moves away from them.",
+                share(*failed, *evaluations)
+            ),
+            PageWarning::FiguresMissing { files, .. } => format!(
+                "Figures missing: {}. Run `wiperlab report --refit` to redraw them.",
+                files.join(", ")
+            ),
+            PageWarning::RecordingChanged { .. } => "The recording has changed since the fit: \
+                 refit with `wiperlab report --refit`."
+                .into(),
+            PageWarning::CannotHashRecording { .. } => "The recording cannot be read, so the page \
+                 cannot check that it is the one fitted."
+                .into(),
+        }
+    }
+
+    /// The full sentence, when it says more than [`PageWarning::headline`].
+    pub fn details(&self) -> Option<String> {
+        match self {
+            PageWarning::Fit(FitWarning::Text { .. }) => None,
+            other => Some(other.to_string()),
+        }
+    }
+}
+
+impl fmt::Display for PageWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PageWarning::Fit(w) => w.fmt(f),
+            PageWarning::Undetermined {
+                parameter,
+                std_error,
+                lower,
+                upper,
+            } => write!(
+                f,
+                "the data leave {parameter} undetermined (1σ {} over a search range [{}, {}]); \
+                 read its value with care and see the correlations",
+                num(*std_error, 3),
+                num(*lower, 4),
+                num(*upper, 4)
+            ),
+            PageWarning::FailedEvaluations {
+                failed,
+                evaluations,
+                first,
+            } => write!(
+                f,
+                "{failed} of {evaluations} model evaluations failed and were given the failure \
+                 cost; first: {}",
+                first.as_deref().unwrap_or("(not recorded)")
+            ),
+            PageWarning::FiguresMissing { dir, files } => write!(
+                f,
+                "figures missing from {}: {} (run `wiperlab report --refit` to redraw them)",
+                dir.display(),
+                files.join(", ")
+            ),
+            PageWarning::RecordingChanged {
+                path,
+                sha256_now,
+                sha256_at_fit,
+            } => write!(
+                f,
+                "the recording {} has changed since the fit (SHA-256 {sha256_now} now, \
+                 {sha256_at_fit} at fit time); refit with `wiperlab report --refit`",
+                path.display()
+            ),
+            PageWarning::CannotHashRecording { reason } => {
+                write!(f, "cannot hash the recording: {reason}")
+            }
+        }
+    }
+}
+
+/// `n` of `of` as a percentage, e.g. "11 %".
+fn share(n: usize, of: usize) -> String {
+    if of == 0 {
+        return "—".into();
+    }
+    format!("{:.0} %", 100.0 * n as f64 / of as f64)
+}
+
+/// A failure cause in words.
+fn cause_words(c: FailureCause) -> &'static str {
+    match c {
+        FailureCause::ContactLoss => "the lip tip would leave the glass",
+        FailureCause::Painleve => "the slip equations have no solution (Painlevé)",
+        FailureCause::ModelFault => "a model fault",
+        FailureCause::StepBudget => "the integrator ran out of steps",
+        FailureCause::NoLine => "a band held no line",
+        FailureCause::Other => "another error",
+    }
+}
+
+/// A line's name at the start of a sentence.
+fn line_subject(source: LineSource, band: &str, o: &LineOrigin) -> String {
+    let whose = match source {
+        LineSource::Recording => "The recording's",
+        LineSource::Model => "The model's",
+    };
+    format!("{whose} line in band '{band}' ({} Hz)", num(o.freq_hz, 4))
+}
+
+/// The headline of one of the result's own warnings.
+fn fit_headline(w: &FitWarning) -> String {
+    use FitWarning::*;
+    match w {
+        Interrupted => "The fit was interrupted: the values are the best point the search had \
+                        reached, without intervals. Run it again to the end."
+            .into(),
+        NoGoodnessOfFit { .. } => "The goodness-of-fit test could not run, so whether the model \
+                                   explains the recording's spectra is not known."
+            .into(),
+        Misfit { test, .. } => format!(
+            "The model does not explain the recording's spectra to their noise (p = {:.3}): \
+             list more candidate models, check the bands, or bound a known parameter \
+             (docs/fit.md, \"Goodness of fit\").",
+            test.p_value
+        ),
+        AbsorbsModelStructure {
+            parameter,
+            chosen,
+            value,
+            other,
+            other_value,
+            sigmas,
+        } => format!(
+            "{parameter} depends on the model choice: {} with {chosen}, {} with {other} ({:.1}σ \
+             apart).",
+            num(*value, 4),
+            num(*other_value, 4),
+            sigmas
+        ),
+        Line {
+            band,
+            source,
+            origin,
+            same_harmonic_on_other_side,
+        } => line_headline(*source, band, origin, *same_harmonic_on_other_side),
+        Undetermined { parameter } => format!(
+            "The data do not determine {parameter} (its 1σ spans 10 % or more of its search \
+             range): fix it from another measurement or narrow its bounds."
+        ),
+        TradeOff {
+            first,
+            second,
+            correlation,
+        } => format!(
+            "{first} and {second} trade off (correlation {correlation:+.3}): the data pin down a \
+             combination of them; each one's interval already spans what the other allows."
+        ),
+        OnBound {
+            parameter,
+            bound,
+            value,
+        } => format!(
+            "{parameter} ended on its {bound} search bound ({}): widen the bound or fix the \
+             parameter.",
+            num(*value, 4)
+        ),
+        ProfileAtBound {
+            parameter, bounds, ..
+        } => format!(
+            "{parameter}'s interval is open at its {} search bound{}: the recording does not \
+             bound it there; widen the bounds to see how far it goes.",
+            bounds
+                .iter()
+                .map(|b| b.name())
+                .collect::<Vec<_>>()
+                .join(" and "),
+            if bounds.len() > 1 { "s" } else { "" }
+        ),
+        ProfileOpen { parameter, end, .. } => format!(
+            "{parameter}'s interval does not close at its {end} end within the profile walk: \
+             the interval there is a lower limit on the uncertainty."
+        ),
+        ProfileMoreLikely {
+            parameter,
+            gain_nats,
+            ..
+        } => format!(
+            "{parameter}'s profile met a point {gain_nats:.2} nats more likely than the fit: the \
+             search ended short of the optimum; refit with more restarts."
+        ),
+        WidenedInterval {
+            parameter,
+            method,
+            widened,
+            ..
+        } => format!(
+            "{parameter}'s interval is widened to [{}, {}] to take in points the search \
+             evaluated as likely (the method alone gave [{}, {}]); the table shows the widened \
+             one.",
+            num(widened[0], 4),
+            num(widened[1], 4),
+            num(method[0], 4),
+            num(method[1], 4)
+        ),
+        ShortOfBestEvaluation { gain_nats } => format!(
+            "The search evaluated a point {gain_nats:.2} nats more likely than the fit: it ended \
+             short of its own best point; refit with more restarts or polish iterations."
+        ),
+        ContactRidge { k1_lo, k1_hi } => format!(
+            "k1 and theta_c trade along the shoulder's contact ridge (k1 from {} to {} N·m/rad \
+             fits as well); both intervals span it.",
+            num(*k1_lo, 4),
+            num(*k1_hi, 4)
+        ),
+        NoIntervals { method, .. } => format!(
+            "No {} intervals: the chosen model has no likelihood to read them from.",
+            match method {
+                UncertaintyMethod::Laplace => "Laplace",
+                UncertaintyMethod::Profile => "profile-likelihood",
+                UncertaintyMethod::Bootstrap => "bootstrap",
+            }
+        ),
+        TargetJobIntervals => {
+            "No intervals: a target job's targets carry no measurement noise.".into()
+        }
+        NoBootstrapReplicates => {
+            "No intervals: the job asks for 0 bootstrap replicates ([fit.uncertainty]).".into()
+        }
+        ToleranceNotProbed { .. } => "The tolerance check did not run (every tighter simulation \
+                                      failed): whether the integrator resolves the optimum is not \
+                                      known."
+            .into(),
+        ToleranceUnresolved { spread_nats, .. } => format!(
+            "The optimum's cost moves by {} nats between solver tolerances: the intervals \
+             understate the uncertainty; tighten [solver] rtol and refit.",
+            num(*spread_nats, 2)
+        ),
+        ChoiceUnresolved {
+            chosen,
+            runner_up,
+            aic_gap,
+            spread_nats,
+        } => format!(
+            "The choice of {chosen} over {runner_up} (ΔAIC {aic_gap:.2}) is within the {} nats \
+             the cost moves between solver tolerances: tighten [solver] rtol and refit.",
+            num(*spread_nats, 2)
+        ),
+        FailedEvaluations {
+            failed,
+            evaluations,
+            causes,
+            ..
+        } => {
+            let by: Vec<String> = causes
+                .iter()
+                .filter(|(_, n)| **n > 0)
+                .map(|(c, n)| format!("{n} where {}", cause_words(*c)))
+                .collect();
+            let why = if by.is_empty() {
+                "causes not recorded".to_string()
+            } else {
+                by.join(", ")
+            };
+            match w.severity() {
+                Severity::Information => format!(
+                    "{failed} of {evaluations} evaluations of the chosen model ({}) failed, \
+                     {why}: the search box reaches parameter sets this blade cannot take, and the \
+                     search discards them.",
+                    share(*failed, *evaluations)
+                ),
+                Severity::Attention => format!(
+                    "{failed} of {evaluations} evaluations of the chosen model ({}) failed \
+                     ({why}): the search spends much of its budget where the model cannot go; \
+                     narrow the bounds, or for integrator failures raise [solver] max_steps.",
+                    share(*failed, *evaluations)
+                ),
+            }
+        }
+        NoBladeModes { .. } => {
+            "The blade's modes could not be computed at the fitted parameters.".into()
+        }
+        Text { text } => text.clone(),
+    }
+}
+
+/// A line warning's headline: the concern that needs attention first, else the harmonic both
+/// spectra share.
+fn line_headline(source: LineSource, band: &str, o: &LineOrigin, same: bool) -> String {
+    let subject = line_subject(source, band, o);
+    if o.prominence.is_nan() || o.prominence < MIN_PROMINENCE {
+        let stands = if o.prominence.is_nan() {
+            "has no measurable floor".to_string()
+        } else {
+            format!("stands only {}× over its floor", num(o.prominence, 2))
+        };
+        return format!(
+            "{subject} {stands}: the band's peak may be noise; choose a band around a clear \
+             line."
+        );
+    }
+    if o.below_dominant > 100.0 {
+        return format!(
+            "{subject} lies {}× below the spectrum's dominant line at {} Hz: the band may see \
+             that line's leakage, not a line of its own.",
+            num(o.below_dominant, 2),
+            num(o.dominant_hz, 4)
+        );
+    }
+    match (o.harmonic_of, same) {
+        (Some(h), true) => {
+            let other = match source {
+                LineSource::Recording => "so is the model's",
+                LineSource::Model => "as the recording's is",
+            };
+            format!(
+                "{subject} is harmonic {} of a {} Hz line, {other}: the band compares the same \
+                 line of the stick–slip comb in both.",
+                h.order,
+                num(h.freq_hz, 4)
+            )
+        }
+        (Some(h), false) => format!(
+            "{subject} is harmonic {} of a {} Hz line, the other spectrum's is not: the band \
+             compares different lines; widen it to take in the fundamental.",
+            h.order,
+            num(h.freq_hz, 4)
+        ),
+        (None, _) => subject,
+    }
+}
