@@ -25,5 +25,16 @@ fn _wiperlab(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(model::modes, m)?)?;
     m.add_function(wrap_pyfunction!(model::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(fit::fit, m)?)?;
+    m.add_function(wrap_pyfunction!(check_panic_guard, m)?)?;
     Ok(())
+}
+
+/// Panics inside [`errors::guard`], as a bug in the library would: the test suite checks that
+/// Python gets `wiperlab.WiperlabError` and the process goes on.
+#[pyfunction]
+#[pyo3(name = "_check_panic_guard")]
+fn check_panic_guard(py: Python<'_>) -> PyResult<()> {
+    errors::guard(py, || -> wiperlab::Result<()> {
+        panic!("the panic of _check_panic_guard")
+    })
 }

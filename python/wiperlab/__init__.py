@@ -381,6 +381,8 @@ class Blade:
         try:
             return self._params[name]
         except KeyError:
+            if name == "shoulder":
+                return None  # optional: a single neck stiffness
             raise AttributeError(f"Blade has no parameter {name!r}") from None
 
     def __setattr__(self, name: str, value: Any) -> None:
