@@ -92,6 +92,7 @@ fn venv(python: &Path, dir: &Path) -> Result<PathBuf, String> {
             text(&out)
         ));
     }
+    // Wheels only, and no byte-compiling of SciPy's thousands of modules at install time.
     let out = run(Command::new(&bin)
         .args([
             "-m",
@@ -100,6 +101,7 @@ fn venv(python: &Path, dir: &Path) -> Result<PathBuf, String> {
             "--quiet",
             "--disable-pip-version-check",
         ])
+        .args(["--no-compile", "--only-binary", ":all:"])
         .args(REQUIREMENTS))?;
     if !out.status.success() {
         return Err(format!(
