@@ -392,3 +392,80 @@ fn the_job_template_points_to_the_references() {
         );
     }
 }
+
+/// The headings and bold labels (`**Label.**`) of a Markdown document, lower case, without
+/// backticks and a trailing full stop.
+fn sections(markdown: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut in_code = false;
+    for line in markdown.lines() {
+        if line.starts_with("```") {
+            in_code = !in_code;
+            continue;
+        }
+        if in_code {
+            continue;
+        }
+        if line.starts_with('#') {
+            out.push(line.trim_start_matches('#').trim().to_string());
+        }
+        for bold in line.split("**").skip(1).step_by(2) {
+            out.push(bold.to_string());
+        }
+    }
+    out.iter()
+        .map(|s| s.replace('`', "").trim_end_matches('.').to_lowercase())
+        .collect()
+}
+
+/// Comments and job files cite a part of the manual as `docs/NAME.md, "Heading"`; each such
+/// heading (or the start of one, or a bold label) exists, so a reader who follows it lands.
+#[test]
+fn cited_sections_of_the_docs_exist() {
+    let mut checked = Vec::new();
+    for dir in ["src", "benches", "examples"] {
+        files(&root().join(dir), ".rs", &mut checked);
+    }
+    for dir in ["src", "fits", "campaigns"] {
+        files(&root().join(dir), ".toml", &mut checked);
+    }
+    let mut cited = 0;
+    for f in &checked {
+        // Comment markers at line starts removed, so a citation may run over two lines.
+        let text: String = read(f)
+            .lines()
+            .map(|l| {
+                l.trim_start()
+                    .trim_start_matches("//!")
+                    .trim_start_matches("///")
+                    .trim_start_matches("//")
+                    .trim_start_matches('#')
+                    .trim()
+            })
+            .collect::<Vec<_>>()
+            .join(" ");
+        for (i, _) in text.match_indices("docs/") {
+            let rest = &text[i + 5..];
+            let Some((name, after)) = rest.split_once(".md, \"") else {
+                continue;
+            };
+            if !name.chars().all(|c| c.is_ascii_lowercase() || c == '_') {
+                continue;
+            }
+            let Some((quoted, _)) = after.split_once('"') else {
+                continue;
+            };
+            let quoted = quoted.trim_end_matches('\\').trim().to_lowercase();
+            let doc = root().join("docs").join(format!("{name}.md"));
+            assert!(doc.is_file(), "{}: cites docs/{name}.md", f.display());
+            let found = sections(&read(&doc));
+            assert!(
+                found.iter().any(|s| s.starts_with(&quoted)),
+                "{}: cites docs/{name}.md, \"{quoted}\", which has no such heading or label",
+                f.display()
+            );
+            cited += 1;
+        }
+    }
+    assert!(cited > 20, "found only {cited} citations");
+}

@@ -44,10 +44,9 @@ pub struct FitJob {
     pub blade: PathBuf,
     #[serde(default)]
     pub spectrum: SpectrumSection,
-    /// Integrator settings for every model evaluation; default rtol 1e-7, atol 1e-9. With the
+    /// Integrator settings for every model evaluation; default rtol 1e-7, atol 1e-9: with the
     /// default bands the fit's spectral peaks stay within 0.05 % of converged down to rtol 1e-5
-    /// (`wiperlab bench`, reports/bench/spectra_vs_rtol.csv), and tests/fit_recovery.rs recovers C
-    /// and k1 to 0.23 % and 0.32 % at 1e-6, 0.11 % and 0.22 % at 1e-7 (docs/validation.md, "Spectra against
+    /// (`wiperlab bench`, reports/bench/spectra_vs_rtol.csv; docs/validation.md, "Spectra against
     /// tolerance"). `[fit] swarm_rtol` may loosen it for the swarm stage only.
     #[serde(default = "fit_solver_default")]
     pub solver: SolverOptions,

@@ -7,7 +7,7 @@
 //!
 //! A shoulder that the neck touches only at the peaks of its swing stiffens it while
 //! |θ| > θ_c, for a fraction of each swing that changes steeply with θ_c: the likelihood's basin is
-//! then a few per cent wide in θ_c and in the friction law (docs/fit.md, "What the search misses"),
+//! then a few per cent wide in θ_c and in the friction law (docs/fit.md, "Shoulder contact"),
 //! and the default search over the whole contact-angle range ends where a model without the
 //! shoulder bends the law to mimic it. Bounds on θ_c of ±4–10 % around the confusion table's
 //! 0.12 rad shoulder let the default search reach the truth's basin, ±17 % did not (docs/fit.md,

@@ -1196,7 +1196,7 @@ pub(super) fn sorted_abs_theta(fit: &CandidateFit) -> Option<Vec<f64>> {
 /// Restarts because the cost surface is rough: the stick–slip comb's largest line jumps as the
 /// parameters move, so one swarm can settle in a nearby minimum: on the shipped recording a single
 /// swarm ends in the truth's basin for some seeds and in a higher minimum for others
-/// (docs/validation.md, "Restarts").
+/// (docs/fit.md, "Restarts").
 /// `warm`: points that one particle of restart `r`'s swarm starts at (`warm[r]`; the others at
 /// random); the first is also returned itself if no restart ends below its cost.
 /// With the likelihood as the cost and more than one restart, a best end that no second end

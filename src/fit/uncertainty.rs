@@ -481,7 +481,7 @@ pub const PROFILE_68_NATS: f64 = 0.5;
 /// `k1c·θ − (k1c − k1)·θ_c` (docs/model.md, "Shoulder contact"), so a neck that rarely leaves the
 /// shoulder shows the spectra `(k1c − k1)·θ_c`, not k1 and θ_c apart; the Fisher information at
 /// the fit sees the stick–slip likelihood's ripples there and can call both determined
-/// (docs/fit.md, "Why the free k1 of a resting neck is not recovered"). Each point
+/// (docs/fit.md, "Shoulder contact"). Each point
 /// `k1' = f·k1`, `θ_c' = (k1c − k1)·θ_c / (k1c − k1')` for f in [`RIDGE_K1_FACTORS`] inside the
 /// search box is evaluated with the other parameters held; one whose cost is within
 /// [`PROFILE_68_NATS`] of the fit's lies inside the 68.27 % profile-likelihood region (holding the
