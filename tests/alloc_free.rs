@@ -1,6 +1,8 @@
 //! The right-hand sides allocate nothing (issue 5, "Speed"): counted with a global allocator that
 //! tallies allocations made by the current thread.
 
+mod common;
+
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use wiperlab::model::belt::Belt;
@@ -42,12 +44,7 @@ fn allocations_in(f: impl FnOnce()) -> usize {
 }
 
 fn params() -> BladeParams {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/data/reversal/blade_true.toml"
-    ))
-    .unwrap();
-    toml::from_str(&text).unwrap()
+    common::true_blade()
 }
 
 #[test]

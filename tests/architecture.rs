@@ -3,6 +3,8 @@
 //! later stage (`crate::<stage>` in code, also inside `use crate::{…}` groups); comments are skipped,
 //! since a doc link is not a dependency.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 /// The pipeline, upstream first. `error` is the shared error type; `lib` and `main` are the crate
@@ -89,7 +91,7 @@ fn first_ident(s: &str) -> String {
 
 #[test]
 fn no_stage_uses_a_later_stage() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let src = common::root().join("src");
     let mut files = Vec::new();
     rust_files(&src, &mut files);
     files.sort();
@@ -142,8 +144,8 @@ fn reference_scanner_sees_paths_and_groups() {
 /// `lib.rs` states the same order as [`STAGES`], so the documented and the checked pipeline agree.
 #[test]
 fn lib_docs_state_the_checked_order() {
-    let lib = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("src/lib.rs"))
-        .expect("src/lib.rs is readable");
+    let lib =
+        std::fs::read_to_string(common::root().join("src/lib.rs")).expect("src/lib.rs is readable");
     let line = lib
         .lines()
         .find(|l| l.contains("Pipeline order:"))

@@ -11,18 +11,15 @@
 //! Input files are written by the cases (small DLTdv, Tracker, DeepLabCut and canonical CSVs) or
 //! are the shipped sample (`data/reversal/`), referenced by absolute path.
 
+mod common;
+use common::{root, stderr, temp_dir, wiperlab};
+
 use std::collections::BTreeSet;
-use std::io::Read;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 /// Longest a refused input may take: validation happens before any simulation or fit.
 const TIMEOUT: Duration = Duration::from_secs(30);
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
 
 /// One row of the table.
 struct Case {
@@ -951,62 +948,41 @@ fn listing(dir: &Path) -> BTreeSet<PathBuf> {
     out
 }
 
-/// Runs `args` in `dir` with a time limit: (exit code, stderr).
+/// Runs `args` in `dir` with an empty standard input and a time limit: (exit code, stderr).
 fn run(dir: &Path, args: &[String]) -> (Option<i32>, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-        .args(args)
-        .current_dir(dir)
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("cannot start the wiperlab binary");
-    let mut stderr = child.stderr.take().expect("piped stderr");
-    let reader = std::thread::spawn(move || {
-        let mut s = String::new();
-        let _ = stderr.read_to_string(&mut s);
-        s
-    });
     let start = Instant::now();
-    let status = loop {
-        if let Some(st) = child.try_wait().expect("wait for child") {
-            break Some(st);
-        }
-        if start.elapsed() > TIMEOUT {
-            let _ = child.kill();
-            let _ = child.wait();
-            break None;
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    let err = reader.join().expect("stderr reader");
-    match status {
-        Some(st) => (st.code(), err),
-        None => (
+    let o = wiperlab(args)
+        .current_dir(dir)
+        .write_stdin("")
+        .timeout(TIMEOUT)
+        .output()
+        .expect("start the wiperlab binary");
+    let err = stderr(&o);
+    if start.elapsed() >= TIMEOUT {
+        return (
             None,
             format!("TIMED OUT after {TIMEOUT:?}; stderr so far:\n{err}"),
-        ),
+        );
     }
+    (o.status.code(), err)
 }
 
 /// Runs one case; `Err` says how it failed.
 fn check(n: usize, c: &Case) -> Result<(), String> {
-    let dir = std::env::temp_dir().join(format!("wiperlab_bad_{}_{n}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("create temp dir");
+    let tmp = temp_dir(&format!("bad_{n}"));
+    let dir = tmp.path();
     for (rel, text) in &c.files {
         let p = dir.join(rel);
         std::fs::create_dir_all(p.parent().expect("parent")).expect("create parent");
         std::fs::write(&p, text).expect("write case file");
     }
-    let before = listing(&dir);
+    let before = listing(dir);
     let d = dir.display().to_string();
     let data = root().join("data").display().to_string();
     let sub = |s: &str| s.replace("$DATA", &data).replace("$D", &d);
     let args: Vec<String> = c.args.iter().map(|a| sub(a)).collect();
-    let (code, err) = run(&dir, &args);
-    let after = listing(&dir);
-    let _ = std::fs::remove_dir_all(&dir);
+    let (code, err) = run(dir, &args);
+    let after = listing(dir);
     let mut why = Vec::new();
     if code != Some(2) {
         why.push(format!("exit code {code:?}, expected 2"));

@@ -2,16 +2,15 @@
 //! event-driven errors (DOPRI5 and DOP853) fall with the tolerance, Moreau–Jean converges at first
 //! order, and the CSV and figures are written. (Timings are not asserted: speed is measured by the bench, not by tests.)
 
+mod common;
+
 use wiperlab::bench::{BenchOptions, run_bench, spectra_vs_rtol, write_reports, write_spectra};
 use wiperlab::model::BladeParams;
 
 #[test]
 fn quick_bench_runs_every_method_and_writes_reports() {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/data/reversal/blade_true.toml"
-    ))
-    .unwrap();
+    let text =
+        std::fs::read_to_string(common::root().join("data/reversal/blade_true.toml")).unwrap();
     let blade: BladeParams = toml::from_str(&text).unwrap();
     let rows = run_bench(&BenchOptions { quick: true, blade }).unwrap();
     let sel = |problem: &str, method: &str| -> Vec<_> {
@@ -61,10 +60,11 @@ fn quick_bench_runs_every_method_and_writes_reports() {
     for w in order.windows(2).skip(1) {
         assert!(w[0].transition_err_s / w[1].transition_err_s > 2f64.powf(3.5));
     }
-    let dir = std::env::temp_dir().join(format!("wiperlab_bench_{}", std::process::id()));
-    write_reports(&dir, &rows).unwrap();
+    let tmp = common::temp_dir("bench");
+    let dir = tmp.path();
+    write_reports(dir, &rows).unwrap();
     let spectra = spectra_vs_rtol("blade_true", &blade, &[1e-6, 1e-8]).unwrap();
-    let loosest = write_spectra(&dir, &spectra, 0.002, 0.05).unwrap();
+    let loosest = write_spectra(dir, &spectra, 0.002, 0.05).unwrap();
     assert_eq!(loosest, Some(1e-6));
     for f in [
         "work_precision.csv",
@@ -80,23 +80,18 @@ fn quick_bench_runs_every_method_and_writes_reports() {
     }
     let csv = std::fs::read_to_string(dir.join("work_precision.csv")).unwrap();
     assert_eq!(csv.lines().count(), rows.len() + 1);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// `wiperlab bench` runs from any working directory: its default blades are the source tree's
-/// (here run from the system temp dir, outputs to a temp dir).
+/// (here run from one temp dir, outputs to another).
 #[test]
 fn bench_runs_from_anywhere() {
-    let cwd = std::env::temp_dir();
-    let out = cwd.join(format!("wiperlab_bench_anywhere_{}", std::process::id()));
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-        .args(["bench", "--quick", "--out-dir", out.to_str().unwrap()])
-        .current_dir(&cwd)
-        .output()
-        .expect("start wiperlab");
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (cwd, out) = (common::temp_dir("bench_cwd"), common::temp_dir("bench_out"));
+    common::wiperlab(["bench", "--quick", "--out-dir", common::s(out.path())])
+        .current_dir(cwd.path())
+        .assert()
+        .success();
     for f in ["work_precision.csv", "spectra_vs_rtol.csv"] {
-        assert!(out.join(f).exists(), "{f} not written");
+        assert!(out.path().join(f).exists(), "{f} not written");
     }
-    let _ = std::fs::remove_dir_all(&out);
 }

@@ -9,51 +9,13 @@
 //!   collected values as the local run. Without Slurm the test says it skipped, unless
 //!   WIPERLAB_REQUIRE_SLURM=1 (CI), where that is a failure.
 
+mod common;
+use common::{ok, root, run, temp_dir};
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 use std::time::{Duration, Instant};
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn wiperlab(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-        .args(args)
-        .output()
-        .expect("cannot start the wiperlab binary")
-}
-
-fn ok(o: &Output, what: &str) -> String {
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{what} failed\nstdout:\n{}\nstderr:\n{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-/// A fresh directory under the system temp dir, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> TempDir {
-        let p =
-            std::env::temp_dir().join(format!("wiperlab_campaign_{}_{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&p);
-        std::fs::create_dir_all(&p).expect("create temp dir");
-        TempDir(p)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// Copies `recordings` (file names in data/campaign/) and their conditions rows into `dir`, and
 /// writes `dir/c.toml`: the example campaign's template on those copies.
@@ -120,7 +82,7 @@ fn num(row: &BTreeMap<String, String>, col: &str) -> f64 {
 
 #[test]
 fn local_campaign_fits_collects_skips_and_survives_a_failure() {
-    let dir = TempDir::new("local");
+    let dir = temp_dir("local");
     let all = [
         "hard_fast_xypts.csv",
         "hard_normal_xypts.csv",
@@ -129,19 +91,20 @@ fn local_campaign_fits_collects_skips_and_survives_a_failure() {
         "soft_normal_xypts.csv",
         "soft_slow_xypts.csv",
     ];
-    let c = campaign_copy(&dir.0, &all);
+    let c = campaign_copy(dir.path(), &all);
     let cs = c.to_str().expect("UTF-8 path");
     let out = ok(
-        &wiperlab(&["campaign", "run", cs, "--jobs", "2"]),
+        &run(&["campaign", "run", cs, "--jobs", "2"]),
         "campaign run",
     );
     assert!(out.contains("6 fitted, 0 skipped"), "{out}");
-    ok(&wiperlab(&["campaign", "collect", cs]), "campaign collect");
-    let rows = read_table(&dir.0.join("c/campaign.csv"));
+    ok(&run(&["campaign", "collect", cs]), "campaign collect");
+    let rows = read_table(&dir.path().join("c/campaign.csv"));
     assert_eq!(rows.len(), 6);
     // The report page lists every recording and draws each parameter against each varying
     // condition (compound, sweep, t0_s, drive speed) and the friction laws.
-    let page = std::fs::read_to_string(dir.0.join("c/report/index.html")).expect("report page");
+    let page =
+        std::fs::read_to_string(dir.path().join("c/report/index.html")).expect("report page");
     for id in ["hard_fast_xypts", "soft_slow_xypts"] {
         assert!(page.contains(id), "{id} missing from the report page");
     }
@@ -151,7 +114,7 @@ fn local_campaign_fits_collects_skips_and_survives_a_failure() {
         "k1_vs_sweep",
         "C_vs_drive_omega_rad_per_s",
     ] {
-        let svg = dir.0.join(format!("c/report/{fig}.svg"));
+        let svg = dir.path().join(format!("c/report/{fig}.svg"));
         assert!(
             page.contains(&format!("{fig}.svg")),
             "{fig} not on the page"
@@ -162,7 +125,7 @@ fn local_campaign_fits_collects_skips_and_survives_a_failure() {
         );
     }
     assert!(
-        !dir.0.join("c/report/C_vs_repeat.svg").exists(),
+        !dir.path().join("c/report/C_vs_repeat.svg").exists(),
         "repeat is 1 everywhere"
     );
     let truth = truth();
@@ -186,26 +149,23 @@ fn local_campaign_fits_collects_skips_and_survives_a_failure() {
         assert!(num(row, "drive_omega_rad_per_s") > 0.0 && num(row, "t0_s") > 0.0);
     }
     // A rerun skips every recording (same content hashes); a changed recording is refitted.
-    let out = ok(&wiperlab(&["campaign", "run", cs]), "campaign rerun");
+    let out = ok(&run(&["campaign", "run", cs]), "campaign rerun");
     assert!(out.contains("0 fitted, 6 skipped"), "{out}");
-    let changed = dir.0.join("soft_slow_xypts.csv");
+    let changed = dir.path().join("soft_slow_xypts.csv");
     let mut text = std::fs::read_to_string(&changed).expect("read copy");
     let last = text.lines().last().expect("a row").to_string();
     text.push_str(&last);
     text.push('\n');
     std::fs::write(&changed, text).expect("append a frame");
-    let out = ok(
-        &wiperlab(&["campaign", "run", cs]),
-        "campaign after a change",
-    );
+    let out = ok(&run(&["campaign", "run", cs]), "campaign after a change");
     assert!(out.contains("1 fitted, 5 skipped"), "{out}");
     // A recording that cannot be read fails alone, with its reason in the table.
     std::fs::write(
-        dir.0.join("hard_slow_xypts.csv"),
+        dir.path().join("hard_slow_xypts.csv"),
         "pt1_cam1_X,pt1_cam1_Y\n1,x\n",
     )
     .expect("break a recording");
-    let o = wiperlab(&["campaign", "run", cs]);
+    let o = run(&["campaign", "run", cs]);
     let out = String::from_utf8_lossy(&o.stdout);
     assert_eq!(
         o.status.code(),
@@ -217,10 +177,10 @@ fn local_campaign_fits_collects_skips_and_survives_a_failure() {
         "{out}"
     );
     ok(
-        &wiperlab(&["campaign", "collect", cs]),
+        &run(&["campaign", "collect", cs]),
         "collect after a failure",
     );
-    let rows = read_table(&dir.0.join("c/campaign.csv"));
+    let rows = read_table(&dir.path().join("c/campaign.csv"));
     let bad = rows
         .iter()
         .find(|r| r["id"] == "hard_slow_xypts")
@@ -232,15 +192,15 @@ fn local_campaign_fits_collects_skips_and_survives_a_failure() {
 
 #[test]
 fn campaign_errors_name_the_file_and_line() {
-    let dir = TempDir::new("errors");
-    let c = campaign_copy(&dir.0, &["soft_fast_xypts.csv"]);
+    let dir = temp_dir("errors");
+    let c = campaign_copy(dir.path(), &["soft_fast_xypts.csv"]);
     let cs = c.to_str().expect("UTF-8 path");
     // A conditions row naming a recording the campaign does not have: file, line, the name.
-    let table = dir.0.join("conditions.csv");
+    let table = dir.path().join("conditions.csv");
     let mut text = std::fs::read_to_string(&table).expect("table");
     text.push_str("nope_xypts.csv,1.0,1.6,soft,normal,1\n");
     std::fs::write(&table, &text).expect("write table");
-    let o = wiperlab(&["campaign", "list", cs]);
+    let o = run(&["campaign", "list", cs]);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
@@ -254,7 +214,7 @@ fn campaign_errors_name_the_file_and_line() {
         format!("{header}\nsoft_fast_xypts.csv,fast,1.6,soft,fast,1\n"),
     )
     .expect("write table");
-    let o = wiperlab(&["campaign", "list", cs]);
+    let o = run(&["campaign", "list", cs]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(
@@ -307,13 +267,13 @@ fn slurm_array_gives_the_local_results() {
         "soft_normal_xypts.csv",
         "soft_slow_xypts.csv",
     ];
-    let via_slurm = TempDir::new("slurm");
-    let local = TempDir::new("slurm_local");
-    let cs = campaign_copy(&via_slurm.0, &four);
-    let cl = campaign_copy(&local.0, &four);
+    let via_slurm = temp_dir("slurm");
+    let local = temp_dir("slurm_local");
+    let cs = campaign_copy(via_slurm.path(), &four);
+    let cl = campaign_copy(local.path(), &four);
     let (cs, cl) = (cs.to_str().expect("path"), cl.to_str().expect("path"));
     let out = ok(
-        &wiperlab(&[
+        &run(&[
             "campaign",
             "slurm",
             cs,
@@ -326,14 +286,11 @@ fn slurm_array_gives_the_local_results() {
         "campaign slurm --submit",
     );
     assert!(out.contains("submitted Slurm job"), "{out}");
-    ok(
-        &wiperlab(&["campaign", "run", cl, "--jobs", "2"]),
-        "local run",
-    );
+    ok(&run(&["campaign", "run", cl, "--jobs", "2"]), "local run");
     // Poll the array through `campaign status` (squeue and the tasks' status files).
     let t0 = Instant::now();
     loop {
-        let st = ok(&wiperlab(&["campaign", "status", cs]), "campaign status");
+        let st = ok(&run(&["campaign", "status", cs]), "campaign status");
         if st.lines().last().is_some_and(|l| l.trim() == "4 done") {
             break;
         }
@@ -344,10 +301,10 @@ fn slurm_array_gives_the_local_results() {
         );
         std::thread::sleep(Duration::from_secs(2));
     }
-    ok(&wiperlab(&["campaign", "collect", cs]), "collect (Slurm)");
-    ok(&wiperlab(&["campaign", "collect", cl]), "collect (local)");
-    let a = read_table(&via_slurm.0.join("c/campaign.csv"));
-    let b = read_table(&local.0.join("c/campaign.csv"));
+    ok(&run(&["campaign", "collect", cs]), "collect (Slurm)");
+    ok(&run(&["campaign", "collect", cl]), "collect (local)");
+    let a = read_table(&via_slurm.path().join("c/campaign.csv"));
+    let b = read_table(&local.path().join("c/campaign.csv"));
     assert_eq!(a.len(), 4);
     for (ra, rb) in a.iter().zip(&b) {
         assert_eq!(ra["id"], rb["id"]);
@@ -364,7 +321,7 @@ fn slurm_array_gives_the_local_results() {
             assert_eq!(ra[col], rb[col], "{col} of {}", ra["id"]);
         }
     }
-    let logs = via_slurm.0.join("c/slurm/logs");
+    let logs = via_slurm.path().join("c/slurm/logs");
     let n_logs = std::fs::read_dir(&logs).map_or(0, |d| d.count());
     assert_eq!(n_logs, 4, "one log per array task in {}", logs.display());
     let _ = Command::new("bash")

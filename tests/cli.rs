@@ -6,76 +6,13 @@
 //! Reference numbers name their source (mostly `data/reversal/truth.json`, written by the
 //! independent implementation that made the sample recording).
 
+mod common;
+use common::{TempDirExt as _, ok, root, run, run_in, s, stderr, stdout, temp_dir, wiperlab_exe};
+use tempfile::TempDir;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, SystemTime};
-
-/// The crate root (working directory of every command).
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// Runs `wiperlab args...` in the crate root.
-fn wiperlab(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("cannot start the wiperlab binary")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-/// Asserts exit code 0 and returns stdout.
-fn ok(o: &Output, what: &str) -> String {
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{what} failed\nstdout:\n{}\nstderr:\n{}",
-        stdout(o),
-        stderr(o)
-    );
-    stdout(o)
-}
-
-/// A directory in the system temp dir, unique per process and `name`, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> TempDir {
-        let p = std::env::temp_dir().join(format!("wiperlab_cli_{}_{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&p);
-        std::fs::create_dir_all(&p).expect("create temp dir");
-        TempDir(p)
-    }
-
-    fn join(&self, rel: &str) -> PathBuf {
-        self.0.join(rel)
-    }
-
-    /// Writes `content` to `<dir>/<rel>` and returns the path.
-    fn write(&self, rel: &str, content: &str) -> PathBuf {
-        let p = self.join(rel);
-        std::fs::write(&p, content).expect("write temp file");
-        p
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("UTF-8 temp path")
-}
 
 /// `data/reversal/truth.json`, parsed.
 fn truth() -> serde_json::Value {
@@ -190,18 +127,14 @@ fn assert_fresh(path: &Path, since: SystemTime) {
 #[test]
 fn main_job_end_to_end() {
     let started = SystemTime::now();
-    let dir = TempDir::new("main_job");
+    let dir = temp_dir("main_job");
     let text = job_text();
     assert!(
         text.contains("method = \"laplace\""),
         "the main job's intervals are Laplace's"
     );
     let job = dir.write("reversal.toml", &text);
-    let o = Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-        .args(["fit", s(&job), "--json"])
-        .current_dir(&dir.0)
-        .output()
-        .expect("cannot start the wiperlab binary");
+    let o = run_in(dir.path(), &["fit", s(&job), "--json"]);
     let out = ok(&o, "the main job");
     let json_line = out
         .lines()
@@ -412,7 +345,7 @@ fn main_job_end_to_end() {
         "friction_law",
         "cost",
     ] {
-        let p = dir.join(&format!("reports/reversal/{fig}.svg"));
+        let p = dir.join(format!("reports/reversal/{fig}.svg"));
         assert_svg(&p);
         assert_fresh(&p, started);
     }
@@ -424,19 +357,19 @@ fn main_job_end_to_end() {
 
 #[test]
 fn missing_job_file() {
-    let dir = TempDir::new("missing_job");
+    let dir = temp_dir("missing_job");
     let job = dir.join("no_such_job.toml");
-    let o = wiperlab(&["fit", s(&job), "--quiet"]);
+    let o = run(&["fit", s(&job), "--quiet"]);
     input_error(&o, &[s(&job), "cannot read"]);
 }
 
 #[test]
 fn job_with_toml_syntax_error() {
-    let dir = TempDir::new("syntax");
+    let dir = temp_dir("syntax");
     // An unterminated string on the `name` line.
     let text = edit(&job_text(), "name = \"reversal\"", "name = \"reversal");
     let job = dir.write("job.toml", &text);
-    let o = wiperlab(&["fit", s(&job), "--quiet"]);
+    let o = run(&["fit", s(&job), "--quiet"]);
     let msg = input_error(&o, &[s(&job)]);
     let (line, col) = line_col(&msg, &job);
     assert_eq!(line, line_of(&text, "name = \"reversal"), "{msg}");
@@ -446,10 +379,10 @@ fn job_with_toml_syntax_error() {
 
 #[test]
 fn job_with_unknown_parameter() {
-    let dir = TempDir::new("unknown_param");
+    let dir = temp_dir("unknown_param");
     let text = edit(&job_text(), "C = [0.1, 1.0]", "C = [0.1, 1.0]\nZ = [0, 1]");
     let job = dir.write("job.toml", &text);
-    let o = wiperlab(&["fit", s(&job), "--quiet"]);
+    let o = run(&["fit", s(&job), "--quiet"]);
     let msg = input_error(&o, &[s(&job), "unknown parameter 'Z'"]);
     let (line, _) = line_col(&msg, &job);
     assert_eq!(line, line_of(&text, "Z = [0, 1]"), "{msg}");
@@ -458,10 +391,10 @@ fn job_with_unknown_parameter() {
 
 #[test]
 fn job_with_bounds_the_wrong_way_round() {
-    let dir = TempDir::new("bounds");
+    let dir = temp_dir("bounds");
     let text = edit(&job_text(), "k1 = [0.005, 0.15]", "k1 = [0.1, 0.01]");
     let job = dir.write("job.toml", &text);
-    let o = wiperlab(&["fit", s(&job), "--quiet"]);
+    let o = run(&["fit", s(&job), "--quiet"]);
     let msg = input_error(&o, &[s(&job), "'k1'", "lower < upper"]);
     let (line, _) = line_col(&msg, &job);
     assert_eq!(line, line_of(&text, "k1 = [0.1, 0.01]"), "{msg}");
@@ -470,7 +403,7 @@ fn job_with_bounds_the_wrong_way_round() {
 
 #[test]
 fn job_with_a_swarm_tolerance_out_of_range() {
-    let dir = TempDir::new("swarm_rtol");
+    let dir = temp_dir("swarm_rtol");
     // The main job's own `swarm_rtol` line, or one added after `restarts` if it has none.
     let text = job_text();
     let text: String = text
@@ -480,7 +413,7 @@ fn job_with_a_swarm_tolerance_out_of_range() {
         .join("\n");
     let text = edit(&text, "restarts = 5", "restarts = 5\nswarm_rtol = 0.0");
     let job = dir.write("job.toml", &text);
-    let o = wiperlab(&["fit", s(&job), "--quiet"]);
+    let o = run(&["fit", s(&job), "--quiet"]);
     let msg = input_error(&o, &[s(&job), "swarm_rtol must be in (0, 1)"]);
     let (line, _) = line_col(&msg, &job);
     assert_eq!(line, line_of(&text, "swarm_rtol = 0.0"), "{msg}");
@@ -503,7 +436,7 @@ fn bad_dltdv(dir: &TempDir) -> PathBuf {
 
 #[test]
 fn job_with_non_number_in_the_recording() {
-    let dir = TempDir::new("bad_recording_job");
+    let dir = temp_dir("bad_recording_job");
     let csv = bad_dltdv(&dir);
     let old = format!(
         "file = \"{}\"",
@@ -513,7 +446,7 @@ fn job_with_non_number_in_the_recording() {
     );
     let text = edit(&job_text(), &old, &format!("file = \"{}\"", csv.display()));
     let job = dir.write("job.toml", &text);
-    let o = wiperlab(&["fit", s(&job), "--quiet"]);
+    let o = run(&["fit", s(&job), "--quiet"]);
     let msg = input_error(&o, &[":5:3:", "pt2_cam1_X", "\"abc\""]);
     assert_eq!(line_col(&msg, &csv), (5, 3), "{msg}");
     assert!(!dir.join("reversal.result.toml").exists());
@@ -521,10 +454,10 @@ fn job_with_non_number_in_the_recording() {
 
 #[test]
 fn import_with_non_number_in_the_recording() {
-    let dir = TempDir::new("bad_recording_import");
+    let dir = temp_dir("bad_recording_import");
     let csv = bad_dltdv(&dir);
     let out = dir.join("t.csv");
-    let o = wiperlab(&[
+    let o = run(&[
         "import",
         s(&csv),
         "--format",
@@ -545,21 +478,21 @@ fn import_with_non_number_in_the_recording() {
 
 #[test]
 fn import_missing_file() {
-    let dir = TempDir::new("import_missing");
+    let dir = temp_dir("import_missing");
     let f = dir.join("no_such_xypts.csv");
-    let o = wiperlab(&["import", s(&f)]);
+    let o = run(&["import", s(&f)]);
     input_error(&o, &[s(&f)]);
 }
 
 #[test]
 fn simulate_negative_mass() {
-    let dir = TempDir::new("negative_mass");
+    let dir = temp_dir("negative_mass");
     let text = std::fs::read_to_string(root().join("data/reversal/blade_true.toml"))
         .expect("read blade_true.toml");
     let text = edit(&text, "head_mass_kg = 0.15\n", "head_mass_kg = -0.15\n");
     let params = dir.write("blade.toml", &text);
     let out_dir = dir.join("out");
-    let o = wiperlab(&["simulate", s(&params), "--out-dir", s(&out_dir)]);
+    let o = run(&["simulate", s(&params), "--out-dir", s(&out_dir)]);
     // validate() runs after deserialisation, so this message names the file and the field but
     // carries no line number.
     input_error(&o, &[s(&params), "head_mass_kg", "-0.15"]);
@@ -568,9 +501,9 @@ fn simulate_negative_mass() {
 
 #[test]
 fn simulate_window_needs_two_values() {
-    let dir = TempDir::new("window_one_value");
+    let dir = temp_dir("window_one_value");
     let out_dir = dir.join("out");
-    let o = wiperlab(&[
+    let o = run(&[
         "simulate",
         "data/reversal/blade_true.toml",
         "--window",
@@ -599,15 +532,15 @@ fn csv_rows(path: &Path) -> (String, Vec<Vec<String>>) {
 
 #[test]
 fn simulate_writes_outputs() {
-    let dir = TempDir::new("simulate");
+    let dir = temp_dir("simulate");
     let out = ok(
-        &wiperlab(&[
+        &run(&[
             "simulate",
             "data/reversal/blade_true.toml",
             "--window",
             "1.83,1.85",
             "--out-dir",
-            s(&dir.0),
+            s(dir.path()),
         ]),
         "simulate",
     );
@@ -660,7 +593,7 @@ fn simulate_writes_outputs() {
     );
 
     for fig in ["tip_relative", "phase", "head_drop"] {
-        assert_svg(&dir.join(&format!("{fig}.svg")));
+        assert_svg(&dir.join(format!("{fig}.svg")));
     }
 }
 
@@ -695,11 +628,11 @@ fn import_describe_and_convert() {
             .count()
     };
 
-    let dir = TempDir::new("import");
+    let dir = temp_dir("import");
     let out = dir.join("t.csv");
     let mut args = SAMPLE_IMPORT.to_vec();
     args.extend(["pt2", "-o", s(&out)]);
-    ok(&wiperlab(&args), "import");
+    ok(&run(&args), "import");
     let (header, rows) = csv_rows(&out);
     assert_eq!(header, "t_s,head_x_m,head_y_m,tip_x_m,tip_y_m");
     assert_eq!(rows.len(), n_frames);
@@ -733,7 +666,7 @@ fn import_describe_and_convert() {
 
     let mut args = SAMPLE_IMPORT.to_vec();
     args.extend(["pt2", "--describe"]);
-    let desc = ok(&wiperlab(&args), "import --describe");
+    let desc = ok(&run(&args), "import --describe");
     // Times to the digits that mean something: frames at 1/10000 s, the last at 1.8868 s.
     assert!(
         desc.contains("t = 0 … 1.8868 s, dt median 1e-4 s (10000 fps)"),
@@ -763,13 +696,13 @@ fn import_describe_and_convert() {
 /// evaluation count, leaves the previous complete result untouched, and exits 130.
 #[test]
 fn sigint_stops_the_fit_and_keeps_the_previous_result() {
-    let dir = TempDir::new("sigint");
+    let dir = temp_dir("sigint");
     let job = dir.write("reversal.toml", &job_text());
     let previous = "# a previous complete result\n";
     let complete = dir.write("reversal.result.toml", previous);
-    let mut child = Command::new(env!("CARGO_BIN_EXE_wiperlab"))
+    let mut child = Command::new(wiperlab_exe())
         .args(["fit", s(&job), "--quiet"])
-        .current_dir(&dir.0)
+        .current_dir(dir.path())
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())
         .spawn()
@@ -817,7 +750,7 @@ fn sigint_stops_the_fit_and_keeps_the_previous_result() {
 #[test]
 fn outputs_get_the_mode_a_normal_write_gives() {
     use std::os::unix::fs::PermissionsExt as _;
-    let dir = TempDir::new("modes");
+    let dir = temp_dir("modes");
     let csv = dir.write(
         "rec.csv",
         "t_s,head_x_m,head_y_m\n0,0,0\n0.001,0.001,0\n0.002,0.002,0\n",
@@ -826,7 +759,7 @@ fn outputs_get_the_mode_a_normal_write_gives() {
         let o = Command::new("sh")
             .arg("-c")
             .arg(format!("umask {umask}; exec \"$0\" \"$@\""))
-            .arg(env!("CARGO_BIN_EXE_wiperlab"))
+            .arg(wiperlab_exe())
             .args(["import", s(&csv), "--format", "canonical", "-o", s(out)])
             .current_dir(root())
             .output()

@@ -3,11 +3,10 @@
 //! documents resolve, headings included; and no source, test or job file cites README for a number
 //! (numbers and methods live in `docs/`, each with the command that reproduces it).
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::root;
 
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
+use std::path::{Path, PathBuf};
 
 fn read(path: &Path) -> String {
     std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))

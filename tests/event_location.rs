@@ -1,6 +1,8 @@
 //! Event location of the hybrid integrator: convergence order of transition times, dips across zero
 //! within one step, and the slip direction after tangential stick→slip departures (physics.md §1.8).
 
+mod common;
+
 use wiperlab::model::benchmarks::{CoulombBelt, seed_law_belt};
 use wiperlab::model::{Blade, BladeParams, StickForm};
 use wiperlab::simulate::Method;
@@ -228,12 +230,7 @@ fn tangential_departures_take_the_consistent_direction() {
     // The blade (default sample parameters), with either method: over the reversal window, every
     // slip phase moves the tip in its own direction (v̇3 sampled at 100 kHz, allowing 1e-9 m/s of
     // rounding).
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/data/reversal/blade_true.toml"
-    ))
-    .unwrap();
-    let params: BladeParams = toml::from_str(&text).unwrap();
+    let params: BladeParams = common::true_blade();
     let (t0, t1) = default_window(&params);
     let n = ((t1 - t0) * 1e5) as usize;
     let times: Vec<f64> = (0..n).map(|i| t0 + i as f64 * 1e-5).collect();

@@ -5,25 +5,15 @@
 //! Reference values: the experiment blade's head frequency 20 Hz (`data/paper/seed_experiment_blade.toml`,
 //! k0 = M_t (2π·20 Hz)² there), which a freed head mass must hold in closed form.
 
+mod common;
+use common::{root, run, temp_dir};
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn wiperlab(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("cannot start the wiperlab binary")
-}
 
 /// Runs `explore JOB --samples N --seed S -o OUT --quiet`, asserts that it succeeds and returns the
 /// `explore.csv` it wrote and its standard output.
 fn explore_csv(job: &Path, samples: &str, seed: &str, out: &Path) -> (String, String) {
-    let o = wiperlab(&[
+    let o = run(&[
         "explore",
         job.to_str().unwrap(),
         "--samples",
@@ -44,13 +34,6 @@ fn explore_csv(job: &Path, samples: &str, seed: &str, out: &Path) -> (String, St
         std::fs::read_to_string(out.join("explore.csv")).unwrap(),
         String::from_utf8_lossy(&o.stdout).into_owned(),
     )
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("wiperlab_explore_{name}_{}", std::process::id()));
-    std::fs::remove_dir_all(&d).ok();
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 /// The shipped geometry job, its blade path made absolute, `[fit.parameters]` replaced by
@@ -74,9 +57,10 @@ fn job(dir: &Path, params: &str) -> PathBuf {
 /// head's 20 Hz, and the result says whether the targets determine the head mass.
 #[test]
 fn a_freed_head_mass_fits_with_the_head_frequency_held_and_reports_identifiability() {
-    let dir = temp_dir("fit");
+    let tmp = temp_dir("explore_fit");
+    let dir = tmp.path();
     let path = job(
-        &dir,
+        dir,
         "A = [0.2, 1.5]\nB = [10.0, 300.0]\nC = [0.1, 1.0]\nhead_mass = [0.01, 0.15]",
     );
     let loaded = wiperlab::fit::job::LoadedJob::load(&path).unwrap();
@@ -110,15 +94,15 @@ fn a_freed_head_mass_fits_with_the_head_frequency_held_and_reports_identifiabili
             out.result.warnings
         );
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// `explore` writes one CSV row per sample, and the same seed gives the same CSV.
 #[test]
 fn explore_csv_has_a_row_per_sample_and_a_seed_repeats_it() {
-    let dir = temp_dir("cli");
+    let tmp = temp_dir("explore_cli");
+    let dir = tmp.path();
     let path = job(
-        &dir,
+        dir,
         "C = [0.3, 0.8]\nhead_mass = [0.01, 0.15]\nl2 = [0.003, 0.006]",
     );
     let run = |out: &str, seed: &str| explore_csv(&path, "6", seed, &dir.join(out)).0;
@@ -153,7 +137,6 @@ fn explore_csv_has_a_row_per_sample_and_a_seed_repeats_it() {
         ),
         None => assert!(text.starts_with("No sample gave every band"), "{text}"),
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The closest achievable pair of an `explore.csv` of the experiment's targets (78.4 Hz ± 1 %,
@@ -196,7 +179,8 @@ fn closest_in_csv(table: &str) -> Option<(usize, f64)> {
 /// test finds in `explore.csv` by the stated rule.
 #[test]
 fn the_closest_achievable_pair_is_the_one_the_table_gives() {
-    let dir = temp_dir("pair");
+    let tmp = temp_dir("explore_pair");
+    let dir = tmp.path();
     let job = root().join("fits/seed_experiment_pair.toml");
     let out = dir.join("out");
     let (table, summary) = explore_csv(&job, "8", "3", &out);
@@ -217,7 +201,6 @@ fn the_closest_achievable_pair_is_the_one_the_table_gives() {
         summary.contains(&format!("sample {k}, distance {d:.2}:")),
         "{summary}"
     );
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A job cannot free the preload beside h_d (the preload is set through h_d): exit 2 naming the
@@ -227,7 +210,7 @@ fn the_closest_achievable_pair_is_the_one_the_table_gives() {
 fn assert_refused_at(dir: &Path, params: &str, key: &str, names: &str, samples: &str) {
     let path = job(dir, params);
     let out = dir.join("out");
-    let o = wiperlab(&[
+    let o = run(&[
         "explore",
         path.to_str().unwrap(),
         "--samples",
@@ -252,32 +235,33 @@ fn assert_refused_at(dir: &Path, params: &str, key: &str, names: &str, samples: 
 
 #[test]
 fn the_preload_cannot_be_freed_beside_hd() {
-    let dir = temp_dir("preload");
+    let tmp = temp_dir("explore_preload");
+    let dir = tmp.path();
     assert_refused_at(
-        &dir,
+        dir,
         "C = [0.3, 0.8]\nhd = [1e-4, 1e-3]\npreload = [1.0, 2.0]",
         "preload",
         "hd",
         "2",
     );
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A bad job (a head mass bound of 0) is refused with exit 2, the file and line, and no output.
 #[test]
 fn explore_refuses_a_bad_job_with_exit_2_and_the_line() {
-    let dir = temp_dir("bad");
+    let tmp = temp_dir("explore_bad");
+    let dir = tmp.path();
     assert_refused_at(
-        &dir,
+        dir,
         "C = [0.3, 0.8]\nhead_mass = [0.0, 0.15]",
         "head_mass",
         "head_mass",
         "4",
     );
     let out = dir.join("out");
-    let good = job(&dir, "C = [0.3, 0.8]");
+    let good = job(dir, "C = [0.3, 0.8]");
     for n in ["0", "65537"] {
-        let o = wiperlab(&[
+        let o = run(&[
             "explore",
             good.to_str().unwrap(),
             "--samples",
@@ -290,5 +274,4 @@ fn explore_refuses_a_bad_job_with_exit_2_and_the_line() {
         assert!(err.contains(&format!("--samples {n}")), "{err}");
         assert!(!out.exists());
     }
-    std::fs::remove_dir_all(&dir).ok();
 }

@@ -20,13 +20,14 @@ fn fit_recovers_friction_c_and_neck_stiffness() {
         *c = c_true;
     }
     let (sim, t0) = common::recording_of(&truth).unwrap();
-    let dir = common::write_case(
+    let case = common::write_case(
         "fit_recovery",
         &sim,
         &base,
         &format!("{{\"C\": {c_true}, \"k1\": {k1_true}}}"),
         &mut || 0.0,
     );
+    let dir = case.path();
     let job = format!(
         r#"name = "recovery"
 blade = "blade.toml"
@@ -80,7 +81,6 @@ keys = {{ C = "/C", k1 = "/k1" }}
             .iter()
             .all(|m| m.freq_hz.is_finite() && m.freq_hz > 0.0)
     );
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Counts add up across candidates and the bootstrap, and the failure warning fires: the preload
@@ -95,8 +95,8 @@ keys = {{ C = "/C", k1 = "/k1" }}
 fn evaluation_and_failure_counts_add_up_and_failures_are_reported() {
     let truth = common::true_blade();
     let (sim, t0) = common::recording_of(&truth).unwrap();
-    let dir = std::env::temp_dir().join(format!("wiperlab_fit_counts_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = common::temp_dir("fit_counts");
+    let dir = tmp.path();
     common::write_dltdv(&dir.join("rec_xypts.csv"), &sim, &mut || 0.0);
     std::fs::write(dir.join("blade.toml"), toml::to_string(&truth).unwrap()).unwrap();
     let hd = truth.hd_m;
@@ -164,5 +164,4 @@ polish_iterations = 4
         r.warnings
     );
     assert_eq!(r.first_failure.is_some(), chosen.failed_evaluations > 0);
-    std::fs::remove_dir_all(&dir).ok();
 }

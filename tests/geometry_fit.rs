@@ -39,13 +39,14 @@ fn recover(id: ParamId, value: f64, bounds: [f64; 2], seed: u64) -> (FitOutcome,
         common::recording_of(&truth).expect("the changed blade keeps contact over the window");
     let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
     let noise = Normal::new(0.0, 0.1).unwrap();
-    let dir = common::write_case(
+    let case = common::write_case(
         &format!("geometry_{id}"),
         &sim,
         &base,
         &format!("{{\"{id}\": {value}, \"C\": {C_TRUE}}}"),
         &mut || noise.sample(&mut rng),
     );
+    let dir = case.path();
     let job = format!(
         r#"name = "geometry"
 blade = "blade.toml"
@@ -68,7 +69,6 @@ keys = {{ {id} = "/{id}", C = "/C" }}
     std::fs::write(dir.join("job.toml"), job).unwrap();
     let loaded = LoadedJob::load(&dir.join("job.toml")).unwrap();
     let out = run_fit(&loaded, false).unwrap();
-    std::fs::remove_dir_all(&dir).ok();
     let r = &out.result;
     eprintln!(
         "{id}: cost {:.3}, {} evaluations ({} failed)",

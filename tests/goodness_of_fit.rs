@@ -8,7 +8,8 @@
 //! confusion table's 0.12 rad shoulder scene ended in when its search missed the shoulder
 //! (A −44 %, B −39 %, C −9 %; reports/model_choice/table.md). About 1 s.
 
-use std::path::Path;
+mod common;
+
 use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::likelihood::{GOODNESS_OF_FIT_LEVEL, GoodnessOfFit};
 use wiperlab::fit::{Candidate, problem_for};
@@ -23,7 +24,7 @@ const TRUTH: [(&str, f64); 4] = [
 
 /// The test of `candidate` on the shipped recording at `values` (one per freed parameter).
 fn test_at(candidate: &str, values: &[(&str, f64)]) -> GoodnessOfFit {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = common::root();
     let job = LoadedJob::load(&root.join("fits/reversal.toml")).expect("the shipped job loads");
     let p = problem_for(&job, candidate.parse::<Candidate>().unwrap()).unwrap();
     let u: Vec<f64> = p

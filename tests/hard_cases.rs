@@ -2,6 +2,8 @@
 //! against an independent number, or stops with `Error::Simulation` naming the time and state. None
 //! may panic or return NaN.
 
+mod common;
+
 use wiperlab::model::belt::Belt;
 use wiperlab::model::benchmarks::{CoulombBelt, seed_law_belt};
 use wiperlab::model::{Blade, BladeParams, FrictionLaw, StickForm};
@@ -10,12 +12,7 @@ use wiperlab::simulate::blade::{BladeSimulation, default_window, simulate_blade}
 use wiperlab::simulate::hybrid::{Mode, Phase, SolverOptions, integrate};
 
 fn sample_params() -> BladeParams {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/data/reversal/blade_true.toml"
-    ))
-    .unwrap();
-    toml::from_str(&text).unwrap()
+    common::true_blade()
 }
 
 fn tight() -> SolverOptions {

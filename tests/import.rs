@@ -490,7 +490,7 @@ fn canonical_round_trip_of_the_sample_is_bit_identical() {
 
 #[test]
 fn missing_file_is_an_io_error_naming_it() {
-    let path = std::env::temp_dir().join("wiperlab_no_such_file_xypts.csv");
+    let path = common::TempFile::path("no_such_file_xypts.csv").0;
     for spec in [
         ImportSpec::default(),
         ImportSpec {
@@ -508,7 +508,7 @@ fn missing_file_is_an_io_error_naming_it() {
         assert!(matches!(err, Error::Io { .. }), "{err:?}");
         assert!(err.is_input_error());
         assert!(
-            err.to_string().contains("wiperlab_no_such_file_xypts.csv"),
+            err.to_string().contains(&path.display().to_string()),
             "{err}"
         );
     }

@@ -2,16 +2,8 @@
 //! the exit code and message for missing settings (through the built binary).
 
 mod common;
-
-use common::{TempFile, shared};
+use common::{TempFile, root, run, shared, temp_dir, wiperlab_exe};
 use std::process::{Command, Output};
-
-fn wiperlab(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-        .args(args)
-        .output()
-        .expect("cannot start the wiperlab binary")
-}
 
 fn text(o: &Output) -> (String, String) {
     (
@@ -28,7 +20,7 @@ fn describe_prints_format_points_time_units_gaps() {
         "describe_sleap.csv",
         "track,frame_idx,head.x,head.y\nm,0,10,20\n,1,,\nm,2,12,22\n",
     );
-    let o = wiperlab(&[
+    let o = run(&[
         "import",
         f.0.to_str().unwrap(),
         "--describe",
@@ -59,7 +51,7 @@ fn missing_fps_is_exit_2_naming_the_setting() {
         "track,frame_idx,a.x,a.y\nm,0,1,2\nm,1,1,3\n",
     );
     let out_csv = TempFile::path("nofps_sleap.trace.csv");
-    let o = wiperlab(&[
+    let o = run(&[
         "import",
         f.0.to_str().unwrap(),
         "--m-per-px",
@@ -74,7 +66,7 @@ fn missing_fps_is_exit_2_naming_the_setting() {
         "{err}"
     );
     assert!(!out_csv.0.exists());
-    let o = wiperlab(&[
+    let o = run(&[
         "import",
         f.0.to_str().unwrap(),
         "--describe",
@@ -92,13 +84,13 @@ fn missing_fps_is_exit_2_naming_the_setting() {
 #[test]
 fn format_flag_overrides_detection() {
     let f = TempFile::with("override.txt", "t\tx\ty\n0\t1\t2\n0.1\t1\t2\n");
-    let o = wiperlab(&["import", f.0.to_str().unwrap(), "--describe"]);
+    let o = run(&["import", f.0.to_str().unwrap(), "--describe"]);
     assert!(
         text(&o).0.starts_with("tracker: 2 frames"),
         "{:?}",
         text(&o)
     );
-    let o = wiperlab(&[
+    let o = run(&[
         "import",
         f.0.to_str().unwrap(),
         "--describe",
@@ -116,7 +108,7 @@ fn scale_points_and_rotation_flags() {
         "flags_xypts.csv",
         "pt1_cam1_X,pt1_cam1_Y\n0,0\n10,0\n20,0\n",
     );
-    let o = wiperlab(&[
+    let o = run(&[
         "import",
         f.0.to_str().unwrap(),
         "--describe",
@@ -144,8 +136,9 @@ fn spectrum_reports_resampling_and_filled_points() {
     ) else {
         return;
     };
-    let dir = std::env::temp_dir().join(format!("wiperlab_import_cli_{}", std::process::id()));
-    let o = wiperlab(&[
+    let tmp = temp_dir("import_cli");
+    let dir = tmp.path();
+    let o = run(&[
         "spectrum",
         path.to_str().unwrap(),
         "--fps",
@@ -157,7 +150,6 @@ fn spectrum_reports_resampling_and_filled_points() {
         "--out-dir",
         dir.to_str().unwrap(),
     ]);
-    let _ = std::fs::remove_dir_all(&dir);
     let (out, err) = text(&o);
     assert_eq!(o.status.code(), Some(0), "{out}{err}");
     // Frame-indexed times (frame/800) are uniform: no resampling, so the gaps stay as imported.
@@ -191,8 +183,9 @@ fn tracker_resampling_is_reported() {
     let Some(path) = shared("realdata/tracker/8047.txt") else {
         return;
     };
-    let dir = std::env::temp_dir().join(format!("wiperlab_import_cli_t_{}", std::process::id()));
-    let o = wiperlab(&[
+    let tmp = temp_dir("import_cli_t");
+    let dir = tmp.path();
+    let o = run(&[
         "spectrum",
         path.to_str().unwrap(),
         "--band",
@@ -200,7 +193,6 @@ fn tracker_resampling_is_reported() {
         "--out-dir",
         dir.to_str().unwrap(),
     ]);
-    let _ = std::fs::remove_dir_all(&dir);
     let (out, err) = text(&o);
     assert_eq!(o.status.code(), Some(0), "{out}{err}");
     assert!(out.contains("resampled: 4206 frame times"), "{out}");
@@ -220,7 +212,7 @@ fn import_never_writes_over_its_input() {
     let dir = f.0.parent().unwrap();
     let other_spelling = dir.join(".").join(f.0.file_name().unwrap());
     for out in [path, other_spelling.to_str().unwrap()] {
-        let o = wiperlab(&[
+        let o = run(&[
             "import",
             path,
             "-o",
@@ -263,12 +255,12 @@ fn spectrum_welch_options_match_the_closed_form() {
             noise()
         ));
     }
-    let dir = std::env::temp_dir().join(format!("wiperlab_welch_cli_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = temp_dir("welch_cli");
+    let dir = tmp.path();
     let path = dir.join("sine.csv");
     std::fs::write(&path, text).unwrap();
     let out = dir.join("out");
-    let o = wiperlab(&[
+    let o = run(&[
         "spectrum",
         path.to_str().unwrap(),
         "--format",
@@ -312,14 +304,13 @@ fn spectrum_welch_options_match_the_closed_form() {
         "{} vs {expected}",
         row[col]
     );
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Settings that cannot work are refused before any spectrum is computed, naming the flag (exit 2):
 /// a segment longer than the record or shorter than 8, a band upside down, a band past Nyquist.
 #[test]
 fn spectrum_refuses_impossible_settings_naming_the_flag() {
-    let Some(path) = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+    let Some(path) = root()
         .join("data/reversal/wiper_reversal_sample_xypts.csv")
         .canonicalize()
         .ok()
@@ -353,7 +344,7 @@ fn spectrum_refuses_impossible_settings_naming_the_flag() {
     for (extra, key) in cases {
         let mut args = base.to_vec();
         args.extend_from_slice(extra);
-        let o = wiperlab(&args);
+        let o = run(&args);
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{extra:?}: {err}");
         assert!(err.contains(key), "{extra:?}: {err}");
@@ -365,7 +356,7 @@ fn spectrum_refuses_impossible_settings_naming_the_flag() {
 #[test]
 fn completions_cover_the_commands() {
     for shell in ["bash", "zsh", "fish"] {
-        let o = wiperlab(&["completions", shell]);
+        let o = run(&["completions", shell]);
         assert!(o.status.success(), "{shell}");
         let script = String::from_utf8_lossy(&o.stdout);
         for word in [
@@ -375,8 +366,8 @@ fn completions_cover_the_commands() {
             assert!(script.contains(word), "{shell}: no {word}");
         }
         if shell == "bash" && std::path::Path::new("/bin/bash").exists() {
-            let dir = std::env::temp_dir().join(format!("wiperlab_compl_{}", std::process::id()));
-            std::fs::create_dir_all(&dir).unwrap();
+            let tmp = temp_dir("compl");
+            let dir = tmp.path();
             let f = dir.join("wiperlab.bash");
             std::fs::write(&f, script.as_bytes()).unwrap();
             let check = Command::new("/bin/bash")
@@ -385,10 +376,9 @@ fn completions_cover_the_commands() {
                 .status()
                 .unwrap();
             assert!(check.success(), "bash -n rejects the script");
-            std::fs::remove_dir_all(&dir).ok();
         }
     }
-    let o = wiperlab(&["completions", "tcsh-nope"]);
+    let o = run(&["completions", "tcsh-nope"]);
     assert_eq!(o.status.code(), Some(2));
 }
 
@@ -396,10 +386,9 @@ fn completions_cover_the_commands() {
 /// creates no file.
 #[test]
 fn import_to_stdout_with_dash() {
-    let rec = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("data/reversal/wiper_reversal_sample_xypts.csv");
-    let dir = std::env::temp_dir().join(format!("wiperlab_dash_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let rec = root().join("data/reversal/wiper_reversal_sample_xypts.csv");
+    let tmp = temp_dir("dash");
+    let dir = tmp.path();
     let file = dir.join("out.trace.csv");
     let common = [
         "import",
@@ -414,21 +403,20 @@ fn import_to_stdout_with_dash() {
     ];
     let mut to_file = common.to_vec();
     to_file.push(file.to_str().unwrap());
-    assert!(wiperlab(&to_file).status.success());
+    assert!(run(&to_file).status.success());
     let mut to_stdout = common.to_vec();
     to_stdout.push("-");
-    let o = wiperlab(&to_stdout);
+    let o = run(&to_stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(o.stdout, std::fs::read(&file).unwrap());
     assert!(!std::path::Path::new("-").exists());
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// `--quiet` (global, any position) silences the import's notes on stderr; the file is written.
 #[test]
 fn quiet_import_writes_without_notes() {
     let out = TempFile::path("quiet.trace.csv");
-    let o = wiperlab(&[
+    let o = run(&[
         "--quiet",
         "import",
         "data/reversal/wiper_reversal_sample_xypts.csv",
@@ -454,7 +442,7 @@ fn a_closed_stdout_ends_quietly() {
     let speeds: Vec<String> = (1..=800)
         .map(|i| format!("{:.4}", 0.0002 * i as f64))
         .collect();
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_wiperlab"))
+    let mut child = std::process::Command::new(wiperlab_exe())
         .args([
             "modes",
             "data/reversal/blade_true.toml",

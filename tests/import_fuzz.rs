@@ -15,9 +15,10 @@
 //! run tries new inputs.
 
 mod common;
+use common::TempFile;
 
 use proptest::prelude::*;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use wiperlab::Error;
 use wiperlab::import::{Format, ImportSpec, canonical, read_trace};
 
@@ -111,23 +112,9 @@ fn spec_for(format: Format) -> ImportSpec {
     s
 }
 
-struct Tmp(PathBuf);
-impl Drop for Tmp {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.0);
-    }
-}
-
-fn tmp(tag: &str) -> Tmp {
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    static N: AtomicUsize = AtomicUsize::new(0);
-    let k = N.fetch_add(1, Ordering::Relaxed);
-    Tmp(std::env::temp_dir().join(format!("wiperlab_fuzz_{}_{k}_{tag}", std::process::id())))
-}
-
 /// Run the reader on `bytes`; panics (= test failure) on a broken contract.
 fn check(format: Option<Format>, bytes: &[u8], rotate: bool) {
-    let f = tmp("in.txt");
+    let f = TempFile::path("in.txt");
     std::fs::write(&f.0, bytes).unwrap();
     let result = match format {
         Some(fm) => {
@@ -235,7 +222,7 @@ proptest! {
 
     #[test]
     fn detection_never_panics(bytes in proptest::collection::vec(any::<u8>(), 0..512)) {
-        let f = tmp("detect.txt");
+        let f = TempFile::path("detect.txt");
         std::fs::write(&f.0, &bytes).unwrap();
         if let Err(e) = Format::detect(&f.0) {
             check_error(&f.0, &e);
@@ -247,13 +234,12 @@ proptest! {
 #[test]
 fn seeds_are_valid() {
     for f in formats() {
-        let t = std::env::temp_dir().join(format!("wiperlab_fuzz_seed_{}", std::process::id()));
-        std::fs::write(&t, builtin_seed(f)).unwrap();
+        let t = TempFile::path("seed.txt");
+        std::fs::write(&t.0, builtin_seed(f)).unwrap();
         let r = match f {
-            Some(fm) => read_trace(&t, &spec_for(fm)),
-            None => canonical::read_trace_csv(&t),
+            Some(fm) => read_trace(&t.0, &spec_for(fm)),
+            None => canonical::read_trace_csv(&t.0),
         };
-        let _ = std::fs::remove_file(&t);
         assert!(r.is_ok(), "{f:?}: {}", r.unwrap_err());
     }
 }

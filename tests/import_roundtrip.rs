@@ -2,26 +2,16 @@
 //! known: every writable layout reads back identically, and the calibration steps (two-point
 //! scale, y flip, rotation to the sweep, frame rate) do what their formulas say.
 
+mod common;
+
 use std::collections::BTreeMap;
 
+use common::TempFile;
 use wiperlab::import::{
     Format, ImportSpec, canonical, dltdv, dltdv_sparse, principal_axis_rad, read_trace,
     read_trace_with_summary, tracker,
 };
 use wiperlab::trace::{PointTrack, Trace};
-
-/// A temp file removed on drop.
-struct Tmp(std::path::PathBuf);
-impl Tmp {
-    fn new(name: &str) -> Tmp {
-        Tmp(std::env::temp_dir().join(format!("wiperlab_rt_{}_{name}", std::process::id())))
-    }
-}
-impl Drop for Tmp {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.0);
-    }
-}
 
 /// Two points over `n` frames at `fps`, with a gap in the tip; coordinates are multiples of 2⁻¹⁶ m
 /// so that pixel ↔ metre conversions with m_per_px = 2⁻¹⁰ are exact in binary floating point.
@@ -75,7 +65,7 @@ fn roles() -> BTreeMap<String, String> {
 #[test]
 fn canonical_csv_round_trip() {
     let t = trace(50, 1000.0);
-    let f = Tmp::new("rt.trace.csv");
+    let f = TempFile::path("rt.trace.csv");
     canonical::write_trace_csv(&f.0, &t).unwrap();
     same(&canonical::read_trace_csv(&f.0).unwrap(), &t);
 }
@@ -87,7 +77,7 @@ fn tracker_text_round_trip() {
     for (k, v) in t.t_s.iter_mut().enumerate() {
         *v += 1e-3 * ((k * 7) % 5) as f64;
     }
-    let f = Tmp::new("rt_tracker.txt");
+    let f = TempFile::path("rt_tracker.txt");
     tracker::write(&f.0, &t).unwrap();
     let (back, sum) = read_trace_with_summary(&f.0, &ImportSpec::default()).unwrap();
     assert_eq!(sum.format, Some(Format::Tracker), "detected by content");
@@ -105,7 +95,7 @@ fn dltdv_xypts_round_trip() {
         points: roles(),
         ..ImportSpec::default()
     };
-    let f = Tmp::new("rt_xypts.csv");
+    let f = TempFile::path("rt_xypts.csv");
     dltdv::write(&f.0, &t, &spec).unwrap();
     let back = read_trace(&f.0, &spec).unwrap();
     same(&back, &t);
@@ -126,7 +116,7 @@ fn dltdv_sparse_round_trip() {
             )
         })
         .collect();
-    let f = Tmp::new("rt_xypts.tsv");
+    let f = TempFile::path("rt_xypts.tsv");
     dltdv_sparse::write(&f.0, &px).unwrap();
     let spec = ImportSpec {
         fps_hz: Some(fps),
@@ -144,7 +134,7 @@ fn dltdv_sparse_round_trip() {
 /// give m_per_px = 0.25/500 = 5e-4 — the same trace as m_per_px given directly.
 #[test]
 fn two_point_scale_equals_direct_scale() {
-    let f = Tmp::new("scale_xypts.csv");
+    let f = TempFile::path("scale_xypts.csv");
     std::fs::write(&f.0, "pt1_cam1_X,pt1_cam1_Y\n100,50\n110,40\n").unwrap();
     let direct = ImportSpec {
         fps_hz: Some(100.0),
@@ -201,7 +191,7 @@ fn rotation_to_the_sweep() {
             v * a.sin()
         ));
     }
-    let f = Tmp::new("rot_tracker.txt");
+    let f = TempFile::path("rot_tracker.txt");
     std::fs::write(&f.0, text).unwrap();
     let est = ImportSpec {
         sweep_from_head: true,
@@ -248,7 +238,7 @@ fn rotation_to_the_sweep() {
 /// Frame-indexed formats without a frame rate fail with a message naming the setting.
 #[test]
 fn frame_rate_is_required_where_the_file_has_none() {
-    let f = Tmp::new("nofps.csv");
+    let f = TempFile::path("nofps.csv");
     std::fs::write(
         &f.0,
         "scorer,s,s,s\nbodyparts,h,h,h\ncoords,x,y,likelihood\n0,1,2,0.9\n1,1,2,0.9\n",

@@ -5,44 +5,23 @@
 //! frame rate 10,000 frames/s, 1.5e-5 m/px, points pt1 = head and pt2 = tip, and the default
 //! bands, which the template's band rule reproduces at 10,000 frames/s).
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+use common::{root, run_in, temp_dir};
+
+use std::process::Output;
+use tempfile::TempDir;
 
 use wiperlab::fit::job::LoadedJob;
 
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn wiperlab(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("cannot start the wiperlab binary")
-}
-
-/// A fresh temp dir holding a copy of the sample recording; removed on drop.
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(name: &str) -> Scratch {
-        let d = std::env::temp_dir().join(format!("wiperlab_init_{}_{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).expect("create temp dir");
-        std::fs::copy(
-            root().join("data/reversal/wiper_reversal_sample_xypts.csv"),
-            d.join("rec_xypts.csv"),
-        )
-        .expect("copy the sample");
-        Scratch(d)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
+/// A fresh temp dir holding a copy of the sample recording as `rec_xypts.csv`; removed on drop.
+fn scratch(name: &str) -> TempDir {
+    let d = temp_dir(&format!("init_{name}"));
+    std::fs::copy(
+        root().join("data/reversal/wiper_reversal_sample_xypts.csv"),
+        d.path().join("rec_xypts.csv"),
+    )
+    .expect("copy the sample");
+    d
 }
 
 fn text(o: &Output) -> String {
@@ -55,10 +34,10 @@ fn text(o: &Output) -> String {
 
 #[test]
 fn without_settings_the_template_marks_what_a_fit_needs() {
-    let s = Scratch::new("bare");
-    let o = wiperlab(&s.0, &["init", "rec_xypts.csv"]);
+    let s = scratch("bare");
+    let o = run_in(s.path(), &["init", "rec_xypts.csv"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
-    let job = s.0.join("rec_xypts.job.toml");
+    let job = s.path().join("rec_xypts.job.toml");
     // The count names the settings marked, not the header that explains the marks: MISSING the
     // blade, the frame rate and the scale; CHECK the roles guessed from the names, t0_s and the
     // default bands (no frame rate).
@@ -89,7 +68,7 @@ fn without_settings_the_template_marks_what_a_fit_needs() {
     assert!(e.to_string().contains("blade"), "{e}");
     // `init` never overwrites a job: exit 2, the file unchanged.
     std::fs::write(&job, "# mine\n").expect("write");
-    let o = wiperlab(&s.0, &["init", "rec_xypts.csv"]);
+    let o = run_in(s.path(), &["init", "rec_xypts.csv"]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("never overwrites"), "{}", text(&o));
     assert_eq!(std::fs::read_to_string(&job).expect("read"), "# mine\n");
@@ -97,10 +76,10 @@ fn without_settings_the_template_marks_what_a_fit_needs() {
 
 #[test]
 fn with_the_sample_settings_the_filled_in_template_loads_like_the_main_job() {
-    let s = Scratch::new("calibrated");
-    std::fs::create_dir_all(s.0.join("jobs")).expect("mkdir");
-    let o = wiperlab(
-        &s.0,
+    let s = scratch("calibrated");
+    std::fs::create_dir_all(s.path().join("jobs")).expect("mkdir");
+    let o = run_in(
+        s.path(),
         &[
             "init",
             "rec_xypts.csv",
@@ -119,7 +98,7 @@ fn with_the_sample_settings_the_filled_in_template_loads_like_the_main_job() {
         ],
     );
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
-    let job = s.0.join("jobs/sample.toml");
+    let job = s.path().join("jobs/sample.toml");
     // Only the blade is MISSING; t0_s and the scaled bands are CHECK.
     assert!(
         String::from_utf8_lossy(&o.stdout).contains("(1 MISSING, 2 CHECK)"),
@@ -129,7 +108,11 @@ fn with_the_sample_settings_the_filled_in_template_loads_like_the_main_job() {
     let t = std::fs::read_to_string(&job).expect("the template");
     assert!(!t.contains("CHECK: guessed"), "roles were given: {t}");
     // The job lives elsewhere than the recording: the recording's path is absolute.
-    let rec = s.0.canonicalize().expect("canon").join("rec_xypts.csv");
+    let rec = s
+        .path()
+        .canonicalize()
+        .expect("canon")
+        .join("rec_xypts.csv");
     assert!(t.contains(&format!("file = \"{}\"", rec.display())), "{t}");
     // Fill in the one MISSING line (the blade) as a user would.
     let blade = root().join("data/reversal/blade.toml");
@@ -164,8 +147,8 @@ fn with_the_sample_settings_the_filled_in_template_loads_like_the_main_job() {
 
 #[test]
 fn describe_needs_no_calibration_and_says_what_a_fit_needs() {
-    let s = Scratch::new("describe");
-    let o = wiperlab(&s.0, &["import", "rec_xypts.csv", "--describe"]);
+    let s = scratch("describe");
+    let o = run_in(s.path(), &["import", "rec_xypts.csv", "--describe"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let out = String::from_utf8_lossy(&o.stdout);
     // 18,869 frames: the sample's row count (data/reversal/README.md), frames 0 … 18868.
@@ -174,8 +157,8 @@ fn describe_needs_no_calibration_and_says_what_a_fit_needs() {
     assert!(out.contains("a fit needs fps_hz (--fps)"), "{out}");
     assert!(out.contains("a fit needs m_per_px (--m-per-px)"), "{out}");
     // With the settings, the same file is described in seconds (frame 18869 at 1.8868 s).
-    let o = wiperlab(
-        &s.0,
+    let o = run_in(
+        s.path(),
         &[
             "import",
             "rec_xypts.csv",
@@ -195,20 +178,20 @@ fn describe_needs_no_calibration_and_says_what_a_fit_needs() {
 /// unknown) and writes no file; the same job as `-o FILE` apart from that path.
 #[test]
 fn dash_o_dash_prints_the_job_on_stdout() {
-    let s = Scratch::new("stdout");
-    let o = wiperlab(&s.0, &["init", "rec_xypts.csv", "-o", "-"]);
+    let s = scratch("stdout");
+    let o = run_in(s.path(), &["init", "rec_xypts.csv", "-o", "-"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let printed = String::from_utf8_lossy(&o.stdout).into_owned();
-    let abs = s.0.canonicalize().unwrap().join("rec_xypts.csv");
+    let abs = s.path().canonicalize().unwrap().join("rec_xypts.csv");
     assert!(
         printed.contains(&format!("file = {:?}", abs.display().to_string())),
         "{printed}"
     );
-    let files: Vec<_> = std::fs::read_dir(&s.0).unwrap().collect();
+    let files: Vec<_> = std::fs::read_dir(s.path()).unwrap().collect();
     assert_eq!(files.len(), 1, "only the recording: {files:?}");
-    let o = wiperlab(&s.0, &["init", "rec_xypts.csv", "-o", "job.toml"]);
+    let o = run_in(s.path(), &["init", "rec_xypts.csv", "-o", "job.toml"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
-    let written = std::fs::read_to_string(s.0.join("job.toml")).unwrap();
+    let written = std::fs::read_to_string(s.path().join("job.toml")).unwrap();
     let strip = |t: &str| -> Vec<String> {
         t.lines()
             .filter(|l| !l.starts_with("file = ") && !l.starts_with("# Fit job for "))
@@ -222,15 +205,15 @@ fn dash_o_dash_prints_the_job_on_stdout() {
 /// (times k/1000 s, so 1000 frames/s, not `1000.000000` or the median step's last bits).
 #[test]
 fn a_recording_with_times_states_its_frame_rate_rounded() {
-    let s = Scratch::new("timed");
+    let s = scratch("timed");
     let mut csv = String::from("t_s,head_x_m,head_y_m\n");
     for k in 0..50 {
         csv.push_str(&format!("{},{},0\n", k as f64 / 1000.0, 1e-4 * k as f64));
     }
-    std::fs::write(s.0.join("timed.csv"), csv).expect("write");
-    let o = wiperlab(&s.0, &["init", "timed.csv", "--format", "canonical"]);
+    std::fs::write(s.path().join("timed.csv"), csv).expect("write");
+    let o = run_in(s.path(), &["init", "timed.csv", "--format", "canonical"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
-    let t = std::fs::read_to_string(s.0.join("timed.job.toml")).expect("the template");
+    let t = std::fs::read_to_string(s.path().join("timed.job.toml")).expect("the template");
     assert!(
         t.contains("# The file's own times give 1000 frames/s;"),
         "{t}"

@@ -3,7 +3,9 @@
 //! sample against its true transition list, and the model's stick-onset rate at the sample's true
 //! parameters against the independent implementation's transition list (`truth.json`).
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::{root, temp_dir};
+
 use wiperlab::fit::job::LoadedJob;
 use wiperlab::model::{BladeParams, StickForm};
 use wiperlab::simulate::SolverOptions;
@@ -12,10 +14,6 @@ use wiperlab::simulate::hybrid::Phase;
 use wiperlab::spectrum::instfreq::{
     RidgeConfig, StickDetector, detect_stick_onsets, ridge_vs_speed,
 };
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf()
-}
 
 /// Slip→stick times of the independent Python implementation that made the sample
 /// (data/reversal/truth.json "simulation.transitions", DOP853 at rtol 1e-10, events by Brent).
@@ -402,16 +400,15 @@ fn measured_and_true_model_agree_on_frequency_against_speed() {
     );
     assert!(meas.ridge.len() >= 15 && model.ridge.len() >= 15);
     // The figure the fit writes, here with the true model: all four series are drawn.
-    let dir = std::env::temp_dir().join(format!("wiperlab_instfreq_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = temp_dir("instfreq");
+    let dir = tmp.path();
     let comparison = wiperlab::fit::instfreq::FreqSpeedComparison {
         measured: meas.clone(),
         model: model.clone(),
         band_hz: cfg.band_hz,
     };
-    wiperlab::report::figures::freq_vs_speed_figure(&dir, &comparison).unwrap();
+    wiperlab::report::figures::freq_vs_speed_figure(dir, &comparison).unwrap();
     let svg = std::fs::read_to_string(dir.join("freq_vs_speed.svg")).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
     for label in [
         "measured: spectrogram ridge",
         "model: spectrogram ridge",
@@ -499,12 +496,8 @@ fn fit_job_with_freq_speed_and_trace_terms_runs_and_reports_them() {
             "polish_iterations = 1\nobjective = \"features\"",
         )
         + "\n[fit.weights]\nfreq_speed = 1.0\ntrace = 1.0\n";
-    let path =
-        std::env::temp_dir().join(format!("wiperlab_instfreq_job_{}.toml", std::process::id()));
-    std::fs::write(&path, text).unwrap();
-    let job = LoadedJob::load(&path);
-    let _ = std::fs::remove_file(&path);
-    let job = job.unwrap();
+    let path = common::TempFile::with("instfreq_job.toml", &text);
+    let job = LoadedJob::load(&path.0).unwrap();
     assert_eq!(job.job.fit.weights.freq_speed, 1.0);
     assert_eq!(job.job.fit.weights.trace, 1.0);
     let out = wiperlab::fit::run_fit(&job, false).unwrap();

@@ -71,9 +71,8 @@ fn coverage(label: &str, recordings: usize, uncertainty: &str, accept: Accept) {
         StickForm::Reduced,
     )
     .unwrap();
-    let dir =
-        std::env::temp_dir().join(format!("wiperlab_coverage_{label}_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = common::temp_dir(&format!("coverage_{label}"));
+    let dir = tmp.path();
     std::fs::write(dir.join("blade.toml"), toml::to_string(&base).unwrap()).unwrap();
     std::fs::write(
         dir.join("truth.json"),
@@ -145,7 +144,6 @@ keys = {{ k1 = "/k1", C = "/C" }}
             *covered.entry(p.name.to_string()).or_default() += usize::from(inside);
         }
     }
-    std::fs::remove_dir_all(&dir).ok();
     // Acceptance region [lo, hi] with P(X < lo) ≈ P(X > hi) ≈ 1 % under Binomial(R, 0.6827).
     let p = 0.6827;
     let lo = (0..=recordings)

@@ -29,8 +29,8 @@ fn joint_fit_of_two_sweep_speeds_recovers_shared_parameters() {
     }
     let mut slow = truth;
     slow.drive_omega_rad_per_s = 0.7 * truth.drive_omega_rad_per_s;
-    let dir = std::env::temp_dir().join(format!("wiperlab_joint_fit_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = common::temp_dir("joint_fit");
+    let dir = tmp.path();
     let t0_fast = write_recording(&truth, &dir.join("fast_xypts.csv"));
     let t0_slow = write_recording(&slow, &dir.join("slow_xypts.csv"));
     std::fs::write(dir.join("blade.toml"), toml::to_string(&base).unwrap()).unwrap();
@@ -130,5 +130,4 @@ keys = {{ C = "/C", k1 = "/k1" }}
             iv.method
         );
     }
-    std::fs::remove_dir_all(&dir).ok();
 }

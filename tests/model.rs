@@ -3,13 +3,15 @@
 //! - the independent Python/SciPy implementation that made the shipped sample
 //!   (data/reversal/clean_10kfps.csv.gz and truth.json, DOP853 rtol 1e-10, exact stick manifold).
 
+mod common;
+
 use std::io::Read;
 use wiperlab::model::{BladeParams, StickForm};
 use wiperlab::simulate::SolverOptions;
 use wiperlab::simulate::blade::simulate_blade;
 
 fn manifest(rel: &str) -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
+    common::root().join(rel)
 }
 
 fn true_params() -> BladeParams {

@@ -1,10 +1,12 @@
 //! Linearised modes (issue 17.1): closed forms through the same linearisation path, and the blade of
 //! the shipped sample.
 
+mod common;
+
 use std::f64::consts::PI;
 
 use wiperlab::model::modes::{Phase, jacobian_central, modes_of_system};
-use wiperlab::model::{Blade, BladeParams, StickForm};
+use wiperlab::model::{Blade, StickForm};
 
 fn lin<const N: usize>(f: impl Fn(&[f64]) -> [f64; N]) -> Vec<wiperlab::model::modes::Mode> {
     let j = jacobian_central(|x: &[f64]| Ok::<_, ()>(f(x).to_vec()), &[0.01; N]).unwrap();
@@ -66,9 +68,7 @@ fn two_mass_chain_matches_closed_form() {
 }
 
 fn sample_blade() -> Blade {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/reversal/blade_true.toml");
-    let params: BladeParams = toml::from_str(&std::fs::read_to_string(p).unwrap()).unwrap();
-    Blade::new(params, StickForm::Reduced)
+    Blade::new(common::true_blade(), StickForm::Reduced)
 }
 
 #[test]
@@ -111,17 +111,11 @@ fn sample_blade_modes_explain_the_lines() {
 /// from the independent Python implementation that made the sample).
 #[test]
 fn modes_command_prints_the_window_modes_as_json() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-        .args(["modes", "data/reversal/blade_true.toml", "--json"])
-        .current_dir(root)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = common::wiperlab(["modes", "data/reversal/blade_true.toml", "--json"])
+        .assert()
+        .success()
+        .get_output()
+        .clone();
     let modes: Vec<serde_json::Value> = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(modes.len(), 7);
     let stick: Vec<_> = modes.iter().filter(|m| m["phase"] == "stick").collect();
@@ -133,11 +127,8 @@ fn modes_command_prints_the_window_modes_as_json() {
         assert!(m["participation"]["neck_lip"].as_f64().unwrap() <= 1.0);
     }
     // A speed the drive never reaches is an input error (exit 2) that names the flag.
-    let bad = std::process::Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-        .args(["modes", "data/reversal/blade_true.toml", "--speeds", "5"])
-        .current_dir(root)
-        .output()
-        .unwrap();
-    assert_eq!(bad.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&bad.stderr).contains("--speeds"));
+    common::wiperlab(["modes", "data/reversal/blade_true.toml", "--speeds", "5"])
+        .assert()
+        .code(2)
+        .stderr(predicates::str::contains("--speeds"));
 }

@@ -14,9 +14,9 @@ const MAIN_JOB_BANDS: &[(&str, [f64; 2], usize)] =
 
 #[test]
 fn necklip_is_fitted_but_not_chosen_for_a_low_band() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let dir = std::env::temp_dir().join(format!("wiperlab_necklip_fit_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let root = common::root();
+    let tmp = common::temp_dir("necklip_fit");
+    let dir = tmp.path();
     // The main job's recording and bands (fits/reversal.toml) on the true blade, with a tiny
     // optimiser budget: this checks the plumbing, not the fitted values (docs/fit.md, "Which model the
     // scene needs"). Here blade2dof also has the lower cost, so what shows the rule is the reason.
@@ -48,7 +48,6 @@ k1 = [0.005, 0.15]
     std::fs::write(&path, job).unwrap();
     let job = LoadedJob::load(&path).unwrap();
     let out = run_fit(&job, false).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
     let trials = &out.result.model_trials;
     assert_eq!(trials.len(), 2);
     let nl = trials.iter().find(|t| t.model == "necklip").unwrap();

@@ -6,69 +6,57 @@
 //! of its inputs (`proj/`), both in a fresh temp dir, and checks the exact files on both sides.
 
 mod common;
+use common::{ok, root, s, temp_dir, wiperlab};
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
+use std::process::Output;
+use tempfile::TempDir;
 
 /// A temp dir with `cwd/` (the working directory of every command) and `proj/` (the inputs),
 /// removed on drop.
-struct Tmp(PathBuf);
+struct Tmp(TempDir);
 
 impl Tmp {
     fn new(name: &str) -> Tmp {
-        let p = std::env::temp_dir().join(format!("wiperlab_outdir_{}_{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&p);
-        std::fs::create_dir_all(p.join("cwd")).expect("create cwd");
-        std::fs::create_dir_all(p.join("proj")).expect("create proj");
-        Tmp(p)
+        let t = temp_dir(&format!("outdir_{name}"));
+        std::fs::create_dir_all(t.path().join("cwd")).expect("create cwd");
+        std::fs::create_dir_all(t.path().join("proj")).expect("create proj");
+        Tmp(t)
     }
 
     fn cwd(&self) -> PathBuf {
-        self.0.join("cwd")
+        self.0.path().join("cwd")
     }
 
     fn proj(&self) -> PathBuf {
-        self.0.join("proj")
+        self.0.path().join("proj")
     }
 
-    /// Runs `wiperlab args...` in `cwd/` and asserts exit code 0; returns stdout.
+    /// Runs `wiperlab args... --quiet` in `cwd/` and asserts exit code 0; returns stdout.
     fn ok(&self, args: &[&str]) -> String {
-        let o = self.run(args);
-        assert_eq!(
-            o.status.code(),
-            Some(0),
-            "wiperlab {args:?}\nstdout:\n{}\nstderr:\n{}",
-            String::from_utf8_lossy(&o.stdout),
-            String::from_utf8_lossy(&o.stderr)
-        );
-        String::from_utf8_lossy(&o.stdout).into_owned()
+        ok(&self.run(args), &format!("wiperlab {args:?}"))
     }
 
     fn run(&self, args: &[&str]) -> Output {
-        Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-            .args(args)
+        wiperlab(args)
             .arg("--quiet")
             .current_dir(self.cwd())
             .output()
-            .expect("cannot start the wiperlab binary")
+            .expect("start the wiperlab binary")
     }
 
     /// Every file under the temp dir, relative to it, as `/`-joined strings.
     fn files(&self) -> BTreeSet<String> {
         let mut out = BTreeSet::new();
-        let mut stack = vec![self.0.clone()];
+        let mut stack = vec![self.0.path().to_path_buf()];
         while let Some(d) = stack.pop() {
             for e in std::fs::read_dir(&d).expect("read dir") {
                 let p = e.expect("dir entry").path();
                 if p.is_dir() {
                     stack.push(p);
                 } else {
-                    let rel = p.strip_prefix(&self.0).expect("under the temp dir");
+                    let rel = p.strip_prefix(self.0.path()).expect("under the temp dir");
                     out.insert(rel.to_string_lossy().replace('\\', "/"));
                 }
             }
@@ -84,16 +72,6 @@ impl Tmp {
             .filter_map(|f| f.strip_prefix(&prefix).map(str::to_string))
             .collect()
     }
-}
-
-impl Drop for Tmp {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("UTF-8 temp path")
 }
 
 /// The set of `names`.
@@ -186,7 +164,7 @@ fn out_dir_moves_import_init_spectrum_and_simulate_outputs() {
     let mut init = vec!["init", "../proj/rec.csv", "--out-dir", "../o/init"];
     init.extend(SAMPLE_FLAGS);
     t.ok(&init);
-    let trace = t.0.join("o/import/rec.trace.csv");
+    let trace = t.0.path().join("o/import/rec.trace.csv");
     t.ok(&["spectrum", s(&trace), "--out-dir", "../o/spectrum"]);
     let blade = root().join("data/reversal/blade_true.toml");
     t.ok(&[
@@ -201,7 +179,7 @@ fn out_dir_moves_import_init_spectrum_and_simulate_outputs() {
     assert_eq!(t.files_under("o/import"), set(&["rec.trace.csv"]));
     assert_eq!(t.files_under("o/init"), set(&["rec.job.toml"]));
     // The job written elsewhere names the recording so that it resolves from there.
-    let job = std::fs::read_to_string(t.0.join("o/init/rec.job.toml")).expect("the job");
+    let job = std::fs::read_to_string(t.0.path().join("o/init/rec.job.toml")).expect("the job");
     let rec = t.proj().canonicalize().expect("proj").join("rec.csv");
     assert!(
         job.contains(&format!("file = {:?}", rec.display().to_string())),
@@ -334,7 +312,7 @@ fn campaign_writes_beside_the_campaign_file_or_in_out_dir() {
         t.files_under("o"),
         set(&["campaign.csv", "report/index.html", "slurm/array.sh"])
     );
-    let script = std::fs::read_to_string(t.0.join("o/slurm/array.sh")).expect("the script");
+    let script = std::fs::read_to_string(t.0.path().join("o/slurm/array.sh")).expect("the script");
     let given = script
         .split("--out-dir '")
         .nth(1)
@@ -345,7 +323,7 @@ fn campaign_writes_beside_the_campaign_file_or_in_out_dir() {
         Path::new(given)
             .canonicalize()
             .expect("the --out-dir exists"),
-        t.0.join("o").canonicalize().expect("o/")
+        t.0.path().join("o").canonicalize().expect("o/")
     );
     assert!(t.files_under("cwd").is_empty());
 }

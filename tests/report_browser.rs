@@ -11,35 +11,11 @@
 //! with `WIPERLAB_REQUIRE_BROWSER=1` (set by `.ci/run`) a missing Chromium fails instead.
 
 mod common;
+use common::{ok, root, run_in, stderr, temp_dir, wiperlab};
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// A temp dir, unique per process and name, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> TempDir {
-        let d = std::env::temp_dir().join(format!(
-            "wiperlab_report_browser_{}_{name}",
-            std::process::id()
-        ));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).expect("create temp dir");
-        TempDir(d)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// The quick job, named `quick`, with absolute paths into `data/reversal/`. Import settings are the
 /// shipped main job's (`fits/reversal.toml`; t0_s from data/reversal/truth.json camera.t0_s). The
@@ -81,28 +57,6 @@ keys = {{ C = "/params/C", k1 = "/params/k1" }}
     let p = dir.join("quick.toml");
     std::fs::write(&p, text).expect("write the quick job");
     p
-}
-
-/// Runs `wiperlab args...` with working directory `cwd`.
-fn wiperlab(cwd: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("cannot start the wiperlab binary")
-}
-
-fn ok(o: &Output, what: &str) -> (String, String) {
-    let (out, err) = (
-        String::from_utf8_lossy(&o.stdout).into_owned(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    );
-    assert!(
-        o.status.success(),
-        "{what} failed ({:?})\nstdout:\n{out}\nstderr:\n{err}",
-        o.status
-    );
-    (out, err)
 }
 
 /// The SVG file names in `dir`, sorted.
@@ -432,18 +386,19 @@ fn fit_svgs(dir: &Path) -> Vec<String> {
 /// result; the page holds the tables, the SHA-256 of the recording, and every figure loads.
 #[test]
 fn report_page_after_a_quick_fit_loads_every_figure_in_chromium() {
-    let tmp = TempDir::new("ok");
-    let job = write_quick_job(&tmp.0);
+    let tmp = temp_dir("ok");
+    let job = write_quick_job(tmp.path());
     let job_s = job.to_str().unwrap();
-    let (out, _) = ok(&wiperlab(&tmp.0, &["fit", job_s, "--quiet"]), "quick fit");
+    let out = ok(&run_in(tmp.path(), &["fit", job_s, "--quiet"]), "quick fit");
     assert!(
         out.contains("wiperlab report") && out.contains("reports/quick/index.html"),
         "fit prints no report hint:\n{out}"
     );
-    let result = tmp.0.join("quick.result.toml");
+    let result = tmp.path().join("quick.result.toml");
     let before = std::fs::read(&result).expect("fit wrote the result");
 
-    let (out, err) = ok(&wiperlab(&tmp.0, &["report", job_s]), "report");
+    let o = run_in(tmp.path(), &["report", job_s]);
+    let (out, err) = (ok(&o, "report"), stderr(&o));
     assert!(
         !err.contains("running the fit"),
         "report refitted although the result exists:\n{err}"
@@ -453,7 +408,7 @@ fn report_page_after_a_quick_fit_loads_every_figure_in_chromium() {
         before,
         "report rewrote the result"
     );
-    let dir = tmp.0.join("reports/quick");
+    let dir = tmp.path().join("reports/quick");
     let page = dir.join("index.html");
     let figs = fit_svgs(&dir);
     assert!(
@@ -507,7 +462,7 @@ fn report_page_after_a_quick_fit_loads_every_figure_in_chromium() {
     }
 
     let Some(chromium) = chromium() else { return };
-    let dom = dump_dom(&chromium, &page, &tmp.0.join("profile"));
+    let dom = dump_dom(&chromium, &page, &tmp.path().join("profile"));
     let check = figure_check(&dom);
     println!("figure check: {check:?}");
     assert_eq!(
@@ -520,8 +475,8 @@ fn report_page_after_a_quick_fit_loads_every_figure_in_chromium() {
         }
     );
     // A full-page screenshot: every figure and table rendered where the page laid it out.
-    let shot = tmp.0.join("report_quick.png");
-    let problems = screenshot_problems(&chromium, &page, &dom, &tmp.0.join("shot"), &shot);
+    let shot = tmp.path().join("report_quick.png");
+    let problems = screenshot_problems(&chromium, &page, &dom, &tmp.path().join("shot"), &shot);
     assert!(problems.is_empty(), "{problems:?}");
     keep_screenshot(&shot, "report_quick.png");
 }
@@ -531,26 +486,26 @@ fn report_page_after_a_quick_fit_loads_every_figure_in_chromium() {
 /// input error that says how to get one, exit 2, nothing written; `--refit` fits first.)
 #[test]
 fn browser_check_catches_a_broken_link_and_a_corrupt_svg() {
-    let tmp = TempDir::new("broken");
-    let job = write_quick_job(&tmp.0);
-    let o = wiperlab(&tmp.0, &["report", job.to_str().unwrap(), "--quiet"]);
+    let tmp = temp_dir("broken");
+    let job = write_quick_job(tmp.path());
+    let o = run_in(tmp.path(), &["report", job.to_str().unwrap(), "--quiet"]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(
         err.contains("no fit result") && err.contains("--refit"),
         "{err}"
     );
-    assert!(!tmp.0.join("quick.result.toml").exists());
-    assert!(!tmp.0.join("reports/quick/index.html").exists());
+    assert!(!tmp.path().join("quick.result.toml").exists());
+    assert!(!tmp.path().join("reports/quick/index.html").exists());
     ok(
-        &wiperlab(
-            &tmp.0,
+        &run_in(
+            tmp.path(),
             &["report", job.to_str().unwrap(), "--refit", "--quiet"],
         ),
         "report --refit",
     );
-    assert!(tmp.0.join("quick.result.toml").is_file());
-    let dir = tmp.0.join("reports/quick");
+    assert!(tmp.path().join("quick.result.toml").is_file());
+    let dir = tmp.path().join("reports/quick");
     let page = dir.join("index.html");
     let html = std::fs::read_to_string(&page).unwrap();
     let n = fit_svgs(&dir).len();
@@ -564,7 +519,7 @@ fn browser_check_catches_a_broken_link_and_a_corrupt_svg() {
         html.replace("src=\"psd_high.svg\"", "src=\"psd_missing.svg\""),
     )
     .unwrap();
-    let dom = dump_dom(&chromium, &bad_link, &tmp.0.join("p1"));
+    let dom = dump_dom(&chromium, &bad_link, &tmp.path().join("p1"));
     let check = figure_check(&dom);
     println!("broken link: {check:?}");
     assert_eq!(check.status, "broken");
@@ -575,8 +530,8 @@ fn browser_check_catches_a_broken_link_and_a_corrupt_svg() {
         &chromium,
         &bad_link,
         &dom,
-        &tmp.0.join("s1"),
-        &tmp.0.join("broken.png"),
+        &tmp.path().join("s1"),
+        &tmp.path().join("broken.png"),
     );
     println!("broken link, screenshot: {problems:?}");
     assert_eq!(problems.len(), 1, "{problems:?}");
@@ -592,14 +547,14 @@ fn browser_check_catches_a_broken_link_and_a_corrupt_svg() {
          xmlns=\"http://www.w3.org/2000/svg\"><rect width=\"3600\" height=\"2000\" fill=\"#FFFFFF\"/></svg>",
     )
     .unwrap();
-    let dom = dump_dom(&chromium, &page, &tmp.0.join("p3"));
+    let dom = dump_dom(&chromium, &page, &tmp.path().join("p3"));
     assert_eq!(figure_check(&dom).status, "ok");
     let problems = screenshot_problems(
         &chromium,
         &page,
         &dom,
-        &tmp.0.join("s3"),
-        &tmp.0.join("blank.png"),
+        &tmp.path().join("s3"),
+        &tmp.path().join("blank.png"),
     );
     println!("blank figure, screenshot: {problems:?}");
     assert_eq!(problems.len(), 1, "{problems:?}");
@@ -610,7 +565,7 @@ fn browser_check_catches_a_broken_link_and_a_corrupt_svg() {
     let svg = dir.join("traces_tip.svg");
     let text = std::fs::read_to_string(&svg).unwrap();
     std::fs::write(&svg, &text[..text.len() / 2]).unwrap();
-    let check = figure_check(&dump_dom(&chromium, &page, &tmp.0.join("p2")));
+    let check = figure_check(&dump_dom(&chromium, &page, &tmp.path().join("p2")));
     println!("corrupt SVG: {check:?}");
     assert_eq!(check.status, "broken");
     assert_eq!((check.loaded, check.total), (n - 1, n));
@@ -622,11 +577,11 @@ fn browser_check_catches_a_broken_link_and_a_corrupt_svg() {
 /// would be one more, broken). Also renders the model-comparison table.
 #[test]
 fn report_escapes_text_from_the_result() {
-    let tmp = TempDir::new("escape");
-    let job = write_quick_job(&tmp.0);
+    let tmp = temp_dir("escape");
+    let job = write_quick_job(tmp.path());
     let job_s = job.to_str().unwrap();
-    ok(&wiperlab(&tmp.0, &["fit", job_s, "--quiet"]), "quick fit");
-    let result = tmp.0.join("quick.result.toml");
+    ok(&run_in(tmp.path(), &["fit", job_s, "--quiet"]), "quick fit");
+    let result = tmp.path().join("quick.result.toml");
     let mut t: toml::Table = toml::from_str(&std::fs::read_to_string(&result).unwrap()).unwrap();
     let evil = r#"<img class="figure" src="injected.svg"> & "quotes""#;
     t.insert("warnings".into(), toml::Value::Array(vec![evil.into()]));
@@ -652,9 +607,9 @@ fn report_escapes_text_from_the_result() {
     );
     std::fs::write(&result, toml::to_string(&t).unwrap()).unwrap();
 
-    ok(&wiperlab(&tmp.0, &["report", job_s]), "report");
-    let page = tmp.0.join("reports/quick/index.html");
-    let n = fit_svgs(&tmp.0.join("reports/quick")).len();
+    ok(&run_in(tmp.path(), &["report", job_s]), "report");
+    let page = tmp.path().join("reports/quick/index.html");
+    let n = fit_svgs(&tmp.path().join("reports/quick")).len();
     let html = std::fs::read_to_string(&page).unwrap();
     assert!(!html.contains("injected.svg\">"), "unescaped markup");
     assert!(html.contains(
@@ -665,7 +620,7 @@ fn report_escapes_text_from_the_result() {
     assert!(!html.contains("Only one model"));
 
     let Some(chromium) = chromium() else { return };
-    let check = figure_check(&dump_dom(&chromium, &page, &tmp.0.join("profile")));
+    let check = figure_check(&dump_dom(&chromium, &page, &tmp.path().join("profile")));
     assert_eq!((check.status.as_str(), check.total), ("ok", n), "{check:?}");
 }
 
@@ -673,11 +628,11 @@ fn report_escapes_text_from_the_result() {
 /// column (exit code 2), not a panic and not a silent refit.
 #[test]
 fn unreadable_result_is_a_clear_input_error() {
-    let tmp = TempDir::new("bad_result");
-    let job = write_quick_job(&tmp.0);
-    let result = tmp.0.join("quick.result.toml");
+    let tmp = temp_dir("bad_result");
+    let job = write_quick_job(tmp.path());
+    let result = tmp.path().join("quick.result.toml");
     std::fs::write(&result, "job = \"quick\"\ncost = \"low\"\n").unwrap();
-    let o = wiperlab(&tmp.0, &["report", job.to_str().unwrap()]);
+    let o = run_in(tmp.path(), &["report", job.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "stderr:\n{err}");
     let lines: Vec<&str> = err.lines().collect();
@@ -686,7 +641,7 @@ fn unreadable_result_is_a_clear_input_error() {
         lines[0].starts_with(&format!("error: {}:2:", result.display())),
         "{err}"
     );
-    assert!(!tmp.0.join("reports/quick/index.html").exists());
+    assert!(!tmp.path().join("reports/quick/index.html").exists());
     assert_eq!(
         std::fs::read_to_string(&result).unwrap(),
         "job = \"quick\"\ncost = \"low\"\n",
@@ -852,13 +807,13 @@ fn axis_titles_are_found_with_and_without_units() {
 /// coordinates fall on quarter pixels).
 #[test]
 fn legends_cover_no_data_in_any_fit_figure() {
-    let tmp = TempDir::new("legends");
-    let job = write_quick_job(&tmp.0);
+    let tmp = temp_dir("legends");
+    let job = write_quick_job(tmp.path());
     ok(
-        &wiperlab(&tmp.0, &["fit", job.to_str().unwrap(), "--quiet"]),
+        &run_in(tmp.path(), &["fit", job.to_str().unwrap(), "--quiet"]),
         "quick fit",
     );
-    let dir = tmp.0.join("reports/quick");
+    let dir = tmp.path().join("reports/quick");
     let figs = svgs(&dir);
     assert!(figs.len() >= 5, "{figs:?}");
     for f in &figs {
@@ -888,13 +843,13 @@ fn svgs_at_least(dir: &Path, min: usize) -> Vec<String> {
 /// `modes` prints a table and draws nothing.
 #[test]
 fn every_figure_of_every_command_has_units_and_a_legend_over_no_data() {
-    let tmp = TempDir::new("all_figures");
+    let tmp = temp_dir("all_figures");
     let rec = root().join("data/reversal/wiper_reversal_sample_xypts.csv");
-    let dir = |n: &str| tmp.0.join(n);
+    let dir = |n: &str| tmp.path().join(n);
     let s = |p: PathBuf| p.to_str().unwrap().to_string();
     let run = |args: &[String], what: &str| {
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
-        ok(&wiperlab(&tmp.0, &args), what)
+        ok(&run_in(tmp.path(), &args), what)
     };
     let spectrum = [
         "spectrum",
@@ -919,7 +874,7 @@ fn every_figure_of_every_command_has_units_and_a_legend_over_no_data() {
         &["bench", "--quick", "--out-dir", &s(dir("bench")), "-q"].map(String::from),
         "bench --quick",
     );
-    let job = explore_job(&tmp.0);
+    let job = explore_job(tmp.path());
     run(
         &[
             "explore",
@@ -1046,13 +1001,13 @@ fn tiny_campaign(dir: &Path) -> PathBuf {
 /// (frequencies inside the job's band, increasing), measured and model traces.
 #[test]
 fn fit_writes_psd_and_trace_csv_with_named_columns() {
-    let tmp = TempDir::new("csv");
-    let job = write_quick_job(&tmp.0);
+    let tmp = temp_dir("csv");
+    let job = write_quick_job(tmp.path());
     ok(
-        &wiperlab(&tmp.0, &["fit", job.to_str().unwrap(), "--quiet"]),
+        &run_in(tmp.path(), &["fit", job.to_str().unwrap(), "--quiet"]),
         "quick fit",
     );
-    let dir = tmp.0.join("reports/quick");
+    let dir = tmp.path().join("reports/quick");
     let read = |name: &str| -> (Vec<String>, Vec<Vec<f64>>) {
         let mut r =
             csv::Reader::from_path(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -1095,7 +1050,8 @@ fn fit_writes_psd_and_trace_csv_with_named_columns() {
         assert!(rows.len() > 100, "{name}: {} rows", rows.len());
     }
     let result: toml::Table =
-        toml::from_str(&std::fs::read_to_string(tmp.0.join("quick.result.toml")).unwrap()).unwrap();
+        toml::from_str(&std::fs::read_to_string(tmp.path().join("quick.result.toml")).unwrap())
+            .unwrap();
     let listed: Vec<&str> = result["data_files"]
         .as_array()
         .unwrap()
@@ -1118,9 +1074,9 @@ fn fit_writes_psd_and_trace_csv_with_named_columns() {
 /// the shipped sample recording (import settings of fits/reversal.toml).
 #[test]
 fn spectrum_writes_psd_csv_and_peaks_json() {
-    let tmp = TempDir::new("spectrum_csv");
+    let tmp = temp_dir("spectrum_csv");
     let rec = root().join("data/reversal/wiper_reversal_sample_xypts.csv");
-    let out = tmp.0.join("spec");
+    let out = tmp.path().join("spec");
     let args = [
         "spectrum",
         rec.to_str().unwrap(),
@@ -1133,7 +1089,7 @@ fn spectrum_writes_psd_csv_and_peaks_json() {
         "--out-dir",
         out.to_str().unwrap(),
     ];
-    ok(&wiperlab(&tmp.0, &args), "spectrum");
+    ok(&run_in(tmp.path(), &args), "spectrum");
     let mut r = csv::Reader::from_path(out.join("psd.csv")).unwrap();
     let header: Vec<String> = r.headers().unwrap().iter().map(str::to_string).collect();
     assert_eq!(header[0], "f_hz");
@@ -1164,16 +1120,15 @@ fn spectrum_writes_psd_csv_and_peaks_json() {
 /// each with the stage, the model runs so far and the elapsed time; `--quiet` prints none.
 #[test]
 fn piped_fit_prints_progress_lines() {
-    let tmp = TempDir::new("piped");
-    let job = write_quick_job(&tmp.0);
+    let tmp = temp_dir("piped");
+    let job = write_quick_job(tmp.path());
     let run = |quiet: bool| {
         let mut args = vec!["fit", job.to_str().unwrap()];
         if quiet {
             args.push("--quiet");
         }
-        Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-            .args(&args)
-            .current_dir(&tmp.0)
+        wiperlab(&args)
+            .current_dir(tmp.path())
             .env("WIPERLAB_PROGRESS_INTERVAL_S", "0")
             .output()
             .unwrap()
@@ -1204,12 +1159,15 @@ fn piped_fit_prints_progress_lines() {
 /// before it, the section says how to make one. In Chromium the map loads with the fit's figures.
 #[test]
 fn target_job_page_shows_the_modes_and_the_exploration_map() {
-    let tmp = TempDir::new("target_map");
-    let job = explore_job(&tmp.0);
+    let tmp = temp_dir("target_map");
+    let job = explore_job(tmp.path());
     let job_s = job.to_str().unwrap();
-    ok(&wiperlab(&tmp.0, &["fit", job_s, "--quiet"]), "target fit");
-    ok(&wiperlab(&tmp.0, &["report", job_s, "--quiet"]), "report");
-    let dir = tmp.0.join("reports/seed_experiment_geometry");
+    ok(
+        &run_in(tmp.path(), &["fit", job_s, "--quiet"]),
+        "target fit",
+    );
+    ok(&run_in(tmp.path(), &["report", job_s, "--quiet"]), "report");
+    let dir = tmp.path().join("reports/seed_experiment_geometry");
     let page = dir.join("index.html");
     let html = std::fs::read_to_string(&page).unwrap();
     assert!(html.contains("<h2 id=\"reachability\">"), "no map section");
@@ -1229,18 +1187,18 @@ fn target_job_page_shows_the_modes_and_the_exploration_map() {
     );
 
     ok(
-        &wiperlab(
-            &tmp.0,
+        &run_in(
+            tmp.path(),
             &["explore", job_s, "--samples", "8", "--seed", "1", "--quiet"],
         ),
         "explore",
     );
     assert!(
-        tmp.0
+        tmp.path()
             .join("reports/explore/seed_experiment_geometry/reachability.svg")
             .is_file()
     );
-    ok(&wiperlab(&tmp.0, &["report", job_s, "--quiet"]), "report");
+    ok(&run_in(tmp.path(), &["report", job_s, "--quiet"]), "report");
     let html = std::fs::read_to_string(&page).unwrap();
     let link = "<img class=\"figure\" src=\"../explore/seed_experiment_geometry/reachability.svg\"";
     assert_eq!(html.matches(link).count(), 1, "map not linked once");
@@ -1248,15 +1206,15 @@ fn target_job_page_shows_the_modes_and_the_exploration_map() {
     let n = svgs(&dir).len() + 1;
 
     let Some(chromium) = chromium() else { return };
-    let dom = dump_dom(&chromium, &page, &tmp.0.join("profile"));
+    let dom = dump_dom(&chromium, &page, &tmp.path().join("profile"));
     let check = figure_check(&dom);
     println!("target job page: {check:?}");
     assert_eq!(
         (check.status.as_str(), check.loaded, check.total),
         ("ok", n, n)
     );
-    let shot = tmp.0.join("report_target_job.png");
-    let problems = screenshot_problems(&chromium, &page, &dom, &tmp.0.join("shot"), &shot);
+    let shot = tmp.path().join("report_target_job.png");
+    let problems = screenshot_problems(&chromium, &page, &dom, &tmp.path().join("shot"), &shot);
     assert!(problems.is_empty(), "{problems:?}");
     keep_screenshot(&shot, "report_target_job.png");
 }

@@ -6,13 +6,11 @@
 //! `traces_*.csv` and `fits/reversal.result.toml` exist after the main job ran, e.g. in
 //! tests/cli.rs, and are skipped with a message when absent).
 
+mod common;
+use common::{root, temp_dir, wiperlab};
+
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
 
 /// The first ```python block of docs/results.md.
 fn example() -> String {
@@ -70,24 +68,11 @@ fn csv_header(path: &Path) -> BTreeSet<String> {
         .collect()
 }
 
-fn run(dir: &Path, args: &[&str]) {
-    let o = Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("start wiperlab");
-    assert!(
-        o.status.success(),
-        "wiperlab {args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
-
 #[test]
 fn every_column_the_pandas_example_reads_exists() {
     let code = example();
-    let dir = std::env::temp_dir().join(format!("wiperlab_results_doc_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let tmp = temp_dir("results_doc");
+    let dir = tmp.path();
     std::fs::create_dir_all(dir.join("data/reversal")).expect("mkdir");
     for f in ["wiper_reversal_sample_xypts.csv", "blade_true.toml"] {
         std::fs::copy(
@@ -97,35 +82,38 @@ fn every_column_the_pandas_example_reads_exists() {
         .expect("copy");
     }
     // The doc's first three commands, in a scratch copy of the layout.
-    run(
-        &dir,
-        &[
-            "import",
-            "data/reversal/wiper_reversal_sample_xypts.csv",
-            "--fps",
-            "10000",
-            "--m-per-px",
-            "1.5e-5",
-            "--head",
-            "pt1",
-            "--tip",
-            "pt2",
-            "-o",
-            "sample.trace.csv",
-        ],
-    );
-    run(
-        &dir,
-        &[
-            "spectrum",
-            "sample.trace.csv",
-            "--band",
-            "30:300",
-            "--band",
-            "500:5000",
-        ],
-    );
-    run(&dir, &["simulate", "data/reversal/blade_true.toml"]);
+    wiperlab([
+        "import",
+        "data/reversal/wiper_reversal_sample_xypts.csv",
+        "--fps",
+        "10000",
+        "--m-per-px",
+        "1.5e-5",
+        "--head",
+        "pt1",
+        "--tip",
+        "pt2",
+        "-o",
+        "sample.trace.csv",
+    ])
+    .current_dir(dir)
+    .assert()
+    .success();
+    wiperlab([
+        "spectrum",
+        "sample.trace.csv",
+        "--band",
+        "30:300",
+        "--band",
+        "500:5000",
+    ])
+    .current_dir(dir)
+    .assert()
+    .success();
+    wiperlab(["simulate", "data/reversal/blade_true.toml"])
+        .current_dir(dir)
+        .assert()
+        .success();
     // Made here, or the main job's (repository root).
     let locate = |rel: &str| -> Option<PathBuf> {
         [dir.join(rel), root().join(rel)]
@@ -197,5 +185,4 @@ fn every_column_the_pandas_example_reads_exists() {
         None => println!("skipped fits/reversal.result.toml: the main job writes it"),
     }
     println!("{checked} columns and keys of docs/results.md checked");
-    let _ = std::fs::remove_dir_all(&dir);
 }

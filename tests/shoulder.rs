@@ -4,6 +4,8 @@
 //! - The blade with a shoulder whose two stiffnesses are equal against the blade without one.
 //! - A shoulder the neck never reaches changes nothing.
 
+mod common;
+
 use wiperlab::model::{BladeParams, Shoulder, StickForm};
 use wiperlab::simulate::blade::simulate_blade;
 use wiperlab::simulate::hybrid::{
@@ -108,8 +110,7 @@ fn bilinear_oscillator_switch_times_match_the_closed_form() {
 }
 
 fn true_params() -> BladeParams {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/reversal/blade_true.toml");
-    toml::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+    common::true_blade()
 }
 
 fn opts() -> SolverOptions {

@@ -27,13 +27,14 @@ fn fit_prefers_and_recovers_the_shoulder() {
         !sim.switches.is_empty(),
         "the recording should touch the shoulder"
     );
-    let dir = common::write_case(
+    let case = common::write_case(
         "shoulder_fit",
         &sim,
         &base,
         &format!("{{\"k1\": {k1_free}, \"k1c\": {k1c}, \"theta_c\": {theta_c}}}"),
         &mut || 0.0,
     );
+    let dir = case.path();
     let job = format!(
         r#"name = "shoulder"
 blade = "blade.toml"
@@ -87,5 +88,4 @@ keys = {{ k1 = "/k1", k1c = "/k1c", theta_c = "/theta_c" }}
         "k1_contact off by {:+.2} %",
         100.0 * k1c_fit.rel_error.unwrap()
     );
-    std::fs::remove_dir_all(&dir).ok();
 }

@@ -2,38 +2,12 @@
 //! of two points, and a fit job's `[spectrum] signal` the model's head and tip coordinates that
 //! have dynamics and their difference; unknown names are errors that list what is known.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+use common::{root, run, temp_dir};
+
+use std::path::Path;
 use wiperlab::spectrum::features::SignalKind;
 use wiperlab::trace::{PointTrack, Trace};
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> Self {
-        let d = std::env::temp_dir().join(format!("wiperlab_signals_{tag}_{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).expect("mkdir");
-        TempDir(d)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-fn wiperlab(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-        .args(args)
-        .output()
-        .expect("start wiperlab")
-}
 
 /// The peak frequency of `signal` in peaks.json (the first band).
 fn peak_hz(dir: &Path, signal: &str) -> f64 {
@@ -67,11 +41,11 @@ fn synthetic(path: &Path) {
 
 #[test]
 fn spectrum_takes_a_points_coordinate_and_a_difference_of_two_points() {
-    let dir = TempDir::new("synthetic");
-    let file = dir.0.join("two.trace.csv");
+    let dir = temp_dir("synthetic");
+    let file = dir.path().join("two.trace.csv");
     synthetic(&file);
-    let out = dir.0.join("out");
-    let o = wiperlab(&[
+    let out = dir.path().join("out");
+    let o = run(&[
         "spectrum",
         file.to_str().unwrap(),
         "--signal",
@@ -115,10 +89,10 @@ fn spectrum_takes_a_points_coordinate_and_a_difference_of_two_points() {
 
 #[test]
 fn spectrum_refuses_an_unknown_point_listing_the_known_ones() {
-    let dir = TempDir::new("unknown");
-    let file = dir.0.join("two.trace.csv");
+    let dir = temp_dir("unknown");
+    let file = dir.path().join("two.trace.csv");
     synthetic(&file);
-    let out = dir.0.join("out");
+    let out = dir.path().join("out");
     for (signal, needle) in [
         ("wrist-shoulder_y", "no point \"wrist-shoulder\""),
         (
@@ -126,7 +100,7 @@ fn spectrum_refuses_an_unknown_point_listing_the_known_ones() {
             "expected <point>_x, <point>_y, <a>-<b>_x or <a>-<b>_y",
         ),
     ] {
-        let o = wiperlab(&[
+        let o = run(&[
             "spectrum",
             file.to_str().unwrap(),
             "--signal",
@@ -156,8 +130,8 @@ fn spectrum_of_wrist_minus_shoulder_on_the_real_deeplabcut_file() {
         println!("skipped: {} is absent", path.display());
         return;
     }
-    let dir = TempDir::new("afam");
-    let o = wiperlab(&[
+    let dir = temp_dir("afam");
+    let o = run(&[
         "spectrum",
         path.to_str().unwrap(),
         "--fps",
@@ -175,10 +149,10 @@ fn spectrum_of_wrist_minus_shoulder_on_the_real_deeplabcut_file() {
         "--band",
         "1:60",
         "--out-dir",
-        dir.0.to_str().unwrap(),
+        dir.path().to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let f = peak_hz(&dir.0, "wstL-shdL_y");
+    let f = peak_hz(dir.path(), "wstL-shdL_y");
     let numpy_hz = 8.203125;
     println!("wstL-shdL_y peaks at {f} Hz (NumPy {numpy_hz} Hz)");
     assert!((f - numpy_hz).abs() <= 700.0 / 8192.0, "{f} Hz");
@@ -216,7 +190,7 @@ fn fit_signals_are_the_models_coordinates_and_their_difference() {
 /// with exit code 2 and before any work.
 #[test]
 fn a_fit_job_with_an_unknown_signal_names_its_line_and_the_known_ones() {
-    let dir = TempDir::new("job");
+    let dir = temp_dir("job");
     let job = std::fs::read_to_string(root().join("fits/reversal.toml")).expect("job");
     let data = root().join("data");
     let job = job
@@ -227,9 +201,9 @@ fn a_fit_job_with_an_unknown_signal_names_its_line_and_the_known_ones() {
         .position(|l| l.starts_with("signal = "))
         .expect("a signal line")
         + 1;
-    let path = dir.0.join("bad_signal.toml");
+    let path = dir.path().join("bad_signal.toml");
     std::fs::write(&path, job).expect("write");
-    let o = wiperlab(&["fit", path.to_str().unwrap(), "--quiet"]);
+    let o = run(&["fit", path.to_str().unwrap(), "--quiet"]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(
@@ -239,5 +213,5 @@ fn a_fit_job_with_an_unknown_signal_names_its_line_and_the_known_ones() {
             ),
         "{err}"
     );
-    assert!(!dir.0.join("bad_signal.result.toml").exists());
+    assert!(!dir.path().join("bad_signal.result.toml").exists());
 }

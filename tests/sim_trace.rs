@@ -8,31 +8,11 @@
 //! - the written rates θ̇, φ̇ against central differences of θ, φ, whose error must fall as h²
 //!   (halving the sample interval divides it by ≈ 4).
 
+mod common;
+use common::{root, s, temp_dir, wiperlab};
+
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> Self {
-        let d =
-            std::env::temp_dir().join(format!("wiperlab_sim_trace_{tag}_{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).expect("mkdir");
-        TempDir(d)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+use std::path::Path;
 
 /// The written trace: numeric columns by name, the phase labels, the transition times.
 struct Written {
@@ -64,19 +44,11 @@ impl Written {
 
 fn simulate(dir: &Path, extra: &[&str]) -> Written {
     let blade = root().join("data/reversal/blade_true.toml");
-    let o = Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-        .arg("simulate")
-        .arg(&blade)
+    wiperlab(["simulate", s(&blade)])
         .args(extra)
-        .arg("--out-dir")
-        .arg(dir)
-        .output()
-        .expect("start wiperlab");
-    assert!(
-        o.status.success(),
-        "simulate: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+        .args(["--out-dir", s(dir)])
+        .assert()
+        .success();
     let text = std::fs::read_to_string(dir.join("trace.csv")).expect("trace.csv");
     let mut lines = text.lines();
     let names: Vec<String> = lines
@@ -125,8 +97,8 @@ fn num(v: &toml::Value, key: &str) -> f64 {
 
 #[test]
 fn trace_has_the_model_state_columns_with_units() {
-    let dir = TempDir::new("columns");
-    let w = simulate(&dir.0, &["--window", "1.83,1.85"]);
+    let dir = temp_dir("columns");
+    let w = simulate(dir.path(), &["--window", "1.83,1.85"]);
     for c in [
         "t_s",
         "head_x_m",
@@ -168,8 +140,8 @@ fn trace_has_the_model_state_columns_with_units() {
 /// stays on the glass, the paper's assumption).
 #[test]
 fn friction_force_obeys_the_papers_law_in_slip_and_its_bound_in_stick() {
-    let dir = TempDir::new("friction");
-    let w = simulate(&dir.0, &[]);
+    let dir = temp_dir("friction");
+    let w = simulate(dir.path(), &[]);
     let b = blade();
     let fr = &b["friction"];
     let (a, bb, c) = (num(fr, "a"), num(fr, "b_s_per_m"), num(fr, "c"));
@@ -286,10 +258,10 @@ fn fd_errors(w: &Written, step: usize, common: &[usize]) -> [f64; 3] {
 
 #[test]
 fn rates_and_normal_force_match_finite_differences_to_second_order() {
-    let (coarse_dir, fine_dir) = (TempDir::new("fd1"), TempDir::new("fd2"));
+    let (coarse_dir, fine_dir) = (temp_dir("fd1"), temp_dir("fd2"));
     let args = |fps: &'static str| ["--window", "1.83,1.85", "--fps", fps, "--rtol", "1e-11"];
-    let coarse = simulate(&coarse_dir.0, &args("100000"));
-    let fine = simulate(&fine_dir.0, &args("200000"));
+    let coarse = simulate(coarse_dir.path(), &args("100000"));
+    let fine = simulate(fine_dir.path(), &args("200000"));
     let nc = coarse.c("t_s").len();
     assert_eq!(fine.c("t_s").len(), 2 * nc - 1);
     let common: Vec<usize> = (1..nc - 1)

@@ -6,8 +6,10 @@
 //! * Closed forms (Parseval, linear-interpolation error bound, chirp instantaneous frequency) are
 //!   derived in the comments where they are used.
 
+mod common;
+
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use wiperlab::spectrum::SpectrumError;
 use wiperlab::spectrum::{
@@ -16,9 +18,7 @@ use wiperlab::spectrum::{
 };
 
 fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/spectrum")
-        .join(name)
+    common::root().join("tests/fixtures/spectrum").join(name)
 }
 
 /// `(comment lines, numeric rows)` of a fixture CSV: `#` lines are comments, the first other line is
@@ -412,7 +412,7 @@ fn spectrogram_ridge_follows_chirp() {
 #[test]
 fn matches_independent_estimator_on_sample() {
     use std::io::Read;
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/sample");
+    let root = common::shared_dir().join("sample");
     let (Ok(gz), Ok(truth)) = (
         std::fs::read(root.join("clean_10kfps.csv.gz")),
         std::fs::read_to_string(root.join("truth.json")),

@@ -17,52 +17,24 @@
 //! T 1.582 s). So the defaults are used, as a user would run it.
 
 mod common;
+use common::{ok, run, s, shared, temp_dir};
 
-use common::shared;
 use std::path::Path;
-use std::process::Command;
-
-/// A directory in the system temp dir, unique per process and `name`, removed on drop.
-struct TempDir(std::path::PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> TempDir {
-        let p = std::env::temp_dir().join(format!(
-            "wiperlab_spectrum_realdata_{}_{name}",
-            std::process::id()
-        ));
-        let _ = std::fs::remove_dir_all(&p);
-        std::fs::create_dir_all(&p).expect("create temp dir");
-        TempDir(p)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// Runs `wiperlab spectrum <file> --band 0.2:1.0` and returns the peak frequency printed for
 /// `signal` (a line `  <signal> band    0.2:1.0: peak <f> Hz (period ...)`).
 fn peak_hz(file: &Path, signal: &str) -> f64 {
     let stem = file.file_stem().unwrap().to_string_lossy().into_owned();
-    let dir = TempDir::new(&stem);
-    let o = Command::new(env!("CARGO_BIN_EXE_wiperlab"))
-        .args(["spectrum", file.to_str().unwrap(), "--band", "0.2:1.0"])
-        .arg("--out-dir")
-        .arg(&dir.0)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("cannot start the wiperlab binary");
-    let out = String::from_utf8_lossy(&o.stdout).into_owned();
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "spectrum {} failed\nstdout:\n{out}\nstderr:\n{}",
-        file.display(),
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let dir = temp_dir(&format!("spectrum_realdata_{stem}"));
+    let o = run(&[
+        "spectrum",
+        s(file),
+        "--band",
+        "0.2:1.0",
+        "--out-dir",
+        s(dir.path()),
+    ]);
+    let out = ok(&o, &format!("spectrum {}", file.display()));
     let f = out
         .lines()
         .find_map(|l| {
@@ -77,9 +49,9 @@ fn peak_hz(file: &Path, signal: &str) -> f64 {
         })
         .unwrap_or_else(|| panic!("no peak for {signal} in band 0.2:1.0 in:\n{out}"));
     assert!(
-        dir.0.join(format!("psd_{signal}.svg")).is_file(),
+        dir.path().join(format!("psd_{signal}.svg")).is_file(),
         "no PSD figure for {signal} in {}",
-        dir.0.display()
+        dir.path().display()
     );
     println!(
         "{}: {signal} peak {f:.6} Hz (period {:.4} s)",

@@ -1,11 +1,115 @@
 //! Helpers shared by the integration tests (`mod common;` in each test file).
 #![allow(dead_code)] // each test file uses a different subset
 
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
+use std::process::Output;
+
+use assert_cmd::assert::OutputAssertExt as _;
+
+/// The repository root (the crate's manifest directory): the working directory of [`wiperlab`],
+/// and where `data/`, `fits/` and `docs/` are.
+pub fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The `wiperlab` binary under test with `args`, to run in the repository root (so the shipped
+/// jobs' relative paths work). `.current_dir(dir)` runs it elsewhere, `.write_stdin(..)` feeds its
+/// standard input, `.timeout(..)` kills it after a time; `.assert()` checks the exit code and the
+/// output with `predicates`, `.output()` returns them.
+pub fn wiperlab<I, S>(args: I) -> assert_cmd::Command
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<OsStr>,
+{
+    let mut cmd = assert_cmd::cargo::cargo_bin_cmd!("wiperlab");
+    cmd.args(args).current_dir(root());
+    cmd
+}
+
+/// The binary's path, for a test that drives the process itself (signals, a closed pipe).
+pub fn wiperlab_exe() -> &'static Path {
+    assert_cmd::cargo::cargo_bin!("wiperlab")
+}
+
+/// Runs `wiperlab args...` in the repository root, with an empty standard input; whatever the
+/// exit code.
+pub fn run<S: AsRef<OsStr>>(args: &[S]) -> Output {
+    wiperlab(args).output().expect("start the wiperlab binary")
+}
+
+/// [`run`] with `dir` as working directory.
+pub fn run_in<S: AsRef<OsStr>>(dir: &Path, args: &[S]) -> Output {
+    wiperlab(args)
+        .current_dir(dir)
+        .output()
+        .expect("start the wiperlab binary")
+}
+
+/// Asserts that the run `what` exited with 0 (printing its code, stdout and stderr otherwise) and
+/// returns its standard output.
+pub fn ok(o: &Output, what: &str) -> String {
+    if let Err(e) = o.clone().assert().try_success() {
+        panic!("{what} failed: {e}");
+    }
+    stdout(o)
+}
+
+/// A run's standard output as text.
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// A run's standard error as text.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A fresh directory `wiperlab_<tag>_XXXXXX` in the system temp dir, removed with its content
+/// when dropped.
+pub fn temp_dir(tag: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("wiperlab_{tag}_"))
+        .tempdir()
+        .expect("create a temp dir")
+}
+
+/// Writes `content` to `dir/rel` (creating its parent folders) and returns the path.
+pub fn write(dir: &Path, rel: &str, content: &str) -> PathBuf {
+    let p = dir.join(rel);
+    if let Some(parent) = p.parent() {
+        std::fs::create_dir_all(parent).expect("create the file's folder");
+    }
+    std::fs::write(&p, content).unwrap_or_else(|e| panic!("write {}: {e}", p.display()));
+    p
+}
+
+/// `join` and `write` on a temp dir, as on its path.
+pub trait TempDirExt {
+    /// `dir/rel`.
+    fn join(&self, rel: impl AsRef<Path>) -> PathBuf;
+    /// Writes `content` to `dir/rel` ([`write`]) and returns the path.
+    fn write(&self, rel: &str, content: &str) -> PathBuf;
+}
+
+impl TempDirExt for tempfile::TempDir {
+    fn join(&self, rel: impl AsRef<Path>) -> PathBuf {
+        self.path().join(rel)
+    }
+
+    fn write(&self, rel: &str, content: &str) -> PathBuf {
+        write(self.path(), rel, content)
+    }
+}
+
+/// A path as `&str` (the temp dir and the clone have UTF-8 paths), for argument lists.
+pub fn s(p: &Path) -> &str {
+    p.to_str().expect("a UTF-8 path")
+}
 
 /// The project's shared data folder, `../shared` beside the clone (`/work/shared`).
 pub fn shared_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared")
+    root().join("../shared")
 }
 
 /// `../shared/<rel>`, or `None` (after printing why) when the shared folder is not beside the
@@ -30,13 +134,15 @@ pub fn shared(rel: &str) -> Option<PathBuf> {
     Some(path)
 }
 
-/// A path in the system temp dir, unique per process and `name`, removed on drop.
-pub struct TempFile(pub PathBuf);
+/// A file path `name` in a fresh temp dir of its own (the file is not created); the dir goes
+/// when this is dropped. The name is kept because readers tell formats apart by it.
+pub struct TempFile(pub PathBuf, tempfile::TempDir);
 
 impl TempFile {
     /// A fresh temp path (the file is not created).
     pub fn path(name: &str) -> TempFile {
-        TempFile(std::env::temp_dir().join(format!("wiperlab_test_{}_{name}", std::process::id())))
+        let dir = temp_dir("file");
+        TempFile(dir.path().join(name), dir)
     }
 
     /// A temp file with `content`.
@@ -47,15 +153,9 @@ impl TempFile {
     }
 }
 
-impl Drop for TempFile {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.0);
-    }
-}
-
 /// The shipped sample's true blade parameters (`data/reversal/blade_true.toml`).
 pub fn true_blade() -> wiperlab::model::BladeParams {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/reversal/blade_true.toml");
+    let p = root().join("data/reversal/blade_true.toml");
     toml::from_str(&std::fs::read_to_string(p).expect("read blade_true.toml")).expect("parse")
 }
 
@@ -78,7 +178,7 @@ pub fn recording_of(
     Ok((sim, t0))
 }
 
-/// A fresh temp directory `wiperlab_<tag>_<pid>` holding a model-made fit case: the recording
+/// A fresh temp directory (`wiperlab_<tag>_...`, removed when dropped) holding a model-made fit case: the recording
 /// `rec_xypts.csv` ([`write_dltdv`] of `sim` with `noise_px`), `blade.toml` (`start`, the blade the
 /// fit starts from) and `truth.json` (`truth_json`, the values the recording was made with).
 pub fn write_case(
@@ -87,9 +187,9 @@ pub fn write_case(
     start: &wiperlab::model::BladeParams,
     truth_json: &str,
     noise_px: &mut dyn FnMut() -> f64,
-) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("wiperlab_{tag}_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("create the case's temp dir");
+) -> tempfile::TempDir {
+    let case = temp_dir(tag);
+    let dir = case.path();
     write_dltdv(&dir.join("rec_xypts.csv"), sim, noise_px);
     std::fs::write(
         dir.join("blade.toml"),
@@ -97,7 +197,7 @@ pub fn write_case(
     )
     .expect("write blade.toml");
     std::fs::write(dir.join("truth.json"), truth_json).expect("write truth.json");
-    dir
+    case
 }
 
 /// Frame times `t0 + k/fps` covering `[t0, t1)`.
@@ -156,8 +256,7 @@ pub fn dltdv_recording(file: &str, t0: f64) -> String {
 
 /// [`dltdv_recording`] of the shipped sample recording, by absolute path.
 pub fn sample_recording() -> String {
-    let file =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("data/reversal/wiper_reversal_sample_xypts.csv");
+    let file = root().join("data/reversal/wiper_reversal_sample_xypts.csv");
     dltdv_recording(&file.display().to_string(), SAMPLE_T0_S)
 }
 
