@@ -883,7 +883,7 @@ fn every_figure_of_every_command_has_units_and_a_legend_over_no_data() {
             "16",
             "--seed",
             "1",
-            "-o",
+            "--out-dir",
             &s(dir("explore")),
             "-q",
         ]
