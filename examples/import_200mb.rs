@@ -1,14 +1,22 @@
-//! Benchmark, not a CI test: a ~200 MB DLTdv export imported and analysed by the real binary, with
-//! wall time and peak memory (the child's maximum resident set size from `wait4`) written to
+//! Benchmark: a ~200 MB DLTdv export imported and analysed by the real binary, with wall time and
+//! peak memory (the child's maximum resident set size from `wait4`) written to
 //! `reports/bench/import_200mb.md` with the machine it ran on.
 //!
-//! Run: `cargo test --release --test import_200mb -- --ignored --nocapture` (about a minute on 2
-//! cores; needs ~0.6 GB of free disk in the system temp dir and about 1 GB of memory).
+//! ```sh
+//! cargo build --release && cargo run --release --example import_200mb
+//! ```
+//!
+//! It runs the `wiperlab` binary beside its own folder (`target/release/wiperlab`, hence the
+//! build first). About a minute on 2 cores; needs ~0.6 GB of free disk in the system temp dir and
+//! about 1 GB of memory.
 //!
 //! The export is synthetic: 12 points of one camera, `%.6f` pixels as DLTdv writes them, rows until
 //! the file holds 200,000,000 bytes, a few `NaN` gaps. The tip (`pt2`) carries a 1,200 Hz line of
 //! known amplitude relative to the head (`pt1`), so the analysis has a known answer: the high band's
 //! tip − head peak must be at 1,200 Hz within one Welch bin.
+
+#[path = "../tests/common/fixtures.rs"]
+mod fixtures;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -98,7 +106,7 @@ struct Run {
 fn measure(what: &'static str, args: Vec<String>, stdout_file: &Path) -> Run {
     let out = std::fs::File::create(stdout_file).expect("stdout file");
     let start = Instant::now();
-    let child = Command::new(env!("CARGO_BIN_EXE_wiperlab"))
+    let child = Command::new(wiperlab_exe())
         .args(&args)
         .stdout(out)
         .stderr(Stdio::inherit())
@@ -124,6 +132,23 @@ fn measure(what: &'static str, args: Vec<String>, stdout_file: &Path) -> Run {
         // Linux reports ru_maxrss in kilobytes (getrusage(2)).
         max_rss_bytes: usage.ru_maxrss as u64 * 1024,
     }
+}
+
+/// The `wiperlab` binary of the same build: `target/<profile>/wiperlab` beside this example's
+/// `target/<profile>/examples/`.
+fn wiperlab_exe() -> PathBuf {
+    let exe = std::env::current_exe().expect("this example's path");
+    let bin = exe
+        .parent()
+        .and_then(Path::parent)
+        .expect("the example inside target/<profile>/examples")
+        .join(format!("wiperlab{}", std::env::consts::EXE_SUFFIX));
+    assert!(
+        bin.is_file(),
+        "{} not found: run `cargo build --release` first",
+        bin.display()
+    );
+    bin
 }
 
 /// `cmd args` on stdout, trimmed, or `unknown`.
@@ -163,13 +188,9 @@ fn mb(bytes: u64) -> f64 {
     bytes as f64 / 1e6
 }
 
-#[test]
-#[ignore = "benchmark: about a minute and 0.6 GB of disk; writes reports/bench/import_200mb.md"]
-fn import_and_analyse_a_200_mb_export() {
-    let dir: PathBuf =
-        std::env::temp_dir().join(format!("wiperlab_import_200mb_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
+fn main() {
+    let tmp = fixtures::temp_dir("import_200mb");
+    let dir: PathBuf = tmp.path().to_path_buf();
     let export = dir.join("big_xypts.csv");
     let t = Instant::now();
     let (frames, bytes) = write_export(&export);
@@ -260,8 +281,8 @@ fn import_and_analyse_a_200_mb_export() {
     }
     let mut md = format!(
         "# Importing and analysing a 200 MB tracking export\n\n\
-         Written by `cargo test --release --test import_200mb -- --ignored --nocapture` \
-         (tests/import_200mb.rs), which generates the export, runs the commands below as child \
+         Written by `cargo build --release && cargo run --release --example import_200mb` \
+         (examples/import_200mb.rs), which generates the export, runs the commands below as child \
          processes and reads each one's peak resident memory (`ru_maxrss` from `wait4`).\n\n\
          - Export: synthetic DLTdv `xypts.csv`, {POINTS} points of one camera, {frames} frames at \
          10,000 frames/s ({:.1} s), {:.1} MB; the tip carries a {TIP_LINE_HZ} Hz line, which both \
@@ -290,7 +311,6 @@ fn import_and_analyse_a_200_mb_export() {
     }
     md.push_str("```\n");
     println!("{md}");
-    let report = Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/bench/import_200mb.md");
+    let report = fixtures::root().join("reports/bench/import_200mb.md");
     std::fs::write(&report, md).expect("write the report");
-    let _ = std::fs::remove_dir_all(&dir);
 }
