@@ -640,7 +640,8 @@ def fit(
     job : str or path
         The fit job TOML (``fits/reversal.toml``).
     progress : bool
-        Show a progress bar on stderr while the fit runs (when stderr is a terminal).
+        Show the fit's progress on the process's stderr, as ``wiperlab fit``: a bar on a
+        terminal, otherwise a line every 5 s.
     out_dir : str or path, optional
         Directory of the figures and data files instead of the job's report directory.
 
