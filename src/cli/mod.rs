@@ -340,7 +340,7 @@ pub enum Command {
     /// Work–precision of the simulation methods (event-driven, Moreau–Jean, smoothed friction) on
     /// the belt benchmark and the blade; writes work_precision.csv and SVG figures.
     Bench {
-        /// Fewer settings and shorter timing loops (about 4 s instead of 16 s on 2 cores).
+        /// Fewer settings and shorter timing loops (about a quarter of the full bench's time).
         #[arg(long)]
         quick: bool,
         /// Blade parameter TOMLs, comma-separated: the first is used for the work–precision problems,
