@@ -24,7 +24,9 @@
 //! the Whittle-type likelihood's own `F⁻¹` overstates it for a deterministic motion plus noise.
 
 use super::likelihood::{self, Evidence, WelchLikelihood};
+use super::job::NoiseSpectrum;
 use super::problem::SpectralProblem;
+use crate::spectrum::noise::{MAX_ABS_RHO, TrackingNoise, ordinate_per_density};
 use crate::Result;
 use crate::simulate::blade::BladeSimulation;
 use nalgebra::DMatrix;
@@ -41,11 +43,24 @@ pub const FISHER_STEP_U: f64 = 3e-3;
 /// points whose Jacobians the sandwich averages ([`RecordingLikelihood::smoothed_jacobian`]).
 pub const SANDWICH_SPAN_SIGMA: f64 = 0.5;
 
-/// One band's measured side: its likelihood and its ordinates.
+/// One band's measured side: its likelihood, its ordinates and what the noise's ordinates need.
 struct BandTerm {
     lik: WelchLikelihood,
     measured: Vec<f64>,
-    noise_psd: f64,
+    /// `cos(2πf/fs)` of the band's bins, for the noise's density.
+    cos_w: Vec<f64>,
+    /// The band's ordinate of a flat density of 1 unit²/Hz ([`ordinate_per_density`]).
+    per_density: f64,
+}
+
+impl BandTerm {
+    /// The expected ordinates of `noise` in this band.
+    fn noise_ordinates(&self, noise: &TrackingNoise, fs_hz: f64) -> Vec<f64> {
+        self.cos_w
+            .iter()
+            .map(|&c| noise.density_at_cos(c, fs_hz) * self.per_density)
+            .collect()
+    }
 }
 
 /// The measured side of the likelihood of one recording, built once per fit.
@@ -53,8 +68,14 @@ pub struct RecordingLikelihood {
     bands: Vec<BandTerm>,
     /// The measured signal (NaN where missing or masked), m.
     measured_x: Vec<f64>,
-    /// Tracking noise of the measured signal, m.
+    /// White-noise σ of the measured signal from its second differences, m
+    /// ([`likelihood::tracking_noise_sigma`]): the noise of the `white` spectrum and the time-domain
+    /// term, and where the `ar1` profile starts.
     pub sigma_m: f64,
+    /// The tracking noise's spectrum ([`NoiseSpectrum`]).
+    pub noise_spectrum: NoiseSpectrum,
+    /// Sampling rate of the recording, Hz.
+    fs_hz: f64,
     /// Whether the time-domain term is part of the likelihood.
     pub time_domain: bool,
     /// The time-domain term's block length, samples: block means with their variance profiled
@@ -133,7 +154,12 @@ impl RecordingLikelihood {
                 Ok(BandTerm {
                     lik: WelchLikelihood::new(&cfg, b.segments, b.psd.len())?,
                     measured: b.psd.clone(),
-                    noise_psd: likelihood::noise_psd(sigma_m, problem.fs_hz, &cfg),
+                    cos_w: b
+                        .freq_hz
+                        .iter()
+                        .map(|f| (std::f64::consts::TAU * f / problem.fs_hz).cos())
+                        .collect(),
+                    per_density: ordinate_per_density(problem.fs_hz, &cfg),
                 })
             })
             .collect::<Result<Vec<_>>>()?;
@@ -145,10 +171,18 @@ impl RecordingLikelihood {
             bands,
             measured_x,
             sigma_m,
+            noise_spectrum: NoiseSpectrum::White,
+            fs_hz: problem.fs_hz,
             time_domain,
             block_len: None,
             saturated_spectral_nats,
         })
+    }
+
+    /// The same likelihood with the tracking noise's spectrum `noise`.
+    pub fn with_noise(mut self, noise: NoiseSpectrum) -> Self {
+        self.noise_spectrum = noise;
+        self
     }
 
     /// The same likelihood with the time-domain term read from block means of `block_len`
@@ -197,15 +231,102 @@ impl RecordingLikelihood {
         Ok((nats, b.len(), rms.max(floor.sqrt())))
     }
 
-    /// The model's expected ordinates of every band: the simulation's plus the noise density.
+    /// The model's expected ordinates of every band: the simulation's plus the tracking noise's
+    /// ([`RecordingLikelihood::noise_for`]).
     fn model_psd(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<Vec<Vec<f64>>> {
-        let f = problem.model_features(sim)?;
-        Ok(self
+        let sim_psd = self.sim_psd(problem, sim)?;
+        let measured: Vec<&[f64]> = self.bands.iter().map(|b| b.measured.as_slice()).collect();
+        let noise = self.noise_for(&sim_psd, &measured, self.sigma_m);
+        Ok(self.expected(&sim_psd, &noise))
+    }
+
+    /// The simulation's Welch ordinates of every band.
+    fn sim_psd(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<Vec<Vec<f64>>> {
+        Ok(problem
+            .model_features(sim)?
             .bands
-            .iter()
-            .zip(&f.bands)
-            .map(|(b, m)| m.psd.iter().map(|p| p + b.noise_psd).collect())
+            .into_iter()
+            .map(|b| b.psd)
             .collect())
+    }
+
+    /// The expected ordinates of every band: `sim_psd` plus the ordinates of `noise`.
+    fn expected(&self, sim_psd: &[Vec<f64>], noise: &TrackingNoise) -> Vec<Vec<f64>> {
+        self.bands
+            .iter()
+            .zip(sim_psd)
+            .map(|(b, s)| {
+                s.iter()
+                    .zip(b.noise_ordinates(noise, self.fs_hz))
+                    .map(|(p, n)| p + n)
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The tracking noise the likelihood of ordinates `measured` reads beside the simulation's
+    /// `sim_psd`: white of `white_sigma_m` (the recording's or a replicate's second-difference
+    /// estimate) for the `white` spectrum, the profile's AR(1) for `ar1`
+    /// ([`RecordingLikelihood::profile_noise`]).
+    fn noise_for(
+        &self,
+        sim_psd: &[Vec<f64>],
+        measured: &[&[f64]],
+        white_sigma_m: f64,
+    ) -> TrackingNoise {
+        match self.noise_spectrum {
+            NoiseSpectrum::White => TrackingNoise::white(white_sigma_m),
+            NoiseSpectrum::Ar1 => self.profile_noise(sim_psd, measured, white_sigma_m),
+        }
+    }
+
+    /// The AR(1) tracking noise that maximises the Whittle likelihood of the bands' ordinates
+    /// `measured` given the simulation's `sim_psd`: the noise's σ and ρ profiled out (Pawitan 2001,
+    /// *In All Likelihood*, §3.4), by Nelder–Mead over `(ln σ, atanh(ρ/ρ_max))` from white noise of
+    /// `start_sigma_m`. The bands share one noise process, so the low band's floor and the high
+    /// band's are tied by the AR(1) shape. No simulation: one pass over the bands' bins per step.
+    pub fn profile_noise(
+        &self,
+        sim_psd: &[Vec<f64>],
+        measured: &[&[f64]],
+        start_sigma_m: f64,
+    ) -> TrackingNoise {
+        let profile = NoiseProfile {
+            lik: self,
+            sim_psd,
+            measured,
+        };
+        let start = [start_sigma_m.max(f64::MIN_POSITIVE).ln(), 0.0];
+        let simplex = vec![
+            start.to_vec(),
+            vec![start[0] + 0.3, start[1]],
+            vec![start[0], start[1] + 0.5],
+        ];
+        let solver = argmin::solver::neldermead::NelderMead::new(simplex)
+            .with_sd_tolerance(NOISE_PROFILE_SD_NATS)
+            .expect("a non-negative tolerance");
+        let best = argmin::core::Executor::new(profile, solver)
+            .configure(|s| s.max_iters(NOISE_PROFILE_MAX_ITERS))
+            .run()
+            .ok()
+            .and_then(|r| r.state.best_param)
+            .unwrap_or_else(|| start.to_vec());
+        NoiseProfile::noise(&best)
+    }
+
+    /// The tracking noise the likelihood reads at the simulation `sim` (for `ar1` the profile's;
+    /// for `white` the recording's fixed estimate).
+    ///
+    /// # Errors
+    /// The simulation's features' errors.
+    pub fn noise_at(
+        &self,
+        problem: &SpectralProblem,
+        sim: &BladeSimulation,
+    ) -> Result<TrackingNoise> {
+        let sim_psd = self.sim_psd(problem, sim)?;
+        let measured: Vec<&[f64]> = self.bands.iter().map(|b| b.measured.as_slice()).collect();
+        Ok(self.noise_for(&sim_psd, &measured, self.sigma_m))
     }
 
     /// The model's signal at the recording's samples, NaN where the measurement is.
@@ -519,17 +640,15 @@ impl RecordingLikelihood {
         problem: &SpectralProblem,
         sim: &BladeSimulation,
     ) -> Result<ReplicateBase> {
-        let sim_psd = problem
-            .model_features(sim)?
-            .bands
-            .into_iter()
-            .map(|b| b.psd)
-            .collect();
-        let noise = rand_distr::Normal::new(0.0, self.sigma_m).map_err(|_| {
-            likelihood::LikelihoodError::InvalidSigma {
-                sigma: self.sigma_m,
+        let sim_psd = self.sim_psd(problem, sim)?;
+        let measured: Vec<&[f64]> = self.bands.iter().map(|b| b.measured.as_slice()).collect();
+        let noise = self.noise_for(&sim_psd, &measured, self.sigma_m);
+        if !(noise.sigma_m.is_finite() && noise.sigma_m > 0.0) {
+            return Err(likelihood::LikelihoodError::InvalidSigma {
+                sigma: noise.sigma_m,
             }
-        })?;
+            .into());
+        }
         Ok(ReplicateBase {
             m: self.model_x(problem, sim)?,
             sim_psd,
@@ -538,21 +657,29 @@ impl RecordingLikelihood {
     }
 
     /// A replicate's Welch ordinates through the measurement's estimator, and per band the noise
-    /// density of the replicate's own `σ̂` (as the fit estimates the recording's).
+    /// ordinates the replicate's own noise estimate gives (as the fit estimates the recording's:
+    /// its own `σ̂`, or its own profile against the simulation's ordinates `base`).
     fn replicate_spectra(
         &self,
         problem: &SpectralProblem,
         x: &[f64],
-    ) -> Result<(crate::spectrum::features::Features, Vec<f64>)> {
+        base: &ReplicateBase,
+    ) -> Result<(crate::spectrum::features::Features, Vec<Vec<f64>>)> {
         let sigma = likelihood::tracking_noise_sigma(x)?;
-        let scale = (sigma / self.sigma_m).powi(2);
         let f = crate::spectrum::features::features(
             x,
             problem.fs_hz,
             &problem.bands,
             problem.max_fill,
         )?;
-        Ok((f, self.bands.iter().map(|b| b.noise_psd * scale).collect()))
+        let measured: Vec<&[f64]> = f.bands.iter().map(|b| b.psd.as_slice()).collect();
+        let noise = self.noise_for(&base.sim_psd, &measured, sigma);
+        let ordinates = self
+            .bands
+            .iter()
+            .map(|b| b.noise_ordinates(&noise, self.fs_hz))
+            .collect();
+        Ok((f, ordinates))
     }
 
     /// One noise replicate's residuals in the response's order: per spectral ordinate
@@ -565,17 +692,23 @@ impl RecordingLikelihood {
         x: &[f64],
         base: &ReplicateBase,
     ) -> Result<Vec<f64>> {
-        let (f, noise) = self.replicate_spectra(problem, x)?;
+        let (f, noise) = self.replicate_spectra(problem, x, base)?;
         let mut res = Vec::with_capacity(base.m.len());
         for ((fb, s), noise) in f.bands.iter().zip(&base.sim_psd).zip(noise) {
-            if fb.psd.len() != s.len() {
+            if fb.psd.len() != s.len() || noise.len() != s.len() {
                 return Err(likelihood::LikelihoodError::LengthMismatch {
                     measured: fb.psd.len(),
                     model: s.len(),
                 }
                 .into());
             }
-            res.extend(fb.psd.iter().zip(s).map(|(p, s)| 1.0 - p / (s + noise)));
+            res.extend(
+                fb.psd
+                    .iter()
+                    .zip(s)
+                    .zip(&noise)
+                    .map(|((p, s), n)| 1.0 - p / (s + n)),
+            );
         }
         if self.time_domain {
             res.extend(self.time_residuals(x, &base.m)?.into_iter().map(|e| -e));
@@ -623,7 +756,7 @@ impl RecordingLikelihood {
             .into_par_iter()
             .map(|r| {
                 let x = base.signal(r);
-                let (f, noise) = self.replicate_spectra(problem, &x)?;
+                let (f, noise) = self.replicate_spectra(problem, &x, &base)?;
                 let mut excess = 0.0;
                 for (((fb, s), noise), b) in f
                     .bands
@@ -632,7 +765,7 @@ impl RecordingLikelihood {
                     .zip(noise)
                     .zip(&self.bands)
                 {
-                    let expected: Vec<f64> = s.iter().map(|v| v + noise).collect();
+                    let expected: Vec<f64> = s.iter().zip(noise).map(|(v, n)| v + n).collect();
                     excess += b.lik.nll(&fb.psd, &expected)? - b.lik.nll(&fb.psd, &fb.psd)?;
                 }
                 Ok(excess)
@@ -659,24 +792,69 @@ impl RecordingLikelihood {
 pub const NOISE_REPLICATES: usize = 256;
 
 /// What noise replicates of a simulation are drawn around: the model's signal at the recording's
-/// samples (NaN where the recording is), its Welch ordinates per band, and white noise of the
-/// recording's `σ`.
+/// samples (NaN where the recording is), its Welch ordinates per band, and the tracking noise the
+/// likelihood reads at the simulation (white of the recording's `σ`, or the `ar1` profile's).
 struct ReplicateBase {
     m: Vec<f64>,
     sim_psd: Vec<Vec<f64>>,
-    noise: rand_distr::Normal<f64>,
+    noise: TrackingNoise,
 }
 
 impl ReplicateBase {
-    /// Replicate `r`'s signal: `m` plus white noise drawn from seed [`NOISE_SEED`]` + r`.
+    /// Replicate `r`'s signal: `m` plus the noise drawn from seed [`NOISE_SEED`]` + r`.
     fn signal(&self, r: usize) -> Vec<f64> {
         use rand::SeedableRng;
-        use rand_distr::Distribution;
         let mut rng = rand::rngs::StdRng::seed_from_u64(NOISE_SEED + r as u64);
         self.m
             .iter()
-            .map(|v| v + self.noise.sample(&mut rng))
+            .zip(self.noise.sample(self.m.len(), &mut rng))
+            .map(|(v, e)| v + e)
             .collect()
+    }
+}
+
+/// Convergence of the noise profile ([`RecordingLikelihood::profile_noise`]): the simplex's
+/// spread of NLL values, nats; far below the 0.1-nat scale on which fits are compared.
+const NOISE_PROFILE_SD_NATS: f64 = 1e-7;
+
+/// Nelder–Mead iterations the noise profile may take (it converges in about 60–100 in two
+/// dimensions).
+const NOISE_PROFILE_MAX_ITERS: u64 = 400;
+
+/// The bands' Whittle NLL as a function of the noise's `(ln σ, atanh(ρ/ρ_max))`, for
+/// [`RecordingLikelihood::profile_noise`].
+struct NoiseProfile<'a> {
+    lik: &'a RecordingLikelihood,
+    sim_psd: &'a [Vec<f64>],
+    measured: &'a [&'a [f64]],
+}
+
+impl NoiseProfile<'_> {
+    /// The noise at the profile's coordinates `p`.
+    fn noise(p: &[f64]) -> TrackingNoise {
+        TrackingNoise::ar1(p[0].exp(), MAX_ABS_RHO * p[1].tanh())
+    }
+}
+
+impl argmin::core::CostFunction for NoiseProfile<'_> {
+    type Param = Vec<f64>;
+    type Output = f64;
+
+    fn cost(&self, p: &Self::Param) -> std::result::Result<f64, argmin::core::Error> {
+        let noise = Self::noise(p);
+        let mut nll = 0.0;
+        for ((b, s), d) in self.lik.bands.iter().zip(self.sim_psd).zip(self.measured) {
+            let expected: Vec<f64> = s
+                .iter()
+                .zip(&b.cos_w)
+                .map(|(v, &c)| v + noise.density_at_cos(c, self.lik.fs_hz) * b.per_density)
+                .collect();
+            nll += match b.lik.nll(d, &expected) {
+                Ok(v) => v,
+                Err(_) => return Ok(f64::INFINITY),
+            };
+        }
+        Ok(nll)
     }
 }
 
@@ -1168,6 +1346,94 @@ fn spread(cov: &DMatrix<f64>, uninformed: &[bool]) -> (Vec<f64>, Vec<Vec<f64>>) 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The likelihood of a pure-noise recording `x` at 10 kHz over the main job's bands (low
+    /// 30–300 Hz at nperseg 4096, high 500–5000 Hz at 512), read with the noise spectrum `kind`;
+    /// with the simulation's ordinates (all zero: no motion).
+    fn noise_only_likelihood(x: &[f64], kind: NoiseSpectrum) -> (RecordingLikelihood, Vec<Vec<f64>>) {
+        use crate::spectrum::features::{BandSpec, features};
+        let fs_hz = 10_000.0;
+        let specs = [
+            BandSpec::new("low", [30.0, 300.0], 4096),
+            BandSpec::new("high", [500.0, 5000.0], 512),
+        ];
+        let f = features(x, fs_hz, &specs, 0).unwrap();
+        let bands: Vec<BandTerm> = f
+            .bands
+            .iter()
+            .map(|b| {
+                let cfg = b.spec.welch_config().unwrap();
+                BandTerm {
+                    lik: WelchLikelihood::new(&cfg, b.segments, b.psd.len()).unwrap(),
+                    measured: b.psd.clone(),
+                    cos_w: b
+                        .freq_hz
+                        .iter()
+                        .map(|f| (std::f64::consts::TAU * f / fs_hz).cos())
+                        .collect(),
+                    per_density: ordinate_per_density(fs_hz, &cfg),
+                }
+            })
+            .collect();
+        let zeros = bands.iter().map(|b| vec![0.0; b.measured.len()]).collect();
+        let lik = RecordingLikelihood {
+            bands,
+            measured_x: x.to_vec(),
+            sigma_m: likelihood::tracking_noise_sigma(x).unwrap(),
+            noise_spectrum: kind,
+            fs_hz,
+            time_domain: false,
+            block_len: None,
+            saturated_spectral_nats: 0.0,
+        };
+        (lik, zeros)
+    }
+
+    #[test]
+    fn the_ar1_profile_recovers_correlated_tracking_noise_that_the_white_estimate_misreads() {
+        // AR(1) noise, σ = 1.5 µm (0.1 px at 15 µm/px), ρ = 0.6, 2 s at 10 kHz. Second differences
+        // read σ√(1 − 4ρ/3 + ρ²/3) = 0.566σ (spectrum::noise module docs); the profile's σ and ρ
+        // land within a few standard errors of the truth (the low band alone holds ~54 Welch
+        // segments of 4096 samples: σ̂ to ~2 %, ρ̂ to ~0.02).
+        use rand::SeedableRng;
+        let (sigma, rho) = (1.5e-6, 0.6);
+        let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+        let x = TrackingNoise::ar1(sigma, rho).sample(20_000, &mut rng);
+        let (lik, zeros) = noise_only_likelihood(&x, NoiseSpectrum::Ar1);
+        let white = (1.0 - 4.0 * rho / 3.0 + rho * rho / 3.0_f64).sqrt();
+        assert!((lik.sigma_m / sigma - white).abs() < 0.03, "{}", lik.sigma_m / sigma);
+        let measured: Vec<&[f64]> = lik.bands.iter().map(|b| b.measured.as_slice()).collect();
+        let n = lik.profile_noise(&zeros, &measured, lik.sigma_m);
+        assert!((n.sigma_m / sigma - 1.0).abs() < 0.08, "σ̂/σ = {}", n.sigma_m / sigma);
+        assert!((n.rho - rho).abs() < 0.06, "ρ̂ = {}", n.rho);
+        // The profile is the likelihood's maximum: the truth's noise is no more likely.
+        let nll = |noise: &TrackingNoise| {
+            let e = lik.expected(&zeros, noise);
+            lik.bands
+                .iter()
+                .zip(&e)
+                .map(|(b, s)| b.lik.nll(&b.measured, s).unwrap())
+                .sum::<f64>()
+        };
+        assert!(nll(&n) <= nll(&TrackingNoise::ar1(sigma, rho)) + 1e-6);
+        // The white floor of the second-difference σ is far less likely (hundreds of nats).
+        assert!(nll(&TrackingNoise::white(lik.sigma_m)) > nll(&n) + 100.0);
+    }
+
+    #[test]
+    fn the_ar1_profile_of_white_noise_finds_no_correlation() {
+        // White noise: the profile's ρ̂ stays near 0 and σ̂ near σ, as the white estimate's does.
+        use rand::SeedableRng;
+        let sigma = 1.5e-6;
+        let mut rng = rand::rngs::StdRng::seed_from_u64(12);
+        let x = TrackingNoise::white(sigma).sample(20_000, &mut rng);
+        let (lik, zeros) = noise_only_likelihood(&x, NoiseSpectrum::Ar1);
+        let measured: Vec<&[f64]> = lik.bands.iter().map(|b| b.measured.as_slice()).collect();
+        let n = lik.profile_noise(&zeros, &measured, lik.sigma_m);
+        assert!(n.rho.abs() < 0.05, "ρ̂ = {}", n.rho);
+        assert!((n.sigma_m / sigma - 1.0).abs() < 0.05, "σ̂/σ = {}", n.sigma_m / sigma);
+        assert!((lik.sigma_m / sigma - 1.0).abs() < 0.03);
+    }
 
     #[test]
     fn sandwich_of_a_diagonal_information_matches_the_hand_product() {

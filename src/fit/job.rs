@@ -258,6 +258,27 @@ pub struct LikelihoodSection {
     /// Read the time-domain term from block means of this length, s, with their variance
     /// profiled out, instead of every sample at the tracking noise.
     pub block_s: Option<f64>,
+    /// The tracking noise's spectrum ([`NoiseSpectrum`]).
+    pub noise: NoiseSpectrum,
+}
+
+crate::names::named_enum! {
+    /// The tracking noise's spectrum in the likelihood (docs/fit.md, "Likelihood";
+    /// [`crate::spectrum::noise`]).
+    pub enum NoiseSpectrum: "noise spectrum" {
+        /// White noise of the σ second differences give, `1.4826·MAD(Δ²x)/√6`, fixed before the
+        /// fit.
+        White => "white",
+        /// AR(1) noise whose σ and ρ maximise the recording's likelihood at every simulation (the
+        /// profile likelihood; [`crate::fit::evidence::RecordingLikelihood::profile_noise`]).
+        Ar1 => "ar1",
+    }
+}
+
+impl Default for NoiseSpectrum {
+    fn default() -> Self {
+        NoiseSpectrum::White
+    }
 }
 
 crate::names::named_enum! {

@@ -47,7 +47,7 @@
 //! **The model's spectrum includes the tracking noise.** A tracked coordinate is the true motion
 //! plus white tracking noise of standard deviation `σ`, so the PSD a model must match is
 //! `S_model(f) = S_sim(f) + S_noise` with the one-sided density `S_noise = 2σ²/fs`
-//! ([`noise_psd`]). `σ` is estimated from the recording itself by [`tracking_noise_sigma`]:
+//! ([`crate::spectrum::noise::TrackingNoise`], whose AR(1) form the `ar1` noise spectrum reads). `σ` is estimated from the recording itself by [`tracking_noise_sigma`]:
 //! `σ̂ = 1.4826·MAD(Δ²x)/√6` (white noise of variance σ² has `Var Δ²x = 6σ²`; the median ignores
 //! the samples where the motion's own curvature is large, such as stick–slip kinks; Hampel 1974
 //! for the MAD's 1.4826), which needs no choice of a "noise-only" band. The spectral floor would
@@ -75,7 +75,7 @@
 //! sides), σ in signal units, NLL in nats.
 
 use crate::spectrum::instfreq::noise_sigma;
-use crate::spectrum::{Average, Scaling, WelchConfig, Window, WindowSums};
+use crate::spectrum::{Average, WelchConfig, Window, WindowSums};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 use statrs::function::gamma::ln_gamma;
 use std::fmt;
@@ -335,7 +335,7 @@ impl WelchLikelihood {
 
     /// The band's negative log-likelihood in nats, `Σ_k ℓ_k / φ` (module docs), of the measured
     /// Welch ordinates `measured` given the model's expected ones `model` (the simulation's Welch
-    /// PSD plus [`noise_psd`]). No allocation.
+    /// PSD plus the tracking noise's). No allocation.
     ///
     /// # Errors
     /// [`LikelihoodError::LengthMismatch`] unless both hold `n_bins` values;
@@ -400,19 +400,6 @@ pub fn band_has_line(band: &crate::spectrum::features::BandFeatures) -> bool {
     let q = chi2.inverse_cdf(1.0 - LINE_FALSE_ALARM / finite.len() as f64);
     let m = chi2.inverse_cdf(0.5);
     largest > median * q / m
-}
-
-/// One-sided PSD of white noise of standard deviation `sigma` (signal units) sampled at `fs_hz`,
-/// as a Welch estimate with `cfg` reads it: `2σ²/fs` for density scaling, `2σ²·Σh²/(Σh)²` for
-/// spectrum scaling.
-pub fn noise_psd(sigma: f64, fs_hz: f64, cfg: &WelchConfig) -> f64 {
-    match cfg.scaling {
-        Scaling::Density => 2.0 * sigma * sigma / fs_hz,
-        Scaling::Spectrum => {
-            let s = WindowSums::of(&cfg.window.periodic(cfg.nperseg));
-            2.0 * sigma * sigma * s.sum_sq / (s.sum * s.sum)
-        }
-    }
 }
 
 /// Robust white-noise standard deviation of a tracked coordinate `x` (NaN for missing samples):

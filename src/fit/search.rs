@@ -482,7 +482,7 @@ fn problem_of(
     } else {
         RecordingLikelihood::new(&p, &m.x, fit.likelihood.time_domain)
             .map(|l| {
-                l.with_blocks(
+                l.with_noise(fit.likelihood.noise).with_blocks(
                     fit.likelihood
                         .block_s
                         .map(|b| (b * p.fs_hz).round() as usize),

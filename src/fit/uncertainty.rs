@@ -2,7 +2,7 @@
 
 use super::evidence::RecordingLikelihood;
 use super::features::{features, noise_floor};
-use super::job::{self, UncertaintyMethod};
+use super::job::{self, NoiseSpectrum, UncertaintyMethod};
 use super::problem::{FreeParam, SpectralProblem};
 use super::result::{FittedParam, Interval, IntervalMethod};
 use super::search::{
@@ -729,8 +729,12 @@ impl ReplicateSource {
             // terms.
             let time_domain = problem.likelihood.as_ref().is_ok_and(|l| l.time_domain);
             let blocks = problem.likelihood.as_ref().ok().and_then(|l| l.block_len);
+            let noise = problem
+                .likelihood
+                .as_ref()
+                .map_or(NoiseSpectrum::default(), |l| l.noise_spectrum);
             rep.likelihood = RecordingLikelihood::new(&rep, &x, time_domain)
-                .map(|l| l.with_blocks(blocks))
+                .map(|l| l.with_noise(noise).with_blocks(blocks))
                 .map(Arc::new)
                 .map_err(|e| e.to_string());
             rep

@@ -13,6 +13,7 @@
 //! * [`peaks`]: [`find_peak`], [`top_peaks`]: largest local maximum with parabolic interpolation of
 //!   the log PSD (J.O. Smith, SASP).
 //! * [`stft`]: [`spectrogram()`] and its [`Spectrogram::ridge`].
+//! * [`noise`]: the tracking noise's spectrum, AR(1) with white as its special case.
 //! * [`stats`]: the median and linear-interpolation quantiles used across the pipeline.
 //! * [`instfreq`]: instantaneous frequency (spectrogram ridge, stick-onset rate) against the lip
 //!   tip's speed; NaN-aware smoothed derivative, robust noise estimate, stick detection.
@@ -26,6 +27,7 @@ pub mod error;
 pub mod features;
 pub mod harmonics;
 pub mod instfreq;
+pub mod noise;
 pub mod peaks;
 pub mod resample;
 pub mod signal;
