@@ -162,6 +162,8 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
             .and_then(|(t, (chosen, runner, gap))| t.choice_warning(chosen, runner, gap)),
     );
     warnings.extend(failure_warning(&cf.problem));
+    let truth_cost = (!interrupted).then(|| truth_cost(job, &cf)).flatten();
+    warnings.extend(truth_cost.and_then(|t| shortfall_warning(best.cost, t)));
     // The chosen model's counts include its bootstrap replicates and the tolerance check's
     // simulations (they share its counters).
     let chosen = &mut selection.trials[selection.chosen];
@@ -189,6 +191,8 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
             interrupted,
             goodness_of_fit,
             tolerance_check,
+            tracking_noise: tracking_noise(&cf, &best.sim),
+            truth_cost,
         },
     );
     Ok(FitOutcome {
@@ -238,6 +242,44 @@ fn goodness_of_fit(
     lik.goodness_of_fit(p, sim)
         .map(Some)
         .map_err(|e| e.to_string())
+}
+
+/// The chosen model's cost with every freed parameter at the job's truth (the others as the blade
+/// file), at the fit's solver; `None` without a truth for every freed parameter or when the truth
+/// cannot be simulated.
+fn truth_cost(job: &LoadedJob, cf: &CandidateFit) -> Option<f64> {
+    let p = &cf.problem;
+    let mut params = p.base;
+    for fp in &p.free {
+        fp.name.set(&mut params, *job.truth.get(&fp.name)?);
+    }
+    p.total_cost(&p.simulate(&params).ok()?).ok()
+}
+
+/// The warning of a fit whose cost `cost` lies above the truth's own `truth_cost` by more than
+/// [`SHORTFALL_TOLERANCE_NATS`]: the search stopped short of the likelihood's maximum.
+fn shortfall_warning(cost: f64, truth_cost: f64) -> Option<FitWarning> {
+    (cost - truth_cost > SHORTFALL_TOLERANCE_NATS).then_some(FitWarning::TruthMoreLikely {
+        fit_cost_nats: cost,
+        truth_cost_nats: truth_cost,
+    })
+}
+
+/// How far above the truth's cost a fit may end before it counts as a search that fell short,
+/// nats: the integrator's own resolution of the cost (the tolerance check's spread on the main job
+/// is a few hundredths of a nat).
+pub const SHORTFALL_TOLERANCE_NATS: f64 = 0.1;
+
+/// The tracking noise the chosen fit's likelihood reads at its optimum `sim`; `None` without a
+/// likelihood or when the simulation's spectra cannot be computed.
+fn tracking_noise(cf: &CandidateFit, sim: &BladeSimulation) -> Option<result::NoiseEstimate> {
+    let lik = cf.problem.likelihood.as_ref().ok()?;
+    let n = lik.noise_at(&cf.problem, sim).ok()?;
+    Some(result::NoiseEstimate {
+        spectrum: lik.noise_spectrum,
+        sigma_m: n.sigma_m,
+        rho: n.rho,
+    })
 }
 
 /// The chosen fit's simulation at its optimum and its [`goodness_of_fit`] (or why there is none).
@@ -516,6 +558,8 @@ struct Assembled {
     interrupted: bool,
     goodness_of_fit: Option<likelihood::GoodnessOfFit>,
     tolerance_check: Option<tolerance::ToleranceCheck>,
+    tracking_noise: Option<result::NoiseEstimate>,
+    truth_cost: Option<f64>,
 }
 
 /// The result of the chosen fit, with the job's provenance (the recording's hash and the effective
@@ -569,6 +613,8 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         interrupted: a.interrupted,
         goodness_of_fit: a.goodness_of_fit,
         tolerance_check: a.tolerance_check,
+        tracking_noise: a.tracking_noise,
+        truth_cost: a.truth_cost,
         history: cf.history.clone(),
     }
 }

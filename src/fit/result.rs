@@ -391,7 +391,37 @@ pub struct FitResult {
     /// before this field.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tolerance_check: Option<crate::fit::tolerance::ToleranceCheck>,
+    /// The tracking noise the chosen fit's likelihood reads at its optimum (`[fit.likelihood]
+    /// noise`); `None` without a likelihood.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tracking_noise: Option<NoiseEstimate>,
+    /// The chosen model's cost at the job's `[truth]` (every freed parameter at its true value, the
+    /// rest as the blade file), nats, at the fit's solver: a fit whose cost lies above it stopped
+    /// short of the likelihood's maximum. `None` without a truth for every freed parameter.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truth_cost: Option<f64>,
     pub history: Vec<HistoryPoint>,
+}
+
+impl FitResult {
+    /// How far the fit's cost lies above the truth's own ([`FitResult::truth_cost`]), nats:
+    /// positive when the search stopped short of a point it could have reached.
+    pub fn shortfall_nats(&self) -> Option<f64> {
+        self.truth_cost.map(|t| self.cost - t)
+    }
+}
+
+/// The tracking noise of the measured signal as the likelihood reads it
+/// ([`crate::spectrum::noise::TrackingNoise`]): white of the second-difference σ, or the AR(1)
+/// profile's σ and ρ at the fit.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct NoiseEstimate {
+    /// The noise spectrum of the job (`white` or `ar1`).
+    pub spectrum: crate::fit::job::NoiseSpectrum,
+    /// Marginal standard deviation, m.
+    pub sigma_m: f64,
+    /// Lag-one autocorrelation (0 for white noise).
+    pub rho: f64,
 }
 
 impl FitResult {
@@ -577,6 +607,8 @@ mod tests {
                 }],
                 vec!["rtol 1e-10: too many steps".into()],
             )),
+            tracking_noise: None,
+            truth_cost: None,
             history: vec![HistoryPoint {
                 stage: SearchStage::Swarm,
                 restart: 1,

@@ -71,6 +71,14 @@ pub enum FitWarning {
     Interrupted,
     /// The goodness-of-fit test could not run.
     NoGoodnessOfFit { reason: String },
+    /// The job's truth is more likely than the fit: the search stopped short of the likelihood's
+    /// maximum.
+    TruthMoreLikely {
+        /// The fit's cost, nats.
+        fit_cost_nats: f64,
+        /// The chosen model's cost at the truth, nats.
+        truth_cost_nats: f64,
+    },
     /// The chosen model does not explain the recording's spectra to their noise.
     Misfit {
         test: GoodnessOfFit,
@@ -231,6 +239,7 @@ impl FitWarning {
             }
             Interrupted
             | NoGoodnessOfFit { .. }
+            | TruthMoreLikely { .. }
             | Misfit { .. }
             | AbsorbsModelStructure { .. }
             | Undetermined { .. }
@@ -253,6 +262,7 @@ impl FitWarning {
         match self {
             Interrupted => "interrupted",
             NoGoodnessOfFit { .. } => "no_goodness_of_fit",
+            TruthMoreLikely { .. } => "truth_more_likely",
             Misfit { .. } => "misfit",
             AbsorbsModelStructure { .. } => "absorbs_model_structure",
             Line { .. } => "line",
@@ -310,6 +320,17 @@ impl fmt::Display for FitWarning {
                  restarts, candidates, curvature or intervals",
             ),
             NoGoodnessOfFit { reason } => write!(f, "no goodness-of-fit test: {reason}"),
+            TruthMoreLikely {
+                fit_cost_nats: fit,
+                truth_cost_nats: truth,
+            } => write!(
+                f,
+                "the truth is more likely than the fit: cost {truth:.2} nats at the true \
+                 parameters against {fit:.2} at the fit ({:.2} nats short): the search stopped \
+                 before the likelihood's maximum, so the fitted values and their intervals \
+                 describe a point that is not the estimate",
+                fit - truth
+            ),
             Misfit {
                 test: g,
                 shoulder_listed,

@@ -777,6 +777,21 @@ pub fn fit_summary(r: &FitResult) -> String {
             }
         );
     }
+    if let Some(n) = &r.tracking_noise {
+        let _ = writeln!(
+            s,
+            "  tracking noise ({}): σ {:.3e} m, lag-one correlation ρ {:.2}",
+            n.spectrum, n.sigma_m, n.rho
+        );
+    }
+    if let (Some(t), Some(short)) = (r.truth_cost, r.shortfall_nats()) {
+        let _ = writeln!(
+            s,
+            "  truth's own cost {t:.2} nats: the fit is {:.2} nats {} likely than the truth",
+            short.abs(),
+            if short > 0.0 { "less" } else { "more" }
+        );
+    }
     if !r.undetermined.is_empty() {
         let _ = writeln!(
             s,

@@ -983,6 +983,8 @@ pub(super) mod tests {
             interrupted: false,
             goodness_of_fit: None,
             tolerance_check: None,
+            tracking_noise: None,
+            truth_cost: None,
             history: vec![],
         }
     }
