@@ -51,9 +51,52 @@ struct BandTerm {
     cos_w: Vec<f64>,
     /// The band's ordinate of a flat density of 1 unit²/Hz ([`ordinate_per_density`]).
     per_density: f64,
+    /// The bins of the band's features the likelihood reads ([`BandTerm::new`]).
+    bins: std::ops::Range<usize>,
 }
 
 impl BandTerm {
+    /// The measured side of the band `b` of a recording sampled at `fs_hz`: its bins at least a
+    /// main lobe away from 0 Hz and from Nyquist ([`likelihood::interior_bin`]), where the Welch
+    /// ordinates follow the χ²_ν law the likelihood reads (the DC and Nyquist ordinates of a real
+    /// series have half its degrees of freedom, and a detrend removes power near 0 Hz; Percival &
+    /// Walden 1993, §6.6).
+    ///
+    /// # Errors
+    /// [`likelihood::LikelihoodError::EmptyBand`] when no bin is interior, and those of
+    /// [`WelchLikelihood::new`].
+    fn new(b: &crate::spectrum::features::BandFeatures, fs_hz: f64) -> Result<Self> {
+        let cfg = b.spec.welch_config()?;
+        let interior: Vec<usize> = (0..b.freq_hz.len())
+            .filter(|&i| likelihood::interior_bin(b.freq_hz[i], fs_hz, &cfg))
+            .collect();
+        let bins = match (interior.first(), interior.last()) {
+            (Some(&lo), Some(&hi)) => lo..hi + 1,
+            _ => return Err(likelihood::LikelihoodError::EmptyBand.into()),
+        };
+        Ok(BandTerm {
+            lik: WelchLikelihood::new(&cfg, b.segments, bins.len())?,
+            measured: b.psd[bins.clone()].to_vec(),
+            cos_w: b.freq_hz[bins.clone()]
+                .iter()
+                .map(|f| (std::f64::consts::TAU * f / fs_hz).cos())
+                .collect(),
+            per_density: ordinate_per_density(fs_hz, &cfg),
+            bins,
+        })
+    }
+
+    /// The band's ordinates the likelihood reads, of a Welch estimate `psd` over the whole band.
+    fn read<'a>(&self, psd: &'a [f64]) -> Result<&'a [f64]> {
+        psd.get(self.bins.clone()).ok_or_else(|| {
+            likelihood::LikelihoodError::LengthMismatch {
+                measured: self.bins.end,
+                model: psd.len(),
+            }
+            .into()
+        })
+    }
+
     /// The expected ordinates of `noise` in this band.
     fn noise_ordinates(&self, noise: &TrackingNoise, fs_hz: f64) -> Vec<f64> {
         self.cos_w
@@ -149,19 +192,7 @@ impl RecordingLikelihood {
             .measured
             .bands
             .iter()
-            .map(|b| {
-                let cfg = b.spec.welch_config()?;
-                Ok(BandTerm {
-                    lik: WelchLikelihood::new(&cfg, b.segments, b.psd.len())?,
-                    measured: b.psd.clone(),
-                    cos_w: b
-                        .freq_hz
-                        .iter()
-                        .map(|f| (std::f64::consts::TAU * f / problem.fs_hz).cos())
-                        .collect(),
-                    per_density: ordinate_per_density(problem.fs_hz, &cfg),
-                })
-            })
+            .map(|b| BandTerm::new(b, problem.fs_hz))
             .collect::<Result<Vec<_>>>()?;
         let saturated_spectral_nats = bands
             .iter()
@@ -242,12 +273,12 @@ impl RecordingLikelihood {
 
     /// The simulation's Welch ordinates of every band.
     fn sim_psd(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<Vec<Vec<f64>>> {
-        Ok(problem
-            .model_features(sim)?
-            .bands
-            .into_iter()
-            .map(|b| b.psd)
-            .collect())
+        let f = problem.model_features(sim)?;
+        self.bands
+            .iter()
+            .zip(&f.bands)
+            .map(|(t, b)| Ok(t.read(&b.psd)?.to_vec()))
+            .collect()
     }
 
     /// The expected ordinates of every band: `sim_psd` plus the ordinates of `noise`.
@@ -664,7 +695,7 @@ impl RecordingLikelihood {
         problem: &SpectralProblem,
         x: &[f64],
         base: &ReplicateBase,
-    ) -> Result<(crate::spectrum::features::Features, Vec<Vec<f64>>)> {
+    ) -> Result<(Vec<Vec<f64>>, Vec<Vec<f64>>)> {
         let sigma = likelihood::tracking_noise_sigma(x)?;
         let f = crate::spectrum::features::features(
             x,
@@ -672,14 +703,20 @@ impl RecordingLikelihood {
             &problem.bands,
             problem.max_fill,
         )?;
-        let measured: Vec<&[f64]> = f.bands.iter().map(|b| b.psd.as_slice()).collect();
-        let noise = self.noise_for(&base.sim_psd, &measured, sigma);
+        let measured = self
+            .bands
+            .iter()
+            .zip(&f.bands)
+            .map(|(t, b)| Ok(t.read(&b.psd)?.to_vec()))
+            .collect::<Result<Vec<Vec<f64>>>>()?;
+        let views: Vec<&[f64]> = measured.iter().map(Vec::as_slice).collect();
+        let noise = self.noise_for(&base.sim_psd, &views, sigma);
         let ordinates = self
             .bands
             .iter()
             .map(|b| b.noise_ordinates(&noise, self.fs_hz))
             .collect();
-        Ok((f, ordinates))
+        Ok((measured, ordinates))
     }
 
     /// One noise replicate's residuals in the response's order: per spectral ordinate
@@ -694,17 +731,16 @@ impl RecordingLikelihood {
     ) -> Result<Vec<f64>> {
         let (f, noise) = self.replicate_spectra(problem, x, base)?;
         let mut res = Vec::with_capacity(base.m.len());
-        for ((fb, s), noise) in f.bands.iter().zip(&base.sim_psd).zip(noise) {
-            if fb.psd.len() != s.len() || noise.len() != s.len() {
+        for ((fb, s), noise) in f.iter().zip(&base.sim_psd).zip(noise) {
+            if fb.len() != s.len() || noise.len() != s.len() {
                 return Err(likelihood::LikelihoodError::LengthMismatch {
-                    measured: fb.psd.len(),
+                    measured: fb.len(),
                     model: s.len(),
                 }
                 .into());
             }
             res.extend(
-                fb.psd
-                    .iter()
+                fb.iter()
                     .zip(s)
                     .zip(&noise)
                     .map(|((p, s), n)| 1.0 - p / (s + n)),
@@ -759,14 +795,13 @@ impl RecordingLikelihood {
                 let (f, noise) = self.replicate_spectra(problem, &x, &base)?;
                 let mut excess = 0.0;
                 for (((fb, s), noise), b) in f
-                    .bands
                     .iter()
                     .zip(&base.sim_psd)
                     .zip(noise)
                     .zip(&self.bands)
                 {
                     let expected: Vec<f64> = s.iter().zip(noise).map(|(v, n)| v + n).collect();
-                    excess += b.lik.nll(&fb.psd, &expected)? - b.lik.nll(&fb.psd, &fb.psd)?;
+                    excess += b.lik.nll(fb, &expected)? - b.lik.nll(fb, fb)?;
                 }
                 Ok(excess)
             })
@@ -1361,19 +1396,7 @@ mod tests {
         let bands: Vec<BandTerm> = f
             .bands
             .iter()
-            .map(|b| {
-                let cfg = b.spec.welch_config().unwrap();
-                BandTerm {
-                    lik: WelchLikelihood::new(&cfg, b.segments, b.psd.len()).unwrap(),
-                    measured: b.psd.clone(),
-                    cos_w: b
-                        .freq_hz
-                        .iter()
-                        .map(|f| (std::f64::consts::TAU * f / fs_hz).cos())
-                        .collect(),
-                    per_density: ordinate_per_density(fs_hz, &cfg),
-                }
-            })
+            .map(|b| BandTerm::new(b, fs_hz).unwrap())
             .collect();
         let zeros = bands.iter().map(|b| vec![0.0; b.measured.len()]).collect();
         let lik = RecordingLikelihood {
