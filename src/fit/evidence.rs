@@ -23,12 +23,12 @@
 //! with `V` the variance of the NLL's gradient over replicates of the recording's tracking noise:
 //! the Whittle-type likelihood's own `F⁻¹` overstates it for a deterministic motion plus noise.
 
-use super::likelihood::{self, Evidence, WelchLikelihood};
 use super::job::NoiseSpectrum;
+use super::likelihood::{self, Evidence, WelchLikelihood};
 use super::problem::SpectralProblem;
-use crate::spectrum::noise::{MAX_ABS_RHO, TrackingNoise, ordinate_per_density};
 use crate::Result;
 use crate::simulate::blade::BladeSimulation;
+use crate::spectrum::noise::{MAX_ABS_RHO, TrackingNoise, ordinate_per_density};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
@@ -794,11 +794,7 @@ impl RecordingLikelihood {
                 let x = base.signal(r);
                 let (f, noise) = self.replicate_spectra(problem, &x, &base)?;
                 let mut excess = 0.0;
-                for (((fb, s), noise), b) in f
-                    .iter()
-                    .zip(&base.sim_psd)
-                    .zip(noise)
-                    .zip(&self.bands)
+                for (((fb, s), noise), b) in f.iter().zip(&base.sim_psd).zip(noise).zip(&self.bands)
                 {
                     let expected: Vec<f64> = s.iter().zip(noise).map(|(v, n)| v + n).collect();
                     excess += b.lik.nll(fb, &expected)? - b.lik.nll(fb, fb)?;
@@ -1385,7 +1381,10 @@ mod tests {
     /// The likelihood of a pure-noise recording `x` at 10 kHz over the main job's bands (low
     /// 30–300 Hz at nperseg 4096, high 500–5000 Hz at 512), read with the noise spectrum `kind`;
     /// with the simulation's ordinates (all zero: no motion).
-    fn noise_only_likelihood(x: &[f64], kind: NoiseSpectrum) -> (RecordingLikelihood, Vec<Vec<f64>>) {
+    fn noise_only_likelihood(
+        x: &[f64],
+        kind: NoiseSpectrum,
+    ) -> (RecordingLikelihood, Vec<Vec<f64>>) {
         use crate::spectrum::features::{BandSpec, features};
         let fs_hz = 10_000.0;
         let specs = [
@@ -1424,10 +1423,18 @@ mod tests {
         let x = TrackingNoise::ar1(sigma, rho).sample(20_000, &mut rng);
         let (lik, zeros) = noise_only_likelihood(&x, NoiseSpectrum::Ar1);
         let white = (1.0 - 4.0 * rho / 3.0 + rho * rho / 3.0_f64).sqrt();
-        assert!((lik.sigma_m / sigma - white).abs() < 0.03, "{}", lik.sigma_m / sigma);
+        assert!(
+            (lik.sigma_m / sigma - white).abs() < 0.03,
+            "{}",
+            lik.sigma_m / sigma
+        );
         let measured: Vec<&[f64]> = lik.bands.iter().map(|b| b.measured.as_slice()).collect();
         let n = lik.profile_noise(&zeros, &measured, lik.sigma_m);
-        assert!((n.sigma_m / sigma - 1.0).abs() < 0.08, "σ̂/σ = {}", n.sigma_m / sigma);
+        assert!(
+            (n.sigma_m / sigma - 1.0).abs() < 0.08,
+            "σ̂/σ = {}",
+            n.sigma_m / sigma
+        );
         assert!((n.rho - rho).abs() < 0.06, "ρ̂ = {}", n.rho);
         // The profile is the likelihood's maximum: the truth's noise is no more likely.
         let nll = |noise: &TrackingNoise| {
@@ -1454,7 +1461,11 @@ mod tests {
         let measured: Vec<&[f64]> = lik.bands.iter().map(|b| b.measured.as_slice()).collect();
         let n = lik.profile_noise(&zeros, &measured, lik.sigma_m);
         assert!(n.rho.abs() < 0.05, "ρ̂ = {}", n.rho);
-        assert!((n.sigma_m / sigma - 1.0).abs() < 0.05, "σ̂/σ = {}", n.sigma_m / sigma);
+        assert!(
+            (n.sigma_m / sigma - 1.0).abs() < 0.05,
+            "σ̂/σ = {}",
+            n.sigma_m / sigma
+        );
         assert!((lik.sigma_m / sigma - 1.0).abs() < 0.03);
     }
 

@@ -193,6 +193,14 @@ fn fit_headline(w: &FitWarning) -> String {
         NoGoodnessOfFit { .. } => "The goodness-of-fit test could not run, so whether the model \
                                    explains the recording's spectra is not known."
             .into(),
+        TruthMoreLikely {
+            fit_cost_nats,
+            truth_cost_nats,
+        } => format!(
+            "The truth is {:.2} nats more likely than the fit: the search stopped short of the \
+             likelihood's maximum, so the values and intervals describe the wrong point.",
+            fit_cost_nats - truth_cost_nats
+        ),
         Misfit { test, .. } => format!(
             "The model does not explain the recording's spectra to their noise (p = {:.3}): \
              list more candidate models, check the bands, or bound a known parameter \

@@ -130,7 +130,10 @@ mod tests {
         let integral: f64 = (0..m)
             .map(|i| n.density((i as f64 + 0.5) * df, fs) * df)
             .sum();
-        assert!((integral / (sigma * sigma) - 1.0).abs() < 1e-6, "{integral}");
+        assert!(
+            (integral / (sigma * sigma) - 1.0).abs() < 1e-6,
+            "{integral}"
+        );
         let white = 2.0 * sigma * sigma / fs;
         assert!((n.density(0.0, fs) / white - 4.0).abs() < 1e-12);
         assert!((n.density(fs / 2.0, fs) / white - 0.25).abs() < 1e-12);
@@ -145,7 +148,8 @@ mod tests {
         let x = TrackingNoise::ar1(sigma, rho).sample(n, &mut rng);
         let var = x.iter().map(|v| v * v).sum::<f64>() / n as f64;
         let lag1 = x.windows(2).map(|w| w[0] * w[1]).sum::<f64>() / (n - 1) as f64;
-        let se_var = sigma * sigma * (2.0 * (1.0 + rho * rho) / ((1.0 - rho * rho) * n as f64)).sqrt();
+        let se_var =
+            sigma * sigma * (2.0 * (1.0 + rho * rho) / ((1.0 - rho * rho) * n as f64)).sqrt();
         assert!((var - sigma * sigma).abs() < 5.0 * se_var, "{var}");
         assert!((lag1 / var - rho).abs() < 5.0 * (1.0 - rho * rho) / (n as f64).sqrt() * 3.0);
     }
