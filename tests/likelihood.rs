@@ -13,7 +13,7 @@ use rand_distr::{Distribution, Normal};
 use wiperlab::fit::likelihood::{
     Evidence, LINE_FALSE_ALARM, LikelihoodError, Side, WelchLikelihood, band_has_line,
     bin_correlation, demeaned_residuals, effective_sample_size, gaussian_nll, interior_bin,
-    likelihood_ratio_test, noise_psd, tracking_noise_sigma, welch_dof,
+    likelihood_ratio_test, tracking_noise_sigma, welch_dof,
 };
 use wiperlab::spectrum::{Scaling, WelchConfig, WelchPlan, Window};
 
@@ -132,7 +132,7 @@ fn welch_ordinates_have_the_mean_and_variance_of_chi2_nu_over_nu() {
                     &cfg,
                     200,
                     |s| white(s, sigma, N_SAMPLES),
-                    |_| noise_psd(sigma, FS_HZ, &cfg),
+                    |_| white_ordinate(sigma, &cfg),
                 ),
             ),
             (
@@ -180,7 +180,7 @@ fn welch_ordinates_have_the_mean_and_variance_of_chi2_nu_over_nu() {
 fn band_sums_and_neighbours_follow_the_bin_correlation() {
     let cfg = WelchConfig::new(NPERSEG);
     let sigma = 1.0;
-    let s = noise_psd(sigma, FS_HZ, &cfg);
+    let s = white_ordinate(sigma, &cfg);
     let mut plan = WelchPlan::new(cfg).unwrap();
     let (mut sums, mut pairs) = (Vec::new(), Vec::new());
     let mut bins = Vec::new();
@@ -295,13 +295,13 @@ fn whittle_nll_of_a_scale_is_minimised_at_the_truth_within_its_standard_error() 
 }
 
 #[test]
-fn noise_psd_matches_the_welch_level_of_white_noise_in_either_scaling() {
+fn white_noise_ordinate_matches_the_welch_level_of_white_noise_in_either_scaling() {
     // Density: checked through every ratio above. Spectrum scaling, Hann: 2σ²·(3N/8)/(N/2)² =
     // 3σ²/N (Σh = N/2, Σh² = 3N/8); the Welch mean over interior bins agrees to MC error.
     let sigma = 2.0;
     let cfg = WelchConfig::new(NPERSEG).with_scaling(Scaling::Spectrum);
     let want = 3.0 * sigma * sigma / NPERSEG as f64;
-    assert!((noise_psd(sigma, FS_HZ, &cfg) - want).abs() < 1e-12 * want);
+    assert!((white_ordinate(sigma, &cfg) - want).abs() < 1e-12 * want);
     let v = ratios(&cfg, 50, |s| white(90_000 + s, sigma, N_SAMPLES), |_| want);
     let (mean, _, se, _) = moments(&v);
     assert!((mean - 1.0).abs() < 4.0 * se, "{mean} ± {se}");
@@ -543,4 +543,9 @@ fn a_band_of_noise_has_no_line_and_a_line_above_the_noise_is_found() {
         found >= seeds as usize * 99 / 100,
         "line found in {found} of {seeds}"
     );
+}
+
+/// The white tracking noise's expected Welch ordinate (`spectrum::noise`; flat, so any frequency).
+fn white_ordinate(sigma: f64, cfg: &wiperlab::spectrum::WelchConfig) -> f64 {
+    wiperlab::spectrum::noise::TrackingNoise::white(sigma).welch_ordinate(1000.0, FS_HZ, cfg)
 }
