@@ -121,7 +121,7 @@ fn cost(c: &mut Criterion) {
         swarm_solver: solver,
         objective: Objective::Likelihood,
         weights: Weights::default(),
-        likelihood: Err("built below".into()),
+        likelihood: Err(wiperlab::fit::NoLikelihood::NotBuilt),
         evaluations: Arc::new(AtomicUsize::new(0)),
         failures: std::sync::Arc::new(AtomicUsize::new(0)),
         failure_causes: Default::default(),

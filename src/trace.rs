@@ -69,30 +69,56 @@ impl Trace {
     /// `t_s` is finite and strictly increasing.
     ///
     /// # Errors
-    /// A sentence naming the first violation (point name and lengths, or the sample index and times).
-    pub fn check(&self) -> Result<(), String> {
+    /// The first violation ([`TraceError`]: the point and its lengths, or the sample and its times).
+    pub fn check(&self) -> Result<(), TraceError> {
         let n = self.t_s.len();
         for p in &self.points {
             if p.x_m.len() != n || p.y_m.len() != n {
-                return Err(format!(
-                    "point {:?} has {} x and {} y samples, the time axis has {n}",
-                    p.name,
-                    p.x_m.len(),
-                    p.y_m.len()
-                ));
+                return Err(TraceError::Lengths {
+                    point: p.name.clone(),
+                    x: p.x_m.len(),
+                    y: p.y_m.len(),
+                    times: n,
+                });
             }
         }
         if let Some(i) = self.t_s.iter().position(|t| !t.is_finite()) {
-            return Err(format!("time sample {i} is {}", self.t_s[i]));
+            return Err(TraceError::TimeNotFinite {
+                sample: i,
+                t_s: self.t_s[i],
+            });
         }
         if let Some(i) = self.t_s.windows(2).position(|w| w[1] <= w[0]) {
-            return Err(format!(
-                "time is not strictly increasing: sample {} is {} s after {} s",
-                i + 1,
-                self.t_s[i + 1],
-                self.t_s[i]
-            ));
+            return Err(TraceError::TimeNotIncreasing {
+                sample: i + 1,
+                t_s: self.t_s[i + 1],
+                before_s: self.t_s[i],
+            });
         }
         Ok(())
     }
+}
+
+/// A trace that breaks the invariants stated on [`Trace`]'s fields ([`Trace::check`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum TraceError {
+    /// A point whose x or y samples are not one per time sample.
+    #[error("point {point:?} has {x} x and {y} y samples, the time axis has {times}")]
+    Lengths {
+        point: String,
+        x: usize,
+        y: usize,
+        times: usize,
+    },
+    /// A time that is not finite.
+    #[error("time sample {sample} is {t_s}")]
+    TimeNotFinite { sample: usize, t_s: f64 },
+    /// A time not after the one before it.
+    #[error("time is not strictly increasing: sample {sample} is {t_s} s after {before_s} s")]
+    TimeNotIncreasing {
+        sample: usize,
+        t_s: f64,
+        before_s: f64,
+    },
 }

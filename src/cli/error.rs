@@ -36,7 +36,10 @@ pub enum CliError {
     /// A `--signal` that names no point (pair) of the trace; `reason` lists the trace's points
     /// (from [`crate::spectrum::SignalExpr::resolve`]).
     #[error("--signal {given}: {reason}")]
-    Signal { given: String, reason: String },
+    Signal {
+        given: String,
+        reason: crate::spectrum::signal::SignalError,
+    },
     /// `--nperseg` outside 8 ..= the record's samples.
     #[error("--nperseg {nperseg}: expected 8 <= nperseg <= the record's {samples} samples")]
     Nperseg { nperseg: usize, samples: usize },

@@ -15,13 +15,18 @@ pub struct BandArg {
     pub range_hz: [f64; 2],
 }
 
+/// A `--band` that is not `LO:HI` with two numbers.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("expected LO:HI in Hz, e.g. 30:300")]
+pub struct BandArgError;
+
 impl std::str::FromStr for BandArg {
-    type Err = String;
-    fn from_str(text: &str) -> std::result::Result<Self, String> {
+    type Err = BandArgError;
+    fn from_str(text: &str) -> std::result::Result<Self, BandArgError> {
         let (lo, hi) = text
             .split_once(':')
             .and_then(|(l, h)| Some((l.parse::<f64>().ok()?, h.parse::<f64>().ok()?)))
-            .ok_or_else(|| "expected LO:HI in Hz, e.g. 30:300".to_string())?;
+            .ok_or(BandArgError)?;
         Ok(BandArg {
             text: text.to_string(),
             range_hz: [lo, hi],

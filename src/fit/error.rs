@@ -3,6 +3,11 @@
 //! [`FitError::is_input`] tells the settings a user can fix (exit code 2) from a fit that failed
 //! (exit code 1).
 
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use crate::model::TrackError;
+
 /// A fit job that cannot be set up, or an optimiser run that failed.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -20,7 +25,7 @@ pub enum FitError {
     /// The neck/lip model without the recording's head and tip tracks; `reason` is why the
     /// measurement has no head motion (recorded when it was measured).
     #[error("the neck/lip model needs the recording's head and tip tracks: {reason}")]
-    NecklipNeedsTracks { reason: String },
+    NecklipNeedsTracks { reason: NoHeadTrack },
     /// The neck/lip model without the recording's head track.
     #[error("the neck/lip model needs the recording's head track")]
     NecklipNeedsHead,
@@ -38,7 +43,7 @@ pub enum FitError {
     #[error(
         "[fit] objective = \"likelihood\" needs the recording's likelihood: {why}; set objective = \"features\""
     )]
-    LikelihoodObjective { why: String },
+    LikelihoodObjective { why: NoLikelihood },
     /// Negative weights of the time-domain terms.
     #[error("[fit.weights] freq_speed and trace must be >= 0 (got {freq_speed} and {trace})")]
     NegativeWeights { freq_speed: f64, trace: f64 },
@@ -102,7 +107,56 @@ pub enum FitError {
     },
     /// A Laplace interval where the recording has no likelihood (`why`, as recorded).
     #[error("fit failed: no likelihood: {why}")]
-    NoLikelihood { why: String },
+    NoLikelihood { why: NoLikelihood },
+}
+
+/// Why a measurement gives the neck/lip model no prescribed head motion (kept with the
+/// measurement, and reported only when a neck/lip candidate needs it).
+#[derive(Debug, Clone, thiserror::Error)]
+#[non_exhaustive]
+pub enum NoHeadTrack {
+    /// The recording has no points with the roles head and tip.
+    #[error("{}: the recording has no 'head' and 'tip' points", path.display())]
+    NoPoints { path: PathBuf },
+    /// The head and tip tracks cannot be smoothed.
+    #[error("{}: {source}", path.display())]
+    Track {
+        path: PathBuf,
+        #[source]
+        source: TrackError,
+    },
+    /// A target job: no recording at all.
+    #[error("a target job has no recording")]
+    TargetJob,
+}
+
+/// Why a problem has no recording likelihood (kept with the problem; an error only where the
+/// likelihood is needed).
+#[derive(Debug, Clone, thiserror::Error)]
+#[non_exhaustive]
+pub enum NoLikelihood {
+    /// The problem is being built; its likelihood comes next.
+    #[error("not built yet")]
+    NotBuilt,
+    /// A target job compares peaks with target ranges: there is no measurement noise.
+    #[error("a target job has no measurement noise")]
+    TargetJob,
+    /// The recording's likelihood could not be computed.
+    #[error(transparent)]
+    Recording(Arc<crate::Error>),
+}
+
+/// Why a fitted candidate has no likelihood at its optimum (then its spread comes from the cost's
+/// curvature).
+#[derive(Debug, Clone, thiserror::Error)]
+#[non_exhaustive]
+pub enum NoEvidence {
+    /// The fit was interrupted before the optimum's likelihood was read.
+    #[error("interrupted")]
+    Interrupted,
+    /// The likelihood at the optimum (or its settling) failed, e.g. a target job's.
+    #[error(transparent)]
+    Failed(Arc<crate::Error>),
 }
 
 impl FitError {

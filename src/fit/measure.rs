@@ -1,10 +1,10 @@
 //! The measured side of a fit: the recording read, its features per band and its noise floors, or
 //! a target job's targets.
 
-use super::FitError;
 use super::features::{self, Features, features, noise_floor};
 use super::instfreq;
 use super::job::{self, LoadedJob};
+use super::{FitError, NoHeadTrack};
 use crate::model::BladeParams;
 use crate::trace::Trace;
 use crate::{Error, Result};
@@ -44,7 +44,7 @@ pub const HEAD_KERNEL_SIGMA_S: f64 = 5e-4;
 pub(super) struct Measurement {
     /// The head drop `−y` of the `head` point and the lean (tip x − head x), smoothed, for the
     /// neck/lip model; why not, when the recording cannot give them.
-    pub(super) head: std::result::Result<Arc<crate::model::necklip::PrescribedHead>, String>,
+    pub(super) head: std::result::Result<Arc<crate::model::necklip::PrescribedHead>, NoHeadTrack>,
     /// Target ranges per band (a target job), instead of measured peaks.
     pub(super) targets: Option<Vec<[f64; 2]>>,
     /// Time-domain objectives (frequency against tip speed, trace error) when weighted.
@@ -65,9 +65,10 @@ pub(super) fn necklip_view(
     m: &Measurement,
     base: &BladeParams,
 ) -> Result<(Features, Vec<f64>, Vec<bool>)> {
-    let head = m.head.as_ref().map_err(|e| FitError::NecklipNeedsTracks {
-        reason: e.to_string(),
-    })?;
+    let head = m
+        .head
+        .as_ref()
+        .map_err(|e| FitError::NecklipNeedsTracks { reason: e.clone() })?;
     let t = &m.trace.t_s;
     let window = (t[0], *t.last().unwrap_or(&t[0]));
     let guard = crate::model::necklip::FLIP_GUARD_OF_REACH * (base.l1_m + base.l2_m);
@@ -176,12 +177,14 @@ pub(super) fn measure_recording(
             )
             .and_then(|p| p.with_lean(&d, 15))
             .map(Arc::new)
-            .map_err(|e| format!("{}: {e}", path.display()))
+            .map_err(|source| NoHeadTrack::Track {
+                path: path.to_path_buf(),
+                source,
+            })
         }
-        None => Err(format!(
-            "{}: the recording has no 'head' and 'tip' points",
-            path.display()
-        )),
+        None => Err(NoHeadTrack::NoPoints {
+            path: path.to_path_buf(),
+        }),
     };
     Ok(Measurement {
         head,
@@ -243,7 +246,7 @@ pub(super) fn measure_targets(job: &LoadedJob, t: &job::TargetsSection) -> Resul
         fs_hz: t.fps_hz,
         measured: Features { bands, filled: 0 },
         floors: vec![0.0; job.job.spectrum.bands.len()],
-        head: Err("a target job has no recording".into()),
+        head: Err(NoHeadTrack::TargetJob),
         targets: Some(targets),
         time_targets: None,
     })

@@ -33,7 +33,7 @@ mod uncertainty;
 pub mod warning;
 
 pub use candidate::{Candidate, NECK_BAND_MIN_HZ, smallest_capable_model};
-pub use error::FitError;
+pub use error::{FitError, NoEvidence, NoHeadTrack, NoLikelihood};
 pub use measure::HEAD_KERNEL_SIGMA_S;
 pub use problem::{FAILED_COST, FreeParam, SpectralProblem, target_cost};
 pub use result::{
@@ -136,7 +136,9 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         pb.finish_and_clear();
     }
     let goodness_of_fit = gof.unwrap_or_else(|e| {
-        warnings.push(FitWarning::NoGoodnessOfFit { reason: e });
+        warnings.push(FitWarning::NoGoodnessOfFit {
+            reason: e.to_string(),
+        });
         None
     });
     let shoulder_listed = candidates.iter().any(|c| c.shoulder);
@@ -228,10 +230,7 @@ fn runner_up(trials: &[result::ModelTrial]) -> Option<(Candidate, Candidate, f64
 ///
 /// # Errors
 /// Why the test could not run (a replicate's spectra or noise estimate failed), for a warning.
-fn goodness_of_fit(
-    cf: &CandidateFit,
-    sim: &BladeSimulation,
-) -> std::result::Result<Option<likelihood::GoodnessOfFit>, String> {
+fn goodness_of_fit(cf: &CandidateFit, sim: &BladeSimulation) -> GoodnessOutcome {
     let p = &cf.problem;
     let Ok(lik) = p.likelihood.as_ref() else {
         return Ok(None);
@@ -239,9 +238,7 @@ fn goodness_of_fit(
     if !p.cost_is_nll() || !p.others.is_empty() || interrupt::stop_requested() {
         return Ok(None);
     }
-    lik.goodness_of_fit(p, sim)
-        .map(Some)
-        .map_err(|e| e.to_string())
+    lik.goodness_of_fit(p, sim).map(Some)
 }
 
 /// The chosen model's cost with every freed parameter at the job's truth (the others as the blade
@@ -293,7 +290,7 @@ fn chosen_goodness(cf: &CandidateFit) -> Result<(BestModel, GoodnessOutcome)> {
 }
 
 /// A goodness-of-fit test, `None` when there is none, or why it could not run.
-type GoodnessOutcome = std::result::Result<Option<likelihood::GoodnessOfFit>, String>;
+type GoodnessOutcome = Result<Option<likelihood::GoodnessOfFit>>;
 
 /// The test in `gof`, when it ran.
 fn gof_ref(gof: &GoodnessOutcome) -> Option<&likelihood::GoodnessOfFit> {

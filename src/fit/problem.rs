@@ -112,7 +112,8 @@ pub struct SpectralProblem {
     pub label: String,
     /// The recording's likelihood ([`super::evidence`]), for model choice and intervals; why not,
     /// for a target job or a recording it cannot be computed for.
-    pub likelihood: std::result::Result<Arc<super::evidence::RecordingLikelihood>, String>,
+    pub likelihood:
+        std::result::Result<Arc<super::evidence::RecordingLikelihood>, super::NoLikelihood>,
     pub evaluations: Arc<AtomicUsize>,
     /// Failed evaluations, shared like `evaluations` with the bootstrap's replicate problems.
     pub failures: Arc<AtomicUsize>,

@@ -218,7 +218,7 @@ pub(super) struct CandidateFit {
     /// The recording's NLL at the optimum (`sigma_u` and `corr` then come from its sandwich
     /// covariance, [`super::evidence::at_fit`]), or why there is none (then from the cost's
     /// curvature).
-    pub(super) evidence: std::result::Result<super::evidence::NllParts, String>,
+    pub(super) evidence: std::result::Result<super::evidence::NllParts, super::NoEvidence>,
     pub(super) swarm_iters: u64,
     pub(super) polish_iters: u64,
     pub(super) wall_time_s: f64,
@@ -470,7 +470,7 @@ fn problem_of(
         swarm_solver: swarm_solver(job),
         objective: fit.objective,
         weights: fit.weights,
-        likelihood: Err("not built yet".into()),
+        likelihood: Err(super::NoLikelihood::NotBuilt),
         evaluations,
         failures: Arc::new(AtomicUsize::new(0)),
         failure_causes: Default::default(),
@@ -478,7 +478,7 @@ fn problem_of(
         near_best: Mutex::new(Default::default()),
     };
     p.likelihood = if p.targets.is_some() {
-        Err("a target job has no measurement noise".into())
+        Err(super::NoLikelihood::TargetJob)
     } else {
         RecordingLikelihood::new(&p, &m.x, fit.likelihood.time_domain)
             .map(|l| {
@@ -489,7 +489,7 @@ fn problem_of(
                 )
             })
             .map(Arc::new)
-            .map_err(|e| e.to_string())
+            .map_err(|e| super::NoLikelihood::Recording(Arc::new(e)))
     };
     Ok(p)
 }
@@ -824,7 +824,7 @@ fn finish(
             vec![f64::NAN; n],
             vec![vec![f64::NAN; n]; n],
             None,
-            Err("interrupted".to_string()),
+            Err(super::NoEvidence::Interrupted),
         )
     } else {
         // With the likelihood as the cost, the estimate is its optimum at the intervals' scale
@@ -841,7 +841,7 @@ fn finish(
             Ok(l) => (l.sigma_u, l.corr, Some(l.curvature_sigma_u), Ok(l.nll)),
             Err(e) => {
                 let (s, c) = curvature(&problem, &best_u);
-                (s, c, None, Err(e.to_string()))
+                (s, c, None, Err(super::NoEvidence::Failed(Arc::new(e))))
             }
         }
     };

@@ -717,7 +717,7 @@ impl ReplicateSource {
             swarm_solver: problem.swarm_solver,
             objective: problem.objective,
             weights: problem.weights,
-            likelihood: Err("not built yet".into()),
+            likelihood: Err(super::NoLikelihood::NotBuilt),
             evaluations: problem.evaluations.clone(),
             failures: problem.failures.clone(),
             failure_causes: problem.failure_causes.clone(),
@@ -736,7 +736,7 @@ impl ReplicateSource {
             rep.likelihood = RecordingLikelihood::new(&rep, &x, time_domain)
                 .map(|l| l.with_noise(noise).with_blocks(blocks))
                 .map(Arc::new)
-                .map_err(|e| e.to_string());
+                .map_err(|e| super::NoLikelihood::Recording(Arc::new(e)));
             rep
         })
     }

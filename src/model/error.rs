@@ -1,4 +1,5 @@
-//! Parameters the model cannot run with: [`ParamError`], naming the parameter and its value.
+//! Parameters the model cannot run with: [`ParamError`], naming the parameter and its value; and
+//! recorded tracks the neck/lip model cannot be driven by: [`TrackError`].
 
 /// A blade or friction parameter that is not finite or not physical. Always an input error: the
 /// parameters come from the user's blade file or job.
@@ -48,4 +49,32 @@ impl ParamError {
     pub fn of(e: &crate::Error) -> Option<&ParamError> {
         e.stage_error()
     }
+}
+
+/// Samples that cannot be smoothed into a track for the neck/lip model's prescribed head
+/// ([`crate::model::necklip::SmoothedTrack`], [`crate::model::necklip::PrescribedHead`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum TrackError {
+    /// A local-quadratic smooth without a positive step or with fewer samples than one window.
+    #[error(
+        "smoothed track: need dt > 0 and at least {window} samples (got dt = {dt_s}, {samples} samples)"
+    )]
+    TooShort {
+        dt_s: f64,
+        samples: usize,
+        window: usize,
+    },
+    /// Fewer than 3 finite samples in the local window around `t_s` (a gap longer than the window).
+    #[error("smoothed track: too few samples around t = {t_s:.6} s for a local fit")]
+    Gap { t_s: f64 },
+    /// A kernel smooth without a positive step or width, or with fewer than 3 finite samples.
+    #[error(
+        "prescribed head: need dt > 0, σ > 0 and at least 3 finite samples (got dt = {dt_s}, σ = {sigma_s}, {finite} finite)"
+    )]
+    Kernel {
+        dt_s: f64,
+        sigma_s: f64,
+        finite: usize,
+    },
 }

@@ -11,6 +11,6 @@ pub mod params;
 pub mod stick_slip;
 
 pub use blade::{Blade, BladeParams, Shoulder, StickForm};
-pub use error::ParamError;
+pub use error::{ParamError, TrackError};
 pub use friction::FrictionLaw;
 pub use params::ParamId;

@@ -24,6 +24,7 @@
 //! ([`NeckLip::state_from_tracks`]). On the sample's blade the guard is 20 ms, and the neck angle
 //! after the flip stays within 2.8e-4 rad of the full model's (`tests/necklip.rs`).
 
+use super::TrackError;
 use super::blade::{Blade, BladeParams, Dynamics, StickForm};
 use super::stick_slip::{Contact, LinearSystem, LinkModel, Mode, ModelFault, StickSlipModel};
 use nalgebra::{Matrix3, Vector3};
@@ -51,20 +52,21 @@ impl SmoothedTrack {
     /// From samples `u_m[k]` at `t0_s + k·dt_s` (any unit; the derivatives are per second).
     ///
     /// # Errors
-    /// A message when fewer than 3 finite samples fall in some local window (a gap longer than the
-    /// window) or the inputs are not usable.
+    /// [`TrackError::Gap`] when fewer than 3 finite samples fall in some local window (a gap
+    /// longer than the window), [`TrackError::TooShort`] when the step or the samples are not
+    /// usable.
     pub fn from_samples(
         t0_s: f64,
         dt_s: f64,
         u_m: &[f64],
         half_width: usize,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, TrackError> {
         if !(dt_s > 0.0 && dt_s.is_finite()) || u_m.len() < 2 * half_width + 1 || half_width == 0 {
-            return Err(format!(
-                "smoothed track: need dt > 0 and at least {} samples (got dt = {dt_s}, {} samples)",
-                2 * half_width + 1,
-                u_m.len()
-            ));
+            return Err(TrackError::TooShort {
+                dt_s,
+                samples: u_m.len(),
+                window: 2 * half_width + 1,
+            });
         }
         let n = u_m.len();
         let (mut u, mut ud, mut udd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
@@ -85,15 +87,13 @@ impl SmoothedTrack {
                 atb += row * uj;
                 count += 1;
             }
-            let c = (count >= 3)
-                .then(|| ata.lu().solve(&atb))
-                .flatten()
-                .ok_or_else(|| {
-                    format!(
-                        "smoothed track: too few samples around t = {:.6} s for a local fit",
-                        t0_s + k as f64 * dt_s
-                    )
-                })?;
+            let c =
+                (count >= 3)
+                    .then(|| ata.lu().solve(&atb))
+                    .flatten()
+                    .ok_or(TrackError::Gap {
+                        t_s: t0_s + k as f64 * dt_s,
+                    })?;
             u[k] = c[0];
             ud[k] = c[1];
             udd[k] = 2.0 * c[2];
@@ -246,7 +246,7 @@ impl PrescribedHead {
         dt_s: f64,
         u_m: &[f64],
         half_width: usize,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, TrackError> {
         Ok(PrescribedHead {
             drop: DropTrack::Local(SmoothedTrack::from_samples(t0_s, dt_s, u_m, half_width)?),
             lean: None,
@@ -257,7 +257,7 @@ impl PrescribedHead {
     ///
     /// # Errors
     /// As [`SmoothedTrack::from_samples`].
-    pub fn with_lean(mut self, d_m: &[f64], half_width: usize) -> Result<Self, String> {
+    pub fn with_lean(mut self, d_m: &[f64], half_width: usize) -> Result<Self, TrackError> {
         let (t0_s, dt_s) = self.drop.grid();
         self.lean = Some(SmoothedTrack::from_samples(t0_s, dt_s, d_m, half_width)?);
         Ok(self)
@@ -267,19 +267,21 @@ impl PrescribedHead {
     /// deviation `sigma_s` ([`KernelTrack`]), without a lean track.
     ///
     /// # Errors
-    /// A message when `dt_s` or `sigma_s` is not positive, or fewer than 3 samples are finite.
+    /// [`TrackError::Kernel`] when `dt_s` or `sigma_s` is not positive, or fewer than 3 samples
+    /// are finite.
     pub fn from_tracked_samples(
         t0_s: f64,
         dt_s: f64,
         u_m: &[f64],
         sigma_s: f64,
-    ) -> Result<Self, String> {
-        if !(dt_s > 0.0 && sigma_s > 0.0 && sigma_s.is_finite())
-            || u_m.iter().filter(|v| v.is_finite()).count() < 3
-        {
-            return Err(format!(
-                "prescribed head: need dt > 0, σ > 0 and at least 3 finite samples (got dt = {dt_s}, σ = {sigma_s})"
-            ));
+    ) -> Result<Self, TrackError> {
+        let finite = u_m.iter().filter(|v| v.is_finite()).count();
+        if !(dt_s > 0.0 && sigma_s > 0.0 && sigma_s.is_finite()) || finite < 3 {
+            return Err(TrackError::Kernel {
+                dt_s,
+                sigma_s,
+                finite,
+            });
         }
         Ok(PrescribedHead {
             drop: DropTrack::Kernel(KernelTrack::new(t0_s, dt_s, u_m, sigma_s)),

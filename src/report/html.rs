@@ -162,8 +162,8 @@ pub struct Provenance {
     pub job_path: String,
     pub result_path: String,
     pub recording_path: String,
-    /// SHA-256 of the recording now, or the reason it could not be computed.
-    pub recording_sha256_now: std::result::Result<String, String>,
+    /// SHA-256 of the recording now, or why it could not be computed.
+    pub recording_sha256_now: std::result::Result<String, std::sync::Arc<Error>>,
     /// When the page was written.
     pub written_utc: String,
 }
@@ -495,7 +495,7 @@ struct ProvenanceView<'a> {
     result_path: &'a str,
     recording_path: &'a str,
     sha256_now: Option<&'a str>,
-    sha256_error: Option<&'a str>,
+    sha256_error: Option<String>,
     written_utc: &'a str,
 }
 
@@ -605,7 +605,11 @@ fn provenance_view(prov: &Provenance) -> ProvenanceView<'_> {
         result_path: &prov.result_path,
         recording_path: &prov.recording_path,
         sha256_now: prov.recording_sha256_now.as_deref().ok(),
-        sha256_error: prov.recording_sha256_now.as_ref().err().map(String::as_str),
+        sha256_error: prov
+            .recording_sha256_now
+            .as_ref()
+            .err()
+            .map(ToString::to_string),
         written_utc: &prov.written_utc,
     }
 }
@@ -732,7 +736,7 @@ pub fn write_report(r: &FitResult, paths: &ReportPaths) -> Result<ReportSummary>
             files: missing.clone(),
         });
     }
-    let now_hash = sha256_file(&paths.recording).map_err(|e| e.to_string());
+    let now_hash = sha256_file(&paths.recording).map_err(std::sync::Arc::new);
     match &now_hash {
         Ok(h) if !r.input_sha256.is_empty() && *h != r.input_sha256 => {
             warnings.push(PageWarning::RecordingChanged {
@@ -741,7 +745,9 @@ pub fn write_report(r: &FitResult, paths: &ReportPaths) -> Result<ReportSummary>
                 sha256_at_fit: r.input_sha256.clone(),
             })
         }
-        Err(m) => warnings.push(PageWarning::CannotHashRecording { reason: m.clone() }),
+        Err(e) => warnings.push(PageWarning::CannotHashRecording {
+            reason: e.to_string(),
+        }),
         _ => {}
     }
 
@@ -1170,7 +1176,10 @@ pub(super) mod tests {
             job_path: "job.toml".into(),
             result_path: "r.toml".into(),
             recording_path: "rec.csv".into(),
-            recording_sha256_now: Err("gone & away".into()),
+            recording_sha256_now: Err(std::sync::Arc::new(Error::input(
+                std::path::Path::new("rec.csv"),
+                "gone & away",
+            ))),
             written_utc: "now".into(),
         };
         let text = PageWarning::Fit(FitWarning::Text {
@@ -1184,7 +1193,7 @@ pub(super) mod tests {
         assert!(html.contains("src=\"psd_a%20b%23%3F.svg\""), "{html}");
         assert!(html.contains("alt=\"a &quot;quoted&quot; &lt;caption&gt;\""));
         assert!(html.contains("<li>&lt;i&gt;w&lt;/i&gt;</li>"));
-        assert!(html.contains("<span class=\"warn\">gone &amp; away</span>"));
+        assert!(html.contains("<span class=\"warn\">rec.csv: gone &amp; away</span>"));
         assert!(html.contains("Fitted 2026-11-22 09:08:07 UTC."));
         assert!(html.contains("model <b>blade2dof</b> (2-DOF blade)"));
         assert!(html.contains("<th>± 1σ</th>"));

@@ -5,6 +5,19 @@
 
 use crate::trace::Trace;
 
+/// A signal name that does not resolve against a trace's points ([`SignalExpr::resolve`]);
+/// `points` lists the trace's points, comma-separated.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SignalError {
+    /// Not `<point>_x`, `<point>_y`, `<a>-<b>_x` or `<a>-<b>_y`.
+    #[error("expected <point>_x, <point>_y, <a>-<b>_x or <a>-<b>_y (points: {points})")]
+    Form { points: String },
+    /// No point of that name, nor two points joined by `-` in it.
+    #[error("no point {name:?} and no two points joined by '-' in it (points: {points})")]
+    NoPoint { name: String, points: String },
+}
+
 /// Which coordinate of a point a signal takes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Axis {
@@ -28,9 +41,9 @@ impl SignalExpr {
     /// Resolves `text` against the points of `trace`.
     ///
     /// # Errors
-    /// A message saying what was expected and listing the trace's points when `text` does not end
-    /// in `_x` or `_y`, or names no point (or pair of points joined by `-`) of the trace.
-    pub fn resolve(text: &str, trace: &Trace) -> Result<SignalExpr, String> {
+    /// [`SignalError`], listing the trace's points, when `text` does not end in `_x` or `_y`, or
+    /// names no point (or pair of points joined by `-`) of the trace.
+    pub fn resolve(text: &str, trace: &Trace) -> Result<SignalExpr, SignalError> {
         let known = || {
             trace
                 .points
@@ -44,10 +57,7 @@ impl SignalExpr {
         } else if let Some(s) = text.strip_suffix("_y") {
             (s, Axis::Y)
         } else {
-            return Err(format!(
-                "expected <point>_x, <point>_y, <a>-<b>_x or <a>-<b>_y (points: {})",
-                known()
-            ));
+            return Err(SignalError::Form { points: known() });
         };
         let has = |n: &str| trace.point(n).is_some();
         let (a, b) = if stem == "tip_rel" && !has("tip_rel") {
@@ -59,17 +69,18 @@ impl SignalExpr {
                 .match_indices('-')
                 .map(|(i, _)| (&stem[..i], &stem[i + 1..]))
                 .find(|(a, b)| has(a) && has(b))
-                .ok_or_else(|| {
-                    format!(
-                        "no point {stem:?} and no two points joined by '-' in it (points: {})",
-                        known()
-                    )
+                .ok_or_else(|| SignalError::NoPoint {
+                    name: stem.to_string(),
+                    points: known(),
                 })?;
             (split.0.to_string(), Some(split.1.to_string()))
         };
         for p in std::iter::once(&a).chain(&b) {
             if !has(p) {
-                return Err(format!("no point {p:?} (points: {})", known()));
+                return Err(SignalError::NoPoint {
+                    name: p.clone(),
+                    points: known(),
+                });
             }
         }
         Ok(SignalExpr {
@@ -161,12 +172,16 @@ mod tests {
     #[test]
     fn unknown_points_are_named_with_the_known_ones() {
         let t = trace();
-        let e = SignalExpr::resolve("wrist-shoulder_y", &t).unwrap_err();
-        assert!(
-            e.contains("\"wrist-shoulder\"") && e.contains("head, tip, left-wrist, shd_L"),
-            "{e}"
+        let points = "head, tip, left-wrist, shd_L".to_string();
+        assert_eq!(
+            SignalExpr::resolve("wrist-shoulder_y", &t),
+            Err(SignalError::NoPoint {
+                name: "wrist-shoulder".into(),
+                points: points.clone(),
+            })
         );
         let e = SignalExpr::resolve("tip_z", &t).unwrap_err();
-        assert!(e.contains("expected <point>_x"), "{e}");
+        assert_eq!(e, SignalError::Form { points });
+        assert!(e.to_string().contains("expected <point>_x"), "{e}");
     }
 }

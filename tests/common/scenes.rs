@@ -262,7 +262,7 @@ keys = {{ {keys} }}
 pub fn log_likelihood_at_truth(job: &LoadedJob, s: &Scene) -> Result<f64, String> {
     let p = wiperlab::fit::problem_for(job, s.truth_model.parse().unwrap())
         .map_err(|e| e.to_string())?;
-    let lik = p.likelihood.as_ref().map_err(|e| e.clone())?;
+    let lik = p.likelihood.as_ref().map_err(|e| e.to_string())?;
     let sim = p.simulate(&truth_params(s)).map_err(|e| e.to_string())?;
     let parts = lik.nll(&p, &sim).map_err(|e| e.to_string())?;
     Ok(-parts.total())
