@@ -48,13 +48,8 @@ fn dltdv_text(sim: &BladeSimulation, noise: &[Vec<f64>; 4]) -> String {
     let mut csv = String::from("pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y\n");
     let px_x = |x: f64| ORIGIN_PX.0 + (x - X_ORIGIN_M) / M_PER_PX;
     let px_y = |y: f64| ORIGIN_PX.1 - y / M_PER_PX;
-    for i in 0..sim.t_s.len() {
-        let clean = [
-            px_x(sim.v_m[i]),
-            px_y(-sim.u_m[i]),
-            px_x(sim.v3_m[i]),
-            px_y(-sim.reach_m),
-        ];
+    for (i, ((&v, &u), &v3)) in sim.v_m.iter().zip(&sim.u_m).zip(&sim.v3_m).enumerate() {
+        let clean = [px_x(v), px_y(-u), px_x(v3), px_y(-sim.reach_m)];
         let row: Vec<String> = (0..4)
             .map(|c| format!("{:.4}", clean[c] + noise[c][i]))
             .collect();

@@ -695,7 +695,7 @@ impl RecordingLikelihood {
         problem: &SpectralProblem,
         x: &[f64],
         base: &ReplicateBase,
-    ) -> Result<(Vec<Vec<f64>>, Vec<Vec<f64>>)> {
+    ) -> Result<ReplicateSpectra> {
         let sigma = likelihood::tracking_noise_sigma(x)?;
         let f = crate::spectrum::features::features(
             x,
@@ -1373,6 +1373,10 @@ fn spread(cov: &DMatrix<f64>, uninformed: &[bool]) -> (Vec<f64>, Vec<Vec<f64>>) 
         .collect();
     (sd, corr)
 }
+
+/// A noise replicate's Welch ordinates per band, and per band the noise ordinates its own noise
+/// estimate gives.
+type ReplicateSpectra = (Vec<Vec<f64>>, Vec<Vec<f64>>);
 
 #[cfg(test)]
 mod tests {

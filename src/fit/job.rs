@@ -265,19 +265,15 @@ pub struct LikelihoodSection {
 crate::names::named_enum! {
     /// The tracking noise's spectrum in the likelihood (docs/fit.md, "Likelihood";
     /// [`crate::spectrum::noise`]).
+    #[derive(Default)]
     pub enum NoiseSpectrum: "noise spectrum" {
         /// White noise of the σ second differences give, `1.4826·MAD(Δ²x)/√6`, fixed before the
         /// fit.
+        #[default]
         White => "white",
         /// AR(1) noise whose σ and ρ maximise the recording's likelihood at every simulation (the
         /// profile likelihood; [`crate::fit::evidence::RecordingLikelihood::profile_noise`]).
         Ar1 => "ar1",
-    }
-}
-
-impl Default for NoiseSpectrum {
-    fn default() -> Self {
-        NoiseSpectrum::White
     }
 }
 
