@@ -7,6 +7,18 @@
 //! Conventions: `t_s` in seconds, positions in metres, physical y **up**, x along the sweep.
 //! Missing points are `f64::NAN`, never 0.
 
+crate::names::named_enum! {
+    /// The roles the model gives tracked points. An import renames the points mapped in
+    /// `[recording.import.points]` (or by `--head`, `--tip`) to their role; the fit, the default
+    /// signals and the figures read the points called by these names.
+    pub enum Role: "point role" {
+        /// The blade's head, which the drive moves.
+        Head => "head",
+        /// The lip's tip on the glass.
+        Tip => "tip",
+    }
+}
+
 /// One tracked point: x and y in metres, one value per time sample (NaN = not tracked there).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PointTrack {
@@ -52,6 +64,11 @@ impl Trace {
     /// The point called `name`, if any.
     pub fn point(&self, name: &str) -> Option<&PointTrack> {
         self.points.iter().find(|p| p.name == name)
+    }
+
+    /// The point that plays `role` (the one called by the role's name), if any.
+    pub fn role(&self, role: Role) -> Option<&PointTrack> {
+        self.point(role.name())
     }
 
     /// Number of NaN coordinates over all points.

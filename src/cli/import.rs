@@ -6,6 +6,7 @@ use super::ImportArgs;
 use crate::Result;
 use crate::fit::job::{parse_toml, read_text};
 use crate::import::{Format, ImportSpec};
+use crate::trace::Role;
 use std::path::{Path, PathBuf};
 
 /// Converts `file` (or only describes it) and writes `output` (default `<stem>.trace.csv` in
@@ -121,10 +122,10 @@ pub(super) fn import_spec(a: &ImportArgs) -> Result<ImportSpec> {
         spec.origin_px = [x, y];
     }
     if let Some(h) = &a.head {
-        spec.points.insert("head".into(), h.clone());
+        spec.points.insert(Role::Head.name().into(), h.clone());
     }
     if let Some(t) = &a.tip {
-        spec.points.insert("tip".into(), t.clone());
+        spec.points.insert(Role::Tip.name().into(), t.clone());
     }
     Ok(spec)
 }

@@ -29,7 +29,7 @@ use crate::spectrum::instfreq::{
     FreqSpeedPoint, RidgeConfig, StickDetector, band_floor, bin_by_speed, detect_stick_onsets,
     onset_rate_vs_speed, ridge_vs_speed,
 };
-use crate::trace::Trace;
+use crate::trace::{Role, Trace};
 
 /// Number of equal speed bins of the `freq_speed` cost term.
 pub const SPEED_BINS: usize = 8;
@@ -47,7 +47,7 @@ pub struct FreqSpeed {
 
 fn tip_x(trace: &Trace) -> Result<&[f64]> {
     trace
-        .point("tip")
+        .role(Role::Tip)
         .map(|p| p.x_m.as_slice())
         .ok_or_else(|| super::FitError::NoTip.into())
 }
@@ -276,7 +276,7 @@ pub struct FreqSpeedComparison {
 /// # Errors
 /// Those of [`measured_freq_speed`] and [`model_freq_speed`].
 pub fn compare_freq_speed(o: &super::FitOutcome) -> Result<Option<FreqSpeedComparison>> {
-    if o.measured_trace.point("tip").is_none() {
+    if o.measured_trace.role(Role::Tip).is_none() {
         return Ok(None);
     }
     let cfg = RidgeConfig::default();
@@ -336,12 +336,12 @@ mod tests {
             t_s: t.clone(),
             points: vec![
                 PointTrack {
-                    name: "head".into(),
+                    name: Role::Head.name().into(),
                     x_m: t.iter().map(|t| 0.01 * t).collect(),
                     y_m: vec![0.0; n],
                 },
                 PointTrack {
-                    name: "tip".into(),
+                    name: Role::Tip.name().into(),
                     x_m: vec![0.05; n],
                     y_m: vec![0.0; n],
                 },

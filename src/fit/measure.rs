@@ -6,7 +6,7 @@ use super::instfreq;
 use super::job::{self, LoadedJob};
 use super::{FitError, NoHeadTrack};
 use crate::model::BladeParams;
-use crate::trace::Trace;
+use crate::trace::{Role, Trace};
 use crate::{Error, Result};
 use std::sync::Arc;
 
@@ -165,7 +165,7 @@ pub(super) fn measure_recording(
     // neck/lip model, smoothed by a Gaussian kernel (HEAD_KERNEL_SIGMA_S).
     // The lean d = tip x − head x, smoothed alike, locates the blade's flip (which the neck/lip model
     // cannot pass) and gives the model's state after it.
-    let head = match trace.point("head").zip(trace.point("tip")) {
+    let head = match trace.role(Role::Head).zip(trace.role(Role::Tip)) {
         Some((h, tip)) => {
             let u: Vec<f64> = h.y_m.iter().map(|y| -y).collect();
             let d: Vec<f64> = tip.x_m.iter().zip(&h.x_m).map(|(a, b)| a - b).collect();

@@ -13,6 +13,7 @@
 
 use crate::Result;
 use crate::import::{ImportSpec, ImportSummary};
+use crate::trace::Role;
 use serde::Serialize;
 use std::path::Path;
 
@@ -86,18 +87,18 @@ fn roles(spec: &ImportSpec, summary: &ImportSummary) -> (Option<String>, Option<
         .filter(|(_, scalar)| !**scalar)
         .map(|((n, _), _)| n.as_str())
         .collect();
-    let given = |role: &str| spec.points.get(role).cloned();
-    if given("head").is_some() || given("tip").is_some() {
-        return (given("head"), given("tip"), false);
+    let given = |role: Role| spec.points.get(role.name()).cloned();
+    if given(Role::Head).is_some() || given(Role::Tip).is_some() {
+        return (given(Role::Head), given(Role::Tip), false);
     }
-    let find = |w: &str| {
+    let find = |role: Role| {
         names
             .iter()
-            .find(|n| n.to_lowercase().contains(w))
+            .find(|n| n.to_lowercase().contains(role.name()))
             .map(|n| n.to_string())
     };
-    let head = find("head").or_else(|| names.first().map(|n| n.to_string()));
-    let tip = find("tip").or_else(|| {
+    let head = find(Role::Head).or_else(|| names.first().map(|n| n.to_string()));
+    let tip = find(Role::Tip).or_else(|| {
         names
             .iter()
             .find(|n| Some(n.to_string()) != head)

@@ -18,7 +18,7 @@ use std::path::Path;
 use crate::error::{Error, Result};
 use crate::import::common::{csv_header, open_csv};
 use crate::import::{csv_error, quote_cell, record_line};
-use crate::trace::{PointTrack, Trace};
+use crate::trace::{PointTrack, Role, Trace};
 
 /// Shortest round-trip text of `v`: plain decimal in [1e-4, 1e15), exponent form otherwise,
 /// `NaN` for any NaN.
@@ -80,9 +80,9 @@ fn is_point_column(name: &str) -> bool {
 
 /// The column order of the canonical CSV: indices into `trace.points`, `head` and `tip` first.
 fn column_order(trace: &Trace) -> Vec<usize> {
-    let mut order: Vec<usize> = ["head", "tip"]
+    let mut order: Vec<usize> = Role::ALL
         .iter()
-        .filter_map(|r| trace.points.iter().position(|p| p.name == *r))
+        .filter_map(|r| trace.points.iter().position(|p| p.name == r.name()))
         .collect();
     for i in 0..trace.points.len() {
         if !order.contains(&i) {

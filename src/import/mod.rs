@@ -36,6 +36,7 @@
 //! ```
 //! # fn main() -> wiperlab::Result<()> {
 //! use wiperlab::import::{read_trace, Format, ImportSpec};
+//! use wiperlab::trace::Role;
 //! let path = std::env::temp_dir().join(format!("wiperlab_doc_{}_xypts.csv", std::process::id()));
 //! std::fs::write(&path, "pt1_cam1_X,pt1_cam1_Y\n210.0,290.0\nNaN,NaN\n").unwrap();
 //! let spec: ImportSpec = toml::from_str(
@@ -43,7 +44,7 @@
 //! ).unwrap();
 //! assert_eq!(Format::detect(&path)?, Format::Dltdv);
 //! let trace = read_trace(&path, &spec)?;
-//! let head = trace.point("head").unwrap();
+//! let head = trace.role(Role::Head).unwrap();
 //! assert_eq!(trace.t_s, [0.0, 1e-3]);
 //! assert!((head.x_m[0] - 1e-3).abs() < 1e-15); // 10 px right of the origin
 //! assert!((head.y_m[0] - 1e-3).abs() < 1e-15); // 10 px above it (image y is down)
@@ -74,7 +75,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::names::significant;
-use crate::trace::{PointTrack, Trace};
+use crate::trace::{PointTrack, Role, Trace};
 pub use error::ImportError;
 
 /// The tracking-tool export layouts wiperlab reads. Serialised in kebab case (`"dltdv"`,
@@ -857,7 +858,7 @@ fn rotate_to_sweep(path: &Path, trace: &mut Trace, spec: &ImportSpec) -> Result<
             format!("rotation: by −{deg}° (sweep_angle_deg) so x runs along the sweep"),
         )
     } else if spec.sweep_from_head {
-        let Some(head) = trace.point("head").or_else(|| trace.points.first()) else {
+        let Some(head) = trace.role(Role::Head).or_else(|| trace.points.first()) else {
             return Err(Error::input(
                 path,
                 "sweep_from_head: the file has no points",
@@ -897,9 +898,6 @@ fn rotate_to_sweep(path: &Path, trace: &mut Trace, spec: &ImportSpec) -> Result<
     Ok(Some(note))
 }
 
-/// Conventional role order: these first, then other roles alphabetically.
-const ROLE_ORDER: [&str; 2] = ["head", "tip"];
-
 /// Rename mapped points to their roles and order them (see the module docs).
 fn assign_roles(path: &Path, trace: Trace, roles: &BTreeMap<String, String>) -> Result<Trace> {
     if roles.is_empty() {
@@ -913,12 +911,13 @@ fn assign_roles(path: &Path, trace: Trace, roles: &BTreeMap<String, String>) -> 
         .map(|p| p.name.as_str())
         .collect::<Vec<_>>()
         .join(", ");
+    // The model's roles first, in their order, then other roles alphabetically.
     let mut ordered: Vec<(&String, &String)> = roles.iter().collect();
     ordered.sort_by_key(|(role, _)| {
-        let rank = ROLE_ORDER
+        let rank = Role::ALL
             .iter()
-            .position(|r| *r == role.as_str())
-            .unwrap_or(ROLE_ORDER.len());
+            .position(|r| r.name() == role.as_str())
+            .unwrap_or(Role::ALL.len());
         (rank, role.as_str())
     });
     let mut out = Vec::with_capacity(slots.len());

@@ -11,6 +11,7 @@ use crate::model::FrictionLaw;
 use crate::simulate::blade::{BladeSimulation, ContactForces};
 use crate::spectrum::Spectrogram;
 use crate::spectrum::instfreq::FreqSpeedPoint;
+use crate::trace::Role;
 use crate::{Error, Result};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -233,7 +234,7 @@ fn trace_figures(dir: &Path, o: &FitOutcome, targets_only: bool) -> Result<()> {
     )?;
     let head_meas = o
         .measured_trace
-        .point("head")
+        .role(Role::Head)
         .map(|p| demean(&p.y_m))
         .unwrap_or_default();
     let head_model: Vec<f64> = demean(&o.best_sim.u_m.iter().map(|u| -u).collect::<Vec<_>>());
@@ -636,7 +637,7 @@ pub fn fit_data_files(dir: &Path, o: &FitOutcome) -> Result<Vec<String>> {
         let sig = o.signal.extract(&o.measured_trace)?;
         let head: Vec<f64> = o
             .measured_trace
-            .point("head")
+            .role(Role::Head)
             .map(|p| p.y_m.clone())
             .unwrap_or_else(|| vec![f64::NAN; sig.len()]);
         let cols: [(&str, &[f64]); 3] = [

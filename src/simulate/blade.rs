@@ -4,7 +4,7 @@ use super::hybrid::{
     Mode, ModelFault, Phase, SolverOptions, Stats, StickSlipModel, Switch, Transition, integrate,
 };
 use crate::model::blade::{Blade, BladeParams, LockedBlade, StickForm};
-use crate::trace::{PointTrack, Trace};
+use crate::trace::{PointTrack, Role, Trace};
 use crate::{Error, Result};
 
 /// How far into a neck/lip segment (s) the runner looks for a state the tracks and the contact
@@ -84,12 +84,12 @@ impl BladeSimulation {
             t_s: self.t_s.clone(),
             points: vec![
                 PointTrack {
-                    name: "head".into(),
+                    name: Role::Head.name().into(),
                     x_m: self.v_m.clone(),
                     y_m: self.u_m.iter().map(|u| -u).collect(),
                 },
                 PointTrack {
-                    name: "tip".into(),
+                    name: Role::Tip.name().into(),
                     x_m: self.v3_m.clone(),
                     y_m: vec![-self.reach_m; n],
                 },

@@ -75,7 +75,10 @@ pub enum SpectrumError {
         "signal needs a tracked point with role '{role}' (map it in [recording.import.points]); the trace has: {}",
         present.join(", ")
     )]
-    MissingPoint { role: String, present: Vec<String> },
+    MissingPoint {
+        role: crate::trace::Role,
+        present: Vec<String>,
+    },
     /// A feature band that holds no frequency bin of the spectrum.
     #[error(
         "band '{band}' [{lo_hz}, {hi_hz}] Hz holds no frequency bin at fs = {} Hz, nperseg = {nperseg} (Nyquist {} Hz)",

@@ -7,7 +7,7 @@ use crate::Result;
 use crate::spectrum::{
     Average, Detrend, Peak, Scaling, WelchConfig, Window, find_peak, welch_gappy,
 };
-use crate::trace::Trace;
+use crate::trace::{Role, Trace};
 use serde::{Deserialize, Serialize};
 
 /// One frequency band and the Welch segment length used in it.
@@ -122,20 +122,18 @@ impl SignalKind {
     /// # Errors
     /// [`SpectrumError::MissingPoint`] when the trace lacks a `head` or `tip` point.
     pub fn extract(self, trace: &Trace) -> Result<Vec<f64>> {
-        let need = |name: &str| {
-            trace
-                .point(name)
-                .ok_or_else(|| SpectrumError::MissingPoint {
-                    role: name.to_string(),
-                    present: trace.points.iter().map(|p| p.name.clone()).collect(),
-                })
+        let need = |role: Role| {
+            trace.role(role).ok_or_else(|| SpectrumError::MissingPoint {
+                role,
+                present: trace.points.iter().map(|p| p.name.clone()).collect(),
+            })
         };
         let diff = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a - b).collect();
         Ok(match self {
-            SignalKind::TipRelX => diff(&need("tip")?.x_m, &need("head")?.x_m),
-            SignalKind::TipRelY => diff(&need("tip")?.y_m, &need("head")?.y_m),
-            SignalKind::HeadY => need("head")?.y_m.clone(),
-            SignalKind::TipX => need("tip")?.x_m.clone(),
+            SignalKind::TipRelX => diff(&need(Role::Tip)?.x_m, &need(Role::Head)?.x_m),
+            SignalKind::TipRelY => diff(&need(Role::Tip)?.y_m, &need(Role::Head)?.y_m),
+            SignalKind::HeadY => need(Role::Head)?.y_m.clone(),
+            SignalKind::TipX => need(Role::Tip)?.x_m.clone(),
         })
     }
 

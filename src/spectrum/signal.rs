@@ -3,7 +3,7 @@
 //! (e.g. `wstL-shdL_y`, wrist y − shoulder y), or `tip_rel_x` / `tip_rel_y` (`tip-head_x`, `_y`).
 //! Point names may themselves contain `-` and `_`: a name is split where the trace's points say.
 
-use crate::trace::Trace;
+use crate::trace::{Role, Trace};
 
 /// A signal name that does not resolve against a trace's points ([`SignalExpr::resolve`]);
 /// `points` lists the trace's points, comma-separated.
@@ -61,7 +61,10 @@ impl SignalExpr {
         };
         let has = |n: &str| trace.point(n).is_some();
         let (a, b) = if stem == "tip_rel" && !has("tip_rel") {
-            ("tip".to_string(), Some("head".to_string()))
+            (
+                Role::Tip.name().to_string(),
+                Some(Role::Head.name().to_string()),
+            )
         } else if has(stem) {
             (stem.to_string(), None)
         } else {
@@ -122,11 +125,11 @@ impl SignalExpr {
                 });
             }
         }
-        if trace.point("head").is_some() && trace.point("tip").is_some() {
+        if trace.role(Role::Head).is_some() && trace.role(Role::Tip).is_some() {
             out.push(SignalExpr {
                 name: "tip_rel_x".into(),
-                a: "tip".into(),
-                b: Some("head".into()),
+                a: Role::Tip.name().into(),
+                b: Some(Role::Head.name().into()),
                 axis: Axis::X,
             });
         }
