@@ -175,7 +175,7 @@ const FIGURE_CHECK: &str = include_str!("templates/figure_check.js");
 
 /// What a model of the hierarchy is, in words (the result stores its short name); empty for a
 /// name this page does not know.
-fn model_label(c: Candidate) -> &'static str {
+pub(super) fn model_label(c: Candidate) -> &'static str {
     match (c.kind, c.shoulder) {
         (ModelKind::Head1dof, _) => "1-DOF head on its spring",
         (ModelKind::Necklip, false) => "neck and lip",
@@ -323,11 +323,18 @@ struct TrialView {
     cost: String,
     wall_time_s: String,
     model_evaluations: usize,
+    failed_evaluations: usize,
     chosen: bool,
+    /// Why, in a few words (the numbers are in their own columns).
+    short_reason: String,
+    /// Why, with every number, as the fit wrote it.
     reason: String,
     log_likelihood: String,
     delta_aic: String,
     delta_bic: String,
+    /// The likelihood-ratio test's p against the candidate this one extends (`X` for
+    /// `X+shoulder`).
+    lrt: String,
 }
 
 #[derive(Serialize)]
@@ -403,6 +410,46 @@ fn tolerance_check_words(t: &crate::fit::tolerance::ToleranceCheck) -> String {
     )
 }
 
+/// Why trial `t` of `r` was (not) chosen, in a few words: the criterion for the chosen one; for
+/// another, a band it cannot produce, what its likelihood-ratio test says, or that its AIC is
+/// higher.
+fn short_reason(r: &FitResult, t: &crate::fit::ModelTrial) -> String {
+    use crate::fit::NECK_BAND_MIN_HZ;
+    if t.chosen {
+        let compared = r
+            .model_trials
+            .iter()
+            .filter(|o| !o.chosen)
+            .any(|o| o.evidence.as_ref().is_some_and(|e| e.delta_aic.is_finite()));
+        return match (r.model_trials.len(), compared) {
+            (1, _) => "the only model fitted".into(),
+            (_, true) => "lowest AIC".into(),
+            (_, false) => "the only candidate that produced every band".into(),
+        };
+    }
+    let bands = r.spectrum.as_ref().map_or(&[][..], |s| &s.bands[..]);
+    let mut why = Vec::new();
+    if !t.model.kind.has_neck_mode()
+        && let Some(b) = bands.iter().find(|b| b.range_hz[0] >= NECK_BAND_MIN_HZ)
+    {
+        why.push(format!("no neck–lip mode for band '{}'", b.name));
+    }
+    if !t.model.kind.has_head_mode()
+        && let Some(b) = bands.iter().find(|b| b.range_hz[0] < NECK_BAND_MIN_HZ)
+    {
+        why.push(format!("imposes band '{}' from the head track", b.name));
+    }
+    match t.evidence.as_ref().and_then(|e| e.lrt.as_ref()) {
+        Some(l) if l.p_value < 0.05 => {
+            why.push("a gain beyond chance, but not worth its parameters".into())
+        }
+        Some(_) => why.push("its extra parameters gain nothing beyond chance".into()),
+        None if why.is_empty() => why.push("higher AIC".into()),
+        None => {}
+    }
+    why.join("; ")
+}
+
 fn trial_rows(r: &FitResult) -> Vec<TrialView> {
     r.model_trials
         .iter()
@@ -412,8 +459,15 @@ fn trial_rows(r: &FitResult) -> Vec<TrialView> {
             cost: num(t.cost, 5),
             wall_time_s: num(t.wall_time_s, 3),
             model_evaluations: t.model_evaluations,
+            failed_evaluations: t.failed_evaluations,
             chosen: t.chosen,
+            short_reason: short_reason(r, t),
             reason: t.reason.clone(),
+            lrt: t
+                .evidence
+                .as_ref()
+                .and_then(|e| e.lrt.as_ref())
+                .map_or("—".into(), |l| format!("{:.3}", l.p_value)),
             log_likelihood: t
                 .evidence
                 .as_ref()
@@ -555,6 +609,8 @@ struct PageView<'a> {
     tolerance_check: Option<String>,
     modes: Vec<ModeView>,
     correlation: Vec<CorrelationRow>,
+    /// The opening summary: what was found, whether the fit is good, what to do if not.
+    summary: super::summary::Summary,
     /// Warnings that need the reader's attention, and those for information.
     attention: Vec<WarningView>,
     information: Vec<WarningView>,
@@ -653,6 +709,7 @@ fn page_view<'a>(
         tolerance_check: r.tolerance_check.as_ref().map(tolerance_check_words),
         modes: mode_rows(r),
         correlation: if pd { correlation_rows(r) } else { Vec::new() },
+        summary: super::summary::summary(r, warnings),
         attention: warning_views(warnings, Severity::Attention),
         information: warning_views(warnings, Severity::Information),
         figures: figures
@@ -1069,6 +1126,20 @@ pub(super) mod tests {
             "{severities:?}"
         );
         let html = std::fs::read_to_string(&s.path).unwrap();
+        // Three need attention, each a headline with its sentence folded under it; the failed
+        // evaluations are for information, folded while something needs attention.
+        let attention = &html[html.find("<ul id=\"attention-list\"").unwrap()..];
+        let attention = &attention[..attention.find("</ul>").unwrap()];
+        assert_eq!(attention.matches("<li>").count(), 3, "{attention}");
+        assert!(attention.contains(
+            "<li>The data leave B undetermined (1σ 0.200 over a search range [0.005000, 0.1500]): \
+             read its value with care, or fix it from another measurement.<details><summary>\
+             details</summary>the data leave B undetermined"
+        ), "{attention}");
+        assert!(html.contains(
+            "<details id=\"information\"><summary><b>For information</b> (1): normal on a good fit"
+        ));
+        assert!(html.contains("<section id=\"summary\" class=\"check\">"));
         assert!(html.contains("<td>[0.02800, 0.03200] (68 %)<sup>1</sup></td>"));
         assert!(html.contains(
             "<sup>1</sup> Interval method: profile likelihood: where the NLL, minimised over the \
@@ -1144,6 +1215,81 @@ pub(super) mod tests {
             "{html}"
         );
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn model_reasons_are_short_and_their_numbers_have_columns() {
+        use crate::fit::{ModelTrial, RatioTest, TrialEvidence};
+        let mut r = result();
+        r.spectrum = Some(Default::default()); // bands low 30–300 Hz, high 500–5000 Hz
+        let evidence = |delta_aic: f64, lrt: Option<RatioTest>| TrialEvidence {
+            log_likelihood_nats: 5805.8,
+            spectral_nll_nats: vec![],
+            time_nll_nats: None,
+            residual_rms_m: 1e-5,
+            n_effective: 1e3,
+            aic: -11603.6 + delta_aic,
+            bic: -11580.0 + delta_aic,
+            delta_aic,
+            delta_bic: delta_aic,
+            lrt,
+        };
+        let trial = |model: &str, chosen: bool, e: TrialEvidence| ModelTrial {
+            model: model.parse().unwrap(),
+            parameters: vec![crate::model::ParamId::K1],
+            cost: 78.3,
+            wall_time_s: 4.0,
+            model_evaluations: 3658,
+            failed_evaluations: 408,
+            chosen,
+            reason: "the fit's own sentence, with every number".into(),
+            evidence: Some(e),
+        };
+        let lrt = |p_value: f64| RatioTest {
+            against: "blade2dof".parse().unwrap(),
+            statistic: 0.21,
+            df: 2,
+            p_value,
+        };
+        r.model_trials = vec![
+            trial("head1dof", false, evidence(905.2, None)),
+            trial("blade2dof", true, evidence(0.0, None)),
+            trial("blade2dof+shoulder", false, evidence(3.8, Some(lrt(0.901)))),
+        ];
+        let rows = trial_rows(&r);
+        let reasons: Vec<&str> = rows.iter().map(|t| t.short_reason.as_str()).collect();
+        assert_eq!(
+            reasons,
+            [
+                "no neck–lip mode for band 'high'",
+                "lowest AIC",
+                "its extra parameters gain nothing beyond chance"
+            ]
+        );
+        assert_eq!(rows[2].lrt, "0.901");
+        assert_eq!(rows[0].lrt, "—");
+        r.model_trials[2].evidence = Some(evidence(1.5, Some(lrt(0.01))));
+        assert_eq!(
+            trial_rows(&r)[2].short_reason,
+            "a gain beyond chance, but not worth its parameters"
+        );
+        // The full sentence stays on the page, folded under the short one.
+        let prov = Provenance {
+            job_path: "job.toml".into(),
+            result_path: "r.toml".into(),
+            recording_path: "rec.csv".into(),
+            recording_sha256_now: Ok(String::new()),
+            written_utc: "now".into(),
+        };
+        let html = render_html(&r, &[], None, &[], &prov).unwrap();
+        assert!(
+            html.contains(
+                "<td class=\"l reason\">lowest AIC<details><summary>why, in numbers</summary>the \
+             fit&#x27;s own sentence, with every number</details></td>"
+            ),
+            "{html}"
+        );
+        assert!(html.contains("<td>3658 (408)</td>"));
     }
 
     #[test]

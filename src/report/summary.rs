@@ -1,0 +1,446 @@
+//! The report page's opening summary: what was found (the chosen model, the friction law and the
+//! neck stiffness with their intervals in words and units), whether the fit is good (the
+//! goodness-of-fit test, the tolerance check, the peaks, the parameters the data determine, the
+//! warnings that need attention), and what to do when it is not.
+
+use super::html::num;
+use super::warning::PageWarning;
+use crate::fit::tolerance::Verdict;
+use crate::fit::{FitResult, FitWarning, FittedParam, Severity};
+use crate::model::ParamId;
+use serde::Serialize;
+
+/// Relative distance between the model's peak and the measured (or target) one above which the
+/// summary marks the peaks as off: 2 %, the accuracy asked of the fitted model's lines.
+pub const PEAK_OFF_FRACTION: f64 = 0.02;
+
+/// One check of the fit: `status` is `"ok"`, `"bad"`, or `"none"` when the result holds no such
+/// check.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Check {
+    pub status: &'static str,
+    pub text: String,
+}
+
+/// What the summary shows, already in words.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    /// The chosen model and how it was chosen.
+    pub model: String,
+    /// The fitted parameters in words: the friction law, the neck stiffness, then any other.
+    pub findings: Vec<String>,
+    pub checks: Vec<Check>,
+    /// True when no check failed.
+    pub good: bool,
+    /// What to do, one item per failed check (empty when the fit is good).
+    pub todo: Vec<String>,
+}
+
+/// The summary of result `r` with the page's `warnings`.
+pub fn summary(r: &FitResult, warnings: &[PageWarning]) -> Summary {
+    let checks_and_todo = checks(r, warnings);
+    let good = checks_and_todo.iter().all(|(c, _)| c.status != "bad");
+    let todo = checks_and_todo
+        .iter()
+        .filter_map(|(_, t)| t.clone())
+        .collect();
+    Summary {
+        model: model_words(r),
+        findings: findings(r),
+        checks: checks_and_todo.into_iter().map(|(c, _)| c).collect(),
+        good,
+        todo,
+    }
+}
+
+/// "Model blade2dof (…), chosen by AIC among N candidates; the next best …".
+fn model_words(r: &FitResult) -> String {
+    let label = super::html::model_label(r.model);
+    let named = if label.is_empty() {
+        format!("Model {}", r.model)
+    } else {
+        format!("Model {} ({label})", r.model)
+    };
+    let others: Vec<_> = r.model_trials.iter().filter(|t| !t.chosen).collect();
+    if others.is_empty() {
+        return format!("{named}, the only model fitted.");
+    }
+    let next = others
+        .iter()
+        .filter_map(|t| t.evidence.as_ref().map(|e| (t, e.delta_aic)))
+        .filter(|(_, d)| d.is_finite())
+        .min_by(|a, b| a.1.total_cmp(&b.1));
+    match next {
+        Some((t, d)) => format!(
+            "{named}, chosen by AIC among {} candidates; the next best, {}, has an AIC {d:.1} \
+             higher.",
+            r.model_trials.len(),
+            t.model
+        ),
+        None => format!(
+            "{named}, chosen among {} candidates (see the model comparison).",
+            r.model_trials.len()
+        ),
+    }
+}
+
+/// Digits enough that the value and its interval's ends read apart (3 to 6 significant digits).
+fn digits(values: &[f64]) -> usize {
+    (3..=6)
+        .find(|&d| {
+            let s: Vec<String> = values.iter().map(|v| num(*v, d)).collect();
+            s.iter()
+                .enumerate()
+                .all(|(i, a)| s[i + 1..].iter().all(|b| a != b))
+        })
+        .unwrap_or(6)
+}
+
+/// `x` with its unit, e.g. "70.6 s/m", or the number alone for a dimensionless parameter.
+fn with_unit(x: String, id: ParamId) -> String {
+    match id.unit() {
+        "-" => x,
+        u => format!("{x} {u}"),
+    }
+}
+
+/// A fitted parameter in words: its value, and its interval (or 1σ) with the level.
+fn value_words(p: &FittedParam) -> String {
+    if !p.determined {
+        return format!(
+            "{} = {} (not determined by the data: read it with care)",
+            p.name,
+            with_unit(num(p.value, 3), p.name)
+        );
+    }
+    match &p.interval {
+        Some(i) => {
+            let d = digits(&[p.value, i.lo, i.hi]);
+            format!(
+                "{} = {} ({:.0} % interval {} to {})",
+                p.name,
+                with_unit(num(p.value, d), p.name),
+                100.0 * i.level,
+                num(i.lo, d),
+                with_unit(num(i.hi, d), p.name)
+            )
+        }
+        None if p.std_error.is_finite() => {
+            let d = digits(&[p.value, p.value + p.std_error]);
+            format!(
+                "{} = {} ± {} (1σ)",
+                p.name,
+                with_unit(num(p.value, d), p.name),
+                with_unit(num(p.std_error, 2), p.name)
+            )
+        }
+        None => format!("{} = {}", p.name, with_unit(num(p.value, 3), p.name)),
+    }
+}
+
+/// The fitted parameters in words: the friction law (with its value at rest and in fast slip when
+/// A, B and C were all fitted), the neck stiffness, then every other fitted parameter.
+fn findings(r: &FitResult) -> Vec<String> {
+    let get = |id: ParamId| r.parameters.iter().find(|p| p.name == id);
+    let mut out = Vec::new();
+    let law: Vec<&FittedParam> = [ParamId::A, ParamId::B, ParamId::C]
+        .into_iter()
+        .filter_map(get)
+        .collect();
+    if !law.is_empty() {
+        let mut s = format!(
+            "Friction law μ_d(v) = A·e^(−B·|v|) + C: {}.",
+            law.iter()
+                .map(|p| value_words(p))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+        if let (Some(a), Some(b), Some(c)) = (get(ParamId::A), get(ParamId::B), get(ParamId::C)) {
+            s += &format!(
+                " The friction coefficient falls from {} at the onset of slip to {} in fast slip, \
+                 half way by {} mm/s.",
+                num(a.value + c.value, 3),
+                num(c.value, 3),
+                num(std::f64::consts::LN_2 / b.value * 1e3, 2)
+            );
+        } else {
+            s += " The law's other coefficients are held at the blade file's values.";
+        }
+        out.push(s);
+    }
+    if let Some(k1) = get(ParamId::K1) {
+        out.push(format!("Neck stiffness {}.", value_words(k1)));
+    }
+    let rest: Vec<String> = r
+        .parameters
+        .iter()
+        .filter(|p| ![ParamId::A, ParamId::B, ParamId::C, ParamId::K1].contains(&p.name))
+        .map(value_words)
+        .collect();
+    if !rest.is_empty() {
+        out.push(format!("Also fitted: {}.", rest.join("; ")));
+    }
+    out
+}
+
+fn ok(text: String) -> (Check, Option<String>) {
+    (Check { status: "ok", text }, None)
+}
+
+fn none(text: String) -> (Check, Option<String>) {
+    (
+        Check {
+            status: "none",
+            text,
+        },
+        None,
+    )
+}
+
+fn bad(text: String, todo: &str) -> (Check, Option<String>) {
+    (
+        Check {
+            status: "bad",
+            text,
+        },
+        Some(todo.to_string()),
+    )
+}
+
+/// Each check with what to do when it failed.
+fn checks(r: &FitResult, warnings: &[PageWarning]) -> Vec<(Check, Option<String>)> {
+    let mut out = Vec::new();
+    out.push(match &r.goodness_of_fit {
+        Some(g) if g.fits() => ok(format!(
+            "The model explains the recording's spectra to their noise (goodness of fit p = \
+             {:.2}).",
+            g.p_value
+        )),
+        Some(g) => bad(
+            format!(
+                "The model does not explain the recording's spectra to their noise (goodness of \
+                 fit p = {:.3}): the spectra hold structure the model lacks, or the search missed \
+                 a basin.",
+                g.p_value
+            ),
+            "Fit more candidate models (e.g. with shoulder contact), check that each band holds \
+             the line it is meant for, or bound a parameter known from the blade's drawing \
+             (docs/fit.md, \"Goodness of fit\").",
+        ),
+        None if r.target_job => {
+            none("No goodness-of-fit test: a target job has no measurement noise.".into())
+        }
+        None if r.interrupted => none("No goodness-of-fit test: the fit was interrupted.".into()),
+        None => none("No goodness-of-fit test in this result (a joint fit has none).".into()),
+    });
+    out.push(match &r.tolerance_check {
+        Some(t) => {
+            let rtols = match (t.points.first(), t.points.last()) {
+                (Some(a), Some(b)) => format!("rtol {:e} to {:e}", a.rtol, b.rtol),
+                _ => String::new(),
+            };
+            match t.verdict() {
+                Verdict::Resolved => ok(format!(
+                    "The integrator resolves the likelihood at the optimum (the cost moves {} \
+                     nats over {rtols}).",
+                    num(t.spread_nats, 2)
+                )),
+                Verdict::Unresolved => bad(
+                    format!(
+                        "The integrator does not resolve the likelihood at the optimum (the cost \
+                         moves {} nats over {rtols}): the intervals understate the uncertainty.",
+                        num(t.spread_nats, 2)
+                    ),
+                    "Tighten [solver] rtol tenfold and refit (docs/fit.md, \"Tolerance check\").",
+                ),
+                Verdict::NotProbed => bad(
+                    "The tolerance check could not run: every tighter simulation failed.".into(),
+                    "Raise [solver] max_steps and refit, so the tolerance check can run.",
+                ),
+            }
+        }
+        None => none("No tolerance check in this result.".into()),
+    });
+    let worst = r
+        .peaks
+        .iter()
+        .filter(|p| p.rel_diff.is_finite())
+        .max_by(|a, b| a.rel_diff.abs().total_cmp(&b.rel_diff.abs()));
+    let against = if r.target_job {
+        "the targets"
+    } else {
+        "the measured ones"
+    };
+    out.push(match worst {
+        Some(p) if p.rel_diff.abs() <= PEAK_OFF_FRACTION => ok(format!(
+            "The model's peaks lie within {} of {against} in every band.",
+            pct_abs(p.rel_diff)
+        )),
+        Some(p) => bad(
+            format!(
+                "The model's peak in band '{}' lies {} from {against} (more than {:.0} %).",
+                p.band,
+                pct_abs(p.rel_diff),
+                100.0 * PEAK_OFF_FRACTION
+            ),
+            "Compare the PSD figures: check that the band holds the line it is meant for and that \
+             the search bounds let the model reach it.",
+        ),
+        None => none("No peaks to compare.".into()),
+    });
+    let undetermined: Vec<String> = r
+        .parameters
+        .iter()
+        .filter(|p| !p.determined)
+        .map(|p| p.name.to_string())
+        .collect();
+    out.push(if undetermined.is_empty() {
+        ok(format!(
+            "The data determine every fitted parameter ({}).",
+            r.parameters
+                .iter()
+                .map(|p| p.name.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))
+    } else {
+        bad(
+            format!(
+                "The data leave {} undetermined.",
+                crate::names::join(&undetermined, ", ")
+            ),
+            "Fix the undetermined parameters from another measurement, or narrow their bounds, \
+             and refit.",
+        )
+    });
+    let attention = warnings
+        .iter()
+        .filter(|w| w.severity() == Severity::Attention)
+        .count();
+    let information = warnings.len() - attention;
+    let info = match information {
+        0 => String::new(),
+        1 => " (1 note for information, below)".into(),
+        n => format!(" ({n} notes for information, below)"),
+    };
+    out.push(match attention {
+        0 => ok(format!("No warning needs your attention{info}.")),
+        n => bad(
+            format!(
+                "{n} warning{} need{} your attention{info}.",
+                if n == 1 { "" } else { "s" },
+                if n == 1 { "s" } else { "" }
+            ),
+            "Read the warnings under \"Needs your attention\": each says what to do.",
+        ),
+    });
+    if warnings
+        .iter()
+        .any(|w| matches!(w, PageWarning::Fit(FitWarning::Interrupted)))
+    {
+        out.push(bad(
+            "The fit was interrupted: the values are the best point the search had reached.".into(),
+            "Run the fit again to the end.",
+        ));
+    }
+    out
+}
+
+/// |x| as a percentage with two significant digits, e.g. "0.089 %".
+fn pct_abs(x: f64) -> String {
+    format!("{} %", num(100.0 * x.abs(), 2))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    use crate::fit::likelihood::GoodnessOfFit;
+    use crate::fit::tolerance::{ToleranceCheck, TolerancePoint};
+
+    fn point(rtol: f64, cost_nats: f64) -> TolerancePoint {
+        TolerancePoint {
+            rtol,
+            atol: rtol * 1e-2,
+            cost_nats,
+            transitions: 146,
+        }
+    }
+
+    #[test]
+    fn a_good_fit_says_so_and_a_doubtful_one_says_what_to_do() {
+        // The report's unit result: k1 with an interval, B undetermined, no test, no check.
+        let mut r = crate::report::html::tests::result();
+        let s = summary(&r, &[]);
+        assert_eq!(
+            s.findings[1],
+            "Neck stiffness k1 = 0.0300 N·m/rad (68 % interval 0.0280 to 0.0320 N·m/rad)."
+        );
+        assert!(
+            s.findings[0].contains("B = 0.0300 s/m (not determined by the data"),
+            "{:?}",
+            s.findings
+        );
+        assert!(s.findings[0].ends_with("held at the blade file's values."));
+        assert!(!s.good);
+        let status = |s: &Summary| s.checks.iter().map(|c| c.status).collect::<Vec<_>>();
+        // Test, tolerance check, peaks (1.0 % off), determined, warnings.
+        assert_eq!(status(&s), ["none", "none", "ok", "bad", "ok"]);
+        assert_eq!(s.todo.len(), 1, "{:?}", s.todo);
+
+        // Determined, a test the fit passes and a resolved check: good, nothing to do.
+        r.parameters[1].determined = true;
+        r.goodness_of_fit = Some(GoodnessOfFit {
+            excess_nll_nats: 78.3,
+            replicate_mean_nats: 75.7,
+            replicate_sd_nats: 7.8,
+            replicates: 999,
+            p_value: 0.341,
+        });
+        let resolved = ToleranceCheck::of(
+            vec![point(1e-8, 78.34), point(1e-9, 78.32), point(1e-10, 78.32)],
+            vec![],
+        );
+        r.tolerance_check = Some(resolved);
+        let info = PageWarning::FailedEvaluations {
+            failed: 2,
+            evaluations: 30,
+            first: None,
+        };
+        let s = summary(&r, std::slice::from_ref(&info));
+        assert!(s.good && s.todo.is_empty(), "{s:?}");
+        assert_eq!(status(&s), ["ok"; 5]);
+        assert_eq!(
+            s.checks[4].text,
+            "No warning needs your attention (1 note for information, below)."
+        );
+
+        // A misfit and an unresolved optimum: each failed check says what to do.
+        r.goodness_of_fit.as_mut().unwrap().p_value = 0.001;
+        r.tolerance_check = Some(ToleranceCheck::of(
+            vec![point(1e-8, 66.8), point(1e-9, 68.4)],
+            vec![],
+        ));
+        let misfit = PageWarning::Fit(FitWarning::Misfit {
+            test: r.goodness_of_fit.unwrap(),
+            shoulder_listed: false,
+        });
+        let s = summary(&r, &[misfit, info]);
+        assert!(!s.good);
+        assert_eq!(status(&s), ["bad", "bad", "ok", "ok", "bad"]);
+        assert_eq!(s.todo.len(), 3, "{:?}", s.todo);
+        assert!(
+            s.todo[1].starts_with("Tighten [solver] rtol"),
+            "{:?}",
+            s.todo
+        );
+    }
+
+    #[test]
+    fn digits_grow_until_the_interval_ends_read_apart() {
+        // 0.02954 in [0.02923, 0.02985]: three digits tell them apart.
+        assert_eq!(digits(&[0.029542, 0.029231, 0.029845]), 3);
+        // 70.551 in [70.53, 70.58]: four are needed (70.6, 70.5, 70.6 at three).
+        assert_eq!(digits(&[70.551, 70.53, 70.58]), 4);
+    }
+}
