@@ -682,6 +682,13 @@ fn data_under_legend(svg: &str) -> Result<(Vec<String>, Vec<[f64; 4]>), String> 
         return Err("no legend group".into());
     }
     data += rest;
+    Ok((data_in_boxes(&data, &boxes), boxes))
+}
+
+/// Every polyline vertex, point along each polyline segment (32 per segment) and circle of `data`
+/// that lies inside one of `boxes` (`[x, y, width, height]`, grown by a circle's radius),
+/// described.
+fn data_in_boxes(data: &str, boxes: &[[f64; 4]]) -> Vec<String> {
     let inside = |px: f64, py: f64, grow: f64| {
         boxes.iter().any(|[x, y, w, h]| {
             px > x - grow && px < x + w + grow && py > y - grow && py < y + h + grow
@@ -722,7 +729,42 @@ fn data_under_legend(svg: &str) -> Result<(Vec<String>, Vec<[f64; 4]>), String> 
             }
         }
     }
-    Ok((hits, boxes))
+    hits
+}
+
+/// The boxes of the marker labels of `svg` (`<text class="marker-label">`, `[x, y, width,
+/// height]`): from `x` to `x + textLength`, and from `0.8·font-size` above the baseline `y` to
+/// `0.25·font-size` below it (plot.rs's module docs).
+fn label_boxes(svg: &str) -> Vec<[f64; 4]> {
+    svg.split("<text class=\"marker-label\"")
+        .skip(1)
+        .map(|t| {
+            let open = &t[..t.find('>').unwrap_or(t.len())];
+            let [x, y, fs, w] = ["x", "y", "font-size", "textLength"]
+                .map(|a| num_attr(open, a).unwrap_or(f64::NAN));
+            [x, y - 0.8 * fs, w, 1.05 * fs]
+        })
+        .collect()
+}
+
+/// Data (outside the legends and the labels' own group) passing under a marker label, described,
+/// with the label boxes; every box must be readable.
+fn data_under_labels(svg: &str) -> (Vec<String>, Vec<[f64; 4]>) {
+    let boxes = label_boxes(svg);
+    for b in &boxes {
+        assert!(
+            b.iter().all(|v| v.is_finite()) && b[2] > 0.0,
+            "unreadable label box {b:?}"
+        );
+    }
+    let mut data = svg.to_string();
+    for group in ["<g class=\"legend\">", "<g class=\"marker-labels\">"] {
+        while let Some(start) = data.find(group) {
+            let end = start + data[start..].find("</g>").expect("group not closed") + 4;
+            data.replace_range(start..end, "");
+        }
+    }
+    (data_in_boxes(&data, &boxes), boxes)
 }
 
 /// The axis titles of a plotters figure: the `<text>` elements turned upright (y axes, colour
@@ -771,6 +813,8 @@ fn check_figure(what: &str, dir: &Path, name: &str, no_legend: bool) {
         }
         Err(e) => assert!(no_legend, "{f}: {e}"),
     }
+    let (hits, b) = data_under_labels(&svg);
+    assert!(hits.is_empty(), "{f}: marker labels {b:?} cover {hits:?}");
 }
 
 /// The checker finds data under a legend box drawn over it (a hand-made SVG whose polyline
@@ -789,6 +833,33 @@ fn legend_check_can_fail() {
                <g class=\"legend\"><rect x=\"45\" y=\"45\" width=\"10\" height=\"10\"/></g></svg>";
     let (hits, boxes) = data_under_legend(two).unwrap();
     assert_eq!((hits.len(), boxes.len()), (1, 2), "{hits:?}");
+}
+
+/// The label checker finds a curve through a label and a marker's circle under it, and passes a
+/// label beside them.
+#[test]
+fn label_check_can_fail() {
+    let label = |x: f64, y: f64| {
+        format!(
+            "<g class=\"marker-labels\"><text class=\"marker-label\" x=\"{x}\" y=\"{y}\" \
+             font-size=\"52\" textLength=\"300\">model 876.39 Hz</text></g>"
+        )
+    };
+    // The label covers [100, 400] × [58.4, 114.6]; the curve runs along y = 100.
+    let svg = format!(
+        "<svg><polyline points=\"0,100 500,100\"/><circle cx=\"90\" cy=\"80\" r=\"20\"/>{}</svg>",
+        label(100.0, 100.0)
+    );
+    let (hits, boxes) = data_under_labels(&svg);
+    assert_eq!(boxes, [[100.0, 58.4, 300.0, 1.05 * 52.0]]);
+    assert!(hits.iter().any(|h| h.starts_with("polyline")), "{hits:?}");
+    assert!(hits.iter().any(|h| h.starts_with("circle")), "{hits:?}");
+    // The same label 100 units higher is clear of both.
+    let svg = format!(
+        "<svg><polyline points=\"0,100 500,100\"/><circle cx=\"90\" cy=\"80\" r=\"20\"/>{}</svg>",
+        label(100.0, 0.0)
+    );
+    assert!(data_under_labels(&svg).0.is_empty());
 }
 
 /// The axis-title reader finds plotters' x title (hung above its anchor) and rotated y title, and
@@ -1086,10 +1157,59 @@ fn spectrum_writes_psd_csv_and_peaks_json() {
         "1.5e-5",
         "--origin-px",
         "200,300",
+        "--band",
+        "30:300",
+        "--band",
+        "500:5000",
         "--out-dir",
         out.to_str().unwrap(),
     ];
     ok(&run_in(tmp.path(), &args), "spectrum");
+    // Each PSD figure shades the two bands, names them in its legend, and keeps its labels and
+    // legend off the data.
+    let psd_svgs: Vec<String> = svgs(&out)
+        .into_iter()
+        .filter(|f| f.starts_with("psd_"))
+        .collect();
+    assert!(!psd_svgs.is_empty());
+    for f in &psd_svgs {
+        let svg = std::fs::read_to_string(out.join(f)).unwrap();
+        let legend = &svg[svg.find("<g class=\"legend\">").unwrap()..];
+        assert!(
+            legend.contains("band 30–300 Hz") && legend.contains("band 500–5000 Hz"),
+            "{f}"
+        );
+        check_figure("spectrum --band", &out, f, false);
+    }
+    // Beside each spectrogram, its numbers: one row per cell, time-major, frequencies ascending
+    // within each time.
+    let sgs: Vec<String> = svgs(&out)
+        .into_iter()
+        .filter(|f| f.starts_with("spectrogram_"))
+        .collect();
+    assert!(!sgs.is_empty());
+    for f in &sgs {
+        let csv_path = out.join(f.replace(".svg", ".csv"));
+        let mut r = csv::Reader::from_path(&csv_path).unwrap();
+        let header: Vec<String> = r.headers().unwrap().iter().map(str::to_string).collect();
+        assert_eq!(header, ["t_s", "freq_hz", "psd_m2_per_hz"], "{f}");
+        let rows: Vec<[f64; 3]> = r
+            .records()
+            .map(|rec| {
+                let v: Vec<f64> = rec.unwrap().iter().map(|v| v.parse().unwrap()).collect();
+                [v[0], v[1], v[2]]
+            })
+            .collect();
+        let times = rows.windows(2).filter(|w| w[1][0] != w[0][0]).count() + 1;
+        let freqs = rows.iter().filter(|r| r[0] == rows[0][0]).count();
+        assert!(times > 10 && freqs > 10, "{f}: {times} × {freqs}");
+        assert_eq!(rows.len(), times * freqs, "{f}");
+        for block in rows.chunks(freqs) {
+            assert!(block.iter().all(|r| r[0] == block[0][0]), "{f}");
+            assert!(block.windows(2).all(|w| w[0][1] < w[1][1]), "{f}");
+        }
+        assert!(rows.iter().all(|r| r[2] >= 0.0), "{f}");
+    }
     let mut r = csv::Reader::from_path(out.join("psd.csv")).unwrap();
     let header: Vec<String> = r.headers().unwrap().iter().map(str::to_string).collect();
     assert_eq!(header[0], "f_hz");

@@ -114,12 +114,15 @@ pub(super) fn run(a: SpectrumArgs) -> Result<()> {
         };
         print_peaks(name, x, &f, cfg.scaling);
         let sg = crate::spectrum::stft::overview_spectrogram(x, fs)?;
-        crate::report::figures::spectrum_figures(&dir, name, &f, sg.as_ref())?;
+        crate::report::figures::spectrum_figures(&dir, name, &f, sg.as_ref(), !a.band.is_empty())?;
         computed.push((name.to_string(), f));
     }
     crate::report::figures::spectrum_data_files(&dir, &computed)?;
     println!("figures in {}", dir.display());
-    println!("psd.csv and peaks.json in {}", dir.display());
+    println!(
+        "psd.csv, peaks.json and spectrogram_<signal>.csv in {}",
+        dir.display()
+    );
     Ok(())
 }
 

@@ -1,7 +1,7 @@
 //! The figures and text summaries each command writes (composition only; drawing is in
 //! [`super::plot`]).
 
-use super::plot::{ChartOpts, Marker, Series, heatmap, line_chart};
+use super::plot::{ChartOpts, Marker, Series, Span, heatmap, line_chart};
 use crate::fit::features::{BandFeatures, Features, noise_floor};
 use crate::fit::instfreq::FreqSpeedComparison;
 use crate::fit::job::Objective;
@@ -28,12 +28,39 @@ fn peak_markers(f: &Features) -> Vec<Marker> {
         .collect()
 }
 
-/// PSD with the peaks of every band marked, and the spectrogram when one is given, for one signal.
+/// Percentiles of the log PSD that span a spectrogram's colour range: the 5th, so the few cells
+/// many decades down (the detrended 0 Hz bin, the window's nulls) take the bottom colour instead
+/// of stretching the scale, and the 99.9th, so the strongest lines keep the top.
+pub const SPECTROGRAM_PERCENTILES: (f64, f64) = (5.0, 99.9);
+
+/// The bands of `f` as shaded spans, named with their range.
+fn band_spans(f: &Features) -> Vec<Span> {
+    f.bands
+        .iter()
+        .map(|b| {
+            let [lo, hi] = b.spec.range_hz;
+            Span {
+                lo,
+                hi,
+                label: format!(
+                    "band {}–{} Hz",
+                    crate::names::significant(lo, 4),
+                    crate::names::significant(hi, 4)
+                ),
+            }
+        })
+        .collect()
+}
+
+/// PSD with the peaks of every band marked (and, with `mark_bands`, the bands shaded), and the
+/// spectrogram with its numbers (`spectrogram_<name>.csv`, [`spectrogram_csv`]) when one is given,
+/// for one signal.
 pub fn spectrum_figures(
     dir: &Path,
     name: &str,
     f: &Features,
     spectrogram: Option<&Spectrogram>,
+    mark_bands: bool,
 ) -> Result<()> {
     let b0 = &f.bands[0];
     let (fr, ps): (Vec<f64>, Vec<f64>) = b0
@@ -63,6 +90,11 @@ pub fn spectrum_figures(
         &ChartOpts {
             log_y: true,
             markers: peak_markers(f),
+            spans: if mark_bands {
+                band_spans(f)
+            } else {
+                Vec::new()
+            },
             ..ChartOpts::default()
         },
     )?;
@@ -80,9 +112,33 @@ pub fn spectrum_figures(
             &sg.freq_hz,
             &sg.density,
             true,
+            Some(SPECTROGRAM_PERCENTILES),
         )?;
+        spectrogram_csv(dir, name, sg)?;
     }
     Ok(())
+}
+
+/// Writes `spectrogram_<name>.csv` into `dir`, the numbers of `spectrogram_<name>.svg`: one row
+/// per cell, `t_s` (the segment's centre, from the first sample), `freq_hz` and
+/// `psd_m2_per_hz` (one-sided density), time-major. Returns the file name.
+///
+/// # Errors
+/// [`Error::Io`] naming the file.
+pub fn spectrogram_csv(dir: &Path, name: &str, sg: &Spectrogram) -> Result<String> {
+    let n = sg.t_s.len() * sg.freq_hz.len();
+    let mut t = Vec::with_capacity(n);
+    let mut f = Vec::with_capacity(n);
+    let mut p = Vec::with_capacity(n);
+    for (ti, row) in sg.t_s.iter().zip(&sg.density) {
+        for (fi, pi) in sg.freq_hz.iter().zip(row) {
+            t.push(*ti);
+            f.push(*fi);
+            p.push(*pi);
+        }
+    }
+    let cols: [(&str, &[f64]); 3] = [("t_s", &t), ("freq_hz", &f), ("psd_m2_per_hz", &p)];
+    write_columns(dir, &format!("spectrogram_{name}.csv"), &cols)
 }
 
 /// Writes a simulation: the trace CSV with the model state ([`write_simulation_trace`]), the
@@ -310,8 +366,10 @@ fn band_psd_figure(
     line_chart(
         &dir.join(format!("psd_{}.svg", d.spec.name)),
         &format!(
-            "Welch PSD, {} band (nperseg {}): {}",
+            "Welch PSD, {} band {}–{} Hz (nperseg {}): {}",
             d.spec.name,
+            crate::names::significant(d.spec.range_hz[0], 4),
+            crate::names::significant(d.spec.range_hz[1], 4),
             d.spec.nperseg,
             if targets_only {
                 "model against the target"

@@ -1,12 +1,21 @@
 //! SVG figures with plotters (SVG backend only; text is emitted as SVG `<text>`, no font files).
 //!
-//! * [`line_chart`]: x–y series (traces, PSDs) with optional log axes, peak markers and vertical
-//!   reference lines. NaN (or, on a log axis, a non-positive value) breaks a line: nothing is drawn
-//!   through a gap, and such points never enter the axis-range computation. Lines are clipped to
-//!   the plotted range. The legend sits in a strip below the plotting area, so it covers no data;
-//!   the chart is drawn at [`SCALE`] times its size and shown at [`FIGURE_SIZE`] through the SVG
-//!   `viewBox`, so coordinates are not rounded to whole pixels.
-//! * [`heatmap`]: a spectrogram-style `z[x][y]` image with a viridis colour map and colour bar.
+//! * [`line_chart`]: x–y series (traces, PSDs) with optional log axes, peak markers, shaded x
+//!   spans (e.g. the requested frequency bands) and vertical reference lines. NaN (or, on a log
+//!   axis, a non-positive value) breaks a line: nothing is drawn through a gap, and such points
+//!   never enter the axis-range computation. Lines are clipped to the plotted range. The legend
+//!   sits in a strip below the plotting area, so it covers no data; each marker's label is placed
+//!   where no line, point or other label crosses it (with a leader line when it had to move away
+//!   from its marker). The chart is drawn at [`SCALE`] times its size and shown at [`FIGURE_SIZE`]
+//!   through the SVG `viewBox`, so coordinates are not rounded to whole pixels.
+//! * [`heatmap`]: a spectrogram-style `z[x][y]` image with a viridis colour map and colour bar,
+//!   whose range can be set from the data's percentiles (so a few extreme cells do not compress
+//!   the rest into one colour).
+//!
+//! A marker label is a `<text class="marker-label">` in a group `<g class="marker-labels">`, with
+//! `x` its left end, `y` its baseline, and `textLength` its width (the glyphs are scaled to it):
+//! it covers `[x, x + textLength] × [y − 0.8·font-size, y + 0.25·font-size]`, the box the
+//! placement kept clear.
 //!
 //! Figures are rendered into memory and written with one `crate::io::write_atomic`, so a failed write is an
 //! [`Error::Io`] naming the path; a plotters drawing failure is a [`ReportError::Draw`] naming the
@@ -129,6 +138,36 @@ pub struct ChartOpts {
     /// fitted to it, the chart's x range), titled by its label: e.g. measured − model under a
     /// trace overlay, where a match cannot be told from overplotting.
     pub residual: Option<Series>,
+    /// Shaded x intervals, each with a legend entry: e.g. the frequency bands a fit or a peak
+    /// search looked at.
+    pub spans: Vec<Span>,
+}
+
+/// An x interval shaded on a [`line_chart`] (in its own tint, under the data) and named in the
+/// legend.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Span {
+    /// Ends in data units.
+    pub lo: f64,
+    pub hi: f64,
+    /// Legend text, e.g. "band low 30–300 Hz".
+    pub label: String,
+}
+
+/// Tints of the [`Span`]s, cycled (light, so the data stay readable over them).
+const SPAN_TINTS: [RGBColor; 4] = [
+    RGBColor(255, 190, 100),
+    RGBColor(130, 180, 255),
+    RGBColor(150, 215, 140),
+    RGBColor(225, 160, 225),
+];
+
+/// Opacity of a [`Span`]'s shading.
+const SPAN_OPACITY: f64 = 0.22;
+
+/// The tint of span number `i`.
+fn span_tint(i: usize) -> RGBColor {
+    SPAN_TINTS[i % SPAN_TINTS.len()]
 }
 
 fn draw_err(path: &Path, e: impl std::fmt::Display) -> Error {
@@ -299,18 +338,18 @@ pub fn line_chart(
     check_ranges(path, opts)?;
     let plane = chart_plane(path, title, series, opts)?;
     let size = (FIGURE_SIZE.0 * SCALE, FIGURE_SIZE.1 * SCALE);
-    let legend = Legend::of(series);
+    let legend = Legend::of(series, &opts.spans);
     let mut svg = String::new();
-    {
+    let labels = {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         root.fill(&WHITE).map_err(|e| draw_err(path, e))?;
         let (plot_root, _) = root.split_vertically(size.1 - legend.height);
         draw_panels(&plot_root, plane, (title, x_label, y_label), series, opts)
-            .and_then(|_| root.present())
-            .map_err(|e| draw_err(path, e))?;
-    }
-    let svg =
-        shown_at_figure_size(&svg, size).replace("</svg>", &legend.svg(size.1 - legend.height));
+            .and_then(|labels| root.present().map(|_| labels))
+            .map_err(|e| draw_err(path, e))?
+    };
+    let tail = labels_svg(&labels) + &legend.svg(size.1 - legend.height);
+    let svg = shown_at_figure_size(&svg, size).replace("</svg>", &tail);
     write_svg(path, &svg)
 }
 
@@ -398,7 +437,7 @@ fn draw_panels(
     labels: (&str, &str, &str),
     series: &[Series],
     opts: &ChartOpts,
-) -> std::result::Result<(), DrawingAreaErrorKind<std::io::Error>> {
+) -> DrawResultOf<Vec<PlacedLabel>> {
     let Some(r) = &opts.residual else {
         return draw_xy(root, plane, labels, series, opts);
     };
@@ -425,14 +464,15 @@ fn draw_panels(
         residual: None,
         ..opts.clone()
     };
-    draw_xy(&top, plane, labels, series, opts)?;
+    let placed = draw_xy(&top, plane, labels, series, opts)?;
     draw_xy(
         &bottom,
         residual_plane,
         (&r.label, labels.1, labels.2),
         std::slice::from_ref(r),
         &plain,
-    )
+    )?;
+    Ok(placed)
 }
 
 /// Internal drawing scale of [`line_chart`]: plotters' SVG backend writes whole-number
@@ -465,6 +505,8 @@ pub(crate) enum Mark {
     Line,
     Point(u32),
     Cross,
+    /// A shaded rectangle (a [`Span`]).
+    Swatch,
 }
 
 /// A legend drawn in a strip below the plotting area (entries flow left to right, then onto a new
@@ -482,19 +524,21 @@ pub(crate) struct Legend {
 impl Legend {
     const ROW: u32 = px(18);
 
-    /// The legend of [`line_chart`]'s series, in the figure's width.
-    fn of(series: &[Series]) -> Legend {
-        Legend::new(
-            series.iter().enumerate().map(|(i, s)| {
-                let mark = if s.style == SeriesStyle::Points {
-                    Mark::Point(px(3))
-                } else {
-                    Mark::Line
-                };
-                (s.label.clone(), series_colour(i), mark)
-            }),
-            FIGURE_SIZE.0,
-        )
+    /// The legend of [`line_chart`]'s series, then its shaded spans, in the figure's width.
+    fn of(series: &[Series], spans: &[Span]) -> Legend {
+        let lines = series.iter().enumerate().map(|(i, s)| {
+            let mark = if s.style == SeriesStyle::Points {
+                Mark::Point(px(3))
+            } else {
+                Mark::Line
+            };
+            (s.label.clone(), series_colour(i), mark)
+        });
+        let shaded = spans
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (s.label.clone(), span_tint(i), Mark::Swatch));
+        Legend::new(lines.chain(shaded), FIGURE_SIZE.0)
     }
 
     /// A legend of `items` laid out in a strip `room_px` display pixels wide.
@@ -575,6 +619,15 @@ fn legend_mark(mark: Mark, c: RGBColor, ex: u32, ey: u32) -> String {
             ex + px(20),
             px(2)
         ),
+        Mark::Swatch => format!(
+            "<rect x=\"{ex}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"{colour}\" \
+             fill-opacity=\"{}\" stroke=\"{colour}\" stroke-width=\"{}\"/>\n",
+            ey - px(6),
+            px(20),
+            px(12),
+            2.0 * SPAN_OPACITY,
+            px(1)
+        ),
         Mark::Cross => {
             let (cx, d, w) = (ex + px(10), px(5), px(2));
             format!(
@@ -593,7 +646,10 @@ fn legend_mark(mark: Mark, c: RGBColor, ex: u32, ey: u32) -> String {
 }
 
 /// What plotters' drawing calls return.
-type DrawResult = std::result::Result<(), DrawingAreaErrorKind<std::io::Error>>;
+type DrawResult = DrawResultOf<()>;
+
+/// A plotters drawing result carrying `T`.
+type DrawResultOf<T> = std::result::Result<T, DrawingAreaErrorKind<std::io::Error>>;
 
 /// The chart [`draw_xy`] draws into: plane coordinates on tick axes.
 type XyChart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<TickAxis, TickAxis>>;
@@ -605,7 +661,7 @@ fn draw_xy(
     (title, x_label, y_label): (&str, &str, &str),
     series: &[Series],
     opts: &ChartOpts,
-) -> DrawResult {
+) -> DrawResultOf<Vec<PlacedLabel>> {
     let Plane { ax, ay, bx, by } = plane;
     let xt = ax.ticks(bx.0, bx.1, 10);
     let yt = ay.ticks(by.0, by.1, 6);
@@ -634,11 +690,32 @@ fn draw_xy(
         .set_all_tick_mark_size(px(5))
         .draw()?;
 
+    draw_spans(&mut chart, plane, &opts.spans)?;
     for (i, s) in series.iter().enumerate() {
         draw_one_series(&mut chart, plane, i, s)?;
     }
     draw_vlines(&mut chart, plane, &opts.vlines)?;
-    draw_markers(&mut chart, plane, &opts.markers)
+    draw_markers(&mut chart, plane, &opts.markers)?;
+    Ok(place_labels(&chart, plane, series, &opts.markers))
+}
+
+/// The spans inside the x range, shaded from the bottom of the plot to its top, under the data.
+fn draw_spans(chart: &mut XyChart<'_, '_>, plane: Plane, spans: &[Span]) -> DrawResult {
+    let Plane { ax, bx, by, .. } = plane;
+    for (i, s) in spans.iter().enumerate() {
+        if !(ax.valid(s.lo) && ax.valid(s.hi)) {
+            continue;
+        }
+        let (a, b) = (ax.fwd(s.lo).max(bx.0), ax.fwd(s.hi).min(bx.1));
+        if a >= b {
+            continue;
+        }
+        chart.draw_series(std::iter::once(Rectangle::new(
+            [(a, by.0), (b, by.1)],
+            span_tint(i).mix(SPAN_OPACITY).filled(),
+        )))?;
+    }
+    Ok(())
 }
 
 /// Series number `i` in its colour: its clipped polylines and/or a circle per visible point, as
@@ -702,27 +779,247 @@ fn draw_vlines(chart: &mut XyChart<'_, '_>, plane: Plane, vlines: &[(f64, String
     Ok(())
 }
 
-/// The visible markers as open circles with their labels.
+/// Radius of a marker's circle, drawing units.
+const MARKER_RADIUS: u32 = px(5);
+
+/// The visible markers as open circles (their labels are placed by [`place_labels`]).
 fn draw_markers(chart: &mut XyChart<'_, '_>, plane: Plane, markers: &[Marker]) -> DrawResult {
-    for (i, m) in markers.iter().enumerate() {
+    for m in markers {
         let Some(p) = plane.point(m.x, m.y) else {
             continue;
         };
-        // Every other label goes below its marker, so two close peaks (measured and model) keep
-        // readable labels.
-        let dy = px(if i % 2 == 0 { 16 } else { 0 }) as i32;
-        let dy = if i % 2 == 0 { -dy } else { px(4) as i32 };
         chart.draw_series(std::iter::once(
-            EmptyElement::at(p)
-                + Circle::new((0, 0), px(5), BLACK.stroke_width(px(2)))
-                + Text::new(
-                    m.label.clone(),
-                    (px(7) as i32, dy),
-                    ("sans-serif", px(13)).into_font(),
-                ),
+            EmptyElement::at(p) + Circle::new((0, 0), MARKER_RADIUS, BLACK.stroke_width(px(2))),
         ))?;
     }
     Ok(())
+}
+
+/// Font size of a marker label, drawing units.
+const LABEL_FONT: f64 = px(13) as f64;
+
+/// A marker label's width per character, in font sizes: wider than a sans-serif font's average
+/// glyph, and exact on the page because the text is scaled to it (`textLength`).
+const LABEL_CHAR_EM: f64 = 0.6;
+
+/// A label's extent above and below its baseline, in font sizes.
+const LABEL_ASCENT_EM: f64 = 0.8;
+const LABEL_DESCENT_EM: f64 = 0.25;
+
+/// Clearance kept between a label and any line, point or other label, drawing units.
+const LABEL_CLEARANCE: f64 = px(3) as f64;
+
+/// Distances (display pixels beyond the marker's circle) at which a label is tried, nearest first;
+/// beyond the first two the label gets a leader line to its marker.
+const LABEL_DISTANCES_PX: [f64; 10] = [
+    3.0, 10.0, 20.0, 32.0, 48.0, 70.0, 100.0, 140.0, 190.0, 250.0,
+];
+
+/// A marker label where [`place_labels`] put it (drawing units).
+#[derive(Debug, Clone, PartialEq)]
+struct PlacedLabel {
+    text: String,
+    /// Left end and baseline.
+    x: f64,
+    y: f64,
+    width: f64,
+    /// From the marker's circle to the label, when the label had to move away.
+    leader: Option<[(f64, f64); 2]>,
+}
+
+/// An axis-aligned box `[x0, x1] × [y0, y1]`, drawing units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct LabelBox {
+    x0: f64,
+    y0: f64,
+    x1: f64,
+    y1: f64,
+}
+
+impl LabelBox {
+    fn grown(self, d: f64) -> LabelBox {
+        LabelBox {
+            x0: self.x0 - d,
+            y0: self.y0 - d,
+            x1: self.x1 + d,
+            y1: self.y1 + d,
+        }
+    }
+    fn overlaps(&self, o: &LabelBox) -> bool {
+        self.x0 < o.x1 && o.x0 < self.x1 && self.y0 < o.y1 && o.y0 < self.y1
+    }
+    fn inside(&self, o: &LabelBox) -> bool {
+        self.x0 >= o.x0 && self.x1 <= o.x1 && self.y0 >= o.y0 && self.y1 <= o.y1
+    }
+    fn crossed_by(&self, p: (f64, f64), q: (f64, f64)) -> bool {
+        clip(p, q, (self.x0, self.x1), (self.y0, self.y1)).is_some()
+    }
+    /// Whether a circle of radius `r` at `c` reaches into the box.
+    fn touches_circle(&self, c: (f64, f64), r: f64) -> bool {
+        let nx = c.0.clamp(self.x0, self.x1);
+        let ny = c.1.clamp(self.y0, self.y1);
+        (nx - c.0).powi(2) + (ny - c.1).powi(2) < r * r
+    }
+}
+
+/// What a label must keep clear of: the data's segments and points, the markers' circles, the
+/// labels placed so far, all in drawing units, and the plotting area it must stay inside.
+struct Obstacles {
+    segments: Vec<((f64, f64), (f64, f64))>,
+    circles: Vec<((f64, f64), f64)>,
+    labels: Vec<LabelBox>,
+    area: LabelBox,
+}
+
+impl Obstacles {
+    fn clear(&self, b: &LabelBox) -> bool {
+        let g = b.grown(LABEL_CLEARANCE);
+        b.inside(&self.area)
+            && !self.segments.iter().any(|(p, q)| g.crossed_by(*p, *q))
+            && !self.circles.iter().any(|(c, r)| g.touches_circle(*c, *r))
+            && !self.labels.iter().any(|l| g.overlaps(l))
+    }
+}
+
+/// Places each visible marker's label where nothing crosses it: the first clear box among
+/// positions around the marker (up-right, up-left, up, right, left, down-right, down-left, down)
+/// at growing distances; the nearest position when none is clear.
+fn place_labels(
+    chart: &XyChart<'_, '_>,
+    plane: Plane,
+    series: &[Series],
+    markers: &[Marker],
+) -> Vec<PlacedLabel> {
+    let to_px = |p: (f64, f64)| {
+        let (x, y) = chart.backend_coord(&p);
+        (f64::from(x), f64::from(y))
+    };
+    let (xr, yr) = chart.plotting_area().get_pixel_range();
+    let mut obstacles = Obstacles {
+        segments: Vec::new(),
+        circles: Vec::new(),
+        labels: Vec::new(),
+        area: LabelBox {
+            x0: f64::from(xr.start),
+            y0: f64::from(yr.start),
+            x1: f64::from(xr.end),
+            y1: f64::from(yr.end),
+        },
+    };
+    for s in series {
+        if s.style != SeriesStyle::Points {
+            for line in plane.polylines(s) {
+                let pts: Vec<(f64, f64)> = line.into_iter().map(to_px).collect();
+                obstacles
+                    .segments
+                    .extend(pts.windows(2).map(|w| (w[0], w[1])));
+            }
+        }
+        if s.style != SeriesStyle::Line {
+            let r = f64::from(px(3));
+            obstacles.circles.extend(
+                s.x.iter()
+                    .zip(&s.y)
+                    .filter_map(|(&x, &y)| plane.point(x, y))
+                    .map(|p| (to_px(p), r)),
+            );
+        }
+    }
+    let centres: Vec<(&Marker, (f64, f64))> = markers
+        .iter()
+        .filter_map(|m| plane.point(m.x, m.y).map(|p| (m, to_px(p))))
+        .collect();
+    let r = f64::from(MARKER_RADIUS);
+    obstacles
+        .circles
+        .extend(centres.iter().map(|(_, c)| (*c, r + f64::from(px(1)))));
+    let mut placed = Vec::new();
+    for (m, c) in centres {
+        let width = LABEL_CHAR_EM * LABEL_FONT * m.label.chars().count() as f64;
+        let height = (LABEL_ASCENT_EM + LABEL_DESCENT_EM) * LABEL_FONT;
+        let candidates: Vec<(LabelBox, f64)> = LABEL_DISTANCES_PX
+            .iter()
+            .flat_map(|d| {
+                let g = r + f64::from(SCALE) * d;
+                let k = std::f64::consts::FRAC_1_SQRT_2 * g;
+                // (left, top) of each position.
+                [
+                    (c.0 + k, c.1 - k - height),
+                    (c.0 - k - width, c.1 - k - height),
+                    (c.0 - width / 2.0, c.1 - g - height),
+                    (c.0 + g, c.1 - height / 2.0),
+                    (c.0 - g - width, c.1 - height / 2.0),
+                    (c.0 + k, c.1 + k),
+                    (c.0 - k - width, c.1 + k),
+                    (c.0 - width / 2.0, c.1 + g),
+                ]
+                .map(|(x0, y0)| {
+                    let b = LabelBox {
+                        x0,
+                        y0,
+                        x1: x0 + width,
+                        y1: y0 + height,
+                    };
+                    (b, *d)
+                })
+            })
+            .collect();
+        let (b, d) = candidates
+            .iter()
+            .find(|(b, _)| obstacles.clear(b))
+            .or_else(|| candidates.iter().find(|(b, _)| b.inside(&obstacles.area)))
+            .copied()
+            .unwrap_or(candidates[0]);
+        obstacles.labels.push(b);
+        let leader = (d > LABEL_DISTANCES_PX[1]).then(|| {
+            let to = (c.0.clamp(b.x0, b.x1), c.1.clamp(b.y0, b.y1));
+            let (dx, dy) = (to.0 - c.0, to.1 - c.1);
+            let n = dx.hypot(dy).max(1e-9);
+            [(c.0 + r * dx / n, c.1 + r * dy / n), to]
+        });
+        placed.push(PlacedLabel {
+            text: m.label.clone(),
+            x: b.x0,
+            y: b.y0 + LABEL_ASCENT_EM * LABEL_FONT,
+            width,
+            leader,
+        });
+    }
+    placed
+}
+
+/// The marker labels as an SVG group (empty without labels): each label's leader line, then its
+/// text on a white halo, scaled to its box's width.
+fn labels_svg(labels: &[PlacedLabel]) -> String {
+    if labels.is_empty() {
+        return String::new();
+    }
+    let mut g = String::from("<g class=\"marker-labels\">\n");
+    for l in labels {
+        if let Some([a, b]) = l.leader {
+            g += &format!(
+                "<line x1=\"{:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"#505050\" \
+                 stroke-width=\"{}\"/>\n",
+                a.0,
+                a.1,
+                b.0,
+                b.1,
+                px(1)
+            );
+        }
+        g += &format!(
+            "<text class=\"marker-label\" x=\"{:.1}\" y=\"{:.1}\" font-family=\"sans-serif\" \
+             font-size=\"{LABEL_FONT}\" textLength=\"{:.1}\" lengthAdjust=\"spacingAndGlyphs\" \
+             fill=\"#000000\" stroke=\"#FFFFFF\" stroke-width=\"{}\" stroke-linejoin=\"round\" \
+             paint-order=\"stroke\">{}</text>\n",
+            l.x,
+            l.y,
+            l.width,
+            px(3),
+            html_escape::encode_text(&l.text)
+        );
+    }
+    g + "</g>\n"
 }
 
 /// Matplotlib's viridis colour map (`colorous::VIRIDIS`). `t` is clamped to [0, 1]; NaN maps to
@@ -794,6 +1091,12 @@ fn block_edges(e: &[f64], b: usize) -> Vec<f64> {
 /// `log_z`, non-positive) cells are drawn light grey. The cells are embedded as one PNG `<image>`
 /// (rendered at the plot's pixel size), the axes and colour bar as SVG, which keeps the file small.
 ///
+/// `percentiles`: the colour range spans these percentiles (0–100) of the colour values (log10 z
+/// with `log_z`) over all finite cells, cells beyond taking the end colours, and the colour bar
+/// says so; `None`: the cells' full extent. A spectrogram's extent holds a few cells many decades
+/// below the rest (the detrended 0 Hz bin, the window's nulls), which would compress every line
+/// into a few colours.
+///
 /// Errors: [`ReportError::Heatmap`] (naming the path) for empty or mismatched shapes, non-increasing
 /// axes, no finite `z`, or a plotters failure; [`Error::Io`] if the file cannot be written.
 #[allow(clippy::too_many_arguments)]
@@ -807,6 +1110,7 @@ pub fn heatmap(
     y: &[f64],
     z: &[Vec<f64>],
     log_z: bool,
+    percentiles: Option<(f64, f64)>,
 ) -> Result<()> {
     let bad = |problem| -> Error {
         ReportError::Heatmap {
@@ -817,14 +1121,23 @@ pub fn heatmap(
         .into()
     };
     check_heatmap_shape(x, y, z).map_err(bad)?;
-    let (xe, ye, zd) = heatmap_cells(x, y, colour_values(z, log_z));
-    let zr = colour_range(&zd, log_z).map_err(bad)?;
+    let values = colour_values(z, log_z);
+    let clipped = percentiles.and_then(|p| percentile_range(&values, p));
+    let (xe, ye, zd) = heatmap_cells(x, y, values);
+    let extent = colour_range(&zd, log_z).map_err(bad)?;
+    let zr = clipped.unwrap_or(extent);
 
     let size = (FIGURE_SIZE.0 * SCALE, FIGURE_SIZE.1 * SCALE);
     let mut svg = String::new();
     let image = {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-        let labels = (title, x_label, y_label, z_label);
+        let desc = match (log_z, clipped.and(percentiles)) {
+            (true, Some((lo, hi))) => format!("{z_label}, log scale, {lo}–{hi} percentile"),
+            (false, Some((lo, hi))) => format!("{z_label}, {lo}–{hi} percentile"),
+            (true, None) => format!("{z_label}, log colour scale"),
+            (false, None) => z_label.to_string(),
+        };
+        let labels = (title, x_label, y_label, desc.as_str());
         let r = draw_heatmap_axes(&root, labels, &xe, &ye, zr, log_z);
         let area = r
             .and_then(|a| root.present().map(|_| a))
@@ -921,6 +1234,21 @@ fn colour_range(zd: &[Vec<f64>], log_z: bool) -> std::result::Result<(f64, f64),
     })
 }
 
+/// The `(lo, hi)` percentiles (0–100) of the finite colour values, `None` when they coincide or
+/// no value is finite.
+fn percentile_range(values: &[Vec<f64>], (lo, hi): (f64, f64)) -> Option<(f64, f64)> {
+    let mut v: Vec<f64> = values
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|v| v.is_finite())
+        .collect();
+    v.sort_by(f64::total_cmp);
+    let q = |p: f64| crate::spectrum::stats::quantile_sorted(&v, p / 100.0);
+    let (a, b) = (q(lo), q(hi));
+    (a.is_finite() && b.is_finite() && b > a).then_some((a, b))
+}
+
 /// Pixel rectangle `(x0, y0, width, height)` of the plotting area.
 type PixelArea = (i32, i32, u32, u32);
 
@@ -977,15 +1305,10 @@ fn draw_heatmap_axes(
         .y_label_area_size(px(90))
         .build_cartesian_2d(0.0..1.0, TickAxis::new(zlo..zhi, &zt))?;
     let zf = |v: &f64| zt.label(*v);
-    let desc = if log_z {
-        format!("{z_label}, log colour scale")
-    } else {
-        z_label.to_string()
-    };
     cb.configure_mesh()
         .disable_mesh()
         .disable_x_axis()
-        .y_desc(desc)
+        .y_desc(z_label)
         .set_tick_mark_size(LabelAreaPosition::Left, px(6) as i32)
         .y_label_formatter(&zf)
         .label_style(("sans-serif", px(12)))
@@ -1172,6 +1495,113 @@ mod tests {
         std::fs::remove_dir_all(&d).ok();
     }
 
+    /// The label boxes of `svg`'s marker labels and its polylines' points (drawing units).
+    fn labels_and_lines(svg: &str) -> (Vec<LabelBox>, Vec<Vec<(f64, f64)>>) {
+        let attr = |el: &str, name: &str| -> f64 {
+            let i = el.find(&format!(" {name}=\"")).unwrap() + name.len() + 3;
+            el[i..].split('"').next().unwrap().parse().unwrap()
+        };
+        let boxes = svg
+            .split("<text class=\"marker-label\"")
+            .skip(1)
+            .map(|t| {
+                let (x, y, fs, w) = (
+                    attr(t, "x"),
+                    attr(t, "y"),
+                    attr(t, "font-size"),
+                    attr(t, "textLength"),
+                );
+                LabelBox {
+                    x0: x,
+                    y0: y - 0.8 * fs,
+                    x1: x + w,
+                    y1: y + 0.25 * fs,
+                }
+            })
+            .collect();
+        let lines = svg
+            .split("<polyline")
+            .skip(1)
+            .map(|p| {
+                let pts = p
+                    .split("points=\"")
+                    .nth(1)
+                    .unwrap()
+                    .split('"')
+                    .next()
+                    .unwrap();
+                pts.split_whitespace()
+                    .map(|xy| {
+                        let (a, b) = xy.split_once(',').unwrap();
+                        (a.parse().unwrap(), b.parse().unwrap())
+                    })
+                    .collect()
+            })
+            .collect();
+        (boxes, lines)
+    }
+
+    #[test]
+    fn peak_labels_keep_clear_of_the_curves_and_of_each_other() {
+        // Two markers on one sharp peak that reaches the top of the plot (as a fit's measured and
+        // model peaks do), a second curve under it and a flat floor across the whole width.
+        let d = tmp_dir("labels");
+        let f: Vec<f64> = (0..400).map(|k| 500.0 + 11.25 * k as f64).collect();
+        let peak = |f0: f64, w: f64| -> Vec<f64> {
+            f.iter()
+                .map(|f| 1e-15 + 4e-15 / (1.0 + ((f - f0) / w).powi(2)))
+                .collect()
+        };
+        let series = [
+            Series::line("measured", f.clone(), peak(875.6, 40.0)),
+            Series::line("model", f.clone(), peak(876.4, 60.0)),
+        ];
+        let markers = vec![
+            Marker {
+                x: 875.6,
+                y: 5e-15,
+                label: "measured 875.61 Hz".into(),
+            },
+            Marker {
+                x: 876.4,
+                y: 5e-15,
+                label: "model 876.39 Hz".into(),
+            },
+        ];
+        let path = d.join("labels.svg");
+        let opts = ChartOpts {
+            log_y: true,
+            markers,
+            spans: vec![Span {
+                lo: 500.0,
+                hi: 1500.0,
+                label: "band 500–1500 Hz".into(),
+            }],
+            ..ChartOpts::default()
+        };
+        line_chart(&path, "peaks", "f [Hz]", "PSD [m²/Hz]", &series, &opts).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        let (boxes, lines) = labels_and_lines(&svg);
+        assert_eq!(boxes.len(), 2, "{svg}");
+        assert!(!boxes[0].overlaps(&boxes[1]), "{boxes:?}");
+        for b in &boxes {
+            for l in &lines {
+                for w in l.windows(2) {
+                    assert!(
+                        !b.crossed_by(w[0], w[1]),
+                        "{b:?} crossed by {:?}",
+                        (w[0], w[1])
+                    );
+                }
+            }
+        }
+        // The band is shaded and named in the legend.
+        assert!(svg.contains("fill-opacity"), "no shading");
+        let legend = &svg[svg.find("<g class=\"legend\">").unwrap()..];
+        assert!(legend.contains("band 500–1500 Hz"));
+        std::fs::remove_dir_all(&d).ok();
+    }
+
     #[test]
     fn nan_breaks_lines_and_is_not_drawn_through() {
         let s = Series::line(
@@ -1273,6 +1703,7 @@ mod tests {
             &sg.freq_hz,
             &sg.density,
             true,
+            None,
         )
         .unwrap();
         let s = assert_svg(
@@ -1300,6 +1731,7 @@ mod tests {
             &[0.0, 1.0, 2.0],
             &[vec![1.0, 2.0, 3.0], vec![4.0, f64::NAN, 6.0]],
             false,
+            None,
         )
         .unwrap();
         assert_svg(&path, &["small"]);
@@ -1319,13 +1751,14 @@ mod tests {
             &[0.0, 1.0],
             &[vec![1.0]],
             false,
+            None,
         )
         .unwrap_err();
         assert!(
             matches!(ReportError::of(&e), Some(ReportError::Heatmap { path, .. }) if path.ends_with("h.svg")),
             "{e}"
         );
-        assert!(heatmap(p, "t", "x", "y", "z", &[], &[], &[], false).is_err());
+        assert!(heatmap(p, "t", "x", "y", "z", &[], &[], &[], false, None).is_err());
         assert!(
             heatmap(
                 p,
@@ -1336,7 +1769,8 @@ mod tests {
                 &[1.0, 0.0],
                 &[0.0],
                 &[vec![1.0], vec![1.0]],
-                false
+                false,
+                None
             )
             .is_err()
         );
@@ -1350,11 +1784,78 @@ mod tests {
                 &[0.0],
                 &[0.0],
                 &[vec![f64::NAN]],
-                false
+                false,
+                Some((5.0, 99.9))
             )
             .is_err()
         );
-        assert!(heatmap(p, "t", "x", "y", "z", &[0.0], &[0.0], &[vec![-1.0]], true).is_err());
+        assert!(
+            heatmap(
+                p,
+                "t",
+                "x",
+                "y",
+                "z",
+                &[0.0],
+                &[0.0],
+                &[vec![-1.0]],
+                true,
+                None
+            )
+            .is_err()
+        );
+    }
+
+    #[test]
+    fn the_colour_range_spans_the_percentiles_asked_for() {
+        // 0..=1000 in one row: NumPy's linear percentiles are 5th → 50, 99.9th → 999 (closed form
+        // for evenly spaced values: q·(n − 1)).
+        let row: Vec<f64> = (0..=1000).map(f64::from).collect();
+        let (lo, hi) = percentile_range(std::slice::from_ref(&row), (5.0, 99.9)).unwrap();
+        assert!(
+            (lo - 50.0).abs() < 1e-9 && (hi - 999.0).abs() < 1e-9,
+            "{lo} {hi}"
+        );
+        // NaN cells are left out; a flat field has no range.
+        let mut with_nan = row;
+        with_nan.push(f64::NAN);
+        assert_eq!(
+            percentile_range(&[with_nan], (0.0, 100.0)),
+            Some((0.0, 1000.0))
+        );
+        assert_eq!(percentile_range(&[vec![3.0; 10]], (5.0, 99.9)), None);
+        // A spectrum-like field: a line at 1e-8 over a 1e-14 floor, and a few cells at 1e-21.
+        // Over its extent the floor sits 7 of 13 decades up; between the percentiles it is the
+        // bottom colour and the line the top, so the line stands out over the whole bar.
+        let mut z = vec![vec![1e-14; 200]; 50];
+        for r in &mut z {
+            r[100] = 1e-8;
+        }
+        z[0][0] = 1e-21;
+        let (lo, hi) = percentile_range(&colour_values(&z, true), (5.0, 99.9)).unwrap();
+        assert!(
+            (lo - -14.0).abs() < 1e-12 && (hi - -8.0).abs() < 1e-12,
+            "{lo} {hi}"
+        );
+        let d = tmp_dir("heat_pct");
+        let path = d.join("sg.svg");
+        let t: Vec<f64> = (0..50).map(f64::from).collect();
+        let f: Vec<f64> = (0..200).map(f64::from).collect();
+        heatmap(
+            &path,
+            "pct",
+            "t [s]",
+            "f [Hz]",
+            "PSD [m²/Hz]",
+            &t,
+            &f,
+            &z,
+            true,
+            Some((5.0, 99.9)),
+        )
+        .unwrap();
+        assert_svg(&path, &["PSD [m²/Hz], log scale, 5–99.9 percentile"]);
+        std::fs::remove_dir_all(&d).ok();
     }
 
     #[test]
