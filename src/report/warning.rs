@@ -278,9 +278,9 @@ fn fit_headline(w: &FitWarning) -> String {
             widened,
             ..
         } => format!(
-            "{parameter}'s interval is widened to [{}, {}] to take in points the search \
-             evaluated as likely (the method alone gave [{}, {}]); the table shows the widened \
-             one.",
+            "{parameter}'s interval is widened to [{}, {}] to include points the search found \
+             about as likely as the fit (the method alone gave [{}, {}]); the table shows the \
+             widened one.",
             num(widened[0], 4),
             num(widened[1], 4),
             num(method[0], 4),
