@@ -5,10 +5,10 @@ mod common;
 
 use std::f64::consts::PI;
 
-use wiperlab::model::modes::{Phase, jacobian_central, modes_of_system};
+use wiperlab::model::modes::{OperatingPoint, jacobian_central, modes_of_system};
 use wiperlab::model::{Blade, StickForm};
 
-fn lin<const N: usize>(f: impl Fn(&[f64]) -> [f64; N]) -> Vec<wiperlab::model::modes::Mode> {
+fn lin<const N: usize>(f: impl Fn(&[f64]) -> [f64; N]) -> Vec<wiperlab::model::modes::Eigenmode> {
     let j = jacobian_central(|x: &[f64]| Ok::<_, ()>(f(x).to_vec()), &[0.01; N]).unwrap();
     modes_of_system(&j)
 }
@@ -77,13 +77,16 @@ fn sample_blade_modes_explain_the_lines() {
     let modes = blade.modes(&[0.01, 0.05, 0.1]).unwrap();
     // Stick: one DOF left. truth.json params.f_pinned_upright_Hz = 1154.0332254739806 (the
     // independent Python implementation that made the sample, tip pinned at upright).
-    let stick: Vec<_> = modes.iter().filter(|m| m.phase == Phase::Stick).collect();
+    let stick: Vec<_> = modes
+        .iter()
+        .filter(|m| m.phase == OperatingPoint::Stick)
+        .collect();
     assert_eq!(stick.len(), 1);
     assert!((stick[0].freq_hz - 1154.0332254739806).abs() < 1e-5 * 1154.0);
     let slip = |v: f64| -> Vec<_> {
         modes
             .iter()
-            .filter(|m| m.phase == Phase::Slip { speed_m_per_s: v })
+            .filter(|m| m.phase == OperatingPoint::Slip { speed_m_per_s: v })
             .collect()
     };
     // On the falling branch at low speed (dμ/dv < 0) both slip modes are self-excited.

@@ -12,7 +12,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use wiperlab::cli::{BAUMGARTE_OMEGA_PER_S, StickChoice};
 use wiperlab::fit::job::{parse_toml, read_text};
-use wiperlab::model::modes::Phase as ModePhase;
+use wiperlab::model::modes::OperatingPoint;
 use wiperlab::model::{Blade, BladeParams, StickForm};
 use wiperlab::simulate::blade::{ModelKind, contact_forces, default_window, simulate_model};
 use wiperlab::simulate::{Method, SolverOptions};
@@ -166,16 +166,16 @@ pub fn modes<'py>(
     let phase: Vec<&str> = modes
         .iter()
         .map(|m| match m.phase {
-            ModePhase::Stick => "stick",
-            ModePhase::Slip { .. } => "slip",
+            OperatingPoint::Stick => "stick",
+            OperatingPoint::Slip { .. } => "slip",
         })
         .collect();
     d.set_item("phase", phase)?;
     d.set_item(
         "speed_m_per_s",
         column(&|m| match m.phase {
-            ModePhase::Stick => f64::NAN,
-            ModePhase::Slip { speed_m_per_s } => speed_m_per_s,
+            OperatingPoint::Stick => f64::NAN,
+            OperatingPoint::Slip { speed_m_per_s } => speed_m_per_s,
         }),
     )?;
     d.set_item("freq_hz", column(&|m| m.freq_hz))?;

@@ -2,7 +2,7 @@
 
 use super::CliError;
 use crate::fit::job::{parse_toml, read_text};
-use crate::model::modes::{BladeMode, ModesError, Phase};
+use crate::model::modes::{BladeMode, ModesError, OperatingPoint};
 use crate::model::{Blade, BladeParams, StickForm};
 use crate::{Error, Result};
 use std::path::Path;
@@ -48,8 +48,8 @@ fn print_table(blade: &Path, modes: &[BladeMode]) {
     );
     for m in modes {
         let phase = match m.phase {
-            Phase::Stick => "stick".to_string(),
-            Phase::Slip { speed_m_per_s } => format!("slip at {speed_m_per_s:.4} m/s"),
+            OperatingPoint::Stick => "stick".to_string(),
+            OperatingPoint::Slip { speed_m_per_s } => format!("slip at {speed_m_per_s:.4} m/s"),
         };
         println!(
             "{phase:<22} {:>12.4} {:>10.4} {:>6.2} {:>10.2} {:>9.2}",

@@ -37,28 +37,31 @@ pub enum ModesError {
     },
 }
 
-/// A phase of the stick–slip cycle.
+/// The state of the stick–slip cycle the blade is linearised about (written as its `phase`:
+/// `stick` or `slip`). The contact phases the integrator switches between are
+/// [`crate::model::stick_slip::Phase`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
 #[serde(tag = "phase", rename_all = "snake_case")]
-pub enum Phase {
+pub enum OperatingPoint {
     /// Tip held on the glass.
     Stick,
     /// Steady slip at `speed_m_per_s`.
     Slip { speed_m_per_s: f64 },
 }
 
-impl std::fmt::Display for Phase {
+impl std::fmt::Display for OperatingPoint {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            Phase::Stick => write!(f, "stick"),
-            Phase::Slip { speed_m_per_s } => write!(f, "slip at {speed_m_per_s} m/s"),
+            OperatingPoint::Stick => write!(f, "stick"),
+            OperatingPoint::Slip { speed_m_per_s } => write!(f, "slip at {speed_m_per_s} m/s"),
         }
     }
 }
 
-/// One oscillatory mode of a linear(ised) first-order system.
+/// One oscillatory mode (eigenmode) of a linear(ised) first-order system. The discrete modes of the
+/// stick–slip integrator are [`crate::model::stick_slip::Mode`].
 #[derive(Debug, Clone, PartialEq)]
-pub struct Mode {
+pub struct Eigenmode {
     /// Undamped natural frequency |λ|/2π, Hz.
     pub freq_hz: f64,
     /// Damping ratio −Re λ/|λ| (negative: self-excited).
@@ -78,11 +81,11 @@ pub struct Participation {
     pub neck_lip: f64,
 }
 
-/// One mode of the blade in a phase.
+/// One mode of the blade at an operating point.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
 pub struct BladeMode {
     #[serde(flatten)]
-    pub phase: Phase,
+    pub phase: OperatingPoint,
     pub freq_hz: f64,
     pub damping_ratio: f64,
     pub participation: Participation,
@@ -115,15 +118,15 @@ pub fn jacobian_central<E>(
 }
 
 /// Oscillatory modes of `ẋ = A x`, sorted by frequency (one per conjugate pair).
-pub fn modes_of_system(a: &DMatrix<f64>) -> Vec<Mode> {
+pub fn modes_of_system(a: &DMatrix<f64>) -> Vec<Eigenmode> {
     let n = a.nrows();
     let ac: DMatrix<Complex<f64>> = a.map(|v| Complex::new(v, 0.0));
     let eig = a.complex_eigenvalues();
     let scale = eig.iter().map(|l| l.norm()).fold(0.0, f64::max).max(1e-300);
-    let mut modes: Vec<Mode> = eig
+    let mut modes: Vec<Eigenmode> = eig
         .iter()
         .filter(|l| l.im > 1e-9 * scale)
-        .map(|&l| Mode {
+        .map(|&l| Eigenmode {
             freq_hz: l.norm() / (2.0 * std::f64::consts::PI),
             damping_ratio: -l.re / l.norm(),
             shape: null_vector(&(ac.clone() - DMatrix::identity(n, n) * l)),
@@ -192,7 +195,7 @@ impl Blade {
             Ok(vec![x[2], x[3], d.theta_dd, d.phi_dd])
         };
         let jac = jacobian_central(rhs, &y0)?;
-        let phase = Phase::Slip { speed_m_per_s };
+        let phase = OperatingPoint::Slip { speed_m_per_s };
         Ok(modes_of_system(&jac)
             .iter()
             .map(|m| self.blade_mode(phase, m, &y0, m.shape[0], m.shape[1]))
@@ -216,15 +219,15 @@ impl Blade {
             .iter()
             .map(|m| {
                 let dth = m.shape[0];
-                self.blade_mode(Phase::Stick, m, &[0.0; 4], dth, dth * (-l1 / l2))
+                self.blade_mode(OperatingPoint::Stick, m, &[0.0; 4], dth, dth * (-l1 / l2))
             })
             .collect())
     }
 
     fn blade_mode(
         &self,
-        phase: Phase,
-        m: &Mode,
+        phase: OperatingPoint,
+        m: &Eigenmode,
         y0: &[f64],
         dth: Complex<f64>,
         dph: Complex<f64>,

@@ -354,8 +354,8 @@ fn mode_rows(r: &FitResult) -> Vec<ModeView> {
         .iter()
         .map(|m| ModeView {
             phase: match m.phase {
-                crate::model::modes::Phase::Stick => "stick".into(),
-                crate::model::modes::Phase::Slip { speed_m_per_s } => {
+                crate::model::modes::OperatingPoint::Stick => "stick".into(),
+                crate::model::modes::OperatingPoint::Slip { speed_m_per_s } => {
                     format!("slip at {} m/s", num(speed_m_per_s, 3))
                 }
             },
