@@ -30,6 +30,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
+use wiperlab::model::ParamId;
 
 #[derive(Parser)]
 #[command(about = "The model-choice confusion table (docs/validation.md, \"Model choice\")")]
@@ -148,7 +149,7 @@ fn confusion_table(only: &[usize]) -> Result<bool, Box<dyn std::error::Error>> {
             }
         };
         let r = &out.result;
-        let chosen = r.model.to_string();
+        let chosen = r.model;
         let true_trial = r
             .model_trials
             .iter()
@@ -163,7 +164,7 @@ fn confusion_table(only: &[usize]) -> Result<bool, Box<dyn std::error::Error>> {
             .evidence
             .as_ref()
             .map_or(f64::NAN, |e| e.log_likelihood_nats - at_truth);
-        let err = |name: &str| {
+        let err = |name: ParamId| {
             r.parameters
                 .iter()
                 .find(|p| p.name == name)
@@ -214,11 +215,11 @@ fn confusion_table(only: &[usize]) -> Result<bool, Box<dyn std::error::Error>> {
             "{}: {switches} switches, true {}, chosen {chosen} (ΔAIC of the true model {d_true:+.2}), A {} B {} C {} k1 {} k1c {}, {:.0} s; {} absorbing warnings",
             s.name,
             s.truth_model,
-            pct(err("A")),
-            pct(err("B")),
-            pct(err("C")),
-            pct(err("k1")),
-            pct(err("k1c")),
+            pct(err(ParamId::A)),
+            pct(err(ParamId::B)),
+            pct(err(ParamId::C)),
+            pct(err(ParamId::K1)),
+            pct(err(ParamId::K1c)),
             r.wall_time_s,
             absorbing.len()
         );
@@ -233,11 +234,11 @@ fn confusion_table(only: &[usize]) -> Result<bool, Box<dyn std::error::Error>> {
             "| {} | {switches} | {} | {chosen} | {d_true:+.2} | {} | {} | {} | {} | {} | {} | {outside} | {above_truth:+.2} | {gof_p} | {spread} |",
             s.name,
             s.truth_model,
-            pct(err("A")),
-            pct(err("B")),
-            pct(err("C")),
-            pct(err("k1")),
-            pct(err("k1c")),
+            pct(err(ParamId::A)),
+            pct(err(ParamId::B)),
+            pct(err(ParamId::C)),
+            pct(err(ParamId::K1)),
+            pct(err(ParamId::K1c)),
             absorbing.len()
         );
         let num = |e: Option<f64>| e.map_or(String::new(), |e| format!("{e}"));
@@ -246,11 +247,11 @@ fn confusion_table(only: &[usize]) -> Result<bool, Box<dyn std::error::Error>> {
             "\"{}\",{switches},{},{chosen},{d_true},{},{},{},{},{},{},\"{outside}\",{above_truth},{gof_p},{spread}",
             s.name,
             s.truth_model,
-            num(err("A")),
-            num(err("B")),
-            num(err("C")),
-            num(err("k1")),
-            num(err("k1c")),
+            num(err(ParamId::A)),
+            num(err(ParamId::B)),
+            num(err(ParamId::C)),
+            num(err(ParamId::K1)),
+            num(err(ParamId::K1c)),
             r.wall_time_s
         );
         write_table(&md, &csv);
@@ -263,7 +264,13 @@ fn confusion_table(only: &[usize]) -> Result<bool, Box<dyn std::error::Error>> {
             ));
         }
         if chosen == s.truth_model {
-            for name in ["A", "B", "C", "k1", "k1c"] {
+            for name in [
+                ParamId::A,
+                ParamId::B,
+                ParamId::C,
+                ParamId::K1,
+                ParamId::K1c,
+            ] {
                 if let Some(e) = err(name)
                     && e.abs() > 0.05
                 {

@@ -23,11 +23,12 @@ mod fixtures;
 use std::fmt::Write as _;
 use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
+use wiperlab::model::ParamId;
 
 fn main() {
     let root = fixtures::root();
     let job_path = root.join("fits/reversal.toml");
-    let names = ["A", "B", "C", "k1"];
+    let names = [ParamId::A, ParamId::B, ParamId::C, ParamId::K1];
     let mut md = String::from(
         "| seed | chosen | cost (nats) | A | B | C | k1 | all within 5 % | model evaluations | wall time |\n|---|---|---|---|---|---|---|---|---|---|\n",
     );

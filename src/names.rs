@@ -5,8 +5,8 @@
 //!
 //! A named enum gets `ALL`, `NAMES`, `name()`, `from_name()`, `Display`, `FromStr` (error:
 //! [`UnknownName`]), serde (as its name; an unknown name is a deserialisation error that lists the
-//! known ones, so a job file's parser reports it with the file, line and column), clap's
-//! `ValueEnum`, and comparison with `&str`.
+//! known ones, so a job file's parser reports it with the file, line and column) and clap's
+//! `ValueEnum`. Code compares variants, never names.
 //!
 //! [`significant`] and [`quantity`] write a computed number for a person (console lines, error
 //! messages): rounded to the digits that mean something, with its unit, never a float's last bits
@@ -149,11 +149,6 @@ macro_rules! named_enum {
             }
         }
 
-        impl PartialEq<&str> for $Name {
-            fn eq(&self, other: &&str) -> bool {
-                self.name() == *other
-            }
-        }
     };
 }
 pub(crate) use named_enum;
@@ -176,7 +171,7 @@ mod tests {
             assert_eq!(json, format!("\"{}\"", f.name()));
             assert_eq!(serde_json::from_str::<Fruit>(&json).unwrap(), *f);
         }
-        assert_eq!(Fruit::BloodOrange, "blood_orange");
+        assert_eq!(Fruit::BloodOrange.name(), "blood_orange");
     }
 
     #[test]

@@ -81,7 +81,10 @@ fn a_freed_head_mass_fits_with_the_head_frequency_held_and_reports_identifiabili
         out.best_params.head_freq_hz()
     );
     // The identifiability report names the head mass when the targets leave it undetermined.
-    let listed = out.result.undetermined.iter().any(|p| *p == "head_mass");
+    let listed = out
+        .result
+        .undetermined
+        .contains(&wiperlab::model::ParamId::HeadMass);
     assert_eq!(listed, !m.determined);
     if !m.determined {
         assert!(

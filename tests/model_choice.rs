@@ -25,7 +25,7 @@ fn scene_problem(
     let dir = common::temp_dir(tag);
     let (job, _) = write_scene(dir.path(), i, s).unwrap();
     let job = LoadedJob::load(&job).unwrap();
-    let p = wiperlab::fit::problem_for(&job, s.truth_model.parse().unwrap()).unwrap();
+    let p = wiperlab::fit::problem_for(&job, s.truth_model).unwrap();
     (s, dir, p)
 }
 

@@ -50,7 +50,10 @@ k1 = [0.005, 0.15]
     let out = run_fit(&job, false).unwrap();
     let trials = &out.result.model_trials;
     assert_eq!(trials.len(), 2);
-    let nl = trials.iter().find(|t| t.model == "necklip").unwrap();
+    let nl = trials
+        .iter()
+        .find(|t| t.model.kind == ModelKind::Necklip)
+        .unwrap();
     eprintln!(
         "necklip: cost {:.4}, {} runs, {:.1} s; {}",
         nl.cost, nl.model_evaluations, nl.wall_time_s, nl.reason
@@ -66,5 +69,6 @@ k1 = [0.005, 0.15]
     // … but the low band disqualifies it, whatever its cost.
     assert!(!nl.chosen);
     assert!(nl.reason.contains("imposes band 'low'"), "{}", nl.reason);
-    assert_eq!(out.result.model, ModelKind::Blade2dof.name());
+    assert_eq!(out.result.model.kind, ModelKind::Blade2dof);
+    assert!(!out.result.model.shoulder);
 }

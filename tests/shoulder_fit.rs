@@ -76,12 +76,18 @@ keys = {{ k1 = "/k1", k1c = "/k1c", theta_c = "/theta_c" }}
             100.0 * p.rel_error.unwrap()
         );
     }
-    assert_eq!(out.result.model, "blade2dof+shoulder");
+    assert_eq!(
+        out.result.model,
+        wiperlab::fit::Candidate {
+            kind: wiperlab::simulate::blade::ModelKind::Blade2dof,
+            shoulder: true
+        }
+    );
     let k1c_fit = out
         .result
         .parameters
         .iter()
-        .find(|p| p.name == "k1c")
+        .find(|p| p.name == wiperlab::model::ParamId::K1c)
         .expect("k1c fitted");
     assert!(
         k1c_fit.rel_error.unwrap().abs() < 0.05,

@@ -93,9 +93,13 @@ impl std::str::FromStr for Candidate {
     type Err = crate::names::UnknownName;
     /// Parses a model name with an optional `+shoulder` (the head model has no shoulder).
     fn from_str(name: &str) -> std::result::Result<Self, Self::Err> {
+        let (base, shoulder) = match name.strip_suffix(SHOULDER_SUFFIX) {
+            Some(base) => (base, true),
+            None => (name, false),
+        };
         Candidate::all()
             .into_iter()
-            .find(|c| *c == name)
+            .find(|c| c.shoulder == shoulder && c.kind.name() == base)
             .ok_or_else(|| crate::names::UnknownName {
                 kind: "model",
                 given: name.to_string(),
@@ -118,15 +122,6 @@ impl<'de> serde::Deserialize<'de> for Candidate {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
         let s = String::deserialize(d)?;
         s.parse().map_err(serde::de::Error::custom)
-    }
-}
-
-impl PartialEq<&str> for Candidate {
-    fn eq(&self, other: &&str) -> bool {
-        match other.strip_suffix(SHOULDER_SUFFIX) {
-            Some(base) => self.shoulder && self.kind.name() == base,
-            None => !self.shoulder && self.kind.name() == *other,
-        }
     }
 }
 

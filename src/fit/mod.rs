@@ -627,6 +627,7 @@ fn blade_modes(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::ParamId;
     use crate::simulate::blade::ModelKind;
     use features::BandSpec;
 
@@ -729,10 +730,10 @@ mod tests {
         );
         // At the sample's true parameters (data/reversal/truth.json), where the model runs.
         let truth = [
-            ("A", 0.88),
-            ("B", 69.74712740275162),
-            ("C", 0.56),
-            ("k1", 0.029748408887917077),
+            (ParamId::A, 0.88),
+            (ParamId::B, 69.74712740275162),
+            (ParamId::C, 0.56),
+            (ParamId::K1, 0.029748408887917077),
         ];
         let u: Vec<f64> = p
             .free

@@ -657,7 +657,7 @@ mod tests {
             .remove("interval")
             .unwrap();
         let r: FitResult = toml::from_str(&toml::to_string(&t).unwrap()).unwrap();
-        assert_eq!(r.model, "blade2dof");
+        assert_eq!(r.model.to_string(), "blade2dof");
         assert!(r.model_trials.is_empty() && r.warnings.is_empty());
         assert!(r.input_sha256.is_empty() && r.settings.is_empty());
         assert_eq!(r.parameters[0].interval, None);

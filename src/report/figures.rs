@@ -7,7 +7,7 @@ use crate::fit::instfreq::FreqSpeedComparison;
 use crate::fit::job::Objective;
 use crate::fit::result::{HistoryPoint, SearchStage};
 use crate::fit::{FitOutcome, FitResult};
-use crate::model::FrictionLaw;
+use crate::model::{FrictionLaw, ParamId};
 use crate::simulate::blade::{BladeSimulation, ContactForces};
 use crate::spectrum::Spectrogram;
 use crate::spectrum::instfreq::FreqSpeedPoint;
@@ -439,8 +439,8 @@ fn max_tip_speed(o: &FitOutcome) -> Option<f64> {
 /// correlations from the result). `None` unless A, B and C were all fitted with finite 1σ and
 /// correlations.
 fn friction_sigma(r: &FitResult, v: &[f64]) -> Option<Vec<f64>> {
-    let idx = |n: &str| r.parameters.iter().position(|p| p.name == n);
-    let ids = [idx("A")?, idx("B")?, idx("C")?];
+    let idx = |n: ParamId| r.parameters.iter().position(|p| p.name == n);
+    let ids = [idx(ParamId::A)?, idx(ParamId::B)?, idx(ParamId::C)?];
     let sd: Vec<f64> = ids.iter().map(|&i| r.parameters[i].std_error).collect();
     let corr = |i: usize, j: usize| r.correlation.get(ids[i])?.get(ids[j]).copied();
     let mut cov = [[0.0; 3]; 3];
@@ -461,7 +461,7 @@ fn friction_sigma(r: &FitResult, v: &[f64]) -> Option<Vec<f64>> {
 /// holds no finite 1σ or correlations for them).
 fn friction_title(r: &FitResult, band: bool) -> String {
     let law = "dynamic friction coefficient μ_d = A e^(−B|v|) + C (seed eq. 4)";
-    let abc = ["A", "B", "C"]
+    let abc = [ParamId::A, ParamId::B, ParamId::C]
         .iter()
         .all(|n| r.parameters.iter().any(|p| p.name == *n));
     match (band, abc) {
@@ -509,14 +509,14 @@ fn friction_law_figure(dir: &Path, o: &FitOutcome) -> Result<()> {
             ));
         }
     }
-    let truth = |n: &str| {
+    let truth = |n: ParamId| {
         o.result
             .parameters
             .iter()
             .find(|p| p.name == n)
             .and_then(|p| p.true_value)
     };
-    if let (Some(a), Some(b), Some(c)) = (truth("A"), truth("B"), truth("C")) {
+    if let (Some(a), Some(b), Some(c)) = (truth(ParamId::A), truth(ParamId::B), truth(ParamId::C)) {
         let law = FrictionLaw::Exponential { a, b_s_per_m: b, c };
         series.push(Series::line(
             "true",

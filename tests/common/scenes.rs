@@ -9,6 +9,7 @@
 
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
+use wiperlab::fit::Candidate;
 use wiperlab::fit::job::LoadedJob;
 use wiperlab::model::{BladeParams, FrictionLaw, Shoulder, StickForm};
 use wiperlab::simulate::SolverOptions;
@@ -19,8 +20,8 @@ use super::{dltdv_recording, frame_times, spectrum_bands, true_blade, write_dltd
 /// One recording: what made it.
 pub struct Scene {
     pub name: &'static str,
-    /// The model that made it, as the candidates are named.
-    pub truth_model: &'static str,
+    /// The model that made it, as a candidate.
+    pub truth_model: Candidate,
     /// The simulated model (the shoulder comes from `shoulder`).
     pub kind: ModelKind,
     /// The sweep's angular frequency as a multiple of the sample's.
@@ -33,10 +34,24 @@ pub struct Scene {
     pub hd_scale: f64,
 }
 
+/// The candidates that made the scenes.
+const BLADE: Candidate = Candidate {
+    kind: ModelKind::Blade2dof,
+    shoulder: false,
+};
+const BLADE_ON_SHOULDER: Candidate = Candidate {
+    kind: ModelKind::Blade2dof,
+    shoulder: true,
+};
+const HEAD: Candidate = Candidate {
+    kind: ModelKind::Head1dof,
+    shoulder: false,
+};
+
 pub const SCENES: [Scene; 9] = [
     Scene {
         name: "no shoulder",
-        truth_model: "blade2dof",
+        truth_model: BLADE,
         kind: ModelKind::Blade2dof,
         speed: 1.0,
         k1: 0.029748408887917077,
@@ -45,7 +60,7 @@ pub const SCENES: [Scene; 9] = [
     },
     Scene {
         name: "no shoulder, 0.7x speed",
-        truth_model: "blade2dof",
+        truth_model: BLADE,
         kind: ModelKind::Blade2dof,
         speed: 0.7,
         k1: 0.029748408887917077,
@@ -56,7 +71,7 @@ pub const SCENES: [Scene; 9] = [
     // measured, 2 switches, the neck enters contact once and stays.
     Scene {
         name: "soft neck on a shoulder at 0.06 rad",
-        truth_model: "blade2dof+shoulder",
+        truth_model: BLADE_ON_SHOULDER,
         kind: ModelKind::Blade2dof,
         speed: 1.0,
         k1: 0.0075,
@@ -65,7 +80,7 @@ pub const SCENES: [Scene; 9] = [
     },
     Scene {
         name: "soft neck on a shoulder at 0.06 rad, 0.7x speed",
-        truth_model: "blade2dof+shoulder",
+        truth_model: BLADE_ON_SHOULDER,
         kind: ModelKind::Blade2dof,
         speed: 0.7,
         k1: 0.0075,
@@ -76,7 +91,7 @@ pub const SCENES: [Scene; 9] = [
     // stiffness 3.25x the free one (measured: 2 switches).
     Scene {
         name: "soft neck on a shoulder at 0.025 rad",
-        truth_model: "blade2dof+shoulder",
+        truth_model: BLADE_ON_SHOULDER,
         kind: ModelKind::Blade2dof,
         speed: 1.0,
         k1: 0.0075,
@@ -85,7 +100,7 @@ pub const SCENES: [Scene; 9] = [
     },
     Scene {
         name: "soft neck on a shoulder at 0.025 rad, 0.7x speed",
-        truth_model: "blade2dof+shoulder",
+        truth_model: BLADE_ON_SHOULDER,
         kind: ModelKind::Blade2dof,
         speed: 0.7,
         k1: 0.0075,
@@ -95,7 +110,7 @@ pub const SCENES: [Scene; 9] = [
     // The sample's neck with a shoulder near its largest |θ|: measured, 68 switches, crossed often.
     Scene {
         name: "sample neck, shoulder at 0.12 rad (crossed often)",
-        truth_model: "blade2dof+shoulder",
+        truth_model: BLADE_ON_SHOULDER,
         kind: ModelKind::Blade2dof,
         speed: 1.0,
         k1: 0.029748408887917077,
@@ -107,7 +122,7 @@ pub const SCENES: [Scene; 9] = [
     // 2.340 s); with 3× it keeps contact through the window (40 transitions).
     Scene {
         name: "head-only motion, 3x preload",
-        truth_model: "head1dof",
+        truth_model: HEAD,
         kind: ModelKind::Head1dof,
         speed: 1.0,
         k1: 0.029748408887917077,
@@ -119,7 +134,7 @@ pub const SCENES: [Scene; 9] = [
     // so the scenes before it keep their noise seeds.
     Scene {
         name: "soft neck resting on a shoulder at 0.08 rad",
-        truth_model: "blade2dof+shoulder",
+        truth_model: BLADE_ON_SHOULDER,
         kind: ModelKind::Blade2dof,
         speed: 1.0,
         k1: 0.0075,
@@ -260,8 +275,7 @@ keys = {{ {keys} }}
 /// found parameters the recording likes better than the truth (the recording does not determine
 /// them that closely).
 pub fn log_likelihood_at_truth(job: &LoadedJob, s: &Scene) -> Result<f64, String> {
-    let p = wiperlab::fit::problem_for(job, s.truth_model.parse().unwrap())
-        .map_err(|e| e.to_string())?;
+    let p = wiperlab::fit::problem_for(job, s.truth_model).map_err(|e| e.to_string())?;
     let lik = p.likelihood.as_ref().map_err(|e| e.to_string())?;
     let sim = p.simulate(&truth_params(s)).map_err(|e| e.to_string())?;
     let parts = lik.nll(&p, &sim).map_err(|e| e.to_string())?;
