@@ -12,17 +12,15 @@
 //! builds are kept equal in `Cargo.toml` and `python/Cargo.toml`); only pyo3, numpy and the
 //! bindings themselves are compiled, once.
 
+mod common;
+
+use common::{root, wiperlab_exe};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::Instant;
 
 /// What the virtual environment holds: the build backend and what the suite imports.
 const REQUIREMENTS: &[&str] = &["maturin>=1.9,<2", "numpy>=1.22", "scipy>=1.11", "pytest>=7"];
-
-/// The source tree.
-fn repo() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 /// The target directory this test binary was built in (`<target>/release/deps/python-…`).
 fn target_dir() -> PathBuf {
@@ -143,7 +141,7 @@ fn python_package_builds_and_its_suite_passes() {
     let started = Instant::now();
     let out = Command::new(&maturin)
         .args(["build", "--release", "--manifest-path"])
-        .arg(repo().join("python").join("Cargo.toml"))
+        .arg(root().join("python").join("Cargo.toml"))
         .arg("--out")
         .arg(&wheels)
         .arg("--interpreter")
@@ -192,9 +190,9 @@ fn python_package_builds_and_its_suite_passes() {
             "no:cacheprovider",
             "python/tests",
         ])
-        .current_dir(repo())
+        .current_dir(root())
         .env("PYTHONDONTWRITEBYTECODE", "1")
-        .env("WIPERLAB_BIN", env!("CARGO_BIN_EXE_wiperlab"))
+        .env("WIPERLAB_BIN", wiperlab_exe())
         .output()
         .expect("run pytest");
     let suite_s = started.elapsed().as_secs_f64();
