@@ -150,21 +150,15 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     warnings.extend(absorbing);
     warnings.extend(line_warnings(&peaks));
     warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
-    let tolerance_check = (!interrupted && !interrupt::stop_requested())
-        .then(|| {
-            let at_job = (best.cost, best.sim.transitions.len());
-            tolerance::ToleranceCheck::run(&cf.problem, &cf.best_u, at_job)
-        })
-        .flatten();
-    warnings.extend(tolerance_check.as_ref().and_then(|t| t.warning()));
-    warnings.extend(
-        tolerance_check
-            .as_ref()
-            .zip(runner_up(&selection.trials))
-            .and_then(|(t, (chosen, runner, gap))| t.choice_warning(chosen, runner, gap)),
+    let (tolerance_check, truth_cost) = optimum_checks(
+        job,
+        &cf,
+        &best,
+        &selection.trials,
+        interrupted,
+        &mut warnings,
     );
     warnings.extend(failure_warning(&cf.problem));
-    let truth_cost = (!interrupted).then(|| truth_cost(job, &cf)).flatten();
     warnings.extend(truth_cost.and_then(|t| shortfall_warning(best.cost, t)));
     // The chosen model's counts include its bootstrap replicates and the tolerance check's
     // simulations (they share its counters).
@@ -207,6 +201,34 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         best_sim: best.sim,
         best_params: best.params,
     })
+}
+
+/// The checks at the chosen optimum `best` that simulate again: the tolerance check, with its
+/// warnings pushed to `warnings` (and whether it leaves the model choice open among `trials`), and
+/// the truth's own cost. Neither runs after an interrupt.
+fn optimum_checks(
+    job: &LoadedJob,
+    cf: &CandidateFit,
+    best: &BestModel,
+    trials: &[result::ModelTrial],
+    interrupted: bool,
+    warnings: &mut Vec<FitWarning>,
+) -> (Option<tolerance::ToleranceCheck>, Option<f64>) {
+    let tolerance_check = (!interrupted && !interrupt::stop_requested())
+        .then(|| {
+            let at_job = (best.cost, best.sim.transitions.len());
+            tolerance::ToleranceCheck::run(&cf.problem, &cf.best_u, at_job)
+        })
+        .flatten();
+    warnings.extend(tolerance_check.as_ref().and_then(|t| t.warning()));
+    warnings.extend(
+        tolerance_check
+            .as_ref()
+            .zip(runner_up(trials))
+            .and_then(|(t, (chosen, runner, gap))| t.choice_warning(chosen, runner, gap)),
+    );
+    let truth_cost = (!interrupted).then(|| truth_cost(job, cf)).flatten();
+    (tolerance_check, truth_cost)
 }
 
 /// The chosen trial's name, the name of the trial with the AIC nearest to it among the others, and
