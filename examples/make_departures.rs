@@ -15,18 +15,14 @@
 //! Run from the crate root: `cargo run --release --example make_departures`. Also writes
 //! `truth.json` (the friction law and k1 of data/reversal/truth.json, and the noise of each file).
 
+#[path = "common/recording.rs"]
+mod recording;
+
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
-use std::fmt::Write as _;
 use std::path::Path;
-use wiperlab::model::{BladeParams, StickForm};
-use wiperlab::simulate::SolverOptions;
-use wiperlab::simulate::blade::{BladeSimulation, default_window, simulate_blade};
+use wiperlab::model::BladeParams;
 
-const M_PER_PX: f64 = 1.5e-5;
-const ORIGIN_PX: (f64, f64) = (200.0, 300.0);
-const X_ORIGIN_M: f64 = 0.1;
-const FPS: f64 = 10_000.0;
 const NOISE_PX: f64 = 0.1;
 
 /// `n` samples of stationary AR(1) noise of marginal standard deviation `sigma` and lag-one
@@ -43,48 +39,22 @@ fn ar1(n: usize, sigma: f64, rho: f64, rng: &mut rand::rngs::StdRng) -> Vec<f64>
     out
 }
 
-/// The simulation as DLTdv8 text with the per-coordinate noise columns `noise[c][i]` (pixels).
-fn dltdv_text(sim: &BladeSimulation, noise: &[Vec<f64>; 4]) -> String {
-    let mut csv = String::from("pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y\n");
-    let px_x = |x: f64| ORIGIN_PX.0 + (x - X_ORIGIN_M) / M_PER_PX;
-    let px_y = |y: f64| ORIGIN_PX.1 - y / M_PER_PX;
-    for (i, ((&v, &u), &v3)) in sim.v_m.iter().zip(&sim.u_m).zip(&sim.v3_m).enumerate() {
-        let clean = [px_x(v), px_y(-u), px_x(v3), px_y(-sim.reach_m)];
-        let row: Vec<String> = (0..4)
-            .map(|c| format!("{:.4}", clean[c] + noise[c][i]))
-            .collect();
-        let _ = writeln!(csv, "{}", row.join(","));
-    }
-    csv
-}
-
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let p: BladeParams = toml::from_str(
-        &std::fs::read_to_string(root.join("data/reversal/blade_true.toml"))
-            .expect("read data/reversal/blade_true.toml"),
-    )
-    .expect("parse blade_true.toml");
+    let p = recording::true_blade(root);
     let out = root.join("data/departures");
     std::fs::create_dir_all(&out).expect("create data/departures");
-    let (t0, t1) = default_window(&p);
-    let n = ((t1 - t0) * FPS) as usize;
-    let times: Vec<f64> = (0..n).map(|k| t0 + k as f64 / FPS).collect();
-    let opts = SolverOptions {
-        rtol: 1e-10,
-        atol: 1e-12,
-        ..SolverOptions::default()
-    };
-    let sim = simulate_blade(&p, (t0, times[n - 1]), &times, &opts, StickForm::Reduced)
-        .expect("simulate the true blade");
+    let (sim, t0) = recording::simulate_window(&p).expect("simulate the true blade");
+    let n = sim.t_s.len();
     let mut files = Vec::new();
     for (name, rho, seed) in [
         ("ar1_rho06_xypts.csv", 0.6, 20_261_125u64),
         ("white_xypts.csv", 0.0, 20_261_126u64),
     ] {
         let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-        let noise = std::array::from_fn(|_| ar1(n, NOISE_PX, rho, &mut rng));
-        std::fs::write(out.join(name), dltdv_text(&sim, &noise)).expect("write recording");
+        let noise: [Vec<f64>; 4] = std::array::from_fn(|_| ar1(n, NOISE_PX, rho, &mut rng));
+        let text = recording::dltdv_text(&sim, |c, i| noise[c][i]);
+        std::fs::write(out.join(name), text).expect("write recording");
         files.push(format!(
             "    \"{name}\": {{ \"noise\": \"ar1\", \"sigma_px\": {NOISE_PX}, \"rho\": {rho} }}"
         ));
