@@ -74,15 +74,17 @@ fn spectrum_takes_a_points_coordinate_and_a_difference_of_two_points() {
         "shd_L_y peaks at {single} Hz"
     );
     assert!(out.join("psd_left-wrist-shd_L_y.svg").exists());
-    // Issue 16 point 4: the spectrogram's colour bar (its only heatmap) says what it shows, in
-    // which unit and on which scale.
+    // The spectrogram's colour bar (its only heatmap) says what it shows, in which unit, on
+    // which scale and over which percentile range of the values its colours span.
     for name in ["left-wrist-shd_L_y", "shd_L_y"] {
         let svg = std::fs::read_to_string(out.join(format!("spectrogram_{name}.svg")))
             .expect("spectrogram");
         assert!(
-            svg.lines()
-                .any(|l| l.trim() == "PSD [m²/Hz], log colour scale"),
-            "spectrogram_{name}.svg: no colour-bar label with its unit"
+            svg.lines().any(|l| {
+                let l = l.trim();
+                l.starts_with("PSD [m²/Hz], log scale, ") && l.ends_with(" percentile")
+            }),
+            "spectrogram_{name}.svg: no colour-bar label with its unit, scale and range"
         );
     }
 }
