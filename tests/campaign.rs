@@ -10,7 +10,7 @@
 //!   WIPERLAB_REQUIRE_SLURM=1 (CI), where that is a failure.
 
 mod common;
-use common::{ok, root, run, temp_dir};
+use common::{ok, root, run, s, temp_dir};
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -219,6 +219,168 @@ fn campaign_errors_name_the_file_and_line() {
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(
         err.contains("conditions.csv:2:2") && err.contains("t0_s"),
+        "{err}"
+    );
+}
+
+/// A campaign of two example recordings whose conditions table gives the first its own blade
+/// file and truth JSON (`blade_file`, `truth_json`, relative to the table in `sub/`) and leaves the
+/// second's cells empty; the template is the example's with a `[truth]` section. Returns the
+/// campaign file and the conditions table.
+fn campaign_with_files(dir: &Path) -> (PathBuf, PathBuf) {
+    let data = root().join("data/campaign");
+    for r in ["soft_fast_xypts.csv", "hard_fast_xypts.csv"] {
+        std::fs::copy(data.join(r), dir.join(r)).expect("copy recording");
+    }
+    std::fs::create_dir_all(dir.join("sub/truths")).expect("mkdir");
+    let blade = std::fs::read_to_string(root().join("data/reversal/blade_true.toml"))
+        .expect("blade_true.toml")
+        .replace("c = 0.56", "c = 0.43");
+    std::fs::write(dir.join("sub/truths/own.blade.toml"), blade).expect("write blade");
+    std::fs::write(
+        dir.join("sub/truths/own.json"),
+        r#"{"params": {"C": 0.43, "k1": 0.021}}"#,
+    )
+    .expect("write truth");
+    std::fs::write(
+        dir.join("default_truth.json"),
+        r#"{"params": {"C": 0.5, "k1": 0.03}}"#,
+    )
+    .expect("write truth");
+    let template = std::fs::read_to_string(root().join("campaigns/example_template.toml"))
+        .expect("template")
+        .replace(
+            "\"../data/reversal/blade_true.toml\"",
+            &format!("{:?}", root().join("data/reversal/blade_true.toml")),
+        )
+        + "\n[truth]\njson = \"default_truth.json\"\nkeys = { C = \"/params/C\", k1 = \"/params/k1\" }\n";
+    std::fs::write(dir.join("template.toml"), template).expect("write template");
+    let table = dir.join("sub/conditions.csv");
+    std::fs::write(
+        &table,
+        "recording,drive_omega_rad_per_s,blade_file,truth_json,compound\n\
+         soft_fast_xypts.csv,2.0,truths/own.blade.toml,truths/own.json,soft\n\
+         hard_fast_xypts.csv,,,,hard\n",
+    )
+    .expect("write table");
+    let campaign = dir.join("c.toml");
+    std::fs::write(
+        &campaign,
+        "template = \"template.toml\"\nrecordings = [\"*_xypts.csv\"]\nconditions = \"sub/conditions.csv\"\n",
+    )
+    .expect("write campaign");
+    (campaign, table)
+}
+
+/// `blade_file` and `truth_json` replace the template's blade file and truth JSON for their row
+/// only (the drive override still applied on top of the row's blade), are not condition labels,
+/// and a changed truth file changes the recording's input hash. No fit runs.
+#[test]
+fn conditions_give_a_recording_its_own_blade_and_truth() {
+    use wiperlab::campaign::run::{EntryPaths, generate};
+    use wiperlab::campaign::{Campaign, FileOverride};
+    let dir = temp_dir("files");
+    let (c, _) = campaign_with_files(dir.path());
+    let campaign = Campaign::load(&c).expect("campaign loads");
+    assert_eq!(campaign.label_columns, vec!["compound".to_string()]);
+    let own = campaign.entry("soft_fast_xypts").expect("entry");
+    let plain = campaign.entry("hard_fast_xypts").expect("entry");
+    assert_eq!(
+        own.files.get(&FileOverride::BladeFile),
+        Some(&dir.path().join("sub/truths/own.blade.toml"))
+    );
+    assert!(plain.files.is_empty(), "{:?}", plain.files);
+    let out = campaign.out_dir();
+    let g = generate(&campaign, own, &EntryPaths::new(&out, own)).expect("generate");
+    let blade: wiperlab::model::BladeParams = toml::from_str(&g.blade_text).expect("blade");
+    match blade.friction {
+        wiperlab::model::FrictionLaw::Exponential { c, .. } => assert_eq!(c, 0.43),
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(blade.drive_omega_rad_per_s, 2.0);
+    let job: toml::Table = toml::from_str(&g.job_text).expect("job");
+    let json = |j: &toml::Table| j["truth"]["json"].as_str().expect("json").to_string();
+    assert_eq!(json(&job), s(&dir.path().join("sub/truths/own.json")));
+    let p = generate(&campaign, plain, &EntryPaths::new(&out, plain)).expect("generate");
+    let plain_blade: wiperlab::model::BladeParams = toml::from_str(&p.blade_text).expect("blade");
+    assert_eq!(plain_blade, common::true_blade());
+    let plain_job: toml::Table = toml::from_str(&p.job_text).expect("job");
+    assert_eq!(json(&plain_job), s(&dir.path().join("default_truth.json")));
+    assert_eq!(
+        campaign.truth_of(own).expect("truth").json,
+        dir.path().join("sub/truths/own.json")
+    );
+    // The truth's bytes are part of the input hash: a changed truth refits the recording.
+    std::fs::write(
+        dir.path().join("sub/truths/own.json"),
+        r#"{"params": {"C": 0.44, "k1": 0.021}}"#,
+    )
+    .expect("rewrite truth");
+    let again = generate(&campaign, own, &EntryPaths::new(&out, own)).expect("generate");
+    assert_ne!(again.input_sha256, g.input_sha256);
+    assert_eq!(again.job_text, g.job_text);
+}
+
+/// A missing, unparsable or incomplete per-recording file is an input error at the table's line
+/// and column that names the column and the file; so is a `truth_json` column for a template
+/// without `[truth]`.
+#[test]
+fn bad_per_recording_files_name_the_table_cell() {
+    let dir = temp_dir("bad_files");
+    let (c, table) = campaign_with_files(dir.path());
+    let cs = c.to_str().expect("UTF-8 path");
+    let original = std::fs::read_to_string(&table).expect("table");
+    let check = |table_text: String, expect: &[&str]| {
+        std::fs::write(&table, table_text).expect("write table");
+        let o = run(&["campaign", "list", cs]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        for e in expect {
+            assert!(err.contains(e), "expected {e:?} in: {err}");
+        }
+    };
+    check(
+        original.replace("truths/own.blade.toml", "truths/none.blade.toml"),
+        &[
+            "conditions.csv:2:3",
+            "blade_file",
+            "none.blade.toml",
+            "cannot read",
+        ],
+    );
+    std::fs::write(
+        dir.path().join("sub/truths/bad.blade.toml"),
+        "l1_m = 0.002\n",
+    )
+    .expect("write");
+    check(
+        original.replace("truths/own.blade.toml", "truths/bad.blade.toml"),
+        &["conditions.csv:2:3", "bad.blade.toml", "not a blade file"],
+    );
+    std::fs::write(
+        dir.path().join("sub/truths/short.json"),
+        r#"{"params": {"C": 0.4}}"#,
+    )
+    .expect("write");
+    check(
+        original.replace("truths/own.json", "truths/short.json"),
+        &["conditions.csv:2:4", "short.json", "/params/k1", "'k1'"],
+    );
+    std::fs::write(dir.path().join("sub/truths/broken.json"), "{\"params\": ").expect("write");
+    check(
+        original.replace("truths/own.json", "truths/broken.json"),
+        &["conditions.csv:2:4", "broken.json", "not valid JSON"],
+    );
+    std::fs::write(&table, &original).expect("write table");
+    let template = dir.path().join("template.toml");
+    let text = std::fs::read_to_string(&template).expect("template");
+    let without = &text[..text.find("[truth]").expect("[truth]")];
+    std::fs::write(&template, without).expect("write template");
+    let o = run(&["campaign", "list", cs]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("conditions.csv:1:4") && err.contains("has no [truth] section"),
         "{err}"
     );
 }

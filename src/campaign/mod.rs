@@ -8,8 +8,11 @@
 //! * `conditions` (optional): a CSV table the lab already keeps, one row per recording, matched by
 //!   the `recording` column (the file name). Columns named like a per-recording setting
 //!   ([`Override`]: `t0_s`, `fps_hz`, `m_per_px`, `drive_a_m`, `drive_omega_rad_per_s`) override
-//!   the template for that recording; every other column is a free-form condition label (blade,
-//!   compound, wet, temperature_c, repeat, …) carried into the collected table.
+//!   the template for that recording; two columns name per-recording input files
+//!   ([`FileOverride`]: `blade_file`, the blade file in place of the template's, and `truth_json`,
+//!   the `[truth]` JSON in place of the template's), relative to the table; every other column is
+//!   a free-form condition label (blade, compound, wet, temperature_c, repeat, …) carried into the
+//!   collected table.
 //!
 //! Everything the campaign writes goes to `<campaign dir>/<name>/`: `jobs/` (one generated job and
 //! blade file per recording), `results/` (`<id>.result.toml` and `<id>.status.json`), `slurm/`
@@ -26,7 +29,8 @@ mod error;
 pub mod run;
 pub mod slurm;
 
-use crate::fit::job::FitJob;
+use crate::fit::job::{FitJob, TruthSection};
+use crate::model::BladeParams;
 use crate::{Error, Result};
 pub use error::CampaignError;
 use serde::Deserialize;
@@ -110,6 +114,36 @@ impl Override {
     }
 }
 
+/// A per-recording input file a conditions column may name in place of the template's: a path
+/// relative to the conditions table, checked when the campaign is loaded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum FileOverride {
+    /// The blade file (TOML with the blade's parameters), in place of the template's `blade`; the
+    /// drive overrides still apply on top of it.
+    BladeFile,
+    /// The `[truth]` JSON, in place of the template's `[truth] json`; read with the template's
+    /// `[truth] keys`, so every key must hold a number in it.
+    TruthJson,
+}
+
+impl FileOverride {
+    /// Every file override, in column order.
+    pub const ALL: [FileOverride; 2] = [FileOverride::BladeFile, FileOverride::TruthJson];
+
+    /// The column name.
+    pub fn column(self) -> &'static str {
+        match self {
+            FileOverride::BladeFile => "blade_file",
+            FileOverride::TruthJson => "truth_json",
+        }
+    }
+
+    /// The override whose column is `name`.
+    pub fn from_column(name: &str) -> Option<FileOverride> {
+        FileOverride::ALL.into_iter().find(|o| o.column() == name)
+    }
+}
+
 /// One recording of a campaign.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Entry {
@@ -119,6 +153,8 @@ pub struct Entry {
     pub recording: PathBuf,
     /// Settings that differ from the template.
     pub overrides: BTreeMap<Override, f64>,
+    /// Input files that replace the template's (absolute, checked to exist and parse).
+    pub files: BTreeMap<FileOverride, PathBuf>,
     /// Condition labels (column → value), in the table's column order.
     pub labels: Vec<(String, String)>,
 }
@@ -148,8 +184,10 @@ impl Campaign {
     ///
     /// # Errors
     /// [`Error::Io`] for unreadable files; [`Error::Parse`] (file, line, column) for TOML or CSV
-    /// problems, a conditions row naming a recording the patterns do not find, or a value that is
-    /// not a positive finite number; [`Error::Input`] for a pattern that matches nothing, a
+    /// problems, a conditions row naming a recording the patterns do not find, a value that is
+    /// not a positive finite number, or a `blade_file`/`truth_json` cell whose file is missing,
+    /// does not parse, or (a truth) lacks one of the template's `[truth] keys`, or a `truth_json`
+    /// column with a template without `[truth]`; [`Error::Input`] for a pattern that matches nothing, a
     /// recording without a conditions row, two recordings with the same file stem, or a template
     /// that is not a fit job with a `[recording]`.
     pub fn load(path: &Path) -> Result<Campaign> {
@@ -174,7 +212,13 @@ impl Campaign {
         }
         let recordings = resolve_recordings(&path, &dir, &file.recordings)?;
         let (entries, label_columns) = match &file.conditions {
-            Some(table) => with_conditions(&path, &dir.join(table), recordings)?,
+            Some(table) => with_conditions(
+                &path,
+                &dir.join(table),
+                &template_path,
+                template.truth.as_ref(),
+                recordings,
+            )?,
             None => (
                 recordings
                     .into_iter()
@@ -182,6 +226,7 @@ impl Campaign {
                         id,
                         recording,
                         overrides: BTreeMap::new(),
+                        files: BTreeMap::new(),
                         labels: Vec::new(),
                     })
                     .collect(),
@@ -225,6 +270,23 @@ impl Campaign {
     /// The entry with identifier `id`.
     pub fn entry(&self, id: &str) -> Option<&Entry> {
         self.entries.iter().find(|e| e.id == id)
+    }
+
+    /// The `[truth]` of `entry`'s fit: the template's keys, read from the entry's `truth_json`
+    /// (absolute) or else the template's own JSON (made absolute); `None` when the template has
+    /// no `[truth]`.
+    pub fn truth_of(&self, entry: &Entry) -> Option<TruthSection> {
+        let template: FitJob = toml::from_str(&self.template_text).ok()?;
+        let mut truth = template.truth?;
+        truth.json = match entry.files.get(&FileOverride::TruthJson) {
+            Some(p) => p.clone(),
+            None => self
+                .template_path
+                .parent()
+                .unwrap_or(Path::new("."))
+                .join(&truth.json),
+        };
+        Some(truth)
     }
 }
 
@@ -321,6 +383,8 @@ fn resolve_recordings(
 fn with_conditions(
     campaign: &Path,
     table: &Path,
+    template_path: &Path,
+    truth: Option<&TruthSection>,
     recordings: Vec<(String, PathBuf)>,
 ) -> Result<(Vec<Entry>, Vec<String>)> {
     let mut reader = csv::ReaderBuilder::new()
@@ -339,9 +403,30 @@ fn with_conditions(
     let label_columns: Vec<String> = headers
         .iter()
         .enumerate()
-        .filter(|(i, h)| *i != key && Override::from_column(h).is_none())
+        .filter(|(i, h)| {
+            *i != key
+                && Override::from_column(h).is_none()
+                && FileOverride::from_column(h).is_none()
+        })
         .map(|(_, h)| h.to_string())
         .collect();
+    if let Some(i) = headers
+        .iter()
+        .position(|h| h == FileOverride::TruthJson.column())
+        && truth.is_none()
+    {
+        return Err(Error::parse(
+            table,
+            1,
+            i + 1,
+            format!(
+                "column {}: the template {} has no [truth] section (json and keys) for the truth files to be read with",
+                FileOverride::TruthJson.column(),
+                template_path.display()
+            ),
+        ));
+    }
+    let files = Files { table, truth };
     let mut rows = BTreeMap::<String, Entry>::new();
     for record in reader.records() {
         let record = record.map_err(|e| csv_error(table, &e))?;
@@ -361,7 +446,7 @@ fn with_conditions(
                 ),
             ));
         };
-        let entry = row_entry(table, line, &headers, &record, key, id, recording)?;
+        let entry = row_entry(&files, line, &headers, &record, key, id, recording)?;
         if rows.insert(id.clone(), entry).is_some() {
             return Err(Error::parse(
                 table,
@@ -390,9 +475,76 @@ fn with_conditions(
     Ok((entries, label_columns))
 }
 
-/// One conditions row as an entry: overrides parsed as positive finite numbers, the rest labels.
+/// What a conditions row's file cells are checked against: the table (paths are relative to its
+/// directory) and the template's `[truth]` (whose keys a truth file must hold).
+struct Files<'a> {
+    table: &'a Path,
+    truth: Option<&'a TruthSection>,
+}
+
+impl Files<'_> {
+    /// The file `value` of column `which` (line `line`, 1-based column `column`) resolved against
+    /// the table's directory, read and parsed as that column's kind of file.
+    fn check(
+        &self,
+        which: FileOverride,
+        line: usize,
+        column: usize,
+        value: &str,
+    ) -> Result<PathBuf> {
+        let table = self.table;
+        let name = which.column();
+        let dir = table.parent().unwrap_or(Path::new("."));
+        let path = dir.join(value);
+        let at = |message: String| Error::parse(table, line, column, message);
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            at(format!(
+                "column {name}: cannot read {} ({e}; paths are relative to the table's directory)",
+                path.display()
+            ))
+        })?;
+        match which {
+            FileOverride::BladeFile => {
+                let blade: BladeParams = toml::from_str(&text).map_err(|e| {
+                    at(format!(
+                        "column {name}: {} is not a blade file: {}",
+                        path.display(),
+                        e.message().trim()
+                    ))
+                })?;
+                blade
+                    .validate()
+                    .map_err(|e| at(format!("column {name}: {}: {e}", path.display())))?;
+            }
+            FileOverride::TruthJson => {
+                let json: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
+                    at(format!(
+                        "column {name}: {} is not valid JSON: {e}",
+                        path.display()
+                    ))
+                })?;
+                for (k, ptr) in self.truth.map(|t| &t.keys).into_iter().flatten() {
+                    if json
+                        .pointer(ptr)
+                        .and_then(serde_json::Value::as_f64)
+                        .is_none()
+                    {
+                        return Err(at(format!(
+                            "column {name}: {} has no number at JSON pointer {ptr} (the template's [truth] key for '{k}')",
+                            path.display()
+                        )));
+                    }
+                }
+            }
+        }
+        absolute(&path)
+    }
+}
+
+/// One conditions row as an entry: overrides parsed as positive finite numbers, file cells checked
+/// ([`Files::check`]), the rest labels.
 fn row_entry(
-    table: &Path,
+    files: &Files,
     line: usize,
     headers: &csv::StringRecord,
     record: &csv::StringRecord,
@@ -400,10 +552,19 @@ fn row_entry(
     id: &str,
     recording: &Path,
 ) -> Result<Entry> {
+    let table = files.table;
     let mut overrides = BTreeMap::new();
+    let mut file_overrides = BTreeMap::new();
     let mut labels = Vec::new();
     for (i, (h, v)) in headers.iter().zip(record.iter()).enumerate() {
         if i == key {
+            continue;
+        }
+        if let Some(f) = FileOverride::from_column(h) {
+            // An empty cell keeps the template's file.
+            if !v.is_empty() {
+                file_overrides.insert(f, files.check(f, line, i + 1, v)?);
+            }
             continue;
         }
         match Override::from_column(h) {
@@ -440,6 +601,7 @@ fn row_entry(
         id: id.to_string(),
         recording: recording.to_path_buf(),
         overrides,
+        files: file_overrides,
         labels,
     })
 }
@@ -478,7 +640,13 @@ mod tests {
     fn override_columns_round_trip() {
         for o in Override::ALL {
             assert_eq!(Override::from_column(o.column()), Some(o));
+            assert_eq!(FileOverride::from_column(o.column()), None);
+        }
+        for f in FileOverride::ALL {
+            assert_eq!(FileOverride::from_column(f.column()), Some(f));
+            assert_eq!(Override::from_column(f.column()), None);
         }
         assert_eq!(Override::from_column("temperature_c"), None);
+        assert_eq!(FileOverride::from_column("blade"), None);
     }
 }

@@ -2,7 +2,7 @@
 //! a Slurm array task runs), and the local parallel run with skipping of finished recordings.
 
 use super::CampaignError;
-use super::{Campaign, Entry, Override};
+use super::{Campaign, Entry, FileOverride, Override};
 use crate::fit::job::LoadedJob;
 use crate::fit::result::sha256_hex;
 use crate::io::write_atomic;
@@ -68,8 +68,10 @@ pub struct Generated {
 }
 
 /// Generates `entry`'s job from the template: `name` = the entry id, `[recording] file` = the
-/// recording, the template's other paths made absolute, the import overrides set, and `blade`
-/// pointing to a copy of the template's blade file with the drive overrides.
+/// recording, the template's other paths made absolute, the import overrides set, `blade`
+/// pointing to a copy of the template's blade file (or the entry's `blade_file`) with the drive
+/// overrides, and `[truth] json` the entry's `truth_json` when it has one. The input hash covers
+/// the truth file's bytes too (a changed truth changes what the result reports).
 ///
 /// # Errors
 /// [`Error::Io`] for an unreadable blade or recording file; [`Error::Input`] when the template's
@@ -79,12 +81,26 @@ pub fn generate(campaign: &Campaign, entry: &Entry, paths: &EntryPaths) -> Resul
     let tpl_dir = tpl.parent().unwrap_or(Path::new("."));
     let mut job: toml::Table = toml::from_str(&campaign.template_text)
         .map_err(|e| Error::input(tpl, format!("template: {e}")))?;
-    let blade_src = tpl_dir.join(str_at(&job, tpl, "blade")?);
+    let blade_src = match entry.files.get(&FileOverride::BladeFile) {
+        Some(p) => p.clone(),
+        None => tpl_dir.join(str_at(&job, tpl, "blade")?),
+    };
     let mut blade: toml::Table = toml::from_str(&read(&blade_src)?)
         .map_err(|e| Error::input(&blade_src, format!("blade file: {e}")))?;
     job.insert("name".into(), entry.id.clone().into());
     job.insert("blade".into(), path_value(&paths.blade));
     absolutise(&mut job, tpl_dir, &["truth", "json"]);
+    if let Some(truth) = entry.files.get(&FileOverride::TruthJson) {
+        table_at(&mut job, tpl, "truth")?.insert("json".into(), path_value(truth));
+    }
+    let truth_bytes = match job
+        .get("truth")
+        .and_then(|t| t.get("json"))
+        .and_then(toml::Value::as_str)
+    {
+        Some(p) => Some(std::fs::read(p).map_err(|e| Error::io(Path::new(p), "cannot read", e))?),
+        None => None,
+    };
     let recording = table_at(&mut job, tpl, "recording")?;
     recording.insert("file".into(), path_value(&entry.recording));
     let import = table_at(recording, tpl, "import")?;
@@ -106,9 +122,13 @@ pub fn generate(campaign: &Campaign, entry: &Entry, paths: &EntryPaths) -> Resul
     let recording_bytes = std::fs::read(&entry.recording)
         .map_err(|e| Error::io(&entry.recording, "cannot read", e))?;
     let mut hashed = recording_bytes;
-    for part in [&job_text, &blade_text] {
+    for part in [job_text.as_bytes(), blade_text.as_bytes()] {
         hashed.extend_from_slice(&[0]);
-        hashed.extend_from_slice(part.as_bytes());
+        hashed.extend_from_slice(part);
+    }
+    if let Some(bytes) = &truth_bytes {
+        hashed.extend_from_slice(&[0]);
+        hashed.extend_from_slice(bytes);
     }
     hashed.extend_from_slice(env!("CARGO_PKG_VERSION").as_bytes());
     Ok(Generated {
