@@ -8,7 +8,7 @@ use std::sync::{Arc, Mutex};
 use wiperlab::fit::SpectralProblem;
 use wiperlab::fit::evidence::RecordingLikelihood;
 use wiperlab::fit::features::{SignalKind, default_bands, features};
-use wiperlab::fit::job::{Objective, Weights};
+use wiperlab::job::{Objective, Weights};
 use wiperlab::model::{Blade, BladeParams, StickForm};
 use wiperlab::simulate::blade::{default_window, simulate_blade};
 use wiperlab::simulate::hybrid::{Mode, Phase, SolverOptions, StickSlipModel};
@@ -107,7 +107,7 @@ fn cost(c: &mut Criterion) {
         lines: measured
             .bands
             .iter()
-            .map(wiperlab::fit::likelihood::band_has_line)
+            .map(wiperlab::likelihood::band_has_line)
             .collect(),
         measured,
         bands,

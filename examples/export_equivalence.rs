@@ -17,9 +17,9 @@
 #[path = "../tests/common/fixtures.rs"]
 mod fixtures;
 
-use wiperlab::fit::Candidate;
-use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
+use wiperlab::job::Candidate;
+use wiperlab::job::LoadedJob;
 
 fn fitted(job: &str) -> Vec<(String, f64)> {
     let mut job = LoadedJob::load(&fixtures::root().join(job)).expect("the shipped job loads");

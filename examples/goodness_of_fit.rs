@@ -4,8 +4,8 @@
 //! `cargo run --release --example goodness_of_fit -- JOB CANDIDATE NAME=VALUE...`, e.g.
 //! `fits/reversal.toml blade2dof A=0.88 B=69.747 C=0.56 k1=0.029748` (freed parameters not
 //! named sit at the middle of their normalised range).
-use wiperlab::fit::Candidate;
-use wiperlab::fit::job::LoadedJob;
+use wiperlab::job::Candidate;
+use wiperlab::job::LoadedJob;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();

@@ -33,8 +33,8 @@ use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use statrs::distribution::{Binomial, DiscreteCDF};
 use std::fmt::Write as _;
-use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
+use wiperlab::job::LoadedJob;
 use wiperlab::model::{FrictionLaw, ParamId, StickForm};
 use wiperlab::simulate::blade::{default_window, simulate_blade};
 

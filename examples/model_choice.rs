@@ -28,8 +28,8 @@ use fixtures::*;
 use scenes::{SCENES, log_likelihood_at_truth, write_scene};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
+use wiperlab::job::LoadedJob;
 use wiperlab::model::ParamId;
 
 #[derive(Parser)]

@@ -21,8 +21,8 @@
 mod fixtures;
 
 use std::fmt::Write as _;
-use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
+use wiperlab::job::LoadedJob;
 use wiperlab::model::ParamId;
 
 fn main() {

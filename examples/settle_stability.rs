@@ -22,8 +22,9 @@
 #[path = "../tests/common/fixtures.rs"]
 mod fixtures;
 
-use wiperlab::fit::job::LoadedJob;
-use wiperlab::fit::{Candidate, SpectralProblem, problem_for};
+use wiperlab::fit::{SpectralProblem, problem_for};
+use wiperlab::job::Candidate;
+use wiperlab::job::LoadedJob;
 
 /// The true A, B, C, k1 (`data/reversal/truth.json` /params).
 const TRUTH: [f64; 4] = [0.88, 69.74712740275162, 0.56, 0.029748408887917077];

@@ -1,6 +1,6 @@
 //! Writing files safely: every file wiperlab writes goes through [`write_atomic`], so a reader, a
 //! crash or an interrupt never leaves a half-written file, and an existing file is replaced only
-//! by a complete new one.
+//! by a complete new one. A result names its input by the SHA-256 of its bytes ([`sha256_file`]).
 
 use crate::{Error, Result};
 use std::path::Path;
@@ -159,9 +159,48 @@ pub fn refuse_overwriting_input(input: &Path, output: &Path) -> Result<()> {
     Ok(())
 }
 
+/// SHA-256 (FIPS 180-4) of a file's bytes, lower-case hex.
+///
+/// # Errors
+/// [`Error::Io`] naming the file if it cannot be read.
+pub fn sha256_file(path: &Path) -> Result<String> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, "cannot read", e))?;
+    Ok(sha256_hex(&bytes))
+}
+
+/// SHA-256 of `bytes`, lower-case hex (64 characters).
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    use sha2::Digest;
+    use std::fmt::Write as _;
+    let digest = sha2::Sha256::digest(bytes);
+    let mut s = String::with_capacity(64);
+    for b in digest.iter() {
+        let _ = write!(s, "{b:02x}");
+    }
+    s
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sha256_fips_180_2_vectors() {
+        // FIPS 180-2, Appendix B.1 ("abc") and B.2 (the 448-bit message); empty string: NIST CSRC
+        // example values for SHA-256.
+        assert_eq!(
+            sha256_hex(b"abc"),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+        );
+        assert_eq!(
+            sha256_hex(b"abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1"
+        );
+        assert_eq!(
+            sha256_hex(b""),
+            "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855"
+        );
+    }
 
     #[test]
     fn replaces_whole_files_and_leaves_no_temporary_behind() {

@@ -5,7 +5,7 @@
 //! The module tree is the pipeline; a stage uses only the stages before it (checked by
 //! `tests/architecture.rs`):
 //!
-//! Pipeline order: `error` → `names` → `io` → `trace` → `import` → `spectrum` → `model` → `simulate` → `fit` → `campaign` → `report` → `bench` → `cli`.
+//! Pipeline order: `error` → `names` → `io` → `trace` → `import` → `spectrum` → `model` → `simulate` → `job` → `likelihood` → `fit` → `explore` → `campaign` → `report` → `bench` → `cli`.
 //!
 //! * [`error`]: the crate's error type, shared by every stage.
 //! * [`names`]: typed names (model kinds, parameter ids, ...), each spelled once.
@@ -18,8 +18,13 @@
 //!   contract between a stick–slip model and the integrator ([`model::stick_slip`]).
 //! * [`simulate`]: the event-driven integrator and the blade runner (a simulation becomes a
 //!   [`trace::Trace`] like a measurement).
+//! * [`job`]: the fit job file (TOML) read and checked, its candidate models, and the template
+//!   `wiperlab init` writes.
+//! * [`likelihood`]: the recording measured as the job asks (features per band, noise floors,
+//!   frequency against tip speed) and the calibrated likelihood that reads its spectra.
 //! * [`fit`]: the friction law A, B, C and the neck stiffness fitted with `argmin`; model choice,
 //!   intervals, results.
+//! * [`explore`]: where a job's freed parameters can take the model's lines (`wiperlab explore`).
 //! * [`campaign`]: one fit job over many recordings, locally in parallel or as a Slurm job array,
 //!   collected into one table.
 //! * [`report`]: SVG figures and the HTML report page, drawn from values computed upstream.
@@ -34,9 +39,12 @@ pub mod bench;
 pub mod campaign;
 pub mod cli;
 pub mod error;
+pub mod explore;
 pub mod fit;
 pub mod import;
 pub mod io;
+pub mod job;
+pub mod likelihood;
 pub mod model;
 pub mod names;
 pub mod report;

@@ -10,8 +10,22 @@ use std::path::{Path, PathBuf};
 /// The pipeline, upstream first. `error` is the shared error type; `lib` and `main` are the crate
 /// roots and may name anything.
 const STAGES: &[&str] = &[
-    "error", "names", "io", "trace", "import", "spectrum", "model", "simulate", "fit", "campaign",
-    "report", "bench", "cli",
+    "error",
+    "names",
+    "io",
+    "trace",
+    "import",
+    "spectrum",
+    "model",
+    "simulate",
+    "job",
+    "likelihood",
+    "fit",
+    "explore",
+    "campaign",
+    "report",
+    "bench",
+    "cli",
 ];
 
 fn rank(stage: &str) -> Option<usize> {
@@ -133,7 +147,7 @@ fn no_stage_uses_a_later_stage() {
 /// The checker itself finds references in the forms the crate uses, so the test above can fail.
 #[test]
 fn reference_scanner_sees_paths_and_groups() {
-    let code = "use crate::fit::job::FitJob;\nuse crate::{Error, report::plot::{a, b}, simulate};\nlet x = crate::cli::run(y);";
+    let code = "use crate::fit::result::FitResult;\nuse crate::{Error, report::plot::{a, b}, simulate};\nlet x = crate::cli::run(y);";
     assert_eq!(
         crate_references(code),
         vec!["fit", "Error", "report", "simulate", "cli"]
@@ -158,4 +172,80 @@ fn lib_docs_state_the_checked_order() {
         .map(|s| s.trim().trim_end_matches('.').trim_matches('`').to_string())
         .collect();
     assert_eq!(stated, STAGES);
+}
+
+/// Most of `src/`'s lines one top-level room may hold: a fifth.
+const MAX_ROOM_SHARE: f64 = 0.2;
+
+/// Every file under `dir` (recursively), templates included.
+fn all_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).expect("directory is readable") {
+        let path = entry.expect("directory entry").path();
+        if path.is_dir() {
+            all_files(&path, out);
+        } else {
+            out.push(path);
+        }
+    }
+}
+
+/// Lines per top-level room (the first component below `src/` without its `.rs`, as in
+/// [`stage_of`]), counted as `wc -l` counts them: newline characters of every file under `src/`,
+/// Rust sources and the templates they include alike, comments, blank lines and tests included.
+fn room_lines(src: &Path) -> Vec<(String, usize)> {
+    let mut files = Vec::new();
+    all_files(src, &mut files);
+    let mut rooms = std::collections::BTreeMap::<String, usize>::new();
+    for file in &files {
+        let bytes = std::fs::read(file).expect("source file is readable");
+        let lines = bytes.iter().filter(|b| **b == b'\n').count();
+        *rooms.entry(stage_of(src, file)).or_default() += lines;
+    }
+    rooms.into_iter().collect()
+}
+
+/// The rooms whose share of `total` lines is above [`MAX_ROOM_SHARE`], with their shares.
+fn oversized(rooms: &[(String, usize)]) -> Vec<String> {
+    let total: usize = rooms.iter().map(|(_, n)| n).sum();
+    rooms
+        .iter()
+        .filter(|(_, n)| *n as f64 > MAX_ROOM_SHARE * total as f64)
+        .map(|(room, n)| {
+            format!(
+                "{room}: {n} of {total} lines ({:.1} %)",
+                100.0 * *n as f64 / total as f64
+            )
+        })
+        .collect()
+}
+
+/// Each room does one job and none holds more than a fifth of the code: a room that grows past
+/// that is split into stages of one job each (and [`STAGES`] says where they run).
+#[test]
+fn no_room_holds_more_than_a_fifth_of_the_code() {
+    let rooms = room_lines(&common::root().join("src"));
+    assert!(
+        rooms.len() > 10,
+        "found only {} rooms under src/",
+        rooms.len()
+    );
+    let over = oversized(&rooms);
+    assert!(
+        over.is_empty(),
+        "rooms above {} % of src/'s lines:\n{}",
+        100.0 * MAX_ROOM_SHARE,
+        over.join("\n")
+    );
+}
+
+/// The share check flags a room just above a fifth and passes one at exactly a fifth.
+#[test]
+fn share_check_flags_a_room_above_a_fifth() {
+    let rooms = |big: usize| {
+        let mut r = vec![("a".to_string(), big)];
+        r.extend(["b", "c", "d", "e"].map(|n| (n.to_string(), 100)));
+        r
+    };
+    assert_eq!(oversized(&rooms(100)), Vec::<String>::new());
+    assert_eq!(oversized(&rooms(101)), vec!["a: 101 of 501 lines (20.2 %)"]);
 }

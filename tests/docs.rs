@@ -215,7 +215,7 @@ fn listed(message: &str) -> Vec<String> {
 
 /// What the job reader lists after reading `toml` (which must fail on an unknown name).
 fn job_lists(toml: &str) -> Vec<String> {
-    match toml::from_str::<wiperlab::fit::job::FitJob>(toml) {
+    match toml::from_str::<wiperlab::job::FitJob>(toml) {
         Ok(_) => panic!("the job reader accepted {toml:?}"),
         Err(e) => listed(e.message()),
     }
@@ -383,7 +383,7 @@ fn the_blade_reference_lists_every_key_the_blade_reader_accepts() {
 /// `wiperlab init`'s template points to the two references.
 #[test]
 fn the_job_template_points_to_the_references() {
-    let template = read(&root().join("src/fit/templates/job.toml"));
+    let template = read(&root().join("src/job/templates/job.toml"));
     for doc in ["docs/job.md", "docs/blade.md"] {
         assert!(
             template.contains(doc),

@@ -63,7 +63,7 @@ fn a_freed_head_mass_fits_with_the_head_frequency_held_and_reports_identifiabili
         dir,
         "A = [0.2, 1.5]\nB = [10.0, 300.0]\nC = [0.1, 1.0]\nhead_mass = [0.01, 0.15]",
     );
-    let loaded = wiperlab::fit::job::LoadedJob::load(&path).unwrap();
+    let loaded = wiperlab::job::LoadedJob::load(&path).unwrap();
     let out = wiperlab::fit::run_fit(&loaded, false).unwrap();
     let names: Vec<String> = out
         .result

@@ -4,10 +4,10 @@
 
 mod common;
 
-use wiperlab::fit::explore::FailureCause;
-use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::{FitWarning, run_fit};
+use wiperlab::job::LoadedJob;
 use wiperlab::model::{BladeParams, FrictionLaw};
+use wiperlab::simulate::failure::FailureCause;
 
 #[test]
 fn fit_recovers_friction_c_and_neck_stiffness() {

@@ -22,8 +22,8 @@ mod common;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use wiperlab::fit::FitOutcome;
-use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
+use wiperlab::job::LoadedJob;
 use wiperlab::model::{BladeParams, ParamId};
 
 /// The sample's friction offset C (data/reversal/blade_true.toml `[friction] c`), left unchanged.

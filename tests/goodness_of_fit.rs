@@ -10,9 +10,10 @@
 
 mod common;
 
-use wiperlab::fit::job::LoadedJob;
-use wiperlab::fit::likelihood::{GOODNESS_OF_FIT_LEVEL, GoodnessOfFit};
-use wiperlab::fit::{Candidate, problem_for};
+use wiperlab::fit::problem_for;
+use wiperlab::job::Candidate;
+use wiperlab::job::LoadedJob;
+use wiperlab::likelihood::{GOODNESS_OF_FIT_LEVEL, GoodnessOfFit};
 
 /// `data/reversal/truth.json` /params: A, B (s/m), C, k1 (N·m/rad).
 const TRUTH: [(&str, f64); 4] = [

@@ -11,7 +11,7 @@ use common::{root, run_in, temp_dir};
 use std::process::Output;
 use tempfile::TempDir;
 
-use wiperlab::fit::job::LoadedJob;
+use wiperlab::job::LoadedJob;
 
 /// A fresh temp dir holding a copy of the sample recording as `rec_xypts.csv`; removed on drop.
 fn scratch(name: &str) -> TempDir {

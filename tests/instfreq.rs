@@ -6,7 +6,7 @@
 mod common;
 use common::{root, temp_dir};
 
-use wiperlab::fit::job::LoadedJob;
+use wiperlab::job::LoadedJob;
 use wiperlab::model::{BladeParams, StickForm};
 use wiperlab::simulate::SolverOptions;
 use wiperlab::simulate::blade::simulate_blade;
@@ -347,7 +347,7 @@ fn sample_and_true_model() -> (
 #[test]
 fn measured_and_true_model_agree_on_frequency_against_speed() {
     use wiperlab::fit::features::SignalKind;
-    use wiperlab::fit::instfreq::{measured_freq_speed, model_freq_speed};
+    use wiperlab::likelihood::instfreq::{measured_freq_speed, model_freq_speed};
     use wiperlab::spectrum::instfreq::{band_floor, bin_by_speed};
     let (trace, sim, _) = sample_and_true_model();
     let fs = 1e4;
@@ -402,7 +402,7 @@ fn measured_and_true_model_agree_on_frequency_against_speed() {
     // The figure the fit writes, here with the true model: all four series are drawn.
     let tmp = temp_dir("instfreq");
     let dir = tmp.path();
-    let comparison = wiperlab::fit::instfreq::FreqSpeedComparison {
+    let comparison = wiperlab::likelihood::instfreq::FreqSpeedComparison {
         measured: meas.clone(),
         model: model.clone(),
         band_hz: cfg.band_hz,
@@ -427,8 +427,8 @@ fn measured_and_true_model_agree_on_frequency_against_speed() {
 #[test]
 fn freq_speed_cost_prefers_the_true_neck_stiffness() {
     use wiperlab::fit::features::SignalKind;
-    use wiperlab::fit::instfreq::TimeTargets;
-    use wiperlab::fit::job::Weights;
+    use wiperlab::job::Weights;
+    use wiperlab::likelihood::instfreq::TimeTargets;
     let (trace, sim, params) = sample_and_true_model();
     let sig = SignalKind::TipRelX;
     let x = sig.extract(&trace).unwrap();
@@ -482,7 +482,7 @@ fn freq_speed_cost_prefers_the_true_neck_stiffness() {
 
 #[test]
 fn fit_job_with_freq_speed_and_trace_terms_runs_and_reports_them() {
-    use wiperlab::fit::instfreq::TimeTargets;
+    use wiperlab::likelihood::instfreq::TimeTargets;
     // The main job with both optional terms on and a tiny budget (this checks the plumbing, not
     // the optimum): the reported cost must include the time-domain terms of the best model.
     let text = std::fs::read_to_string(root().join("fits/reversal.toml"))

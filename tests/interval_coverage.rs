@@ -11,8 +11,8 @@ mod common;
 
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
+use wiperlab::job::LoadedJob;
 use wiperlab::model::StickForm;
 use wiperlab::model::{BladeParams, FrictionLaw};
 use wiperlab::simulate::SolverOptions;

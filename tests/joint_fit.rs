@@ -7,8 +7,8 @@
 mod common;
 
 use std::path::Path;
-use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
+use wiperlab::job::LoadedJob;
 use wiperlab::model::{BladeParams, FrictionLaw};
 
 /// Simulates `p` over its default window at 10 kfps and writes a DLTdv xypts file; returns t0.

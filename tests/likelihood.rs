@@ -1,4 +1,4 @@
-//! The likelihood of `wiperlab::fit::likelihood` against processes whose spectra are known in
+//! The likelihood of `wiperlab::likelihood` against processes whose spectra are known in
 //! closed form: Gaussian white noise (one-sided PSD `2σ²/fs`) and a Gaussian AR(1) process
 //! `x_t = a·x_{t−1} + e_t` (PSD `2σ_e²/(fs·(1 − 2a·cos ω + a²))`, ω = 2πf/fs; Priestley 1981,
 //! *Spectral Analysis and Time Series*, §4.12), both run through our Welch estimator.
@@ -10,7 +10,7 @@
 use rand::SeedableRng;
 use rand::rngs::StdRng;
 use rand_distr::{Distribution, Normal};
-use wiperlab::fit::likelihood::{
+use wiperlab::likelihood::{
     Evidence, LINE_FALSE_ALARM, LikelihoodError, Side, WelchLikelihood, band_has_line,
     bin_correlation, demeaned_residuals, effective_sample_size, gaussian_nll, interior_bin,
     likelihood_ratio_test, tracking_noise_sigma, welch_dof,

@@ -8,7 +8,7 @@
 mod common;
 
 use common::scenes::{SCENES, Scene, truth_params, write_scene};
-use wiperlab::fit::job::LoadedJob;
+use wiperlab::job::LoadedJob;
 use wiperlab::model::BladeParams;
 
 /// Scene `i` written to a fresh temp directory named after `tag`, and its true model's problem: the

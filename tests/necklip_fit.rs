@@ -4,8 +4,8 @@
 
 mod common;
 
-use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
+use wiperlab::job::LoadedJob;
 use wiperlab::simulate::blade::ModelKind;
 
 /// The main job's bands (fits/reversal.toml).

@@ -341,7 +341,7 @@ fn shipped_jobs_write_to_the_repositorys_reports() {
         "seed_simulation",
     ] {
         let path = root().join(format!("fits/{job}.toml"));
-        let loaded = wiperlab::fit::job::LoadedJob::load(&path).expect("a shipped job");
+        let loaded = wiperlab::job::LoadedJob::load(&path).expect("a shipped job");
         let dir = loaded.reports_dir().canonicalize().expect("reports_dir");
         assert_eq!(dir, reports, "{job}");
     }

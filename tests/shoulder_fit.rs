@@ -6,8 +6,8 @@
 
 mod common;
 
-use wiperlab::fit::job::LoadedJob;
 use wiperlab::fit::run_fit;
+use wiperlab::job::LoadedJob;
 use wiperlab::model::{BladeParams, Shoulder};
 
 #[test]
@@ -78,7 +78,7 @@ keys = {{ k1 = "/k1", k1c = "/k1c", theta_c = "/theta_c" }}
     }
     assert_eq!(
         out.result.model,
-        wiperlab::fit::Candidate {
+        wiperlab::job::Candidate {
             kind: wiperlab::simulate::blade::ModelKind::Blade2dof,
             shoulder: true
         }

@@ -75,7 +75,10 @@ pub fn to_py_as(py: Python<'_>, e: Error, input_class: &str) -> PyErr {
             raise(py, "SimulationError", (message,))
         }
         _ if e.stage_error::<wiperlab::fit::FitError>().is_some()
-            || e.stage_error::<wiperlab::fit::likelihood::LikelihoodError>()
+            || e.stage_error::<wiperlab::job::JobError>().is_some()
+            || e.stage_error::<wiperlab::likelihood::MeasureError>()
+                .is_some()
+            || e.stage_error::<wiperlab::likelihood::LikelihoodError>()
                 .is_some() =>
         {
             raise(py, "FitError", (message,))

@@ -14,7 +14,7 @@ use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError};
 use pyo3::prelude::*;
 use wiperlab::Error;
 use wiperlab::fit::interrupt;
-use wiperlab::fit::job::LoadedJob;
+use wiperlab::job::LoadedJob;
 
 use crate::errors::{guard, panic_error, to_py};
 

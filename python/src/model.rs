@@ -11,7 +11,7 @@ use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use wiperlab::cli::{BAUMGARTE_OMEGA_PER_S, StickChoice};
-use wiperlab::fit::job::{parse_toml, read_text};
+use wiperlab::job::{parse_toml, read_text};
 use wiperlab::model::modes::OperatingPoint;
 use wiperlab::model::{Blade, BladeParams, StickForm};
 use wiperlab::simulate::blade::{ModelKind, contact_forces, default_window, simulate_model};

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use wiperlab::fit::job::{parse_toml, read_text};
 use wiperlab::import::{Format, ImportSpec, ImportSummary};
+use wiperlab::job::{parse_toml, read_text};
 
 use crate::errors::{guard_as, value_error};
 

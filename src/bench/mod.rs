@@ -591,7 +591,7 @@ pub struct SpectrumRow {
     pub high_peak_hz: f64,
 }
 
-/// The fit's spectral peaks (src/fit/features.rs: default bands, signal tip − head x, Welch) of the
+/// The fit's spectral peaks (src/spectrum/features.rs: default bands, signal tip − head x, Welch) of the
 /// blade simulated over its default window at 10 kHz (the shipped recording's sampling), for each
 /// `rtol` (atol = rtol·1e-2).
 pub fn spectra_vs_rtol(

@@ -29,7 +29,7 @@ mod error;
 pub mod run;
 pub mod slurm;
 
-use crate::fit::job::{FitJob, TruthSection};
+use crate::job::{FitJob, TruthSection};
 use crate::model::BladeParams;
 use crate::{Error, Result};
 pub use error::CampaignError;

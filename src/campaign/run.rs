@@ -3,9 +3,9 @@
 
 use super::CampaignError;
 use super::{Campaign, Entry, FileOverride, Override};
-use crate::fit::job::LoadedJob;
-use crate::fit::result::sha256_hex;
+use crate::io::sha256_hex;
 use crate::io::write_atomic;
+use crate::job::LoadedJob;
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};

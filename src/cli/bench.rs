@@ -1,6 +1,6 @@
 //! `wiperlab bench`: the work–precision study and the spectra against tolerance.
 
-use crate::fit::job::{parse_toml, read_text};
+use crate::job::{parse_toml, read_text};
 use crate::model::BladeParams;
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};

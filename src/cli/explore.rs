@@ -1,8 +1,8 @@
 //! `wiperlab explore`: samples a job's freed parameters and writes the reachability map.
 
 use crate::Result;
-use crate::fit::explore::{explore, simulations};
-use crate::fit::job::LoadedJob;
+use crate::explore::{explore, simulations};
+use crate::job::LoadedJob;
 use crate::report::explore::{SAMPLES_CSV, summary, write_exploration};
 use std::path::{Path, PathBuf};
 
@@ -11,8 +11,8 @@ use std::path::{Path, PathBuf};
 /// and prints the summary.
 pub(super) fn run(job: &Path, samples: usize, seed: u32, out: Option<PathBuf>) -> Result<()> {
     let loaded = LoadedJob::load(job)?;
-    if samples == 0 || samples > crate::fit::explore::MAX_SAMPLES {
-        let max = crate::fit::explore::MAX_SAMPLES;
+    if samples == 0 || samples > crate::explore::MAX_SAMPLES {
+        let max = crate::explore::MAX_SAMPLES;
         return Err(crate::fit::FitError::Samples { samples, max }.into());
     }
     let dir = out.unwrap_or_else(|| loaded.reports_dir().join("explore").join(&loaded.name));

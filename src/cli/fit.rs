@@ -1,6 +1,6 @@
 //! `wiperlab fit` and `wiperlab report`: a fit job's result, figures and report page.
 
-use crate::fit::job::LoadedJob;
+use crate::job::LoadedJob;
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -151,7 +151,12 @@ pub fn fit_files(
     let result_path = result_path(job);
     let toml_text = outcome.result.to_toml()?;
     crate::io::write_atomic(&result_path, toml_text.as_bytes())?;
-    let freq_speed = crate::fit::instfreq::compare_freq_speed(&outcome)?;
+    let freq_speed = crate::likelihood::instfreq::compare_freq_speed(
+        &outcome.measured_trace,
+        &outcome.best_sim,
+        outcome.fs_hz,
+        outcome.signal,
+    )?;
     crate::report::figures::fit_figures(report_dir, &outcome, freq_speed.as_ref())?;
     Ok((outcome.result, result_path))
 }

@@ -4,8 +4,8 @@
 use super::CliError;
 use super::ImportArgs;
 use crate::Result;
-use crate::fit::job::{parse_toml, read_text};
 use crate::import::{Format, ImportSpec};
+use crate::job::{parse_toml, read_text};
 use crate::trace::Role;
 use std::path::{Path, PathBuf};
 

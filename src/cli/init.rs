@@ -1,7 +1,7 @@
 //! `wiperlab init`: a commented fit-job template for a recording.
 
 use super::ImportArgs;
-use crate::fit::template::{TemplateInput, job_template};
+use crate::job::template::{TemplateInput, job_template};
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -43,7 +43,7 @@ pub(super) fn run(
         import: &spec,
         summary: &summary,
     })?;
-    let (missing, check) = crate::fit::template::count_marks(&text);
+    let (missing, check) = crate::job::template::count_marks(&text);
     if stdout {
         // `-o -`: the job on stdout, the count on stderr.
         print!("{text}");

@@ -296,7 +296,7 @@ pub enum Command {
         /// The fit-job TOML whose [fit.parameters] are sampled.
         job: PathBuf,
         /// Number of samples (1 to 65536).
-        #[arg(long, default_value_t = crate::fit::explore::DEFAULT_SAMPLES)]
+        #[arg(long, default_value_t = crate::explore::DEFAULT_SAMPLES)]
         samples: usize,
         /// Scramble seed of the Sobol sequence (same seed, same samples).
         #[arg(long, default_value_t = 1)]
@@ -386,7 +386,7 @@ fn input_dir(input: &Path) -> &Path {
 /// the input whatever the working directory.
 fn default_report_dir(input: &Path, command: &str) -> PathBuf {
     input_dir(input)
-        .join(crate::fit::job::DEFAULT_REPORTS_DIR)
+        .join(crate::job::DEFAULT_REPORTS_DIR)
         .join(command)
         .join(stem(input))
 }

@@ -1,7 +1,7 @@
 //! `wiperlab modes`: the linearised blade's modes in stick and in steady slip.
 
 use super::CliError;
-use crate::fit::job::{parse_toml, read_text};
+use crate::job::{parse_toml, read_text};
 use crate::model::modes::{BladeMode, ModesError, OperatingPoint};
 use crate::model::{Blade, BladeParams, StickForm};
 use crate::{Error, Result};

@@ -1,7 +1,7 @@
 //! `wiperlab simulate`: the blade model over its reversal window.
 
 use super::CliError;
-use crate::fit::job::{parse_toml, read_text};
+use crate::job::{parse_toml, read_text};
 use crate::model::{BladeParams, StickForm};
 use crate::names::named_enum;
 use crate::simulate::blade::{ModelKind, contact_forces, default_window, simulate_model};

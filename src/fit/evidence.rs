@@ -1,5 +1,5 @@
 //! The recording's likelihood of a fitted model, in nats: what model choice and the Laplace
-//! intervals read ([`super::likelihood`] has the statistics and their sources).
+//! intervals read ([`crate::likelihood`] has the statistics and their sources).
 //!
 //! For a recording with measured signal `d` (the job's `[spectrum] signal`) and a simulation `m`:
 //!
@@ -23,10 +23,13 @@
 //! with `V` the variance of the NLL's gradient over replicates of the recording's tracking noise:
 //! the Whittle-type likelihood's own `F⁻¹` overstates it for a deterministic motion plus noise.
 
-use super::job::NoiseSpectrum;
-use super::likelihood::{self, Evidence, WelchLikelihood};
 use super::problem::SpectralProblem;
 use crate::Result;
+use crate::job::NoiseSpectrum;
+use crate::likelihood::covariance::{
+    cholesky_of_covariance, covariance, sample_covariance, sandwich_covariance,
+};
+use crate::likelihood::{self, Evidence, WelchLikelihood};
 use crate::simulate::blade::BladeSimulation;
 use crate::spectrum::noise::{MAX_ABS_RHO, TrackingNoise, ordinate_per_density};
 use nalgebra::DMatrix;
@@ -936,20 +939,6 @@ impl Jacobian {
     }
 }
 
-/// The sample covariance (divisor `n − 1`) of the vectors `x`.
-fn sample_covariance(x: &[Vec<f64>]) -> DMatrix<f64> {
-    let (n, k) = (x.len(), x.first().map_or(0, Vec::len));
-    let mean: Vec<f64> = (0..k)
-        .map(|i| x.iter().map(|v| v[i]).sum::<f64>() / n as f64)
-        .collect();
-    DMatrix::from_fn(k, k, |i, j| {
-        x.iter()
-            .map(|v| (v[i] - mean[i]) * (v[j] - mean[j]))
-            .sum::<f64>()
-            / (n.max(2) - 1) as f64
-    })
-}
-
 /// A candidate's fit read through the likelihood: its NLL by term, the spread of its estimate
 /// (the sandwich) and the likelihood's own curvature (the Fisher information).
 #[derive(Debug, Clone)]
@@ -1258,18 +1247,6 @@ fn surface_step(
     Some(to_u(&z).into_iter().map(|x| x.clamp(0.0, 1.0)).collect())
 }
 
-/// The lower Cholesky factor `L` of the covariance with 1σ `sigma` and correlations `corr`
-/// (`LLᵀ = Σ`; `u + L z` maps whitened coordinates `z` to normalised ones). `None` where a 1σ is
-/// not finite (a coordinate without information) or the covariance is not positive definite.
-fn cholesky_of_covariance(sigma: &[f64], corr: &[Vec<f64>]) -> Option<DMatrix<f64>> {
-    if sigma.iter().any(|s| !s.is_finite()) {
-        return None;
-    }
-    let k = sigma.len();
-    let cov = DMatrix::from_fn(k, k, |i, j| corr[i][j] * sigma[i] * sigma[j]);
-    Some(cov.cholesky()?.l())
-}
-
 /// Least-squares quadratic `c + gᵀz + ½ zᵀHz` through the values `y` at the points `z`: its
 /// gradient `g` and Hessian `H` at the origin. `None` when the design does not determine them.
 fn fit_quadratic(z: &[Vec<f64>], y: &[f64]) -> Option<(nalgebra::DVector<f64>, DMatrix<f64>)> {
@@ -1303,75 +1280,6 @@ fn fit_quadratic(z: &[Vec<f64>], y: &[f64]) -> Option<(nalgebra::DVector<f64>, D
         }
     }
     Some((g, h))
-}
-
-/// Covariance of the normalised coordinates from a Fisher information `f` (its pseudo-inverse over
-/// the directions the data inform): per parameter the standard deviation (∞ where the parameter
-/// loads on a direction with no information) and the correlation matrix (NaN there).
-pub fn covariance(f: &DMatrix<f64>) -> (Vec<f64>, Vec<Vec<f64>>) {
-    let (pinv, uninformed) = pseudo_inverse(f);
-    spread(&pinv, &uninformed)
-}
-
-/// The sandwich covariance `F⁺ V F⁺` of the normalised coordinates for a Fisher information (the
-/// NLL's expected Hessian) `f` and a variability (the variance of the NLL's gradient) `v`, with
-/// `F⁺` the pseudo-inverse over the directions `f` informs (see [`at_fit`] for why): per
-/// parameter the standard deviation (∞ where the parameter loads on a direction with no
-/// information) and the correlation matrix (NaN there). With `v = f` it is `F⁺`.
-pub fn sandwich_covariance(f: &DMatrix<f64>, v: &DMatrix<f64>) -> (Vec<f64>, Vec<Vec<f64>>) {
-    let (pinv, uninformed) = pseudo_inverse(f);
-    spread(&(&pinv * v * &pinv), &uninformed)
-}
-
-/// The pseudo-inverse of a symmetric positive semi-definite `f` over its informed directions
-/// (eigenvalues above 1e-12 of the largest), and per coordinate whether it loads on an
-/// uninformed direction.
-fn pseudo_inverse(f: &DMatrix<f64>) -> (DMatrix<f64>, Vec<bool>) {
-    let k = f.nrows();
-    let eig = f.clone().symmetric_eigen();
-    let max = eig.eigenvalues.iter().fold(0.0_f64, |a, b| a.max(*b));
-    let informed = |l: f64| l > 1e-12 * max && max > 0.0;
-    let uninformed = (0..k)
-        .map(|i| {
-            (0..k).any(|j| !informed(eig.eigenvalues[j]) && eig.eigenvectors[(i, j)].powi(2) > 1e-6)
-        })
-        .collect();
-    let pinv = DMatrix::from_fn(k, k, |i, j| {
-        (0..k)
-            .filter(|&m| informed(eig.eigenvalues[m]))
-            .map(|m| eig.eigenvectors[(i, m)] * eig.eigenvectors[(j, m)] / eig.eigenvalues[m])
-            .sum::<f64>()
-    });
-    (pinv, uninformed)
-}
-
-/// Standard deviations (∞ for an uninformed coordinate) and correlations (NaN there) of a
-/// covariance matrix.
-fn spread(cov: &DMatrix<f64>, uninformed: &[bool]) -> (Vec<f64>, Vec<Vec<f64>>) {
-    let k = cov.nrows();
-    let sd: Vec<f64> = (0..k)
-        .map(|i| {
-            if uninformed[i] {
-                f64::INFINITY
-            } else {
-                cov[(i, i)].max(0.0).sqrt()
-            }
-        })
-        .collect();
-    let corr = (0..k)
-        .map(|i| {
-            (0..k)
-                .map(|j| {
-                    if sd[i].is_finite() && sd[j].is_finite() {
-                        cov[(i, j)] / (sd[i] * sd[j])
-                    } else {
-                        f64::NAN
-                    }
-                })
-                .collect()
-        })
-        .collect();
-    (sd, corr)
 }
 
 /// A noise replicate's Welch ordinates per band, and per band the noise ordinates its own noise
@@ -1471,67 +1379,6 @@ mod tests {
             n.sigma_m / sigma
         );
         assert!((lik.sigma_m / sigma - 1.0).abs() < 0.03);
-    }
-
-    #[test]
-    fn sandwich_of_a_diagonal_information_matches_the_hand_product() {
-        // F = diag(4, 1), V = [[1, 0.5], [0.5, 4]]: F⁻¹VF⁻¹ = [[1/16, 1/8], [1/8, 4]], so
-        // σ = (1/4, 2) and the correlation (1/8)/(1/4·2) = 1/4.
-        let f = DMatrix::from_row_slice(2, 2, &[4.0, 0.0, 0.0, 1.0]);
-        let v = DMatrix::from_row_slice(2, 2, &[1.0, 0.5, 0.5, 4.0]);
-        let (sd, corr) = sandwich_covariance(&f, &v);
-        assert!(
-            (sd[0] - 0.25).abs() < 1e-12 && (sd[1] - 2.0).abs() < 1e-12,
-            "{sd:?}"
-        );
-        assert!((corr[0][1] - 0.25).abs() < 1e-12, "{corr:?}");
-        // With V = F the sandwich is F⁻¹: σ = (1/2, 1), uncorrelated.
-        let (sd, corr) = sandwich_covariance(&f, &f);
-        assert!(
-            (sd[0] - 0.5).abs() < 1e-12 && (sd[1] - 1.0).abs() < 1e-12,
-            "{sd:?}"
-        );
-        assert!(corr[0][1].abs() < 1e-12);
-    }
-
-    #[test]
-    fn sample_covariance_of_two_points_is_half_their_squared_difference() {
-        // Two vectors (0, 0) and (2, 4): mean (1, 2), divisor n − 1 = 1, so the covariance is
-        // [[2, 4], [4, 8]].
-        let c = sample_covariance(&[vec![0.0, 0.0], vec![2.0, 4.0]]);
-        assert_eq!(c, DMatrix::from_row_slice(2, 2, &[2.0, 4.0, 4.0, 8.0]));
-    }
-
-    #[test]
-    fn covariance_of_a_diagonal_information_is_its_inverse() {
-        // Independent parameters: Var = 1/F_ii, correlation 0.
-        let f = DMatrix::from_row_slice(2, 2, &[4.0, 0.0, 0.0, 100.0]);
-        let (sd, corr) = covariance(&f);
-        assert!((sd[0] - 0.5).abs() < 1e-12 && (sd[1] - 0.1).abs() < 1e-12);
-        assert!(corr[0][1].abs() < 1e-12);
-    }
-
-    #[test]
-    fn covariance_of_a_correlated_pair_matches_the_2x2_inverse() {
-        // F = [[a, b], [b, c]]: Var_0 = c/(ac − b²), corr = −b/√(ac).
-        let (a, b, c) = (3.0, 1.5, 2.0);
-        let f = DMatrix::from_row_slice(2, 2, &[a, b, b, c]);
-        let (sd, corr) = covariance(&f);
-        let det: f64 = a * c - b * b;
-        assert!((sd[0] - (c / det).sqrt()).abs() < 1e-12);
-        assert!((sd[1] - (a / det).sqrt()).abs() < 1e-12);
-        assert!((corr[0][1] + b / (a * c).sqrt()).abs() < 1e-12);
-    }
-
-    #[test]
-    fn a_parameter_without_information_is_undetermined() {
-        // The second parameter does not move the likelihood: infinite spread, NaN correlation,
-        // and the first keeps its own.
-        let f = DMatrix::from_row_slice(2, 2, &[4.0, 0.0, 0.0, 0.0]);
-        let (sd, corr) = covariance(&f);
-        assert!((sd[0] - 0.5).abs() < 1e-12);
-        assert!(sd[1].is_infinite());
-        assert!(corr[0][1].is_nan());
     }
 
     /// A bowl `0.5 (u − m)ᵀ Σ⁻¹ (u − m)` with σ = (0.01, 0.02) and correlation 0.5, plus (with

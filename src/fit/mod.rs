@@ -10,32 +10,22 @@
 //! rayon), then a Nelder–Mead polish from the best particle. Parameters are searched in normalised
 //! coordinates `u ∈ [0, 1]` (logarithmic for bounds spanning a factor ≥ 10).
 
-mod candidate;
 mod error;
 pub mod evidence;
-pub mod explore;
 /// The spectral features the fit compares (they belong to the spectrum stage).
 pub use crate::spectrum::features;
-pub mod instfreq;
 pub mod interrupt;
-pub mod job;
-pub mod likelihood;
-mod measure;
 mod problem;
-pub mod reach;
 pub mod result;
 pub mod scan;
 mod search;
 mod select;
-pub mod template;
 pub mod tolerance;
 mod uncertainty;
 pub mod warning;
 
-pub use candidate::{Candidate, NECK_BAND_MIN_HZ, smallest_capable_model};
-pub use error::{FitError, NoEvidence, NoHeadTrack, NoLikelihood};
-pub use measure::HEAD_KERNEL_SIGMA_S;
-pub use problem::{FAILED_COST, FreeParam, SpectralProblem, target_cost};
+pub use error::{FitError, NoEvidence, NoLikelihood};
+pub use problem::{FAILED_COST, SpectralProblem, target_cost};
 pub use result::{
     FitResult, FittedParam, HistoryPoint, Interval, IntervalMethod, ModelTrial, PeakComparison,
     RatioTest, SearchStage, SpreadSource, TrialEvidence,
@@ -49,14 +39,15 @@ pub use uncertainty::{
 pub use warning::{FitWarning, Severity, Warnings};
 
 use crate::Result;
+use crate::job::{self, Candidate, LoadedJob};
+use crate::likelihood;
+use crate::likelihood::measure::measure;
 use crate::model::BladeParams;
 use crate::simulate::blade::BladeSimulation;
 use crate::trace::Trace;
 use features::{Features, SignalKind};
-use job::LoadedJob;
 use std::sync::atomic::Ordering;
 
-use measure::measure;
 use search::{CandidateFit, confirm_deferred, descend_chosen, fit_candidates, progress_bar};
 
 /// The result plus what the report draws.
@@ -85,10 +76,10 @@ pub struct FitOutcome {
 pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let started = std::time::Instant::now();
     // Provenance: the hash of the recording as it was read.
-    let input_sha256 = result::sha256_file(&job.recording_path)?;
+    let input_sha256 = crate::io::sha256_file(&job.recording_path)?;
     let meas = measure(job)?;
     let fit = &job.job.fit;
-    let candidates = candidates_of(job);
+    let candidates = job.candidates();
     let pb = progress.then(|| progress_bar(job, &candidates));
     let mut fits = fit_candidates(job, &meas, &candidates, &pb)?;
     let gaps = select::score_gaps(&fits, &job.job.spectrum.bands);
@@ -329,18 +320,6 @@ fn misfit_warning(g: &likelihood::GoodnessOfFit, shoulder_listed: bool) -> Optio
     })
 }
 
-/// The candidates the job asks for, or the smallest model capable of its bands.
-fn candidates_of(job: &LoadedJob) -> Vec<Candidate> {
-    if job.job.fit.models.is_empty() {
-        vec![Candidate {
-            kind: smallest_capable_model(&job.job.spectrum.bands),
-            shoulder: false,
-        }]
-    } else {
-        job.job.fit.models.clone()
-    }
-}
-
 /// The chosen fit's intervals and their warnings, and whether the run was interrupted (then no
 /// intervals, and a warning saying what was left out).
 fn chosen_intervals(
@@ -552,7 +531,7 @@ fn failure_warning(problem: &SpectralProblem) -> Option<FitWarning> {
 /// The chosen problem's failed evaluations by cause (its own and its joint recordings').
 fn failure_causes(
     problem: &SpectralProblem,
-) -> std::collections::BTreeMap<explore::FailureCause, usize> {
+) -> std::collections::BTreeMap<crate::simulate::failure::FailureCause, usize> {
     let mut causes = std::collections::BTreeMap::new();
     for p in std::iter::once(problem).chain(&problem.others) {
         let by = p.failure_causes.lock().unwrap_or_else(|e| e.into_inner());
@@ -650,12 +629,6 @@ fn blade_modes(
 mod tests {
     use super::*;
     use crate::model::ParamId;
-    use crate::simulate::blade::ModelKind;
-    use features::BandSpec;
-
-    fn band(name: &str, lo: f64, hi: f64) -> BandSpec {
-        BandSpec::new(name, [lo, hi], 1024)
-    }
 
     /// The misfit warning fires only when the recording's statistic is beyond all but 1 % of its
     /// replicates', and quotes the numbers.
@@ -688,30 +661,6 @@ mod tests {
         let typical = likelihood::GoodnessOfFit::of(80.0, &replicates).unwrap();
         assert_eq!(misfit_warning(&typical, false), None);
         assert_eq!(misfit_warning(&typical, true), None);
-    }
-
-    /// The default chain: the head model for low bands only, the full blade as soon as a band
-    /// needs the neck–lip mode; the neck/lip model only when named.
-    #[test]
-    fn smallest_capable_model_follows_the_bands() {
-        let low = band("low", 30.0, 300.0);
-        let high = band("high", 500.0, 5000.0);
-        assert_eq!(
-            smallest_capable_model(std::slice::from_ref(&low)),
-            ModelKind::Head1dof
-        );
-        assert_eq!(
-            smallest_capable_model(std::slice::from_ref(&high)),
-            ModelKind::Blade2dof
-        );
-        assert_eq!(
-            smallest_capable_model(&[low.clone(), high]),
-            ModelKind::Blade2dof
-        );
-        // The neck/lip model imposes a low band, so it cannot produce one.
-        let nl = "necklip+shoulder".parse::<Candidate>().unwrap();
-        assert!(nl.shoulder && nl.kind == ModelKind::Necklip);
-        assert!(nl.cannot_produce(&[low]).is_some());
     }
 
     /// `[fit] swarm_rtol`: the swarm stage simulates at its own tolerance (atol scaled alike),

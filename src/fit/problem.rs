@@ -1,77 +1,25 @@
-//! The fit's cost problem: the freed parameters in normalised coordinates and everything one cost
-//! evaluation needs ([`SpectralProblem`]), as argmin sees it ([`Shared`]).
+//! The fit's cost problem: everything one cost evaluation needs ([`SpectralProblem`]), as argmin
+//! sees it ([`Shared`]).
 
 use super::features::{BandSpec, Features, SignalKind, features};
-use super::instfreq;
-use super::job::{Objective, Weights};
 use super::result::SearchStage;
 use crate::Result;
+use crate::job::{FreeParam, Objective, Weights};
+use crate::likelihood::instfreq;
 use crate::model::BladeParams;
-use crate::model::ParamId;
 use crate::model::blade::StickForm;
 use crate::simulate::SolverOptions;
 use crate::simulate::blade::{BladeSimulation, ModelKind, simulate_model};
 use argmin::core::CostFunction;
-use serde::Serialize;
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
-use super::explore::FailureCause;
+use crate::simulate::failure::FailureCause;
 
 /// Cost assigned to a parameter set whose simulation fails (contact loss, Painlevé, ...). Failures
 /// are counted and the first message is reported; they are never silent.
 pub const FAILED_COST: f64 = 1e9;
-
-/// One freed parameter: which, bounds, and whether it is searched on a log scale.
-#[derive(Debug, Clone, Serialize)]
-pub struct FreeParam {
-    pub name: ParamId,
-    pub lower: f64,
-    pub upper: f64,
-    pub log: bool,
-}
-
-impl FreeParam {
-    pub(super) fn new(name: ParamId, lower: f64, upper: f64) -> Self {
-        FreeParam {
-            name,
-            lower,
-            upper,
-            log: lower > 0.0 && upper / lower >= 10.0,
-        }
-    }
-    /// Physical value at normalised coordinate `u` (clamped to [0, 1]).
-    pub fn value(&self, u: f64) -> f64 {
-        self.value_unclamped(u.clamp(0.0, 1.0))
-    }
-    /// [`FreeParam::value`] without the clamp: the same map extended beyond the box (for interval
-    /// ends).
-    pub fn value_unclamped(&self, u: f64) -> f64 {
-        if self.log {
-            (self.lower.ln() + u * (self.upper / self.lower).ln()).exp()
-        } else {
-            self.lower + u * (self.upper - self.lower)
-        }
-    }
-    /// Normalised coordinate of `value` (the inverse of [`FreeParam::value`], clamped to [0, 1]).
-    pub fn u_of(&self, value: f64) -> f64 {
-        let u = if self.log {
-            (value / self.lower).ln() / (self.upper / self.lower).ln()
-        } else {
-            (value - self.lower) / (self.upper - self.lower)
-        };
-        u.clamp(0.0, 1.0)
-    }
-    /// d(value)/du at `u`.
-    pub fn slope(&self, u: f64) -> f64 {
-        if self.log {
-            self.value(u) * (self.upper / self.lower).ln()
-        } else {
-            self.upper - self.lower
-        }
-    }
-}
 
 /// Everything a cost evaluation needs; shared read-only between threads.
 pub struct SpectralProblem {
@@ -86,7 +34,7 @@ pub struct SpectralProblem {
     pub measured: Features,
     pub floors: Vec<f64>,
     /// Per band, whether the measured band has a line above its noise
-    /// ([`super::likelihood::band_has_line`]); [`SpectralProblem::cost_of`] compares peak
+    /// ([`crate::likelihood::band_has_line`]); [`SpectralProblem::cost_of`] compares peak
     /// frequencies only where it has.
     pub lines: Vec<bool>,
     pub bands: Vec<BandSpec>,

@@ -4,8 +4,8 @@
 //! Every type here is `Serialize + Deserialize`. Optional fields carry `#[serde(default)]`, so a
 //! result file without them loads (with the field empty).
 
-use super::Candidate;
-use super::job::{FitSection, SpectrumSection};
+use crate::job::Candidate;
+use crate::job::{FitSection, SpectrumSection};
 use crate::model::ParamId;
 use crate::names::named_enum;
 use crate::simulate::blade::ModelKind;
@@ -384,7 +384,7 @@ pub struct FitResult {
     /// `None` without a likelihood (a target job, a joint fit), when interrupted, and in results
     /// written before this field.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub goodness_of_fit: Option<crate::fit::likelihood::GoodnessOfFit>,
+    pub goodness_of_fit: Option<crate::likelihood::GoodnessOfFit>,
     /// The chosen optimum's cost again at tenfold and hundredfold tighter solver tolerances
     /// ([`crate::fit::tolerance::ToleranceCheck`]): whether the integrator resolves the likelihood
     /// there. `None` without a likelihood, for a joint fit, when interrupted, and in results written
@@ -417,7 +417,7 @@ impl FitResult {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct NoiseEstimate {
     /// The noise spectrum of the job (`white` or `ar1`).
-    pub spectrum: crate::fit::job::NoiseSpectrum,
+    pub spectrum: crate::job::NoiseSpectrum,
     /// Marginal standard deviation, m.
     pub sigma_m: f64,
     /// Lag-one autocorrelation (0 for white noise).
@@ -430,8 +430,8 @@ impl FitResult {
     /// # Errors
     /// [`Error::Io`] if unreadable; [`Error::Parse`] (line, column) if not a result TOML.
     pub fn read(path: &Path) -> Result<FitResult> {
-        let text = super::job::read_text(path)?;
-        super::job::parse_toml(path, &text)
+        let text = crate::job::read_text(path)?;
+        crate::job::parse_toml(path, &text)
     }
 
     /// The result as TOML text (`fits/<job>.result.toml`).
@@ -440,48 +440,9 @@ impl FitResult {
     }
 }
 
-/// SHA-256 (FIPS 180-4) of a file's bytes, lower-case hex.
-///
-/// # Errors
-/// [`Error::Io`] naming the file if it cannot be read.
-pub fn sha256_file(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, "cannot read", e))?;
-    Ok(sha256_hex(&bytes))
-}
-
-/// SHA-256 of `bytes`, lower-case hex (64 characters).
-pub fn sha256_hex(bytes: &[u8]) -> String {
-    use sha2::Digest;
-    use std::fmt::Write as _;
-    let digest = sha2::Sha256::digest(bytes);
-    let mut s = String::with_capacity(64);
-    for b in digest.iter() {
-        let _ = write!(s, "{b:02x}");
-    }
-    s
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn sha256_fips_180_2_vectors() {
-        // FIPS 180-2, Appendix B.1 ("abc") and B.2 (the 448-bit message); empty string: NIST CSRC
-        // example values for SHA-256.
-        assert_eq!(
-            sha256_hex(b"abc"),
-            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
-        );
-        assert_eq!(
-            sha256_hex(b"abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
-            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1"
-        );
-        assert_eq!(
-            sha256_hex(b""),
-            "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855"
-        );
-    }
 
     fn sample_parameter() -> FittedParam {
         FittedParam {
@@ -591,7 +552,7 @@ mod tests {
             data_files: vec!["psd_low.csv".into()],
             modes: vec![],
             interrupted: false,
-            goodness_of_fit: Some(crate::fit::likelihood::GoodnessOfFit {
+            goodness_of_fit: Some(crate::likelihood::GoodnessOfFit {
                 excess_nll_nats: 78.3,
                 replicate_mean_nats: 75.7,
                 replicate_sd_nats: 7.8,

@@ -1,4 +1,4 @@
-//! The contact-angle scan ([`super::job::ContactAngleScan`]): when the chosen model fails its
+//! The contact-angle scan ([`crate::job::ContactAngleScan`]): when the chosen model fails its
 //! goodness-of-fit test, each `+shoulder` candidate is searched again, once per slice of the
 //! contact angle θ_c, by its whole search (local polishes from the smaller model's optimum, the
 //! global restarts and their second batch) with θ_c bounded to the slice; the best slice's end,
@@ -16,16 +16,16 @@
 //! resting on its shoulder, θ_c below the median, has a wide basin the default search reaches) in
 //! overlapping slices of [`SLICE_LOG_WIDTH`] on the log scale.
 
-use super::candidate::Candidate;
 use super::interrupt;
-use super::job::{ContactAngleScan, LoadedJob};
-use super::likelihood::GoodnessOfFit;
-use super::measure::Measurement;
 use super::search::{
     CandidateFit, Confirmation, NESTED_WARM_POINTS, Optimised, Reporting, VALLEY_GAIN_NATS,
     add_note, fit_candidate, polish_budget, settle_anew, sorted_abs_theta,
 };
 use crate::Result;
+use crate::job::Candidate;
+use crate::job::{ContactAngleScan, LoadedJob};
+use crate::likelihood::GoodnessOfFit;
+use crate::likelihood::measure::Measurement;
 use crate::model::ParamId;
 use std::sync::atomic::Ordering;
 

@@ -2,14 +2,15 @@
 //! history and progress reported through argmin observers, and the cost's curvature at the optimum.
 
 use super::FitError;
-use super::candidate::Candidate;
 use super::evidence::RecordingLikelihood;
 use super::interrupt;
-use super::job::{self, LoadedJob};
-use super::measure::{Measurement, measure, measure_recording, necklip_view};
-use super::problem::{FreeParam, Pinned, Shared, SpectralProblem};
+use super::problem::{Pinned, Shared, SpectralProblem};
 use super::result::{HistoryPoint, SearchStage};
 use crate::Result;
+use crate::job::Candidate;
+use crate::job::FreeParam;
+use crate::job::{self, LoadedJob};
+use crate::likelihood::measure::{Measurement, measure, measure_recording, necklip_view};
 use crate::model::BladeParams;
 use crate::model::ParamId;
 use crate::simulate::SolverOptions;
@@ -357,7 +358,7 @@ pub(super) fn build_problem(
     meas: &Measurement,
     candidate: Candidate,
 ) -> Result<(SpectralProblem, Vec<FreeParam>)> {
-    let (base, free) = freed(job, candidate)?;
+    let (base, free) = job.freed(candidate)?;
     let evaluations = Arc::new(AtomicUsize::new(0));
     let build = |m: &Measurement, base: BladeParams, label: String| {
         let recording = Recording { m, base, label };
@@ -375,31 +376,6 @@ pub(super) fn build_problem(
         main.others.push(build(&m, b, more.name.clone())?);
     }
     Ok((main, free))
-}
-
-/// The base parameters and the freed ones of `candidate`: the job's, and for a shoulder candidate
-/// the shoulder's two, started at the middle of their `[fit.shoulder]` bounds.
-fn freed(job: &LoadedJob, candidate: Candidate) -> Result<(BladeParams, Vec<FreeParam>)> {
-    let mut base = job.blade;
-    let mut free: Vec<FreeParam> = job
-        .free
-        .iter()
-        .map(|&(n, lo, hi)| FreeParam::new(n, lo, hi))
-        .collect();
-    if candidate.shoulder {
-        let sb = job.job.fit.shoulder.ok_or(FitError::ShoulderBounds)?;
-        base.shoulder = Some(crate::model::Shoulder {
-            contact_angle_rad: 0.5 * (sb.theta_c[0] + sb.theta_c[1]),
-            k1_contact_nm_per_rad: 0.5 * (sb.k1c[0] + sb.k1c[1]),
-        });
-        free.push(FreeParam::new(ParamId::K1c, sb.k1c[0], sb.k1c[1]));
-        free.push(FreeParam::new(
-            ParamId::ThetaC,
-            sb.theta_c[0],
-            sb.theta_c[1],
-        ));
-    }
-    Ok((base, free))
 }
 
 /// One recording of a fit: its measurement, the blade's base parameters for it (its own drive) and
@@ -455,7 +431,7 @@ fn problem_of(
         lines: measured
             .bands
             .iter()
-            .map(super::likelihood::band_has_line)
+            .map(crate::likelihood::band_has_line)
             .collect(),
         measured,
         floors,
@@ -1008,7 +984,7 @@ fn search(
 }
 
 /// The NLL gain (nats) above which a nested candidate's local search is followed by the global one
-/// ([`crate::fit::job::NestedSearch::Adaptive`]): 0.1 nats, a likelihood-ratio statistic 2Δ = 0.2,
+/// ([`crate::job::NestedSearch::Adaptive`]): 0.1 nats, a likelihood-ratio statistic 2Δ = 0.2,
 /// below the 10th percentile of χ²₂, the law the global search's statistic follows when the two
 /// shoulder parameters add nothing. A smaller local gain says they do nothing near the smaller
 /// model's optimum. The local gain is not a test of the shoulder: a real shoulder away from the

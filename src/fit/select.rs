@@ -6,10 +6,10 @@
 //! compares `cost + 2k` ([`aic`]).
 
 use super::features::BandSpec;
-use super::likelihood::{self, Evidence};
 use super::problem::FAILED_COST;
 use super::result::{ModelTrial, RatioTest, TrialEvidence};
 use super::search::CandidateFit;
+use crate::likelihood::{self, Evidence};
 use std::sync::atomic::Ordering;
 
 /// Akaike's information criterion with the cost read as −2 ln L (a χ² on the cost's scales):

@@ -12,7 +12,8 @@
 //! smaller than the spread do not tell parameter sets apart, and intervals read from the local
 //! curvature at the 0.5-nat scale understate the uncertainty. The check costs two simulations.
 
-use super::{Candidate, FitWarning, SpectralProblem};
+use super::{FitWarning, SpectralProblem};
+use crate::job::Candidate;
 use serde::{Deserialize, Serialize};
 
 /// Factors by which the probes divide the job's `rtol` and `atol`.

@@ -2,8 +2,7 @@
 
 use super::evidence::RecordingLikelihood;
 use super::features::{features, noise_floor};
-use super::job::{self, NoiseSpectrum, UncertaintyMethod};
-use super::problem::{FreeParam, SpectralProblem};
+use super::problem::SpectralProblem;
 use super::result::{FittedParam, Interval, IntervalMethod};
 use super::search::{
     CandidateFit, Confirmation, POLISH_STEP_U, ProgressObserver, Reporting, optimise, polish,
@@ -11,6 +10,8 @@ use super::search::{
 };
 use super::warning::{End, FitWarning};
 use crate::Result;
+use crate::job::FreeParam;
+use crate::job::{self, NoiseSpectrum, UncertaintyMethod};
 use crate::simulate::blade::BladeSimulation;
 use crate::spectrum::stats::quantile_sorted;
 use rand::SeedableRng;

@@ -14,14 +14,14 @@
 //! recording and in the model, model evaluations that failed where the lip tip would leave the
 //! glass).
 
-use super::Candidate;
-use super::explore::FailureCause;
-use super::job::UncertaintyMethod;
-use super::likelihood::GoodnessOfFit;
 use super::tolerance::{SPREAD_WARN_NATS, TolerancePoint};
 use super::uncertainty::{PROFILE_68_NATS, PROFILE_MAX_STEPS};
+use crate::job::Candidate;
+use crate::job::UncertaintyMethod;
+use crate::likelihood::GoodnessOfFit;
 use crate::model::ParamId;
 use crate::names::named_enum;
+use crate::simulate::failure::FailureCause;
 use crate::spectrum::harmonics::{LineOrigin, MIN_PROMINENCE};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;

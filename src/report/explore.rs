@@ -3,10 +3,10 @@
 //! (`constraint.txt`, also in `sensitivity.md` and the terminal summary) and the reachability map
 //! (`reachability.svg`, the pair marked), from an [`Exploration`] computed upstream.
 
-use crate::fit::explore::{Exploration, Outcome, Sample, Sensitivity};
-use crate::fit::reach::{
+use crate::explore::reach::{
     BOUND_MARGIN, Constraint, EDGE_SHARE, MAX_LEVER_FACTOR, Push, Side, band_tolerance, constraint,
 };
+use crate::explore::{Exploration, Outcome, Sample, Sensitivity};
 use crate::report::plot::{Category, Panel, Target, scatter_panels};
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};
@@ -178,7 +178,7 @@ pub fn sensitivity_markdown(e: &Exploration) -> String {
         e.job,
         e.model,
         e.signal.label(),
-        100.0 * crate::fit::explore::OAT_STEP
+        100.0 * crate::explore::OAT_STEP
     );
     s += &oat_table(e, &e.sensitivity);
     s += "\n## Closest achievable pair and the constraint\n\n";
@@ -188,7 +188,7 @@ pub fn sensitivity_markdown(e: &Exploration) -> String {
     if let Some(k) = e.closest_pair {
         s += &format!(
             "\nAround sample {k}, each freed parameter moved alone by ±{:.0} % (a bound may be crossed):\n\n",
-            100.0 * crate::fit::explore::OAT_STEP
+            100.0 * crate::explore::OAT_STEP
         );
         s += &oat_table(e, &e.around_closest);
     }
@@ -248,7 +248,7 @@ fn pair_text(e: &Exploration, s: &Sample) -> String {
                 format!(
                     " against {} Hz ({:+.2} %)",
                     span_text(t),
-                    100.0 * crate::fit::reach::relative_miss(l.freq_hz, t)
+                    100.0 * crate::explore::reach::relative_miss(l.freq_hz, t)
                 )
             });
             format!(
@@ -344,7 +344,7 @@ fn binding_lines(e: &Exploration, c: &Constraint, s: &Sample, b: usize, miss: f6
         "Farthest from its target: band {name}, {f_hz:.1} Hz ({:+.2} %, {:.1} tolerances). Levers (elasticity d ln f / d ln θ from the sample's ±{:.0} % steps, both keeping an own, prominent line; first-order value for {goal} Hz within {}x of the sample's), strongest first:",
         100.0 * miss,
         miss.abs() / band_tolerance(b),
-        100.0 * crate::fit::explore::OAT_STEP,
+        100.0 * crate::explore::OAT_STEP,
         MAX_LEVER_FACTOR
     )];
     let mut levers: Vec<&Push> = c
@@ -428,7 +428,7 @@ fn check_verdict(e: &Exploration, o: &Outcome, b: usize, miss: f64) -> String {
     let (Some(lines), Some(t)) = (o.lines(), e.targets[b]) else {
         return ", where the simulation failed".into();
     };
-    let m = crate::fit::reach::relative_miss(lines[b].freq_hz, t);
+    let m = crate::explore::reach::relative_miss(lines[b].freq_hz, t);
     let how = if m.abs() <= band_tolerance(b) {
         "within the tolerance"
     } else if m.abs() < miss.abs() {
@@ -467,7 +467,7 @@ fn others_line(e: &Exploration, c: &Constraint, s: &Sample) -> Option<String> {
     if !jumps.is_empty() {
         parts.push(format!(
             "a ±{:.0} % step lost the band's own, prominent line (another line took its place, or the run failed): {}",
-            100.0 * crate::fit::explore::OAT_STEP,
+            100.0 * crate::explore::OAT_STEP,
             jumps.join(", ")
         ));
     }
@@ -486,7 +486,7 @@ fn outcome_text(e: &Exploration, o: &Outcome) -> String {
 }
 
 /// What the outer [`EDGE_SHARE`] of the box beside a bound gave, and the one-at-a-time step past it.
-fn edge_line(e: &Exploration, c: &Constraint, x: &crate::fit::reach::Edge) -> String {
+fn edge_line(e: &Exploration, c: &Constraint, x: &crate::explore::reach::Edge) -> String {
     let f = &e.free[x.param];
     let causes: Vec<String> = x.failures.iter().map(|(k, n)| format!("{k} {n}")).collect();
     let failed = x.samples - x.with_lines;
@@ -515,7 +515,7 @@ fn edge_line(e: &Exploration, c: &Constraint, x: &crate::fit::reach::Edge) -> St
         let what = outcome_text(e, o);
         s += &format!(
             "; the sample's ±{:.0} % step past it gave {what}",
-            100.0 * crate::fit::explore::OAT_STEP
+            100.0 * crate::explore::OAT_STEP
         );
     }
     s.push('.');
@@ -526,7 +526,7 @@ fn edge_line(e: &Exploration, c: &Constraint, x: &crate::fit::reach::Edge) -> St
 fn nearer_line(e: &Exploration, c: &Constraint, what: &str) -> Option<String> {
     let (k, d, band, flaw) = c.nearer.best?;
     let n: usize = c.nearer.by_flaw.iter().map(|x| x.1).sum();
-    let list = |v: &[(crate::fit::reach::LineFlaw, usize)]| {
+    let list = |v: &[(crate::explore::reach::LineFlaw, usize)]| {
         v.iter()
             .map(|(f, n)| format!("{f} {n}"))
             .collect::<Vec<_>>()

@@ -3,10 +3,10 @@
 
 use super::plot::{ChartOpts, Marker, Series, Span, heatmap, line_chart};
 use crate::fit::features::{BandFeatures, Features, noise_floor};
-use crate::fit::instfreq::FreqSpeedComparison;
-use crate::fit::job::Objective;
 use crate::fit::result::{HistoryPoint, SearchStage};
 use crate::fit::{FitOutcome, FitResult};
+use crate::job::Objective;
+use crate::likelihood::instfreq::FreqSpeedComparison;
 use crate::model::{FrictionLaw, ParamId};
 use crate::simulate::blade::{BladeSimulation, ContactForces};
 use crate::spectrum::Spectrogram;
@@ -361,7 +361,7 @@ fn band_psd_figure(
     m: &BandFeatures,
     targets_only: bool,
 ) -> Result<()> {
-    // The cost adds the measurement's noise floor to the model PSD (src/fit/mod.rs cost_of);
+    // The cost adds the measurement's noise floor to the model PSD (src/fit/problem.rs, `cost_of`);
     // without it the model's deep stick–slip troughs look like misfits they are not.
     let floor = noise_floor(d);
     let markers = band_psd_markers(o, d, m, targets_only);
@@ -720,7 +720,7 @@ pub fn fit_data_files(dir: &Path, o: &FitOutcome) -> Result<Vec<String>> {
 
 /// Writes `freq_vs_speed.svg` into `dir`: ridge and stick-onset rate against the tip's mean speed
 /// (mm/s), measurement and model on one chart, frequency axis limited to the comparison's band
-/// (computed upstream by [`crate::fit::instfreq::compare_freq_speed`]).
+/// (computed upstream by [`crate::likelihood::instfreq::compare_freq_speed`]).
 ///
 /// # Errors
 /// [`Error::Io`]/[`super::ReportError`] from drawing.

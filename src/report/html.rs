@@ -21,11 +21,12 @@
 //! `data-total`, `data-broken` = the failing `src`s separated by spaces). A reader sees it as a
 //! line at the end of the page; `tests/report_browser.rs` reads it from headless Chromium's DOM.
 
-use crate::fit::Candidate;
 use crate::fit::features::SignalKind;
-use crate::fit::job::FitSection;
-use crate::fit::result::{FitResult, sha256_file};
+use crate::fit::result::FitResult;
 use crate::fit::{FitWarning, Severity};
+use crate::io::sha256_file;
+use crate::job::Candidate;
+use crate::job::FitSection;
 pub use crate::report::warning::PageWarning;
 use crate::simulate::blade::ModelKind;
 use crate::{Error, Result};
@@ -370,7 +371,7 @@ fn mode_rows(r: &FitResult) -> Vec<ModeView> {
 }
 
 /// The goodness-of-fit test in a sentence.
-fn goodness_of_fit_words(g: &crate::fit::likelihood::GoodnessOfFit) -> String {
+fn goodness_of_fit_words(g: &crate::likelihood::GoodnessOfFit) -> String {
     let verdict = if g.fits() {
         "the model explains the recording's spectra to their noise"
     } else {
@@ -414,7 +415,7 @@ fn tolerance_check_words(t: &crate::fit::tolerance::ToleranceCheck) -> String {
 /// another, a band it cannot produce, what its likelihood-ratio test says, or that its AIC is
 /// higher.
 fn short_reason(r: &FitResult, t: &crate::fit::ModelTrial) -> String {
-    use crate::fit::NECK_BAND_MIN_HZ;
+    use crate::job::NECK_BAND_MIN_HZ;
     if t.chosen {
         let compared = r
             .model_trials
@@ -932,7 +933,7 @@ fn result_warnings(r: &FitResult) -> Vec<PageWarning> {
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
-    use crate::fit::result::sha256_hex;
+    use crate::io::sha256_hex;
 
     #[test]
     fn line_words_give_the_origin_and_the_prominence() {
@@ -1166,7 +1167,7 @@ pub(super) mod tests {
         r.parameters[1].determined = true;
         r.failed_evaluations = 0;
         // A fit its recording contradicts: the paragraph says so in words, with its numbers.
-        r.goodness_of_fit = Some(crate::fit::likelihood::GoodnessOfFit {
+        r.goodness_of_fit = Some(crate::likelihood::GoodnessOfFit {
             excess_nll_nats: 170.96,
             replicate_mean_nats: 78.37,
             replicate_sd_nats: 7.96,

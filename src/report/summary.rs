@@ -355,8 +355,8 @@ fn pct_abs(x: f64) -> String {
 mod tests {
     use super::*;
 
-    use crate::fit::likelihood::GoodnessOfFit;
     use crate::fit::tolerance::{ToleranceCheck, TolerancePoint};
+    use crate::likelihood::GoodnessOfFit;
 
     fn point(rtol: f64, cost_nats: f64) -> TolerancePoint {
         TolerancePoint {

@@ -3,11 +3,11 @@
 //! full sentence ([`std::fmt::Display`]) the page folds under it.
 
 use super::html::num;
-use crate::fit::explore::FailureCause;
-use crate::fit::job::UncertaintyMethod;
 use crate::fit::warning::LineSource;
 use crate::fit::{FitWarning, Severity};
+use crate::job::UncertaintyMethod;
 use crate::model::ParamId;
+use crate::simulate::failure::FailureCause;
 use crate::spectrum::harmonics::{LineOrigin, MIN_PROMINENCE};
 use std::fmt;
 use std::path::PathBuf;

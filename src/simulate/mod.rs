@@ -7,6 +7,7 @@ pub mod belt;
 pub mod blade;
 pub mod dop853;
 pub mod error;
+pub mod failure;
 pub mod hybrid;
 pub mod method;
 pub mod rk;

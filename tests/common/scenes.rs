@@ -9,8 +9,8 @@
 
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
-use wiperlab::fit::Candidate;
-use wiperlab::fit::job::LoadedJob;
+use wiperlab::job::Candidate;
+use wiperlab::job::LoadedJob;
 use wiperlab::model::{BladeParams, FrictionLaw, Shoulder, StickForm};
 use wiperlab::simulate::SolverOptions;
 use wiperlab::simulate::blade::{ModelKind, default_window, simulate_model};

@@ -14,14 +14,13 @@
 //! Samples run in parallel (rayon); each is independent of the others and of the thread count, so
 //! a seed gives the same table on any machine with the same build.
 
-use super::candidate::{Candidate, smallest_capable_model};
-use super::features::line_origin;
-use super::job::LoadedJob;
-use super::problem::{FreeParam, SpectralProblem};
+pub mod reach;
+
+use crate::fit::{FitError, SpectralProblem, problem_for};
+use crate::job::{Candidate, FreeParam, LoadedJob, smallest_capable_model};
 use crate::model::BladeParams;
-use crate::model::stick_slip::ModelFault;
-use crate::names::named_enum;
-use crate::simulate::error::{SimulationError, StopCause};
+use crate::simulate::failure::FailureCause;
+use crate::spectrum::features::line_origin;
 use crate::{Error, Result};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -34,42 +33,6 @@ pub const MAX_SAMPLES: usize = 1 << 16;
 
 /// Relative step of the one-at-a-time sensitivity around the start (5 %).
 pub const OAT_STEP: f64 = 0.05;
-
-named_enum! {
-    /// Why a sample gave no lines.
-    pub enum FailureCause: "failure cause" {
-        /// The lip tip left the glass (normal force N ≤ 0).
-        ContactLoss => "contact_loss",
-        /// The slip equations became singular (Painlevé-type).
-        Painleve => "painleve",
-        /// Another model fault: a singular system, no stick angle, no starting equilibrium.
-        ModelFault => "model_fault",
-        /// The adaptive step collapsed, or the step or transition budget ran out (Zeno).
-        StepBudget => "step_budget",
-        /// A band of the simulated signal holds no local maximum.
-        NoLine => "no_line",
-        /// Anything else (the message says what).
-        Other => "other",
-    }
-}
-
-impl FailureCause {
-    /// The cause of a failed simulation or feature computation.
-    pub fn of(e: &Error) -> FailureCause {
-        match SimulationError::of(e).map(|s| &s.cause) {
-            Some(StopCause::ContactLost { .. }) => FailureCause::ContactLoss,
-            Some(StopCause::Model(ModelFault::Painleve { .. })) => FailureCause::Painleve,
-            Some(StopCause::Model(_)) => FailureCause::ModelFault,
-            Some(
-                StopCause::StepSizeCollapse { .. }
-                | StopCause::StepBudget { .. }
-                | StopCause::TooManyTransitions { .. }
-                | StopCause::Zeno { .. },
-            ) => FailureCause::StepBudget,
-            _ => FailureCause::Other,
-        }
-    }
-}
 
 /// The line one band shows at one parameter set.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -136,18 +99,18 @@ pub struct Exploration {
     pub bands: Vec<(String, [f64; 2])>,
     /// Per band, the frequency range to reach: a target job's targets, else the recording's line.
     pub targets: Vec<Option<[f64; 2]>>,
-    pub signal: super::features::SignalKind,
+    pub signal: crate::spectrum::features::SignalKind,
     pub seed: u32,
     pub samples: Vec<Sample>,
     /// The job's start (the blade file's values of the freed parameters) and what it gave.
     pub start: Sample,
     pub sensitivity: Vec<Sensitivity>,
-    /// The closest achievable pair ([`super::reach::closest_pair`]): an index into `samples`.
+    /// The closest achievable pair ([`reach::closest_pair`]): an index into `samples`.
     pub closest_pair: Option<usize>,
     /// The one-at-a-time sensitivity around the closest achievable pair (empty without one).
     pub around_closest: Vec<Sensitivity>,
     /// The closest pair with each lever set to its first-order value, simulated ([`lever_checks`]).
-    pub lever_checks: Vec<super::reach::LeverCheck>,
+    pub lever_checks: Vec<reach::LeverCheck>,
     pub wall_time_s: f64,
     pub threads: usize,
 }
@@ -165,7 +128,7 @@ pub fn explored_candidate(job: &LoadedJob) -> Candidate {
 /// one-at-a-time sensitivity around the start; `progress` is moved once per simulation.
 ///
 /// # Errors
-/// [`super::FitError::Samples`] for 0 or more than [`MAX_SAMPLES`] samples; the errors of reading and
+/// [`FitError::Samples`] for 0 or more than [`MAX_SAMPLES`] samples; the errors of reading and
 /// measuring the job's recording. Failed simulations are outcomes, not errors.
 pub fn explore(
     job: &LoadedJob,
@@ -175,11 +138,11 @@ pub fn explore(
 ) -> Result<Exploration> {
     if samples == 0 || samples > MAX_SAMPLES {
         let max = MAX_SAMPLES;
-        return Err(super::FitError::Samples { samples, max }.into());
+        return Err(FitError::Samples { samples, max }.into());
     }
     let started = std::time::Instant::now();
     let candidate = explored_candidate(job);
-    let problem = super::problem_for(job, candidate)?;
+    let problem = problem_for(job, candidate)?;
     let dims = problem.free.len();
     let tick = || {
         if let Some(pb) = progress {
@@ -224,7 +187,7 @@ pub fn explore(
     };
     let sensitivity = oat(&start, &problem.base);
     let targets = targets(&problem);
-    let closest_pair = super::reach::closest_pair(&drawn, &targets).map(|c| c.sample);
+    let closest_pair = reach::closest_pair(&drawn, &targets).map(|c| c.sample);
     let around_closest = match closest_pair {
         Some(k) => oat(&drawn[k], &params_with(&problem, &drawn[k].values)),
         None => Vec::new(),
@@ -255,19 +218,19 @@ pub fn explore(
     Ok(e)
 }
 
-/// The closest achievable pair with each lever of its binding band ([`super::reach::Push`] within
-/// [`super::reach::MAX_LEVER_FACTOR`]) set alone to its first-order value, inside the box or beyond
+/// The closest achievable pair with each lever of its binding band ([`reach::Push`] within
+/// [`reach::MAX_LEVER_FACTOR`]) set alone to its first-order value, inside the box or beyond
 /// it, and simulated.
 fn lever_checks(
     problem: &SpectralProblem,
     e: &Exploration,
     tick: &(dyn Fn() + Sync),
-) -> Vec<super::reach::LeverCheck> {
+) -> Vec<reach::LeverCheck> {
     let Some(k) = e.closest_pair else {
         return Vec::new();
     };
     let at = &e.samples[k];
-    let c = super::reach::constraint(e);
+    let c = reach::constraint(e);
     c.pushes
         .par_iter()
         .filter(|p| p.is_lever(at.values[p.param]))
@@ -276,7 +239,7 @@ fn lever_checks(
             values[p.param] = p.needed;
             let outcome = outcome(problem, &params_with(problem, &values));
             tick();
-            super::reach::LeverCheck {
+            reach::LeverCheck {
                 param: p.param,
                 value: p.needed,
                 outcome,
@@ -437,7 +400,7 @@ impl Exploration {
     /// Whether sample `s` reaches every band's target: its line within `rel_tol` of the target
     /// (of the range's edges for a range), at least [`crate::spectrum::harmonics::MIN_PROMINENCE`]
     /// times its local floor, and not a harmonic of a stronger line (the criterion for the seed
-    /// paper's pairs, [`super::reach::band_tolerance`], takes 1 % for the low line and 2 % for the
+    /// paper's pairs, [`reach::band_tolerance`], takes 1 % for the low line and 2 % for the
     /// high one).
     pub fn reaches(&self, s: &Sample, rel_tol: &[f64]) -> bool {
         let Some(lines) = s.outcome.lines() else {

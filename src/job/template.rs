@@ -1,6 +1,6 @@
 //! A commented fit-job template for a recording (`wiperlab init`).
 //!
-//! The template is a complete job in the format of [`super::job::FitJob`] with every setting a
+//! The template is a complete job in the format of [`super::FitJob`] with every setting a
 //! user has to decide written out and explained. What the recording and the command line could
 //! not tell is marked: `MISSING` (the job does not run until it is filled in: the blade file, a
 //! frame rate for a file without times, a scale for a file in pixels) and `CHECK` (a guess that
@@ -110,14 +110,14 @@ fn roles(spec: &ImportSpec, summary: &ImportSummary) -> (Option<String>, Option<
 /// A TOML value as it is written in a file (strings quoted and escaped).
 fn toml_value<T: Serialize>(v: &T) -> Result<String> {
     let wrapped = toml::to_string(&std::collections::BTreeMap::from([("v", v)]))
-        .map_err(super::FitError::TomlValue)?;
+        .map_err(super::JobError::TomlValue)?;
     Ok(wrapped.trim_start_matches("v = ").trim_end().to_string())
 }
 
 /// The commented job template for `input` (see the module docs for what is marked).
 ///
 /// # Errors
-/// [`super::FitError`] if a value cannot be written as TOML (a non-UTF-8 path).
+/// [`super::JobError`] if a value cannot be written as TOML (a non-UTF-8 path).
 pub fn job_template(input: &TemplateInput) -> Result<String> {
     let s = input.summary;
     let spec = input.import;
@@ -128,7 +128,7 @@ pub fn job_template(input: &TemplateInput) -> Result<String> {
     let recording = input
         .recording
         .to_str()
-        .ok_or_else(|| super::FitError::PathNotUtf8 {
+        .ok_or_else(|| super::JobError::PathNotUtf8 {
             path: input.recording.to_path_buf(),
         })?;
     let ctx = minijinja::context! {
@@ -161,7 +161,7 @@ pub fn job_template(input: &TemplateInput) -> Result<String> {
     env.add_template("job.toml", TEMPLATE)
         .and_then(|_| env.get_template("job.toml"))
         .and_then(|t| t.render(ctx))
-        .map_err(|e| super::FitError::Template(e).into())
+        .map_err(|e| super::JobError::Template(e).into())
 }
 
 /// How many settings a template still marks: `(missing, check)`, counting the comment lines

@@ -73,6 +73,18 @@
 //!
 //! Units: PSD in (signal units)²/Hz (or units² for `Scaling::Spectrum`, consistently on both
 //! sides), σ in signal units, NLL in nats.
+//!
+//! What the likelihood and the cost read of a recording is measured here too: [`measure`] reads the
+//! recording (or a target job's targets) into features per band and noise floors, [`instfreq`]
+//! adds frequency against tip speed. [`covariance`] turns the likelihood's information into the
+//! spread of an estimate.
+
+pub mod covariance;
+mod error;
+pub mod instfreq;
+pub mod measure;
+
+pub use error::{MeasureError, NoHeadTrack};
 
 use crate::spectrum::instfreq::noise_sigma;
 use crate::spectrum::{Average, WelchConfig, Window, WindowSums};

@@ -6,7 +6,7 @@
 //!   (0 inside a range, (f − hi)/hi above it, (f − lo)/lo below) over the band's tolerance
 //!   ([`band_tolerance`]: 1 % for the first band, 2 % for the others, as for the seed paper's pairs), and
 //!   the largest of these. A sample with distance ≤ 1 whose lines are all their own and prominent
-//!   is one that [`super::explore::Exploration::reaches`] counts.
+//!   is one that [`super::Exploration::reaches`] counts.
 //! - **Closest achievable pair**: the sample of smallest distance among those whose every band's
 //!   line is its own (not a harmonic of a stronger line) and at least
 //!   [`MIN_PROMINENCE`] times its local floor, from a run that did not fail.
@@ -17,7 +17,7 @@
 //!   θ·(f_target/f)^(1/e), and whether it lies beyond a bound. Past each such bound, what the
 //!   outer [`EDGE_SHARE`] of the box on that side gave (failures by cause).
 
-use super::explore::{Exploration, FailureCause, Outcome, Sample, Sensitivity};
+use super::{Exploration, FailureCause, Outcome, Sample, Sensitivity};
 use crate::names::named_enum;
 use crate::spectrum::harmonics::MIN_PROMINENCE;
 use serde::Serialize;
@@ -68,7 +68,7 @@ named_enum! {
 }
 
 impl LineFlaw {
-    fn of(l: &super::explore::BandLine) -> Option<LineFlaw> {
+    fn of(l: &super::BandLine) -> Option<LineFlaw> {
         if l.harmonic_of_hz.is_some() {
             Some(LineFlaw::Harmonic)
         } else if !l.prominence.is_finite() {
@@ -210,7 +210,7 @@ impl Push {
 }
 
 /// One freed parameter of the closest sample set to its first-order value ([`Push::needed`]) and
-/// simulated: what the linear estimate is worth (computed by [`super::explore::explore`]).
+/// simulated: what the linear estimate is worth (computed by [`super::explore`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LeverCheck {
     pub param: usize,
@@ -436,8 +436,8 @@ pub fn constraint(e: &Exploration) -> Constraint {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fit::explore::BandLine;
-    use crate::fit::problem::FreeParam;
+    use crate::explore::BandLine;
+    use crate::job::FreeParam;
     use crate::model::ParamId;
 
     fn line(freq_hz: f64, prominence: f64, harmonic_of_hz: Option<f64>) -> BandLine {

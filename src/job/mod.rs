@@ -1,12 +1,22 @@
 //! The fit job file (TOML): which recording, which blade, which parameters to free, and settings.
 //!
-//! Paths inside a job are relative to the job file. Example: `fits/reversal.toml`.
+//! Paths inside a job are relative to the job file. Example: `fits/reversal.toml`. The stage also
+//! names the job's candidate models ([`Candidate`]) and writes a new job from its template
+//! ([`template`], `wiperlab init`).
 
-use super::Candidate;
-use super::features::{BandSpec, SignalKind, default_bands};
+mod candidate;
+mod error;
+mod free;
+pub mod template;
+
+pub use candidate::{Candidate, NECK_BAND_MIN_HZ, smallest_capable_model};
+pub use error::JobError;
+pub use free::FreeParam;
+
 use crate::import::ImportSpec;
 use crate::model::{BladeParams, ParamId};
 use crate::simulate::SolverOptions;
+use crate::spectrum::features::{BandSpec, SignalKind, default_bands};
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -150,7 +160,7 @@ impl Default for SpectrumSection {
     }
 }
 
-/// Cost weights (see [`super::SpectralProblem::cost_of`]).
+/// Cost weights (see [`crate::fit::SpectralProblem::cost_of`]).
 #[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct Weights {
@@ -161,10 +171,10 @@ pub struct Weights {
     /// Weight of the mean squared log-PSD difference across each band.
     pub shape: f64,
     /// Weight of the instantaneous frequency against tip speed (spectrogram ridge, binned by
-    /// speed; `(Δln f / 0.01)²` per bin, see [`super::instfreq`]). Default 0: off.
+    /// speed; `(Δln f / 0.01)²` per bin, see [`crate::likelihood::instfreq`]). Default 0: off.
     pub freq_speed: f64,
     /// Weight of the time-domain error of the job's signal (means removed, relative to the
-    /// measurement's variance; see [`super::instfreq::trace_error`]). Default 0: off.
+    /// measurement's variance; see [`crate::likelihood::instfreq::trace_error`]). Default 0: off.
     pub trace: f64,
 }
 
@@ -218,7 +228,7 @@ pub struct FitSection {
     pub weights: Weights,
     /// Models of the hierarchy to fit and compare ([`Candidate`]), e.g. `["head1dof",
     /// "blade2dof", "blade2dof+shoulder"]`. Empty (the default): only the smallest model that can produce every
-    /// band the job asks for (see [`crate::fit::smallest_capable_model`]). With several, each is
+    /// band the job asks for (see [`crate::job::smallest_capable_model`]). With several, each is
     /// fitted and the one with the lowest Akaike criterion (cost + 2k) is reported.
     #[serde(default)]
     pub models: Vec<Candidate>,
@@ -598,6 +608,46 @@ impl LoadedJob {
 }
 
 impl LoadedJob {
+    /// The candidates the job asks for, or the smallest model capable of its bands.
+    pub fn candidates(&self) -> Vec<Candidate> {
+        if self.job.fit.models.is_empty() {
+            vec![Candidate {
+                kind: smallest_capable_model(&self.job.spectrum.bands),
+                shoulder: false,
+            }]
+        } else {
+            self.job.fit.models.clone()
+        }
+    }
+
+    /// The base parameters and the freed ones of `candidate`: the job's, and for a shoulder candidate
+    /// the shoulder's two, started at the middle of their `[fit.shoulder]` bounds.
+    ///
+    /// # Errors
+    /// [`JobError::ShoulderBounds`] for a shoulder candidate without `[fit.shoulder]` bounds.
+    pub fn freed(&self, candidate: Candidate) -> Result<(BladeParams, Vec<FreeParam>)> {
+        let mut base = self.blade;
+        let mut free: Vec<FreeParam> = self
+            .free
+            .iter()
+            .map(|&(n, lo, hi)| FreeParam::new(n, lo, hi))
+            .collect();
+        if candidate.shoulder {
+            let sb = self.job.fit.shoulder.ok_or(JobError::ShoulderBounds)?;
+            base.shoulder = Some(crate::model::Shoulder {
+                contact_angle_rad: 0.5 * (sb.theta_c[0] + sb.theta_c[1]),
+                k1_contact_nm_per_rad: 0.5 * (sb.k1c[0] + sb.k1c[1]),
+            });
+            free.push(FreeParam::new(ParamId::K1c, sb.k1c[0], sb.k1c[1]));
+            free.push(FreeParam::new(
+                ParamId::ThetaC,
+                sb.theta_c[0],
+                sb.theta_c[1],
+            ));
+        }
+        Ok((base, free))
+    }
+
     /// `<job dir>/<reports_dir>` (default `<job dir>/reports`): where the job's figures, report
     /// page and exploration go, wherever the command runs.
     pub fn reports_dir(&self) -> PathBuf {

@@ -19,12 +19,13 @@
 //!
 //! Units: s, m, m/s, Hz.
 
-use super::features::SignalKind;
-use super::job::Weights;
+use super::MeasureError;
 use crate::Result;
+use crate::job::Weights;
 use crate::simulate::blade::BladeSimulation;
 use crate::simulate::hybrid::Phase;
 use crate::spectrum::SpectrumError;
+use crate::spectrum::features::SignalKind;
 use crate::spectrum::instfreq::{
     FreqSpeedPoint, RidgeConfig, StickDetector, band_floor, bin_by_speed, detect_stick_onsets,
     onset_rate_vs_speed, ridge_vs_speed,
@@ -49,7 +50,7 @@ fn tip_x(trace: &Trace) -> Result<&[f64]> {
     trace
         .role(Role::Tip)
         .map(|p| p.x_m.as_slice())
-        .ok_or_else(|| super::FitError::NoTip.into())
+        .ok_or_else(|| MeasureError::NoTip.into())
 }
 
 /// Ridge and stick-onset rate of a measured, uniformly sampled trace (`fs_hz`, first frame at
@@ -57,7 +58,7 @@ fn tip_x(trace: &Trace) -> Result<&[f64]> {
 /// stick onsets.
 ///
 /// # Errors
-/// [`super::FitError::NoTip`] / [`crate::spectrum::SpectrumError`] for a trace without `tip` (or `head` when `signal` needs it) or bad settings.
+/// [`MeasureError::NoTip`] / [`crate::spectrum::SpectrumError`] for a trace without `tip` (or `head` when `signal` needs it) or bad settings.
 /// A trace whose noise cannot be estimated gives no onsets and a [`FreqSpeed::note`], not an error.
 pub fn measured_freq_speed(
     trace: &Trace,
@@ -154,7 +155,7 @@ impl TimeTargets {
     /// (nothing is computed then). `x` is the job's signal of `trace`, sampled at `fs_hz`.
     ///
     /// # Errors
-    /// [`super::FitError`] for a negative weight, a trace without `tip` when `freq_speed > 0`, or no
+    /// [`MeasureError`] for a negative weight, a trace without `tip` when `freq_speed > 0`, or no
     /// ridge point in the measurement (the term would have nothing to compare).
     pub fn for_job(
         weights: &Weights,
@@ -164,7 +165,7 @@ impl TimeTargets {
         signal: SignalKind,
     ) -> Result<Option<TimeTargets>> {
         if !(weights.freq_speed >= 0.0 && weights.trace >= 0.0) {
-            return Err(super::FitError::NegativeWeights {
+            return Err(MeasureError::NegativeWeights {
                 freq_speed: weights.freq_speed,
                 trace: weights.trace,
             }
@@ -190,7 +191,7 @@ impl TimeTargets {
             let ridge = ridge_vs_speed(t0, fs_hz, x, tip, &cfg, 0.0)?;
             let vmax = ridge.iter().map(|p| p.speed_m_per_s).fold(0.0, f64::max);
             if ridge.is_empty() || vmax <= 0.0 {
-                return Err(super::FitError::NoRidgePoint {
+                return Err(MeasureError::NoRidgePoint {
                     signal: signal.label(),
                     band_hz: cfg.band_hz,
                     min_snr: cfg.min_snr,
@@ -269,23 +270,29 @@ pub struct FreqSpeedComparison {
     pub band_hz: (f64, f64),
 }
 
-/// The measured and fitted-model instantaneous frequency against lip-tip speed of a fit outcome,
-/// with the default ridge and stick-detector settings. `None` when the recording has no `tip`
-/// point or neither estimator finds a point in the band.
+/// The measured and fitted-model instantaneous frequency against lip-tip speed of a fit outcome
+/// (the recording `measured_trace` at `fs_hz`, the best fit's simulation `best_sim`, the job's
+/// `signal`), with the default ridge and stick-detector settings. `None` when the recording has no
+/// `tip` point or neither estimator finds a point in the band.
 ///
 /// # Errors
 /// Those of [`measured_freq_speed`] and [`model_freq_speed`].
-pub fn compare_freq_speed(o: &super::FitOutcome) -> Result<Option<FreqSpeedComparison>> {
-    if o.measured_trace.role(Role::Tip).is_none() {
+pub fn compare_freq_speed(
+    measured_trace: &Trace,
+    best_sim: &BladeSimulation,
+    fs_hz: f64,
+    signal: SignalKind,
+) -> Result<Option<FreqSpeedComparison>> {
+    if measured_trace.role(Role::Tip).is_none() {
         return Ok(None);
     }
     let cfg = RidgeConfig::default();
     let stick = StickDetector::default();
-    let measured = measured_freq_speed(&o.measured_trace, o.fs_hz, o.signal, &cfg, &stick)?;
-    let x = o.signal.extract(&o.measured_trace)?;
+    let measured = measured_freq_speed(measured_trace, fs_hz, signal, &cfg, &stick)?;
+    let x = signal.extract(measured_trace)?;
     let mask: Vec<bool> = x.iter().map(|v| !v.is_finite()).collect();
-    let floor = band_floor(&x, o.fs_hz, &cfg)?;
-    let model = model_freq_speed(&o.best_sim, o.fs_hz, o.signal, &cfg, floor, &mask)?;
+    let floor = band_floor(&x, fs_hz, &cfg)?;
+    let model = model_freq_speed(best_sim, fs_hz, signal, &cfg, floor, &mask)?;
     let in_band = |p: &[FreqSpeedPoint]| {
         p.iter()
             .any(|q| q.freq_hz >= cfg.band_hz.0 && q.freq_hz <= cfg.band_hz.1)

@@ -1,29 +1,29 @@
 //! The measured side of a fit: the recording read, its features per band and its noise floors, or
 //! a target job's targets.
 
-use super::features::{self, Features, features, noise_floor};
 use super::instfreq;
-use super::job::{self, LoadedJob};
-use super::{FitError, NoHeadTrack};
+use super::{MeasureError, NoHeadTrack};
+use crate::job::{self, LoadedJob};
 use crate::model::BladeParams;
+use crate::spectrum::features::{self, Features, features, noise_floor};
 use crate::trace::{Role, Trace};
 use crate::{Error, Result};
 use std::sync::Arc;
 
 /// Sampling rate of a trace: the recording's fps if given, else from the time column. Errors if
 /// the frame times are not uniform to 1e-6 relative (resample first).
-pub(super) fn sampling_rate(trace: &Trace, fps: Option<f64>) -> Result<f64> {
+pub(crate) fn sampling_rate(trace: &Trace, fps: Option<f64>) -> Result<f64> {
     let fs = match fps {
         Some(f) => f,
         None => crate::spectrum::median_rate_hz(&trace.t_s),
     };
     if !(fs.is_finite() && fs > 0.0) {
-        return Err(FitError::NoFrameRate { median_rate_hz: fs }.into());
+        return Err(MeasureError::NoFrameRate { median_rate_hz: fs }.into());
     }
     let dt = 1.0 / fs;
     for w in trace.t_s.windows(2) {
         if ((w[1] - w[0]) - dt).abs() > 1e-6 * dt.max(1e-12) * 1e3 {
-            return Err(FitError::NonUniformFrames {
+            return Err(MeasureError::NonUniformFrames {
                 fs_hz: fs,
                 step_s: w[1] - w[0],
             }
@@ -41,26 +41,26 @@ pub(super) fn sampling_rate(trace: &Trace, fps: Option<f64>) -> Result<f64> {
 pub const HEAD_KERNEL_SIGMA_S: f64 = 5e-4;
 
 /// The measured side of a fit, shared by every candidate.
-pub(super) struct Measurement {
+pub(crate) struct Measurement {
     /// The head drop `−y` of the `head` point and the lean (tip x − head x), smoothed, for the
     /// neck/lip model; why not, when the recording cannot give them.
-    pub(super) head: std::result::Result<Arc<crate::model::necklip::PrescribedHead>, NoHeadTrack>,
+    pub(crate) head: std::result::Result<Arc<crate::model::necklip::PrescribedHead>, NoHeadTrack>,
     /// Target ranges per band (a target job), instead of measured peaks.
-    pub(super) targets: Option<Vec<[f64; 2]>>,
+    pub(crate) targets: Option<Vec<[f64; 2]>>,
     /// Time-domain objectives (frequency against tip speed, trace error) when weighted.
-    pub(super) time_targets: Option<instfreq::TimeTargets>,
-    pub(super) trace: Trace,
-    pub(super) x: Vec<f64>,
-    pub(super) fs_hz: f64,
-    pub(super) measured: Features,
-    pub(super) floors: Vec<f64>,
+    pub(crate) time_targets: Option<instfreq::TimeTargets>,
+    pub(crate) trace: Trace,
+    pub(crate) x: Vec<f64>,
+    pub(crate) fs_hz: f64,
+    pub(crate) measured: Features,
+    pub(crate) floors: Vec<f64>,
 }
 
 /// The measurement as the neck/lip model sees it: the samples in the guard around the blade's flip
 /// (where the model does not run, [`crate::model::necklip::PrescribedHead::segments`]) are masked,
 /// and the measured features and noise floors are taken again without them, so that measurement
 /// and model are compared on the same samples. Returns `(features, floors, NaN mask)`.
-pub(super) fn necklip_view(
+pub(crate) fn necklip_view(
     job: &LoadedJob,
     m: &Measurement,
     base: &BladeParams,
@@ -68,7 +68,7 @@ pub(super) fn necklip_view(
     let head = m
         .head
         .as_ref()
-        .map_err(|e| FitError::NecklipNeedsTracks { reason: e.clone() })?;
+        .map_err(|e| MeasureError::NecklipNeedsTracks { reason: e.clone() })?;
     let t = &m.trace.t_s;
     let window = (t[0], *t.last().unwrap_or(&t[0]));
     let guard = crate::model::necklip::FLIP_GUARD_OF_REACH * (base.l1_m + base.l2_m);
@@ -131,7 +131,7 @@ fn check_bands(job: &LoadedJob, path: &std::path::Path, n: usize, fs_hz: f64) ->
 }
 
 /// Reads the recording and its features.
-pub(super) fn measure_recording(
+pub(crate) fn measure_recording(
     job: &LoadedJob,
     path: &std::path::Path,
     spec: &crate::import::ImportSpec,
@@ -206,20 +206,20 @@ pub(super) fn measure_recording(
 
 /// A target job's "measurement": the model's default reversal window sampled at the target rate, no
 /// recorded points, and per band the target range.
-pub(super) fn measure_targets(job: &LoadedJob, t: &job::TargetsSection) -> Result<Measurement> {
+pub(crate) fn measure_targets(job: &LoadedJob, t: &job::TargetsSection) -> Result<Measurement> {
     let (t0, t1) = crate::simulate::blade::default_window(&job.blade);
     let n = ((t1 - t0) * t.fps_hz).floor() as usize + 1;
     let times: Vec<f64> = (0..n).map(|k| t0 + k as f64 / t.fps_hz).collect();
     let mut targets = Vec::new();
     let mut bands = Vec::new();
     for b in &job.job.spectrum.bands {
-        let tp = t
-            .peaks
-            .iter()
-            .find(|p| p.band == b.name)
-            .ok_or_else(|| FitError::NoTarget {
-                band: b.name.clone(),
-            })?;
+        let tp =
+            t.peaks
+                .iter()
+                .find(|p| p.band == b.name)
+                .ok_or_else(|| MeasureError::NoTarget {
+                    band: b.name.clone(),
+                })?;
         let r = tp.range();
         targets.push(r);
         bands.push(features::BandFeatures {
@@ -253,10 +253,10 @@ pub(super) fn measure_targets(job: &LoadedJob, t: &job::TargetsSection) -> Resul
 }
 
 /// The job's measured side: its recording measured, or its targets.
-pub(super) fn measure(job: &LoadedJob) -> Result<Measurement> {
+pub(crate) fn measure(job: &LoadedJob) -> Result<Measurement> {
     match (&job.job.recording, &job.job.targets) {
         (Some(rec), _) => measure_recording(job, &job.recording_path, &rec.import),
         (None, Some(t)) => measure_targets(job, t),
-        (None, None) => Err(FitError::NothingToFit.into()),
+        (None, None) => Err(MeasureError::NothingToFit.into()),
     }
 }

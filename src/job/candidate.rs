@@ -1,8 +1,8 @@
 //! The model hierarchy a fit chooses from: candidates ([`Candidate`]) and which bands each can
 //! produce.
 
-use super::features::BandSpec;
 use crate::simulate::blade::ModelKind;
+use crate::spectrum::features::BandSpec;
 use serde::Serialize;
 
 /// Lower edge of a band, Hz, at or above which the band asks for the neck–lip mode. The head
@@ -146,4 +146,37 @@ pub fn smallest_capable_model(bands: &[BandSpec]) -> ModelKind {
             .is_none()
         })
         .unwrap_or(ModelKind::Blade2dof)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn band(name: &str, lo: f64, hi: f64) -> BandSpec {
+        BandSpec::new(name, [lo, hi], 1024)
+    }
+
+    /// The default chain: the head model for low bands only, the full blade as soon as a band
+    /// needs the neck–lip mode; the neck/lip model only when named.
+    #[test]
+    fn smallest_capable_model_follows_the_bands() {
+        let low = band("low", 30.0, 300.0);
+        let high = band("high", 500.0, 5000.0);
+        assert_eq!(
+            smallest_capable_model(std::slice::from_ref(&low)),
+            ModelKind::Head1dof
+        );
+        assert_eq!(
+            smallest_capable_model(std::slice::from_ref(&high)),
+            ModelKind::Blade2dof
+        );
+        assert_eq!(
+            smallest_capable_model(&[low.clone(), high]),
+            ModelKind::Blade2dof
+        );
+        // The neck/lip model imposes a low band, so it cannot produce one.
+        let nl = "necklip+shoulder".parse::<Candidate>().unwrap();
+        assert!(nl.shoulder && nl.kind == ModelKind::Necklip);
+        assert!(nl.cannot_produce(&[low]).is_some());
+    }
 }
