@@ -321,44 +321,13 @@ impl fmt::Display for FitWarning {
             ),
             NoGoodnessOfFit { reason } => write!(f, "no goodness-of-fit test: {reason}"),
             TruthMoreLikely {
-                fit_cost_nats: fit,
-                truth_cost_nats: truth,
-            } => write!(
-                f,
-                "the truth is more likely than the fit: cost {truth:.2} nats at the true \
-                 parameters against {fit:.2} at the fit ({:.2} nats short): the search stopped \
-                 before the likelihood's maximum, so the fitted values and their intervals \
-                 describe a point that is not the estimate",
-                fit - truth
-            ),
+                fit_cost_nats,
+                truth_cost_nats,
+            } => truth_more_likely(f, *fit_cost_nats, *truth_cost_nats),
             Misfit {
-                test: g,
+                test,
                 shoulder_listed,
-            } => {
-                write!(
-                    f,
-                    "the chosen model does not explain the recording's spectra to their noise: \
-                     excess NLL {:.1} nats against {:.1} ± {:.1} for {} noise replicates of the \
-                     fit (p = {:.3}, {:.1}σ); the recording holds structure no candidate \
-                     reproduces, or the search missed a candidate's basin, and the fitted \
-                     parameters may be bent to absorb it",
-                    g.excess_nll_nats,
-                    g.replicate_mean_nats,
-                    g.replicate_sd_nats,
-                    g.replicates,
-                    g.p_value,
-                    g.z()
-                )?;
-                if *shoulder_listed {
-                    f.write_str(
-                        "; a shoulder the neck touches only at the peaks of its swing has a basin \
-                         a few per cent wide in theta_c that the search can miss: bounding \
-                         [fit.shoulder] theta_c to a contact angle known from the blade's drawing \
-                         lets it find one (docs/fit.md, \"Shoulder contact\")",
-                    )?;
-                }
-                Ok(())
-            }
+            } => misfit(f, test, *shoulder_listed),
             AbsorbsModelStructure {
                 parameter,
                 chosen,
@@ -366,11 +335,11 @@ impl fmt::Display for FitWarning {
                 other,
                 other_value,
                 sigmas,
-            } => write!(
+            } => absorbs_model_structure(
                 f,
-                "{parameter} moves from {value:.6} ({chosen}) to {other_value:.6} ({other}), \
-                 {sigmas:.1}σ: it absorbs structure one model has and the other has not, so its \
-                 value depends on the model choice"
+                *parameter,
+                [(chosen, *value), (other, *other_value)],
+                *sigmas,
             ),
             Line {
                 band,
@@ -382,163 +351,326 @@ impl fmt::Display for FitWarning {
                     .concern(&line_name(*source, band))
                     .unwrap_or_else(|| format!("{} needs no warning", line_name(*source, band))),
             ),
-            Undetermined { parameter } => write!(
-                f,
-                "{parameter} is not determined by the data: its 1σ spans 10 % or more of its \
-                 search range"
-            ),
+            Undetermined { parameter } => undetermined(f, *parameter),
             TradeOff {
                 first,
                 second,
                 correlation,
-            } => write!(
-                f,
-                "{first} and {second} trade off (correlation {correlation:+.3}): the data pin \
-                 down a combination of them, not each"
-            ),
+            } => trade_off(f, [*first, *second], *correlation),
             OnBound {
                 parameter,
                 bound,
                 value,
-            } => write!(
-                f,
-                "{parameter} ended on its {bound} bound ({value}); widen the bound or fix the \
-                 parameter"
-            ),
+            } => on_bound(f, *parameter, *bound, *value),
             ProfileAtBound {
                 parameter,
                 rise_limit_nats,
                 bounds,
-            } => write!(
-                f,
-                "{parameter}'s profile likelihood stays within {rise_limit_nats:.3} nats of the \
-                 fit up to its search box's {} bound: the recording does not bound it there",
-                bounds
-                    .iter()
-                    .map(|b| b.name())
-                    .collect::<Vec<_>>()
-                    .join(" and ")
-            ),
+            } => profile_at_bound(f, *parameter, *rise_limit_nats, bounds),
             ProfileOpen {
                 parameter,
                 rise_limit_nats,
                 end,
                 value,
-            } => write!(
-                f,
-                "{parameter}'s profile likelihood stays within {rise_limit_nats:.3} nats of the \
-                 fit over the walk's {PROFILE_MAX_STEPS} steps: its {end} end ({value:.4e}) is \
-                 the last step, not where the likelihood bounds it"
-            ),
+            } => profile_open(f, *parameter, *rise_limit_nats, *end, *value),
             ProfileMoreLikely {
                 parameter,
                 gain_nats,
                 value,
-            } => write!(
-                f,
-                "{parameter}'s profile met a point {gain_nats:.2} nats more likely than the fit \
-                 ({parameter} = {value:.4e}): the search ended short of the likelihood's maximum"
-            ),
+            } => profile_more_likely(f, *parameter, *gain_nats, *value),
             WidenedInterval {
                 parameter,
                 rise_limit_nats,
-                points: [p_lo, p_hi],
-                method: [lo0, hi0],
-                widened: [lo, hi],
-            } => write!(
-                f,
-                "{parameter}: points the search evaluated within {rise_limit_nats:.2} nats of the \
-                 fit span {p_lo:.4e} to {p_hi:.4e}, beyond the method's own interval \
-                 [{lo0:.4e}, {hi0:.4e}]: the likelihood is flatter there than that interval \
-                 says, so it is widened to [{lo:.4e}, {hi:.4e}]"
-            ),
-            ShortOfBestEvaluation { gain_nats } => write!(
-                f,
-                "the search evaluated a point {gain_nats:.2} nats more likely than the fit: it \
-                 ended short of its own best evaluation"
-            ),
-            ContactRidge { k1_lo, k1_hi } => write!(
-                f,
-                "k1 and theta_c trade along the shoulder's contact-moment ridge ((k1c − k1)·θ_c \
-                 held): k1 from {k1_lo:.4e} to {k1_hi:.4e} N·m/rad stays within \
-                 {PROFILE_68_NATS} nats of the fit, so both intervals span it; the recording \
-                 determines the moment at contact, not k1 and theta_c apart"
-            ),
-            NoIntervals { method, reason } => match method {
-                UncertaintyMethod::Laplace => write!(f, "no Laplace intervals: {reason}"),
-                UncertaintyMethod::Profile => {
-                    write!(f, "no profile-likelihood intervals: {reason}")
-                }
-                UncertaintyMethod::Bootstrap => write!(f, "no bootstrap intervals: {reason}"),
-            },
+                points,
+                method,
+                widened,
+            } => widened_interval(f, *parameter, *rise_limit_nats, [points, method, widened]),
+            ShortOfBestEvaluation { gain_nats } => short_of_best_evaluation(f, *gain_nats),
+            ContactRidge { k1_lo, k1_hi } => contact_ridge(f, *k1_lo, *k1_hi),
+            NoIntervals { method, reason } => no_intervals(f, *method, reason),
             TargetJobIntervals => {
                 f.write_str("no intervals for a target job: targets carry no measurement noise")
             }
             NoBootstrapReplicates => {
                 f.write_str("no bootstrap intervals: [fit.uncertainty] bootstrap = 0 replicates")
             }
-            ToleranceNotProbed { failures } => write!(
-                f,
-                "the tolerance check did not run: every probe failed ({}), so it is not known \
-                 whether the integrator resolves the likelihood at the optimum (docs/fit.md, \
-                 \"Tolerance check\")",
-                failures.join("; ")
-            ),
+            ToleranceNotProbed { failures } => tolerance_not_probed(f, failures),
             ToleranceUnresolved {
                 points,
                 spread_nats,
-            } => {
-                let at: Vec<String> = points
-                    .iter()
-                    .map(|p| {
-                        format!(
-                            "{:.3} nats at rtol {:e} ({} transitions)",
-                            p.cost_nats, p.rtol, p.transitions
-                        )
-                    })
-                    .collect();
-                write!(
-                    f,
-                    "the likelihood at the optimum is not resolved by the integrator: {} ({:.2} \
-                     nats apart, more than the {SPREAD_WARN_NATS} nats of a 1σ interval); the \
-                     stick–slip sequence hangs on grazing events, so the cost surface is rough \
-                     at that depth, cost differences below it do not tell parameter sets apart \
-                     and the intervals understate the uncertainty (docs/fit.md, \"Tolerance \
-                     check\")",
-                    crate::names::join(&at, ", "),
-                    spread_nats
-                )
-            }
+            } => tolerance_unresolved(f, points, *spread_nats),
             ChoiceUnresolved {
                 chosen,
                 runner_up,
                 aic_gap,
                 spread_nats,
-            } => write!(
-                f,
-                "the choice of {chosen} over {runner_up} (ΔAIC {aic_gap:.2}, {:.2} nats) is \
-                 smaller than the {spread_nats:.2} nats the chosen optimum's cost moves between \
-                 solver tolerances: the integrator does not resolve it (docs/fit.md, \
-                 \"Tolerance check\")",
-                aic_gap.abs() / 2.0
-            ),
+            } => choice_unresolved(f, [chosen, runner_up], *aic_gap, *spread_nats),
             FailedEvaluations {
                 failed,
                 evaluations,
                 first,
                 ..
-            } => write!(
-                f,
-                "{failed} of {evaluations} model evaluations failed (first: {}); the bounds reach \
-                 parameter sets the model cannot simulate",
-                first.as_deref().unwrap_or_default()
-            ),
+            } => failed_evaluations(f, *failed, *evaluations, first.as_deref()),
             NoBladeModes { reason } => {
                 write!(f, "no blade modes at the fitted parameters: {reason}")
             }
             Text { text } => f.write_str(text),
         }
     }
+}
+
+/// [`FitWarning::TruthMoreLikely`]'s sentence.
+fn truth_more_likely(f: &mut fmt::Formatter<'_>, fit: f64, truth: f64) -> fmt::Result {
+    write!(
+        f,
+        "the truth is more likely than the fit: cost {truth:.2} nats at the true parameters \
+         against {fit:.2} at the fit ({:.2} nats short): the search stopped before the \
+         likelihood's maximum, so the fitted values and their intervals describe a point that is \
+         not the estimate",
+        fit - truth
+    )
+}
+
+/// [`FitWarning::Misfit`]'s sentence, with the shoulder's advice when the job lists a shoulder
+/// candidate.
+fn misfit(f: &mut fmt::Formatter<'_>, g: &GoodnessOfFit, shoulder_listed: bool) -> fmt::Result {
+    write!(
+        f,
+        "the chosen model does not explain the recording's spectra to their noise: excess NLL \
+         {:.1} nats against {:.1} ± {:.1} for {} noise replicates of the fit (p = {:.3}, \
+         {:.1}σ); the recording holds structure no candidate reproduces, or the search missed a \
+         candidate's basin, and the fitted parameters may be bent to absorb it",
+        g.excess_nll_nats,
+        g.replicate_mean_nats,
+        g.replicate_sd_nats,
+        g.replicates,
+        g.p_value,
+        g.z()
+    )?;
+    if shoulder_listed {
+        f.write_str(
+            "; a shoulder the neck touches only at the peaks of its swing has a basin a few per \
+             cent wide in theta_c that the search can miss: bounding [fit.shoulder] theta_c to a \
+             contact angle known from the blade's drawing lets it find one (docs/fit.md, \
+             \"Shoulder contact\")",
+        )?;
+    }
+    Ok(())
+}
+
+/// [`FitWarning::AbsorbsModelStructure`]'s sentence: the parameter's value in the chosen model,
+/// then in the other.
+fn absorbs_model_structure(
+    f: &mut fmt::Formatter<'_>,
+    parameter: ParamId,
+    [(chosen, value), (other, other_value)]: [(&Candidate, f64); 2],
+    sigmas: f64,
+) -> fmt::Result {
+    write!(
+        f,
+        "{parameter} moves from {value:.6} ({chosen}) to {other_value:.6} ({other}), \
+         {sigmas:.1}σ: it absorbs structure one model has and the other has not, so its \
+         value depends on the model choice"
+    )
+}
+
+/// [`FitWarning::Undetermined`]'s sentence.
+fn undetermined(f: &mut fmt::Formatter<'_>, parameter: ParamId) -> fmt::Result {
+    write!(
+        f,
+        "{parameter} is not determined by the data: its 1σ spans 10 % or more of its \
+         search range"
+    )
+}
+
+/// [`FitWarning::TradeOff`]'s sentence.
+fn trade_off(
+    f: &mut fmt::Formatter<'_>,
+    [first, second]: [ParamId; 2],
+    correlation: f64,
+) -> fmt::Result {
+    write!(
+        f,
+        "{first} and {second} trade off (correlation {correlation:+.3}): the data pin \
+         down a combination of them, not each"
+    )
+}
+
+/// [`FitWarning::OnBound`]'s sentence.
+fn on_bound(f: &mut fmt::Formatter<'_>, parameter: ParamId, bound: End, value: f64) -> fmt::Result {
+    write!(
+        f,
+        "{parameter} ended on its {bound} bound ({value}); widen the bound or fix the \
+         parameter"
+    )
+}
+
+/// [`FitWarning::ShortOfBestEvaluation`]'s sentence.
+fn short_of_best_evaluation(f: &mut fmt::Formatter<'_>, gain_nats: f64) -> fmt::Result {
+    write!(
+        f,
+        "the search evaluated a point {gain_nats:.2} nats more likely than the fit: it \
+         ended short of its own best evaluation"
+    )
+}
+
+/// [`FitWarning::ProfileAtBound`]'s sentence.
+fn profile_at_bound(
+    f: &mut fmt::Formatter<'_>,
+    parameter: ParamId,
+    rise_limit_nats: f64,
+    bounds: &[End],
+) -> fmt::Result {
+    write!(
+        f,
+        "{parameter}'s profile likelihood stays within {rise_limit_nats:.3} nats of the fit up \
+         to its search box's {} bound: the recording does not bound it there",
+        bounds
+            .iter()
+            .map(|b| b.name())
+            .collect::<Vec<_>>()
+            .join(" and ")
+    )
+}
+
+/// [`FitWarning::ProfileOpen`]'s sentence.
+fn profile_open(
+    f: &mut fmt::Formatter<'_>,
+    parameter: ParamId,
+    rise_limit_nats: f64,
+    end: End,
+    value: f64,
+) -> fmt::Result {
+    write!(
+        f,
+        "{parameter}'s profile likelihood stays within {rise_limit_nats:.3} nats of the fit over \
+         the walk's {PROFILE_MAX_STEPS} steps: its {end} end ({value:.4e}) is the last step, not \
+         where the likelihood bounds it"
+    )
+}
+
+/// [`FitWarning::ProfileMoreLikely`]'s sentence.
+fn profile_more_likely(
+    f: &mut fmt::Formatter<'_>,
+    parameter: ParamId,
+    gain_nats: f64,
+    value: f64,
+) -> fmt::Result {
+    write!(
+        f,
+        "{parameter}'s profile met a point {gain_nats:.2} nats more likely than the fit \
+         ({parameter} = {value:.4e}): the search ended short of the likelihood's maximum"
+    )
+}
+
+/// [`FitWarning::WidenedInterval`]'s sentence: the span of the evaluated points, the method's
+/// interval and the widened one, in that order.
+fn widened_interval(
+    f: &mut fmt::Formatter<'_>,
+    parameter: ParamId,
+    rise_limit_nats: f64,
+    [[p_lo, p_hi], [lo0, hi0], [lo, hi]]: [&[f64; 2]; 3],
+) -> fmt::Result {
+    write!(
+        f,
+        "{parameter}: points the search evaluated within {rise_limit_nats:.2} nats of the fit \
+         span {p_lo:.4e} to {p_hi:.4e}, beyond the method's own interval [{lo0:.4e}, \
+         {hi0:.4e}]: the likelihood is flatter there than that interval says, so it is widened \
+         to [{lo:.4e}, {hi:.4e}]"
+    )
+}
+
+/// [`FitWarning::ContactRidge`]'s sentence.
+fn contact_ridge(f: &mut fmt::Formatter<'_>, k1_lo: f64, k1_hi: f64) -> fmt::Result {
+    write!(
+        f,
+        "k1 and theta_c trade along the shoulder's contact-moment ridge ((k1c − k1)·θ_c held): \
+         k1 from {k1_lo:.4e} to {k1_hi:.4e} N·m/rad stays within {PROFILE_68_NATS} nats of the \
+         fit, so both intervals span it; the recording determines the moment at contact, not k1 \
+         and theta_c apart"
+    )
+}
+
+/// [`FitWarning::NoIntervals`]'s sentence, naming the method.
+fn no_intervals(
+    f: &mut fmt::Formatter<'_>,
+    method: UncertaintyMethod,
+    reason: &str,
+) -> fmt::Result {
+    match method {
+        UncertaintyMethod::Laplace => write!(f, "no Laplace intervals: {reason}"),
+        UncertaintyMethod::Profile => write!(f, "no profile-likelihood intervals: {reason}"),
+        UncertaintyMethod::Bootstrap => write!(f, "no bootstrap intervals: {reason}"),
+    }
+}
+
+/// [`FitWarning::ToleranceNotProbed`]'s sentence.
+fn tolerance_not_probed(f: &mut fmt::Formatter<'_>, failures: &[String]) -> fmt::Result {
+    write!(
+        f,
+        "the tolerance check did not run: every probe failed ({}), so it is not known whether \
+         the integrator resolves the likelihood at the optimum (docs/fit.md, \"Tolerance \
+         check\")",
+        failures.join("; ")
+    )
+}
+
+/// [`FitWarning::ToleranceUnresolved`]'s sentence, with the cost at each tolerance.
+fn tolerance_unresolved(
+    f: &mut fmt::Formatter<'_>,
+    points: &[TolerancePoint],
+    spread_nats: f64,
+) -> fmt::Result {
+    let at: Vec<String> = points
+        .iter()
+        .map(|p| {
+            format!(
+                "{:.3} nats at rtol {:e} ({} transitions)",
+                p.cost_nats, p.rtol, p.transitions
+            )
+        })
+        .collect();
+    write!(
+        f,
+        "the likelihood at the optimum is not resolved by the integrator: {} ({:.2} nats apart, \
+         more than the {SPREAD_WARN_NATS} nats of a 1σ interval); the stick–slip sequence hangs \
+         on grazing events, so the cost surface is rough at that depth, cost differences below \
+         it do not tell parameter sets apart and the intervals understate the uncertainty \
+         (docs/fit.md, \"Tolerance check\")",
+        crate::names::join(&at, ", "),
+        spread_nats
+    )
+}
+
+/// [`FitWarning::ChoiceUnresolved`]'s sentence: `chosen` over `runner_up`.
+fn choice_unresolved(
+    f: &mut fmt::Formatter<'_>,
+    [chosen, runner_up]: [&Candidate; 2],
+    aic_gap: f64,
+    spread_nats: f64,
+) -> fmt::Result {
+    write!(
+        f,
+        "the choice of {chosen} over {runner_up} (ΔAIC {aic_gap:.2}, {:.2} nats) is smaller \
+         than the {spread_nats:.2} nats the chosen optimum's cost moves between solver \
+         tolerances: the integrator does not resolve it (docs/fit.md, \"Tolerance check\")",
+        aic_gap.abs() / 2.0
+    )
+}
+
+/// [`FitWarning::FailedEvaluations`]'s sentence.
+fn failed_evaluations(
+    f: &mut fmt::Formatter<'_>,
+    failed: usize,
+    evaluations: usize,
+    first: Option<&str>,
+) -> fmt::Result {
+    write!(
+        f,
+        "{failed} of {evaluations} model evaluations failed (first: {}); the bounds reach \
+         parameter sets the model cannot simulate",
+        first.unwrap_or_default()
+    )
 }
 
 /// A fit's warnings, in the order the fit found them. In the result file: `warnings`, their

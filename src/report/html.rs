@@ -1053,29 +1053,34 @@ pub(super) mod tests {
         }
     }
 
-    #[test]
-    fn page_tables_and_warnings_from_a_result() {
-        let dir = std::env::temp_dir().join(format!("wiperlab_html_unit_{}", std::process::id()));
+    /// A fresh directory `wiperlab_html_<name>_<pid>` for a page: its `reports/` folder holding
+    /// an empty SVG for each of `figures`, and the recording `rec.csv` holding `recording`.
+    fn page_paths(name: &str, figures: &[impl AsRef<str>], recording: &str) -> ReportPaths {
+        let dir = std::env::temp_dir().join(format!("wiperlab_html_{name}_{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         let figs = dir.join("reports");
         std::fs::create_dir_all(&figs).unwrap();
-        // Only two of the fit's figures, plus one extra SVG.
-        for f in ["cost.svg", "psd_low.svg", "extra.svg", "freq_vs_speed.svg"] {
-            std::fs::write(figs.join(f), "<svg xmlns=\"http://www.w3.org/2000/svg\"/>").unwrap();
+        for f in figures {
+            let svg = "<svg xmlns=\"http://www.w3.org/2000/svg\"/>";
+            std::fs::write(figs.join(f.as_ref()), svg).unwrap();
         }
         let rec = dir.join("rec.csv");
-        std::fs::write(&rec, "the recording changed since").unwrap();
+        std::fs::write(&rec, recording).unwrap();
+        ReportPaths {
+            job: dir.join("job.toml"),
+            result: dir.join("unit.result.toml"),
+            recording: rec,
+            dir: figs,
+        }
+    }
+
+    #[test]
+    fn page_tables_and_warnings_from_a_result() {
+        // Only two of the fit's figures, plus one extra SVG.
+        let figures = ["cost.svg", "psd_low.svg", "extra.svg", "freq_vs_speed.svg"];
+        let paths = page_paths("unit", &figures, "the recording changed since");
         let r = result();
-        let s = write_report(
-            &r,
-            &ReportPaths {
-                job: dir.join("job.toml"),
-                result: dir.join("unit.result.toml"),
-                recording: rec.clone(),
-                dir: figs.clone(),
-            },
-        )
-        .unwrap();
+        let s = write_report(&r, &paths).unwrap();
         // Fit figures in fit_figure_list order, then the optional ones, then the others by name.
         assert_eq!(
             s.figures,
@@ -1157,13 +1162,18 @@ pub(super) mod tests {
         assert!(html.contains("The result does not record the job's settings."));
         // No test in the result: no goodness-of-fit paragraph.
         assert!(!html.contains("id=\"goodness-of-fit\""));
+        std::fs::remove_dir_all(paths.dir.parent().unwrap()).ok();
+    }
 
-        // Unchanged recording, all figures present, nothing failed: no warnings at all.
-        std::fs::write(&rec, "the recording at fit time").unwrap();
-        for (f, _) in fit_figure_list(&r) {
-            std::fs::write(figs.join(f), "<svg xmlns=\"http://www.w3.org/2000/svg\"/>").unwrap();
-        }
-        let mut r = r;
+    /// Unchanged recording, all figures present, nothing failed: no warnings at all; a fit its
+    /// recording contradicts gets the goodness-of-fit paragraph in words, with its numbers.
+    #[test]
+    fn page_without_warnings_and_with_a_misfit_paragraph() {
+        let mut r = result();
+        // Every fit figure, beside the first page's optional and extra ones.
+        let mut figures: Vec<String> = fit_figure_list(&r).into_iter().map(|(f, _)| f).collect();
+        figures.extend(["freq_vs_speed.svg", "extra.svg"].map(String::from));
+        let paths = page_paths("misfit", &figures, "the recording at fit time");
         r.parameters[1].determined = true;
         r.failed_evaluations = 0;
         // A fit its recording contradicts: the paragraph says so in words, with its numbers.
@@ -1174,22 +1184,13 @@ pub(super) mod tests {
             replicates: 999,
             p_value: 0.001,
         });
-        let s = write_report(
-            &r,
-            &ReportPaths {
-                job: dir.join("job.toml"),
-                result: dir.join("unit.result.toml"),
-                recording: rec,
-                dir: figs,
-            },
-        )
-        .unwrap();
+        let s = write_report(&r, &paths).unwrap();
         assert!(s.warnings.is_empty(), "{:?}", s.warnings);
         let html = std::fs::read_to_string(&s.path).unwrap();
         assert!(html.contains("<p id=\"warning-list\">None.</p>"));
         assert!(html.contains("<p id=\"goodness-of-fit\">Goodness of fit: the recording&#x27;s excess NLL at the fit is 170.96 nats, against 78.37 ± 8.0 for 999 replicates"), "{html}");
         assert!(html.contains("(p = 0.001): the spectra hold more than the model and noise"));
-        std::fs::remove_dir_all(&dir).ok();
+        std::fs::remove_dir_all(paths.dir.parent().unwrap()).ok();
     }
 
     #[test]

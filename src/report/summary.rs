@@ -209,8 +209,20 @@ fn bad(text: String, todo: &str) -> (Check, Option<String>) {
 
 /// Each check with what to do when it failed.
 fn checks(r: &FitResult, warnings: &[PageWarning]) -> Vec<(Check, Option<String>)> {
-    let mut out = Vec::new();
-    out.push(match &r.goodness_of_fit {
+    let mut out = vec![
+        goodness_of_fit_check(r),
+        tolerance_check(r),
+        peak_check(r),
+        determined_check(r),
+        warnings_check(warnings),
+    ];
+    out.extend(interrupted_check(warnings));
+    out
+}
+
+/// Whether the model explains the recording's spectra to their noise.
+fn goodness_of_fit_check(r: &FitResult) -> (Check, Option<String>) {
+    match &r.goodness_of_fit {
         Some(g) if g.fits() => ok(format!(
             "The model explains the recording's spectra to their noise (goodness of fit p = \
              {:.2}).",
@@ -232,8 +244,12 @@ fn checks(r: &FitResult, warnings: &[PageWarning]) -> Vec<(Check, Option<String>
         }
         None if r.interrupted => none("No goodness-of-fit test: the fit was interrupted.".into()),
         None => none("No goodness-of-fit test in this result (a joint fit has none).".into()),
-    });
-    out.push(match &r.tolerance_check {
+    }
+}
+
+/// Whether the integrator resolves the likelihood at the optimum.
+fn tolerance_check(r: &FitResult) -> (Check, Option<String>) {
+    match &r.tolerance_check {
         Some(t) => {
             let rtols = match (t.points.first(), t.points.last()) {
                 (Some(a), Some(b)) => format!("rtol {:e} to {:e}", a.rtol, b.rtol),
@@ -260,7 +276,12 @@ fn checks(r: &FitResult, warnings: &[PageWarning]) -> Vec<(Check, Option<String>
             }
         }
         None => none("No tolerance check in this result.".into()),
-    });
+    }
+}
+
+/// Whether the model's peaks lie within [`PEAK_OFF_FRACTION`] of the measured ones (or the
+/// targets) in every band.
+fn peak_check(r: &FitResult) -> (Check, Option<String>) {
     let worst = r
         .peaks
         .iter()
@@ -271,7 +292,7 @@ fn checks(r: &FitResult, warnings: &[PageWarning]) -> Vec<(Check, Option<String>
     } else {
         "the measured ones"
     };
-    out.push(match worst {
+    match worst {
         Some(p) if p.rel_diff.abs() <= PEAK_OFF_FRACTION => ok(format!(
             "The model's peaks lie within {} of {against} in every band.",
             pct_abs(p.rel_diff)
@@ -287,14 +308,18 @@ fn checks(r: &FitResult, warnings: &[PageWarning]) -> Vec<(Check, Option<String>
              the search bounds let the model reach it.",
         ),
         None => none("No peaks to compare.".into()),
-    });
+    }
+}
+
+/// Whether the data determine every fitted parameter.
+fn determined_check(r: &FitResult) -> (Check, Option<String>) {
     let undetermined: Vec<String> = r
         .parameters
         .iter()
         .filter(|p| !p.determined)
         .map(|p| p.name.to_string())
         .collect();
-    out.push(if undetermined.is_empty() {
+    if undetermined.is_empty() {
         ok(format!(
             "The data determine every fitted parameter ({}).",
             r.parameters
@@ -312,7 +337,11 @@ fn checks(r: &FitResult, warnings: &[PageWarning]) -> Vec<(Check, Option<String>
             "Fix the undetermined parameters from another measurement, or narrow their bounds, \
              and refit.",
         )
-    });
+    }
+}
+
+/// Whether any warning needs the reader's attention (and how many notes are for information).
+fn warnings_check(warnings: &[PageWarning]) -> (Check, Option<String>) {
     let attention = warnings
         .iter()
         .filter(|w| w.severity() == Severity::Attention)
@@ -323,7 +352,7 @@ fn checks(r: &FitResult, warnings: &[PageWarning]) -> Vec<(Check, Option<String>
         1 => " (1 note for information, below)".into(),
         n => format!(" ({n} notes for information, below)"),
     };
-    out.push(match attention {
+    match attention {
         0 => ok(format!("No warning needs your attention{info}.")),
         n => bad(
             format!(
@@ -333,17 +362,22 @@ fn checks(r: &FitResult, warnings: &[PageWarning]) -> Vec<(Check, Option<String>
             ),
             "Read the warnings under \"Needs your attention\": each says what to do.",
         ),
-    });
+    }
+}
+
+/// The interrupted fit's check, when it was interrupted.
+fn interrupted_check(warnings: &[PageWarning]) -> Option<(Check, Option<String>)> {
     if warnings
         .iter()
         .any(|w| matches!(w, PageWarning::Fit(FitWarning::Interrupted)))
     {
-        out.push(bad(
+        Some(bad(
             "The fit was interrupted: the values are the best point the search had reached.".into(),
             "Run the fit again to the end.",
-        ));
+        ))
+    } else {
+        None
     }
-    out
 }
 
 /// |x| as a percentage with two significant digits, e.g. "0.089 %".

@@ -3,12 +3,13 @@
 //! full sentence ([`std::fmt::Display`]) the page folds under it.
 
 use super::html::num;
-use crate::fit::warning::LineSource;
+use crate::fit::warning::{End, LineSource};
 use crate::fit::{FitWarning, Severity};
-use crate::job::UncertaintyMethod;
+use crate::job::{Candidate, UncertaintyMethod};
 use crate::model::ParamId;
 use crate::simulate::failure::FailureCause;
 use crate::spectrum::harmonics::{LineOrigin, MIN_PROMINENCE};
+use std::collections::BTreeMap;
 use std::fmt;
 use std::path::PathBuf;
 
@@ -196,17 +197,8 @@ fn fit_headline(w: &FitWarning) -> String {
         TruthMoreLikely {
             fit_cost_nats,
             truth_cost_nats,
-        } => format!(
-            "The truth is {:.2} nats more likely than the fit: the search stopped short of the \
-             likelihood's maximum, so the values and intervals describe the wrong point.",
-            fit_cost_nats - truth_cost_nats
-        ),
-        Misfit { test, .. } => format!(
-            "The model does not explain the recording's spectra to their noise (p = {:.3}): \
-             list more candidate models, check the bands, or bound a known parameter \
-             (docs/fit.md, \"Goodness of fit\").",
-            test.p_value
-        ),
+        } => truth_more_likely_headline(fit_cost_nats - truth_cost_nats),
+        Misfit { test, .. } => misfit_headline(test.p_value),
         AbsorbsModelStructure {
             parameter,
             chosen,
@@ -214,12 +206,10 @@ fn fit_headline(w: &FitWarning) -> String {
             other,
             other_value,
             sigmas,
-        } => format!(
-            "{parameter} depends on the model choice: {} with {chosen}, {} with {other} ({:.1}σ \
-             apart).",
-            num(*value, 4),
-            num(*other_value, 4),
-            sigmas
+        } => absorbs_headline(
+            *parameter,
+            [(chosen, *value), (other, *other_value)],
+            *sigmas,
         ),
         Line {
             band,
@@ -235,31 +225,15 @@ fn fit_headline(w: &FitWarning) -> String {
             first,
             second,
             correlation,
-        } => format!(
-            "{first} and {second} trade off (correlation {correlation:+.3}): the data pin down a \
-             combination of them; each one's interval already spans what the other allows."
-        ),
+        } => trade_off_headline([*first, *second], *correlation),
         OnBound {
             parameter,
             bound,
             value,
-        } => format!(
-            "{parameter} ended on its {bound} search bound ({}): widen the bound or fix the \
-             parameter.",
-            num(*value, 4)
-        ),
+        } => on_bound_headline(*parameter, *bound, *value),
         ProfileAtBound {
             parameter, bounds, ..
-        } => format!(
-            "{parameter}'s interval is open at its {} search bound{}: the recording does not \
-             bound it there; widen the bounds to see how far it goes.",
-            bounds
-                .iter()
-                .map(|b| b.name())
-                .collect::<Vec<_>>()
-                .join(" and "),
-            if bounds.len() > 1 { "s" } else { "" }
-        ),
+        } => profile_at_bound_headline(*parameter, bounds),
         ProfileOpen { parameter, end, .. } => format!(
             "{parameter}'s interval does not close at its {end} end within the profile walk: \
              the interval there is a lower limit on the uncertainty."
@@ -268,42 +242,19 @@ fn fit_headline(w: &FitWarning) -> String {
             parameter,
             gain_nats,
             ..
-        } => format!(
-            "{parameter}'s profile met a point {gain_nats:.2} nats more likely than the fit: the \
-             search ended short of the optimum; refit with more restarts."
-        ),
+        } => profile_more_likely_headline(*parameter, *gain_nats),
         WidenedInterval {
             parameter,
             method,
             widened,
             ..
-        } => format!(
-            "{parameter}'s interval is widened to [{}, {}] to include points the search found \
-             about as likely as the fit (the method alone gave [{}, {}]); the table shows the \
-             widened one.",
-            num(widened[0], 4),
-            num(widened[1], 4),
-            num(method[0], 4),
-            num(method[1], 4)
-        ),
+        } => widened_headline(*parameter, method, widened),
         ShortOfBestEvaluation { gain_nats } => format!(
             "The search evaluated a point {gain_nats:.2} nats more likely than the fit: it ended \
              short of its own best point; refit with more restarts or polish iterations."
         ),
-        ContactRidge { k1_lo, k1_hi } => format!(
-            "k1 and theta_c trade along the shoulder's contact ridge (k1 from {} to {} N·m/rad \
-             fits as well); both intervals span it.",
-            num(*k1_lo, 4),
-            num(*k1_hi, 4)
-        ),
-        NoIntervals { method, .. } => format!(
-            "No {} intervals: the chosen model has no likelihood to read them from.",
-            match method {
-                UncertaintyMethod::Laplace => "Laplace",
-                UncertaintyMethod::Profile => "profile-likelihood",
-                UncertaintyMethod::Bootstrap => "bootstrap",
-            }
-        ),
+        ContactRidge { k1_lo, k1_hi } => contact_ridge_headline(*k1_lo, *k1_hi),
+        NoIntervals { method, .. } => no_intervals_headline(*method),
         TargetJobIntervals => {
             "No intervals: a target job's targets carry no measurement noise.".into()
         }
@@ -314,56 +265,188 @@ fn fit_headline(w: &FitWarning) -> String {
                                       failed): whether the integrator resolves the optimum is not \
                                       known."
             .into(),
-        ToleranceUnresolved { spread_nats, .. } => format!(
-            "The optimum's cost moves by {} nats between solver tolerances: the intervals \
-             understate the uncertainty; tighten [solver] rtol and refit.",
-            num(*spread_nats, 2)
-        ),
+        ToleranceUnresolved { spread_nats, .. } => tolerance_unresolved_headline(*spread_nats),
         ChoiceUnresolved {
             chosen,
             runner_up,
             aic_gap,
             spread_nats,
-        } => format!(
-            "The choice of {chosen} over {runner_up} (ΔAIC {aic_gap:.2}) is within the {} nats \
-             the cost moves between solver tolerances: tighten [solver] rtol and refit.",
-            num(*spread_nats, 2)
-        ),
+        } => choice_unresolved_headline([chosen, runner_up], *aic_gap, *spread_nats),
         FailedEvaluations {
             failed,
             evaluations,
             causes,
             ..
-        } => {
-            let by: Vec<String> = causes
-                .iter()
-                .filter(|(_, n)| **n > 0)
-                .map(|(c, n)| format!("{n} where {}", cause_words(*c)))
-                .collect();
-            let why = if by.is_empty() {
-                "causes not recorded".to_string()
-            } else {
-                by.join(", ")
-            };
-            match w.severity() {
-                Severity::Information => format!(
-                    "{failed} of {evaluations} evaluations of the chosen model ({}) failed, \
-                     {why}: the search box reaches parameter sets this blade cannot take, and the \
-                     search discards them.",
-                    share(*failed, *evaluations)
-                ),
-                Severity::Attention => format!(
-                    "{failed} of {evaluations} evaluations of the chosen model ({}) failed \
-                     ({why}): the search spends much of its budget where the model cannot go; \
-                     narrow the bounds, or for integrator failures raise [solver] max_steps.",
-                    share(*failed, *evaluations)
-                ),
-            }
-        }
+        } => failed_evaluations_headline(w.severity(), *failed, *evaluations, causes),
         NoBladeModes { .. } => {
             "The blade's modes could not be computed at the fitted parameters.".into()
         }
         Text { text } => text.clone(),
+    }
+}
+
+/// [`FitWarning::TruthMoreLikely`]'s headline, the truth `short_nats` more likely than the fit.
+fn truth_more_likely_headline(short_nats: f64) -> String {
+    format!(
+        "The truth is {:.2} nats more likely than the fit: the search stopped short of the \
+         likelihood's maximum, so the values and intervals describe the wrong point.",
+        short_nats
+    )
+}
+
+/// [`FitWarning::AbsorbsModelStructure`]'s headline: the parameter's value with the chosen model,
+/// then with the other.
+fn absorbs_headline(
+    parameter: ParamId,
+    [(chosen, value), (other, other_value)]: [(&Candidate, f64); 2],
+    sigmas: f64,
+) -> String {
+    format!(
+        "{parameter} depends on the model choice: {} with {chosen}, {} with {other} ({:.1}σ \
+         apart).",
+        num(value, 4),
+        num(other_value, 4),
+        sigmas
+    )
+}
+
+/// [`FitWarning::ProfileAtBound`]'s headline.
+fn profile_at_bound_headline(parameter: ParamId, bounds: &[End]) -> String {
+    format!(
+        "{parameter}'s interval is open at its {} search bound{}: the recording does not \
+         bound it there; widen the bounds to see how far it goes.",
+        bounds
+            .iter()
+            .map(|b| b.name())
+            .collect::<Vec<_>>()
+            .join(" and "),
+        if bounds.len() > 1 { "s" } else { "" }
+    )
+}
+
+/// [`FitWarning::WidenedInterval`]'s headline: the `widened` interval and the `method`'s own.
+fn widened_headline(parameter: ParamId, method: &[f64; 2], widened: &[f64; 2]) -> String {
+    format!(
+        "{parameter}'s interval is widened to [{}, {}] to include points the search found \
+         about as likely as the fit (the method alone gave [{}, {}]); the table shows the \
+         widened one.",
+        num(widened[0], 4),
+        num(widened[1], 4),
+        num(method[0], 4),
+        num(method[1], 4)
+    )
+}
+
+/// [`FitWarning::Misfit`]'s headline, with the test's p-value.
+fn misfit_headline(p_value: f64) -> String {
+    format!(
+        "The model does not explain the recording's spectra to their noise (p = {:.3}): \
+         list more candidate models, check the bands, or bound a known parameter \
+         (docs/fit.md, \"Goodness of fit\").",
+        p_value
+    )
+}
+
+/// [`FitWarning::TradeOff`]'s headline.
+fn trade_off_headline([first, second]: [ParamId; 2], correlation: f64) -> String {
+    format!(
+        "{first} and {second} trade off (correlation {correlation:+.3}): the data pin down a \
+         combination of them; each one's interval already spans what the other allows."
+    )
+}
+
+/// [`FitWarning::OnBound`]'s headline.
+fn on_bound_headline(parameter: ParamId, bound: End, value: f64) -> String {
+    format!(
+        "{parameter} ended on its {bound} search bound ({}): widen the bound or fix the \
+         parameter.",
+        num(value, 4)
+    )
+}
+
+/// [`FitWarning::ProfileMoreLikely`]'s headline.
+fn profile_more_likely_headline(parameter: ParamId, gain_nats: f64) -> String {
+    format!(
+        "{parameter}'s profile met a point {gain_nats:.2} nats more likely than the fit: the \
+         search ended short of the optimum; refit with more restarts."
+    )
+}
+
+/// [`FitWarning::ToleranceUnresolved`]'s headline.
+fn tolerance_unresolved_headline(spread_nats: f64) -> String {
+    format!(
+        "The optimum's cost moves by {} nats between solver tolerances: the intervals \
+         understate the uncertainty; tighten [solver] rtol and refit.",
+        num(spread_nats, 2)
+    )
+}
+
+/// [`FitWarning::ChoiceUnresolved`]'s headline: `chosen` over `runner_up`.
+fn choice_unresolved_headline(
+    [chosen, runner_up]: [&Candidate; 2],
+    aic_gap: f64,
+    spread_nats: f64,
+) -> String {
+    format!(
+        "The choice of {chosen} over {runner_up} (ΔAIC {aic_gap:.2}) is within the {} nats \
+         the cost moves between solver tolerances: tighten [solver] rtol and refit.",
+        num(spread_nats, 2)
+    )
+}
+
+/// [`FitWarning::ContactRidge`]'s headline.
+fn contact_ridge_headline(k1_lo: f64, k1_hi: f64) -> String {
+    format!(
+        "k1 and theta_c trade along the shoulder's contact ridge (k1 from {} to {} N·m/rad \
+         fits as well); both intervals span it.",
+        num(k1_lo, 4),
+        num(k1_hi, 4)
+    )
+}
+
+/// [`FitWarning::NoIntervals`]'s headline, naming the method.
+fn no_intervals_headline(method: UncertaintyMethod) -> String {
+    format!(
+        "No {} intervals: the chosen model has no likelihood to read them from.",
+        match method {
+            UncertaintyMethod::Laplace => "Laplace",
+            UncertaintyMethod::Profile => "profile-likelihood",
+            UncertaintyMethod::Bootstrap => "bootstrap",
+        }
+    )
+}
+
+/// [`FitWarning::FailedEvaluations`]'s headline at the warning's `severity`: the failures by
+/// cause, and what to do when they take much of the budget.
+fn failed_evaluations_headline(
+    severity: Severity,
+    failed: usize,
+    evaluations: usize,
+    causes: &BTreeMap<FailureCause, usize>,
+) -> String {
+    let by: Vec<String> = causes
+        .iter()
+        .filter(|(_, n)| **n > 0)
+        .map(|(c, n)| format!("{n} where {}", cause_words(*c)))
+        .collect();
+    let why = if by.is_empty() {
+        "causes not recorded".to_string()
+    } else {
+        by.join(", ")
+    };
+    match severity {
+        Severity::Information => format!(
+            "{failed} of {evaluations} evaluations of the chosen model ({}) failed, \
+             {why}: the search box reaches parameter sets this blade cannot take, and the \
+             search discards them.",
+            share(failed, evaluations)
+        ),
+        Severity::Attention => format!(
+            "{failed} of {evaluations} evaluations of the chosen model ({}) failed \
+             ({why}): the search spends much of its budget where the model cannot go; \
+             narrow the bounds, or for integrator failures raise [solver] max_steps.",
+            share(failed, evaluations)
+        ),
     }
 }
 
