@@ -589,6 +589,20 @@ fn simulate_cases() -> Vec<Case> {
             &["$D/b.toml:", "coulombish"],
         ),
         case(
+            "simulate: a friction law without one of its keys",
+            b(
+                "b.toml",
+                "law = \"exponential\"",
+                "law = \"stribeck\"\nv_s_m_per_s = 0.1",
+            ),
+            &["simulate", "$D/b.toml"],
+            &[
+                "$D/b.toml:",
+                "stribeck",
+                "`b_s_per_m` (known: a, c, v_s_m_per_s, delta); missing delta",
+            ],
+        ),
+        case(
             "simulate: --window with one value",
             vec![],
             &["simulate", BLADE, "--window", "1.83"],

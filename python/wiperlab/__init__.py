@@ -356,7 +356,8 @@ class Blade:
 
     ``Blade(**params)`` takes every field of ``data/reversal/blade_true.toml`` by name (``l1_m``,
     ``head_mass_kg``, ``k1_nm_per_rad``, ..., ``friction`` as a dict such as ``{"law":
-    "exponential", "a": 0.88, "b_s_per_m": 69.7, "c": 0.56}``, optional ``shoulder``);
+    "exponential", "a": 0.88, "b_s_per_m": 69.7, "c": 0.56}`` or any other law of docs/blade.md
+    (``exponential_viscous``, ``stribeck``, ``coulomb``, ``leine``), optional ``shoulder``);
     ``Blade.from_toml(path)`` reads such a file. Each field is an attribute (``blade.k1_nm_per_rad``);
     ``to_dict()`` gives them all and ``replace(**changes)`` a changed copy. The library checks the
     values (positive lengths and masses, a valid friction law) and raises ``wiperlab.InputError``

@@ -5,7 +5,7 @@ use super::run::{EntryPaths, State, read_status};
 use super::{Campaign, Override};
 use crate::fit::result::FitResult;
 use crate::io::write_atomic;
-use crate::model::{BladeParams, FrictionLaw};
+use crate::model::{BladeParams, FrictionLaw, ParamId};
 use crate::{Error, Result};
 use std::path::PathBuf;
 
@@ -41,7 +41,7 @@ pub struct Row {
     pub model_evaluations: usize,
     pub failed_evaluations: usize,
     pub wall_time_s: f64,
-    /// The fitted friction law: the recording's blade file with the fitted A, B, C in place
+    /// The fitted friction law: the recording's blade file with the fitted friction coefficients in place
     /// (`None` until the recording is done).
     pub friction: Option<FrictionLaw>,
 }
@@ -151,23 +151,21 @@ fn fill_from_result(row: &mut Row, r: &FitResult, table: &mut Table) {
     }
 }
 
-/// The blade file's friction law with the fitted `A`, `B`, `C` in place of its own values.
+/// The blade file's friction law with the fitted coefficients (A, B, C, D, v_s, δ, as many as the
+/// law has and the fit freed) in place of its own values.
 fn fitted_law(
     blade: &std::path::Path,
     params: &[(String, ParamValue)],
 ) -> Result<Option<FrictionLaw>> {
     let text = std::fs::read_to_string(blade).map_err(|e| Error::io(blade, "cannot read", e))?;
-    let p: BladeParams =
+    let mut p: BladeParams =
         toml::from_str(&text).map_err(|e| Error::input(blade, format!("blade file: {e}")))?;
-    let get = |n: &str| params.iter().find(|(k, _)| k == n).map(|(_, v)| v.value);
-    Ok(Some(match p.friction {
-        FrictionLaw::Exponential { a, b_s_per_m, c } => FrictionLaw::Exponential {
-            a: get("A").unwrap_or(a),
-            b_s_per_m: get("B").unwrap_or(b_s_per_m),
-            c: get("C").unwrap_or(c),
-        },
-        other => other,
-    }))
+    for (name, v) in params {
+        if let Some(id) = ParamId::from_name(name).filter(|id| id.is_friction()) {
+            id.set(&mut p, v.value);
+        }
+    }
+    Ok(Some(p.friction))
 }
 
 fn num(x: f64) -> String {

@@ -28,6 +28,26 @@ pub enum ParamError {
         "friction law: A, B, C must be finite and >= 0 with A + C > 0 (got A = {a}, B = {b_s_per_m}, C = {c})"
     )]
     Exponential { a: f64, b_s_per_m: f64, c: f64 },
+    /// The exponential law with a viscous term.
+    #[error(
+        "friction law exponential_viscous: a, b_s_per_m, c, d_s_per_m must be finite and >= 0 with a + c > 0 (got a = {a}, b_s_per_m = {b_s_per_m}, c = {c}, d_s_per_m = {d_s_per_m})"
+    )]
+    ExponentialViscous {
+        a: f64,
+        b_s_per_m: f64,
+        c: f64,
+        d_s_per_m: f64,
+    },
+    /// Stribeck's law with a shape exponent.
+    #[error(
+        "friction law stribeck: a, c must be finite and >= 0 with a + c > 0, v_s_m_per_s and delta finite and > 0 (got a = {a}, c = {c}, v_s_m_per_s = {v_s_m_per_s}, delta = {delta})"
+    )]
+    Stribeck {
+        a: f64,
+        c: f64,
+        v_s_m_per_s: f64,
+        delta: f64,
+    },
     /// Coulomb's coefficients.
     #[error(
         "Coulomb friction: need 0 <= mu_k <= mu_s, mu_s > 0 (got mu_s = {mu_s}, mu_k = {mu_k})"

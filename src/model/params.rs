@@ -13,12 +13,16 @@ named_enum! {
         B => "B",
         /// Friction law C, 1.
         C => "C",
+        /// Viscous coefficient D of the `exponential_viscous` law, s/m.
+        D => "D",
         /// Head damper c0, N·s/m.
         C0 => "c0",
         /// Neck damper c1, N·m·s/rad.
         C1 => "c1",
         /// Lip damper c2, N·m·s/rad.
         C2 => "c2",
+        /// Shape exponent δ of the `stribeck` law, 1.
+        Delta => "delta",
         /// Preload compression h_d, m.
         Hd => "hd",
         /// Head mass M, kg, with the head's natural frequency held (k0 follows).
@@ -39,6 +43,8 @@ named_enum! {
         Preload => "preload",
         /// Shoulder contact angle, rad.
         ThetaC => "theta_c",
+        /// Stribeck speed v_s of the `stribeck` law, m/s.
+        Vs => "v_s",
     }
 }
 
@@ -49,6 +55,11 @@ impl ParamId {
             ParamId::A => "friction A (seed eq. 4), 1",
             ParamId::B => "friction B, s/m",
             ParamId::C => "friction C, 1",
+            ParamId::D => {
+                "friction viscous coefficient D, s/m (needs law = \"exponential_viscous\")"
+            }
+            ParamId::Delta => "friction Stribeck exponent δ, 1 (needs law = \"stribeck\")",
+            ParamId::Vs => "friction Stribeck speed v_s, m/s (needs law = \"stribeck\")",
             ParamId::C0 => "head damper c0, N·s/m",
             ParamId::C1 => "neck damper c1, N·m·s/rad",
             ParamId::C2 => "lip damper c2, N·m·s/rad",
@@ -76,8 +87,9 @@ impl ParamId {
     /// The parameter's SI unit (`-` for a pure number).
     pub fn unit(self) -> &'static str {
         match self {
-            ParamId::A | ParamId::C => "-",
-            ParamId::B => "s/m",
+            ParamId::A | ParamId::C | ParamId::Delta => "-",
+            ParamId::B | ParamId::D => "s/m",
+            ParamId::Vs => "m/s",
             ParamId::C0 => "N·s/m",
             ParamId::C1 | ParamId::C2 => "N·m·s/rad",
             ParamId::Hd | ParamId::L2 => "m",
@@ -94,6 +106,26 @@ impl ParamId {
     pub fn axis_label(self) -> String {
         let what = self.meaning().split(", ").next().unwrap_or(self.name());
         format!("{what} [{}]", self.unit())
+    }
+
+    /// Whether the parameter is a coefficient of the friction law (A, B, C, D, v_s, δ).
+    pub fn is_friction(self) -> bool {
+        matches!(
+            self,
+            ParamId::A | ParamId::B | ParamId::C | ParamId::D | ParamId::Delta | ParamId::Vs
+        )
+    }
+
+    /// The friction laws (their names in a blade file) that have the friction parameter `self`;
+    /// empty for a parameter that is not the friction law's.
+    pub fn friction_laws(self) -> &'static [&'static str] {
+        match self {
+            ParamId::A | ParamId::C => &["exponential", "exponential_viscous", "stribeck"],
+            ParamId::B => &["exponential", "exponential_viscous"],
+            ParamId::D => &["exponential_viscous"],
+            ParamId::Delta | ParamId::Vs => &["stribeck"],
+            _ => &[],
+        }
     }
 
     /// Whether the parameter belongs to the shoulder contact ([`super::Shoulder`]).
@@ -113,7 +145,12 @@ impl ParamId {
         self.is_geometry()
             || matches!(
                 self,
-                ParamId::K0 | ParamId::K1 | ParamId::Hd | ParamId::Preload
+                ParamId::K0
+                    | ParamId::K1
+                    | ParamId::Hd
+                    | ParamId::Preload
+                    | ParamId::Vs
+                    | ParamId::Delta
             )
     }
 
@@ -129,16 +166,12 @@ impl ParamId {
     }
 
     /// The parameter's value in `p`: `None` when `p` has no such parameter (a shoulder parameter
-    /// without a shoulder, a friction coefficient of a law other than the exponential one).
+    /// without a shoulder, a friction coefficient the blade's law does not have).
     pub fn get(self, p: &BladeParams) -> Option<f64> {
-        let friction = match p.friction {
-            FrictionLaw::Exponential { a, b_s_per_m, c } => Some((a, b_s_per_m, c)),
-            _ => None,
-        };
         Some(match self {
-            ParamId::A => friction?.0,
-            ParamId::B => friction?.1,
-            ParamId::C => friction?.2,
+            ParamId::A | ParamId::B | ParamId::C | ParamId::D | ParamId::Delta | ParamId::Vs => {
+                *friction_slot(self, &mut p.friction.clone())?
+            }
             ParamId::C0 => p.c0_ns_per_m,
             ParamId::C1 => p.c1_nms_per_rad,
             ParamId::C2 => p.c2_nms_per_rad,
@@ -170,14 +203,12 @@ impl ParamId {
     ///   `head_mass`, `k0` and `lip_mass`).
     pub fn set(self, p: &mut BladeParams, v: f64) -> bool {
         let slot: &mut f64 = match self {
-            ParamId::A | ParamId::B | ParamId::C => match &mut p.friction {
-                FrictionLaw::Exponential { a, b_s_per_m, c } => match self {
-                    ParamId::A => a,
-                    ParamId::B => b_s_per_m,
-                    _ => c,
-                },
-                _ => return false,
-            },
+            ParamId::A | ParamId::B | ParamId::C | ParamId::D | ParamId::Delta | ParamId::Vs => {
+                match friction_slot(self, &mut p.friction) {
+                    Some(slot) => slot,
+                    None => return false,
+                }
+            }
             ParamId::C0 => &mut p.c0_ns_per_m,
             ParamId::C1 => &mut p.c1_nms_per_rad,
             ParamId::C2 => &mut p.c2_nms_per_rad,
@@ -201,6 +232,26 @@ impl ParamId {
         };
         *slot = v;
         true
+    }
+}
+
+/// The coefficient of `law` that the friction parameter `id` names, if the law has it: A and C
+/// in the exponential law, its viscous form and Stribeck's; B in the first two; D in the viscous
+/// form; v_s and δ in Stribeck's.
+fn friction_slot(id: ParamId, law: &mut FrictionLaw) -> Option<&mut f64> {
+    match (id, law) {
+        (ParamId::A, FrictionLaw::Exponential { a, .. })
+        | (ParamId::A, FrictionLaw::ExponentialViscous { a, .. })
+        | (ParamId::A, FrictionLaw::Stribeck { a, .. })
+        | (ParamId::B, FrictionLaw::Exponential { b_s_per_m: a, .. })
+        | (ParamId::B, FrictionLaw::ExponentialViscous { b_s_per_m: a, .. })
+        | (ParamId::C, FrictionLaw::Exponential { c: a, .. })
+        | (ParamId::C, FrictionLaw::ExponentialViscous { c: a, .. })
+        | (ParamId::C, FrictionLaw::Stribeck { c: a, .. })
+        | (ParamId::D, FrictionLaw::ExponentialViscous { d_s_per_m: a, .. })
+        | (ParamId::Vs, FrictionLaw::Stribeck { v_s_m_per_s: a, .. })
+        | (ParamId::Delta, FrictionLaw::Stribeck { delta: a, .. }) => Some(a),
+        _ => None,
     }
 }
 
@@ -300,6 +351,73 @@ mod tests {
                 0.5 * v
             );
         }
+    }
+
+    /// Each friction parameter reads and sets the coefficient of the laws that have it
+    /// ([`ParamId::friction_laws`]) and is absent from the others.
+    #[test]
+    fn friction_parameters_belong_to_their_laws() {
+        let laws = [
+            FrictionLaw::Exponential {
+                a: 0.8,
+                b_s_per_m: 10.0,
+                c: 0.2,
+            },
+            FrictionLaw::ExponentialViscous {
+                a: 0.8,
+                b_s_per_m: 10.0,
+                c: 0.2,
+                d_s_per_m: 0.3,
+            },
+            FrictionLaw::Stribeck {
+                a: 0.8,
+                c: 0.2,
+                v_s_m_per_s: 0.1,
+                delta: 2.0,
+            },
+            FrictionLaw::Coulomb {
+                mu_s: 0.6,
+                mu_k: 0.4,
+            },
+        ];
+        let friction_ids: Vec<ParamId> = ParamId::ALL
+            .iter()
+            .copied()
+            .filter(|id| id.is_friction())
+            .collect();
+        assert_eq!(friction_ids.len(), 6);
+        for law in laws {
+            let mut p = experiment_blade();
+            p.friction = law;
+            for &id in &friction_ids {
+                let has = id.friction_laws().contains(&law.name());
+                assert_eq!(id.get(&p).is_some(), has, "{id} in {law:?}");
+                let mut q = p;
+                assert_eq!(id.set(&mut q, 0.125), has, "{id} in {law:?}");
+                if has {
+                    assert_eq!(id.get(&q), Some(0.125));
+                    // Only that coefficient moved.
+                    for &other in friction_ids.iter().filter(|&&o| o != id) {
+                        assert_eq!(other.get(&q), other.get(&p), "{other} after {id}");
+                    }
+                } else {
+                    assert_eq!(q, p);
+                }
+            }
+        }
+        let mut p = experiment_blade();
+        p.friction = laws[2];
+        ParamId::Vs.set(&mut p, 0.05);
+        ParamId::Delta.set(&mut p, 1.5);
+        assert_eq!(
+            p.friction,
+            FrictionLaw::Stribeck {
+                a: 0.8,
+                c: 0.2,
+                v_s_m_per_s: 0.05,
+                delta: 1.5
+            }
+        );
     }
 
     /// The preload set after the head mass is k0·h_d with the new head's k0: the experiment blade

@@ -180,7 +180,7 @@ fn param_figure(dir: &Path, t: &Table, p: &str, cond: &str, values: &[String]) -
     })
 }
 
-/// `friction_laws.svg`: μ_d(v) = A e^(−B|v|) + C of every done recording.
+/// `friction_laws.svg`: the fitted μ_d(|v|) of every done recording (its blade file's law).
 fn friction_figure(dir: &Path, t: &Table) -> Result<Option<Figure>> {
     let v: Vec<f64> = (0..=200).map(|i| i as f64 * 0.2 / 200.0).collect();
     let series: Vec<Series> = t
@@ -204,7 +204,7 @@ fn friction_figure(dir: &Path, t: &Table) -> Result<Option<Figure>> {
     }
     line_chart(
         &dir.join("friction_laws.svg"),
-        "fitted dynamic friction laws μ_d = A e^(−B|v|) + C (seed eq. 4)",
+        "fitted dynamic friction laws μ_d(|v|), each recording's blade law",
         "slip speed |v| [m/s]",
         "dynamic friction coefficient μ_d [-]",
         &series,
