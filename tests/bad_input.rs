@@ -724,6 +724,17 @@ fn fit_cases() -> Vec<Case> {
             &["--samples 0"],
         ),
         case(
+            "fit: a friction parameter the blade's law lacks",
+            j(&[("C = [0.1, 1.0]", "C = [0.1, 1.0]\nD = [0.0, 1.0]")]),
+            fit,
+            &[
+                "$D/job.toml:",
+                "'D'",
+                "friction law `exponential`",
+                "law = \"exponential_viscous\"",
+            ],
+        ),
+        case(
             "fit: lip mass freed beside the k1 it holds",
             j(&[("C = [0.1, 1.0]", "C = [0.1, 1.0]\nlip_mass = [1e-4, 1e-3]")]),
             fit,

@@ -715,7 +715,15 @@ impl Check<'_> {
                 return Err(self.error(
                     &at,
                     format!(
-                        "[fit.parameters]: '{id}' is not a parameter of the blade's friction law (A, B, C need the exponential law)"
+                        "[fit.parameters]: '{id}' ({}) is not a coefficient of the friction law `{}` in the blade file {}; it needs law = {}",
+                        id.axis_label(),
+                        blade.friction.name(),
+                        blade_path.display(),
+                        id.friction_laws()
+                            .iter()
+                            .map(|l| format!("\"{l}\""))
+                            .collect::<Vec<_>>()
+                            .join(" or ")
                     ),
                 ));
             }
