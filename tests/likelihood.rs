@@ -336,6 +336,7 @@ fn lrt_p_values_match_closed_forms_and_tables() {
         nll,
         k,
         n_effective: 100.0,
+        effective_parameters: None,
     };
     // df = 1: P(χ²₁ ≥ x) = P(|N(0,1)| ≥ √x) = erfc(√(x/2)).
     for x in [0.1, 1.0, 2.5, 3.841458820694124, 10.0, 30.0] {

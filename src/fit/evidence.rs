@@ -27,7 +27,7 @@ use super::problem::SpectralProblem;
 use crate::Result;
 use crate::job::NoiseSpectrum;
 use crate::likelihood::covariance::{
-    cholesky_of_covariance, covariance, sample_covariance, sandwich_covariance,
+    cholesky_of_covariance, covariance, effective_parameters, sample_covariance, sandwich_covariance,
 };
 use crate::likelihood::{self, Evidence, WelchLikelihood};
 use crate::simulate::blade::BladeSimulation;
@@ -158,6 +158,10 @@ pub struct NllParts {
     /// Effective number of observations: the bands' independent bins plus (with the time term) the
     /// residuals' AR(1) effective sample size.
     pub n_effective: f64,
+    /// Takeuchi's effective number of parameters `tr(F⁺V)` at the fit, when the variability was
+    /// estimated ([`at_fit`]; [`crate::likelihood::covariance::effective_parameters`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub effective_parameters: Option<f64>,
 }
 
 impl NllParts {
@@ -172,6 +176,7 @@ impl NllParts {
             nll: self.total(),
             k,
             n_effective: self.n_effective,
+            effective_parameters: self.effective_parameters,
         }
     }
 }
@@ -456,6 +461,7 @@ impl RecordingLikelihood {
             residual_rho: t.rho,
             block_rms_m: t.block_rms,
             n_effective,
+            effective_parameters: None,
         })
     }
 
@@ -998,8 +1004,10 @@ pub fn at_fit_smoothed(problem: &SpectralProblem, u: &[f64]) -> Result<LocalFit>
 
 /// [`at_fit`] and [`at_fit_smoothed`].
 fn local_fit(problem: &SpectralProblem, u: &[f64], spread: Spread) -> Result<LocalFit> {
-    let (nll, info, var) = information(problem, u, spread)?;
-    let (sigma_u, corr) = sandwich_covariance(&info, &var.expect("asked for"));
+    let (mut nll, info, var) = information(problem, u, spread)?;
+    let var = var.expect("asked for");
+    nll.effective_parameters = Some(effective_parameters(&info, &var));
+    let (sigma_u, corr) = sandwich_covariance(&info, &var);
     let (curvature_sigma_u, curvature_corr) = covariance(&info);
     Ok(LocalFit {
         nll,

@@ -222,10 +222,10 @@ fn optimum_checks(
     (tolerance_check, truth_cost)
 }
 
-/// The chosen trial's name, the name of the trial with the AIC nearest to it among the others, and
-/// that AIC's distance above the chosen one's (`None` without two trials in likelihood units).
+/// The chosen trial's name, the name of the trial with the TIC nearest to it among the others, and
+/// that TIC's distance above the chosen one's (`None` without two trials in likelihood units).
 fn runner_up(trials: &[result::ModelTrial]) -> Option<(Candidate, Candidate, f64)> {
-    let aic = |t: &result::ModelTrial| t.evidence.as_ref().map(|e| e.aic);
+    let aic = |t: &result::ModelTrial| t.evidence.as_ref().map(|e| e.tic);
     let chosen = trials.iter().find(|t| t.chosen)?;
     let chosen_aic = aic(chosen)?;
     trials

@@ -271,6 +271,16 @@ pub struct TrialEvidence {
     pub residual_rms_m: f64,
     /// Effective number of observations (BIC's n).
     pub n_effective: f64,
+    /// Takeuchi's effective number of parameters `tr(F⁺V)` (the TIC's penalty is twice it), when
+    /// the score's variability was estimated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub effective_parameters: Option<f64>,
+    /// `2·tr(F⁺V) + 2·NLL`, the criterion the choice reads (`2k + 2·NLL` without `tr(F⁺V)`).
+    #[serde(default)]
+    pub tic: f64,
+    /// TIC minus the chosen model's.
+    #[serde(default)]
+    pub delta_tic: f64,
     /// `2k + 2·NLL`.
     pub aic: f64,
     /// `k ln n + 2·NLL`.
@@ -497,6 +507,9 @@ mod tests {
                 time_nll_nats: None,
                 residual_rms_m: 1e-5,
                 n_effective: 40.0,
+                effective_parameters: Some(1.2),
+                tic: 25.4,
+                delta_tic: 3.2,
                 aic: 27.0,
                 bic: 28.7,
                 delta_aic: 4.0,

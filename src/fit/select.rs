@@ -1,9 +1,14 @@
 //! Model-selection stage: which candidate the result reports, and why, in numbers.
 //!
-//! With a recording, candidates are compared in likelihood units ([`super::evidence`]): Akaike's
-//! `AIC = 2k + 2·NLL` chooses, Schwarz's BIC and, for nested candidates, Wilks' likelihood-ratio
-//! test are reported beside it. A target job has no likelihood (its targets carry no noise); it
-//! compares `cost + 2k` ([`aic`]).
+//! With a recording, candidates are compared in likelihood units ([`super::evidence`]): Takeuchi's
+//! `TIC = 2·tr(F⁺V) + 2·NLL` chooses ([`Evidence::tic`]), the AIC of a likelihood that is composite
+//! and does not describe the ordinates' spread (its calibrated penalty `tr(F⁺V)` is a fraction of
+//! `k` on the shipped recording, where Akaike's `2k` would overcharge each parameter). Candidates
+//! within [`INDISTINGUISHABLE_TIC`] of the lowest TIC are not distinguishable by the recording: the
+//! one with the fewest freed parameters among them is reported, and its reason and a warning say
+//! so. Akaike's AIC, Schwarz's BIC and, for nested candidates, Wilks' likelihood-ratio test are
+//! reported beside it. A target job has no likelihood (its targets carry no noise); it compares
+//! `cost + 2k` ([`aic`]).
 
 use super::features::BandSpec;
 use super::problem::FAILED_COST;
@@ -19,10 +24,19 @@ pub fn aic(cost: f64, k: usize) -> f64 {
     cost + 2.0 * k as f64
 }
 
+/// Candidates whose TIC lies within 2 of the lowest are not distinguishable by the recording:
+/// a difference of 2 in an information criterion is "substantial support" for both (Burnham &
+/// Anderson, *Model Selection and Multimodel Inference*, 2nd ed. 2002, §2.6), and the simpler
+/// model is reported.
+pub const INDISTINGUISHABLE_TIC: f64 = 2.0;
+
 /// The outcome of model selection: the chosen candidate's index and every candidate's trial.
 pub(super) struct Selection {
     pub(super) chosen: usize,
     pub(super) trials: Vec<ModelTrial>,
+    /// The candidates the recording cannot tell from the chosen one, with their TIC above the
+    /// chosen one's (negative when more likely by the criterion but not by enough).
+    pub(super) indistinguishable: Vec<(usize, f64)>,
 }
 
 /// Each candidate's evidence, when every candidate that produced a model has one (else none: the
@@ -55,9 +69,22 @@ fn evidences(fits: &[CandidateFit]) -> Option<Vec<Option<Evidence>>> {
 pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) -> Selection {
     let evidence = evidences(fits);
     let (aics, scores) = criteria(fits, bands, evidence.as_deref());
-    let chosen = (0..fits.len())
+    let best = (0..fits.len())
         .min_by(|&a, &b| scores[a].total_cmp(&scores[b]))
         .unwrap_or(0);
+    let near = |i: usize| {
+        evidence.is_some() && scores[i].is_finite() && scores[i] - scores[best] <= INDISTINGUISHABLE_TIC
+    };
+    let chosen = (0..fits.len())
+        .filter(|&i| near(i))
+        .min_by(|&a, &b| {
+            (fits[a].free.len().cmp(&fits[b].free.len())).then(scores[a].total_cmp(&scores[b]))
+        })
+        .unwrap_or(best);
+    let indistinguishable: Vec<(usize, f64)> = (0..fits.len())
+        .filter(|&i| i != chosen && near(i))
+        .map(|i| (i, scores[i] - scores[chosen]))
+        .collect();
     let scored = Scored {
         aics: &aics,
         scores: &scores,
@@ -82,10 +109,14 @@ pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) ->
             evidence: scored.trial_evidence(fits, i),
         })
         .collect();
-    Selection { chosen, trials }
+    Selection {
+        chosen,
+        trials,
+        indistinguishable,
+    }
 }
 
-/// How far each candidate's score (the AIC [`choose`] chooses by) lies above the chosen one's, as
+/// How far each candidate's score (the TIC [`choose`] chooses by) lies above the lowest, as
 /// the fits stand: 0 for the chosen, +∞ for one that cannot be chosen (it imposes a band, or has
 /// no AIC).
 pub(super) fn score_gaps(fits: &[CandidateFit], bands: &[BandSpec]) -> Vec<f64> {
@@ -98,7 +129,8 @@ pub(super) fn score_gaps(fits: &[CandidateFit], bands: &[BandSpec]) -> Vec<f64> 
         .collect()
 }
 
-/// Every candidate's AIC, and its score: the AIC where [`choose`] may choose it, else +∞.
+/// Every candidate's criterion (TIC with a likelihood, else `cost + 2k`), and its score: the
+/// criterion where [`choose`] may choose it, else +∞.
 fn criteria(
     fits: &[CandidateFit],
     bands: &[BandSpec],
@@ -108,7 +140,7 @@ fn criteria(
         .iter()
         .enumerate()
         .map(|(i, f)| match evidence {
-            Some(e) => e[i].map_or(f64::INFINITY, |e| e.aic()),
+            Some(e) => e[i].map_or(f64::INFINITY, |e| e.tic()),
             None if f.cost < FAILED_COST => aic(f.cost, f.free.len()),
             None => f64::INFINITY,
         })
@@ -177,6 +209,9 @@ impl Scored<'_> {
             time_nll_nats: parts.time_nats,
             residual_rms_m: parts.residual_rms_m,
             n_effective: e.n_effective,
+            effective_parameters: e.effective_parameters,
+            tic: e.tic(),
+            delta_tic: e.tic() - best.tic(),
             aic: e.aic(),
             bic: e.bic(),
             delta_aic: e.aic() - best.aic(),
@@ -188,7 +223,7 @@ impl Scored<'_> {
     /// The criterion's name in the reasons.
     fn criterion(&self) -> &'static str {
         if self.evidence.is_some() {
-            "AIC = 2k + 2·NLL"
+            "TIC = 2·tr(F⁺V) + 2·NLL"
         } else {
             "AIC = cost + 2k"
         }
@@ -243,11 +278,26 @@ impl Scored<'_> {
                 )
             };
         }
+        let penalty = self
+            .of(i)
+            .and_then(|e| e.effective_parameters)
+            .map(|p| format!(", tr(F⁺V) = {p:.2}"))
+            .unwrap_or_default();
+        let name = self.criterion().split(' ').next().unwrap_or("AIC");
         let mut r = format!(
-            "AIC {:.2} ({lnl}k = {k}), {:+.2} against the chosen model",
+            "{name} {:.2} ({lnl}k = {k}{penalty}), {:+.2} against the chosen model",
             self.aics[i],
             self.aics[i] - self.aics[self.chosen]
         );
+        if self.evidence.is_some()
+            && (self.aics[i] - self.aics[self.chosen]).abs() <= INDISTINGUISHABLE_TIC
+            && self.scores[i].is_finite()
+        {
+            r.push_str(&format!(
+                "; not distinguishable by this recording (within {INDISTINGUISHABLE_TIC} of the \
+                 chosen model's TIC, which has fewer parameters)"
+            ));
+        }
         if let (Some(e), Some(best)) = (self.of(i), self.of(self.chosen)) {
             r.push_str(&format!("; ΔBIC {:+.2}", e.bic() - best.bic()));
         }
@@ -259,7 +309,7 @@ impl Scored<'_> {
                 t.df,
                 t.p_value,
                 if t.p_value < 0.05 {
-                    "a gain beyond chance, but not worth its parameters by AIC"
+                    "a gain beyond chance, but not worth its parameters by TIC"
                 } else {
                     "no gain beyond chance from the extra parameters"
                 }

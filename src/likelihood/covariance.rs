@@ -50,6 +50,19 @@ pub fn sandwich_covariance(f: &DMatrix<f64>, v: &DMatrix<f64>) -> (Vec<f64>, Vec
     spread(&(&pinv * v * &pinv), &uninformed)
 }
 
+/// Takeuchi's effective number of parameters `tr(F⁺V)` for a Fisher information (the NLL's
+/// expected Hessian) `f` and a variability (the variance of the NLL's gradient) `v`: the bias of the
+/// maximised log-likelihood as an estimate of the expected log-likelihood of new data, so that
+/// `TIC = 2·NLL + 2·tr(F⁺V)` compares models whose likelihood is misspecified or composite
+/// (Takeuchi 1976, *Suri-Kagaku* 153:12; Konishi & Kitagawa 2008, *Information Criteria and
+/// Statistical Modeling*, §3.4.3, eq. 3.112). Where the likelihood is right, `V = F` and the trace
+/// is the number of informed directions (Akaike's `k`); a direction `f` does not inform (a
+/// parameter the recording leaves flat) adds nothing, since the fit cannot tune it to the noise.
+pub fn effective_parameters(f: &DMatrix<f64>, v: &DMatrix<f64>) -> f64 {
+    let (pinv, _) = pseudo_inverse(f);
+    (&pinv * v).trace()
+}
+
 /// The pseudo-inverse of a symmetric positive semi-definite `f` over its informed directions
 /// (eigenvalues above 1e-12 of the largest), and per coordinate whether it loads on an
 /// uninformed direction.
@@ -103,6 +116,37 @@ fn spread(cov: &DMatrix<f64>, uninformed: &[bool]) -> (Vec<f64>, Vec<Vec<f64>>) 
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+
+    /// A positive definite 3×3 information.
+    fn info() -> DMatrix<f64> {
+        DMatrix::from_row_slice(3, 3, &[4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 2.0])
+    }
+
+    #[test]
+    fn takeuchi_trace_is_akaikes_k_where_the_likelihood_is_right() {
+        // V = F: tr(F⁻¹F) = k (Konishi & Kitagawa 2008, §3.4.3).
+        let f = info();
+        assert!((effective_parameters(&f, &f) - 3.0).abs() < 1e-12);
+        // V = cF (a likelihood whose scale is off by c): c·k.
+        assert!((effective_parameters(&f, &(0.3 * &f)) - 0.9).abs() < 1e-12);
+    }
+
+    #[test]
+    fn takeuchi_trace_counts_only_informed_directions() {
+        // A parameter with no information (its row and column zero): rank 2, so 2 with V = F.
+        let mut f = info();
+        for k in 0..3 {
+            f[(2, k)] = 0.0;
+            f[(k, 2)] = 0.0;
+        }
+        assert!((effective_parameters(&f, &f) - 2.0).abs() < 1e-12);
+        // Diagonal F and V: Σ v_i/f_i over the informed ones.
+        let f = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![2.0, 5.0, 0.0]));
+        let v = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![1.0, 1.0, 7.0]));
+        assert!((effective_parameters(&f, &v) - (0.5 + 0.2)).abs() < 1e-12);
+    }
+
     use super::*;
 
     #[test]

@@ -606,6 +606,9 @@ pub struct Evidence {
     /// Effective number of observations (BIC's `n`): effectively independent bins plus the
     /// residuals' `n_eff`.
     pub n_effective: f64,
+    /// Takeuchi's effective number of parameters `tr(F⁺V)`
+    /// ([`covariance::effective_parameters`]), when the variability of the score was estimated.
+    pub effective_parameters: Option<f64>,
 }
 
 impl Evidence {
@@ -617,6 +620,13 @@ impl Evidence {
     /// Akaike's criterion `2k + 2·NLL`.
     pub fn aic(&self) -> f64 {
         2.0 * self.k as f64 + 2.0 * self.nll
+    }
+
+    /// Takeuchi's criterion `2·tr(F⁺V) + 2·NLL`, the AIC of a misspecified or composite
+    /// likelihood ([`covariance::effective_parameters`]); Akaike's `2k + 2·NLL` without a
+    /// variability estimate.
+    pub fn tic(&self) -> f64 {
+        2.0 * self.effective_parameters.unwrap_or(self.k as f64) + 2.0 * self.nll
     }
 
     /// Schwarz's criterion `k ln n + 2·NLL`.
