@@ -27,7 +27,8 @@ use super::problem::SpectralProblem;
 use crate::Result;
 use crate::job::NoiseSpectrum;
 use crate::likelihood::covariance::{
-    cholesky_of_covariance, covariance, effective_parameters, sample_covariance, sandwich_covariance,
+    cholesky_of_covariance, covariance, effective_parameters, sample_covariance,
+    sandwich_covariance,
 };
 use crate::likelihood::{self, Evidence, WelchLikelihood};
 use crate::simulate::blade::BladeSimulation;

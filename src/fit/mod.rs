@@ -19,7 +19,7 @@ mod problem;
 pub mod result;
 pub mod scan;
 mod search;
-mod select;
+pub mod select;
 pub mod tolerance;
 mod uncertainty;
 pub mod warning;
@@ -225,7 +225,7 @@ fn optimum_checks(
 /// The chosen trial's name, the name of the trial with the TIC nearest to it among the others, and
 /// that TIC's distance above the chosen one's (`None` without two trials in likelihood units).
 fn runner_up(trials: &[result::ModelTrial]) -> Option<(Candidate, Candidate, f64)> {
-    let aic = |t: &result::ModelTrial| t.evidence.as_ref().map(|e| e.tic);
+    let aic = |t: &result::ModelTrial| t.evidence.as_ref().and_then(|e| e.tic);
     let chosen = trials.iter().find(|t| t.chosen)?;
     let chosen_aic = aic(chosen)?;
     trials

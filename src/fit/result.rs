@@ -276,11 +276,11 @@ pub struct TrialEvidence {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub effective_parameters: Option<f64>,
     /// `2·tr(F⁺V) + 2·NLL`, the criterion the choice reads (`2k + 2·NLL` without `tr(F⁺V)`).
-    #[serde(default)]
-    pub tic: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tic: Option<f64>,
     /// TIC minus the chosen model's.
-    #[serde(default)]
-    pub delta_tic: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub delta_tic: Option<f64>,
     /// `2k + 2·NLL`.
     pub aic: f64,
     /// `k ln n + 2·NLL`.
@@ -508,8 +508,8 @@ mod tests {
                 residual_rms_m: 1e-5,
                 n_effective: 40.0,
                 effective_parameters: Some(1.2),
-                tic: 25.4,
-                delta_tic: 3.2,
+                tic: Some(25.4),
+                delta_tic: Some(3.2),
                 aic: 27.0,
                 bic: 28.7,
                 delta_aic: 4.0,

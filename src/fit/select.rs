@@ -34,9 +34,6 @@ pub const INDISTINGUISHABLE_TIC: f64 = 2.0;
 pub(super) struct Selection {
     pub(super) chosen: usize,
     pub(super) trials: Vec<ModelTrial>,
-    /// The candidates the recording cannot tell from the chosen one, with their TIC above the
-    /// chosen one's (negative when more likely by the criterion but not by enough).
-    pub(super) indistinguishable: Vec<(usize, f64)>,
 }
 
 /// Each candidate's evidence, when every candidate that produced a model has one (else none: the
@@ -73,7 +70,9 @@ pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) ->
         .min_by(|&a, &b| scores[a].total_cmp(&scores[b]))
         .unwrap_or(0);
     let near = |i: usize| {
-        evidence.is_some() && scores[i].is_finite() && scores[i] - scores[best] <= INDISTINGUISHABLE_TIC
+        evidence.is_some()
+            && scores[i].is_finite()
+            && scores[i] - scores[best] <= INDISTINGUISHABLE_TIC
     };
     let chosen = (0..fits.len())
         .filter(|&i| near(i))
@@ -81,10 +80,6 @@ pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) ->
             (fits[a].free.len().cmp(&fits[b].free.len())).then(scores[a].total_cmp(&scores[b]))
         })
         .unwrap_or(best);
-    let indistinguishable: Vec<(usize, f64)> = (0..fits.len())
-        .filter(|&i| i != chosen && near(i))
-        .map(|i| (i, scores[i] - scores[chosen]))
-        .collect();
     let scored = Scored {
         aics: &aics,
         scores: &scores,
@@ -109,11 +104,7 @@ pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) ->
             evidence: scored.trial_evidence(fits, i),
         })
         .collect();
-    Selection {
-        chosen,
-        trials,
-        indistinguishable,
-    }
+    Selection { chosen, trials }
 }
 
 /// How far each candidate's score (the TIC [`choose`] chooses by) lies above the lowest, as
@@ -210,8 +201,8 @@ impl Scored<'_> {
             residual_rms_m: parts.residual_rms_m,
             n_effective: e.n_effective,
             effective_parameters: e.effective_parameters,
-            tic: e.tic(),
-            delta_tic: e.tic() - best.tic(),
+            tic: Some(e.tic()),
+            delta_tic: Some(e.tic() - best.tic()),
             aic: e.aic(),
             bic: e.bic(),
             delta_aic: e.aic() - best.aic(),

@@ -147,8 +147,6 @@ mod tests {
         assert!((effective_parameters(&f, &v) - (0.5 + 0.2)).abs() < 1e-12);
     }
 
-    use super::*;
-
     #[test]
     fn sandwich_of_a_diagonal_information_matches_the_hand_product() {
         // F = diag(4, 1), V = [[1, 0.5], [0.5, 4]]: F⁻¹VF⁻¹ = [[1/16, 1/8], [1/8, 4]], so

@@ -476,7 +476,10 @@ fn trial_rows(r: &FitResult) -> Vec<TrialView> {
             delta_aic: t
                 .evidence
                 .as_ref()
-                .map_or("—".into(), |e| format!("{:+.2}", e.delta_aic)),
+                .map_or("—".into(), |e| match e.delta_tic {
+                    Some(d) => format!("{d:+.2}"),
+                    None => format!("{:+.2} (AIC)", e.delta_aic),
+                }),
             delta_bic: t
                 .evidence
                 .as_ref()
@@ -1231,8 +1234,8 @@ pub(super) mod tests {
             residual_rms_m: 1e-5,
             n_effective: 1e3,
             effective_parameters: None,
-            tic: -11603.6 + delta_aic,
-            delta_tic: delta_aic,
+            tic: Some(-11603.6 + delta_aic),
+            delta_tic: Some(delta_aic),
             aic: -11603.6 + delta_aic,
             bic: -11580.0 + delta_aic,
             delta_aic,

@@ -53,7 +53,8 @@ pub fn summary(r: &FitResult, warnings: &[PageWarning]) -> Summary {
     }
 }
 
-/// "Model blade2dof (…), chosen by AIC among N candidates; the next best …".
+/// "Model blade2dof (…), chosen by TIC among N candidates; the next best …", and which candidates
+/// the recording cannot tell from it (TIC within [`crate::fit::select::INDISTINGUISHABLE_TIC`]).
 fn model_words(r: &FitResult) -> String {
     let label = super::html::model_label(r.model);
     let named = if label.is_empty() {
@@ -65,15 +66,28 @@ fn model_words(r: &FitResult) -> String {
     if others.is_empty() {
         return format!("{named}, the only model fitted.");
     }
+    // The criterion the choice read: TIC where the result has it, AIC in older results.
+    let criterion = |e: &crate::fit::TrialEvidence| match e.delta_tic {
+        Some(d) => ("TIC", d),
+        None => ("AIC", e.delta_aic),
+    };
     let next = others
         .iter()
-        .filter_map(|t| t.evidence.as_ref().map(|e| (t, e.delta_aic)))
-        .filter(|(_, d)| d.is_finite())
-        .min_by(|a, b| a.1.total_cmp(&b.1));
+        .filter_map(|t| t.evidence.as_ref().map(|e| (t, criterion(e))))
+        .filter(|(_, (_, d))| d.is_finite())
+        .min_by(|a, b| a.1.1.total_cmp(&b.1.1));
+    let near = crate::fit::select::INDISTINGUISHABLE_TIC;
     match next {
-        Some((t, d)) => format!(
-            "{named}, chosen by AIC among {} candidates; the next best, {}, has an AIC {d:.1} \
-             higher.",
+        Some((t, ("TIC", d))) if d <= near => format!(
+            "{named}, chosen by TIC among {} candidates; {} is not distinguishable by this \
+             recording (TIC {d:+.1}, within {near}), and the model with fewer parameters is \
+             reported.",
+            r.model_trials.len(),
+            t.model
+        ),
+        Some((t, (name, d))) => format!(
+            "{named}, chosen by {name} among {} candidates; the next best, {}, has a {name} \
+             {d:.1} higher.",
             r.model_trials.len(),
             t.model
         ),
