@@ -6,8 +6,10 @@
 use std::fmt::Write as _;
 use std::path::Path;
 use wiperlab::model::{BladeParams, StickForm};
-use wiperlab::simulate::SolverOptions;
-use wiperlab::simulate::blade::{BladeSimulation, default_window, simulate_blade};
+use wiperlab::simulate::blade::{
+    BladeSimulation, ModelKind, default_window, simulate_blade, simulate_model,
+};
+use wiperlab::simulate::{Method, SolverOptions};
 
 /// Metres per pixel and the pixel origin of the sample's camera.
 const M_PER_PX: f64 = 1.5e-5;
@@ -18,6 +20,7 @@ const X_ORIGIN_M: f64 = 0.1;
 pub const FPS: f64 = 10_000.0;
 
 /// `data/reversal/blade_true.toml` under the crate root `root`.
+#[allow(dead_code)] // not used by make_calibration
 pub fn true_blade(root: &Path) -> BladeParams {
     toml::from_str(
         &std::fs::read_to_string(root.join("data/reversal/blade_true.toml"))
@@ -26,8 +29,32 @@ pub fn true_blade(root: &Path) -> BladeParams {
     .expect("parse blade_true.toml")
 }
 
+/// `p`'s default reversal window at `fps_hz` frames/s by model `kind`, simulated with DOP853 at
+/// rtol 1e-10, atol 1e-12 (the fits run DOPRI5 at looser tolerances: no model evaluation of a fit
+/// reproduces it); with the first frame's time.
+#[allow(dead_code)] // used by make_calibration only
+pub fn simulate_model_window(
+    kind: ModelKind,
+    p: &BladeParams,
+    fps_hz: f64,
+) -> wiperlab::Result<(BladeSimulation, f64)> {
+    let (t0, t1) = default_window(p);
+    let n = ((t1 - t0) * fps_hz) as usize;
+    let times: Vec<f64> = (0..n).map(|k| t0 + k as f64 / fps_hz).collect();
+    let opts = SolverOptions {
+        rtol: 1e-10,
+        atol: 1e-12,
+        method: Method::Dop853,
+        ..SolverOptions::default()
+    };
+    let window = (t0, *times.last().expect("frames"));
+    let sim = simulate_model(kind, p, window, &times, &opts, StickForm::Reduced)?;
+    Ok((sim, t0))
+}
+
 /// `p`'s default reversal window at [`FPS`], simulated at rtol 1e-10, atol 1e-12 (no model
 /// evaluation of a fit reproduces it bit for bit); with the first frame's time.
+#[allow(dead_code)] // not used by make_calibration
 pub fn simulate_window(p: &BladeParams) -> wiperlab::Result<(BladeSimulation, f64)> {
     let (t0, t1) = default_window(p);
     let n = ((t1 - t0) * FPS) as usize;
@@ -46,10 +73,21 @@ pub fn simulate_window(p: &BladeParams) -> wiperlab::Result<(BladeSimulation, f6
 /// (x = v, y = −u) and the lip tip (x = v3, y = −reach, the glass), `%.4f`. `noise_px(c, i)` is the
 /// tracking noise (pixels) of column `c` (head x, head y, tip x, tip y) at frame `i`, drawn row by
 /// row.
-pub fn dltdv_text(sim: &BladeSimulation, mut noise_px: impl FnMut(usize, usize) -> f64) -> String {
+#[allow(dead_code)] // not every example including this file writes through the sample's camera
+pub fn dltdv_text(sim: &BladeSimulation, noise_px: impl FnMut(usize, usize) -> f64) -> String {
+    dltdv_text_at(sim, M_PER_PX, noise_px)
+}
+
+/// [`dltdv_text`] through a camera of `m_per_px` metres per pixel (the same origin); a NaN noise
+/// writes `NaN`, DLTdv's lost point.
+pub fn dltdv_text_at(
+    sim: &BladeSimulation,
+    m_per_px: f64,
+    mut noise_px: impl FnMut(usize, usize) -> f64,
+) -> String {
     let mut csv = String::from("pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y\n");
-    let px_x = |x: f64| ORIGIN_PX.0 + (x - X_ORIGIN_M) / M_PER_PX;
-    let px_y = |y: f64| ORIGIN_PX.1 - y / M_PER_PX;
+    let px_x = |x: f64| ORIGIN_PX.0 + (x - X_ORIGIN_M) / m_per_px;
+    let px_y = |y: f64| ORIGIN_PX.1 - y / m_per_px;
     for i in 0..sim.t_s.len() {
         let clean = [
             px_x(sim.v_m[i]),

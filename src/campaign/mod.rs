@@ -22,15 +22,18 @@
 //! * [`run::run_local`] fits every pending recording in parallel, skipping those whose result is
 //!   complete and whose inputs (recording, job and blade text, wiperlab version) hash the same;
 //! * [`slurm`] writes and submits the `sbatch` array script, and reads the array's state;
-//! * [`collect::collect`] merges the results into `campaign.csv`.
+//! * [`collect::collect`] merges the results into `campaign.csv`;
+//! * [`calibrate::write`] tabulates, when the recordings carry truths, how the fit's intervals,
+//!   search and model choice fare against them (`calibration.md`).
 
+pub mod calibrate;
 pub mod collect;
 mod error;
 pub mod run;
 pub mod slurm;
 
 use crate::job::{FitJob, TruthSection};
-use crate::model::BladeParams;
+use crate::model::{BladeParams, ParamId};
 use crate::{Error, Result};
 pub use error::CampaignError;
 use serde::Deserialize;
@@ -51,6 +54,25 @@ pub struct CampaignFile {
     /// Optional CSV table of per-recording settings and condition labels.
     #[serde(default)]
     pub conditions: Option<PathBuf>,
+    /// Keys added to the template's `[truth] keys` (parameter → JSON pointer), e.g. the shoulder's
+    /// `theta_c` and `k1c` when the recordings' truth files hold them and the template is a job
+    /// whose own truth does not.
+    #[serde(default)]
+    pub truth_keys: BTreeMap<ParamId, String>,
+    /// Scale the template's Welch bands to each recording's frame rate (`fps_hz` column): keep
+    /// each band's bin width (nperseg, and noverlap and nfft when given, times the frame-rate
+    /// ratio, rounded to a power of two as `wiperlab init` does) and clip its upper edge at the
+    /// recording's Nyquist frequency.
+    #[serde(default)]
+    pub bands_follow_frame_rate: bool,
+    /// Where the calibration table goes (`<reports_dir>/<name>/calibration.md`), relative to the
+    /// campaign file; default: the campaign's `report/` directory.
+    #[serde(default)]
+    pub reports_dir: Option<PathBuf>,
+    /// Text printed at the top of the calibration table (what the campaign is, how its seeds were
+    /// chosen).
+    #[serde(default)]
+    pub notes: Option<String>,
     /// Defaults for `wiperlab campaign slurm`.
     #[serde(default)]
     pub slurm: slurm::SlurmSettings,
@@ -210,13 +232,22 @@ impl Campaign {
                 "a campaign template must be a fit job with a [recording] section (its file is replaced per recording)",
             ));
         }
+        if !file.truth_keys.is_empty() && template.truth.is_none() {
+            return Err(Error::input(
+                &path,
+                format!(
+                    "truth_keys adds to the template's [truth] keys, but the template {} has no [truth] section",
+                    template_path.display()
+                ),
+            ));
+        }
         let recordings = resolve_recordings(&path, &dir, &file.recordings)?;
         let (entries, label_columns) = match &file.conditions {
             Some(table) => with_conditions(
                 &path,
                 &dir.join(table),
                 &template_path,
-                template.truth.as_ref(),
+                merged_truth(template.truth, &file.truth_keys).as_ref(),
                 recordings,
             )?,
             None => (
@@ -255,6 +286,20 @@ impl Campaign {
         Ok(self)
     }
 
+    /// Where the calibration table goes: `<reports_dir>/<name>/` when the campaign file sets
+    /// `reports_dir`, else `<out dir>/report/`.
+    pub fn calibration_dir(&self) -> PathBuf {
+        match &self.file.reports_dir {
+            Some(r) => self
+                .path
+                .parent()
+                .unwrap_or(Path::new("."))
+                .join(r)
+                .join(&self.name),
+            None => self.out_dir().join("report"),
+        }
+    }
+
     /// `<campaign dir>/<name>/` (or `--out-dir`): everything the campaign writes.
     pub fn out_dir(&self) -> PathBuf {
         match &self.out_dir_override {
@@ -272,12 +317,12 @@ impl Campaign {
         self.entries.iter().find(|e| e.id == id)
     }
 
-    /// The `[truth]` of `entry`'s fit: the template's keys, read from the entry's `truth_json`
-    /// (absolute) or else the template's own JSON (made absolute); `None` when the template has
-    /// no `[truth]`.
+    /// The `[truth]` of `entry`'s fit: the template's keys and the campaign's `truth_keys`, read
+    /// from the entry's `truth_json` (absolute) or else the template's own JSON (made absolute);
+    /// `None` when the template has no `[truth]`.
     pub fn truth_of(&self, entry: &Entry) -> Option<TruthSection> {
         let template: FitJob = toml::from_str(&self.template_text).ok()?;
-        let mut truth = template.truth?;
+        let mut truth = merged_truth(template.truth, &self.file.truth_keys)?;
         truth.json = match entry.files.get(&FileOverride::TruthJson) {
             Some(p) => p.clone(),
             None => self
@@ -288,6 +333,16 @@ impl Campaign {
         };
         Some(truth)
     }
+}
+
+/// The template's `[truth]` with the campaign's `truth_keys` added (the campaign's win).
+fn merged_truth(
+    truth: Option<TruthSection>,
+    extra: &BTreeMap<ParamId, String>,
+) -> Option<TruthSection> {
+    let mut t = truth?;
+    t.keys.extend(extra.iter().map(|(k, v)| (*k, v.clone())));
+    Some(t)
 }
 
 fn absolute(path: &Path) -> Result<PathBuf> {

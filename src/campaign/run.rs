@@ -6,6 +6,7 @@ use super::{Campaign, Entry, FileOverride, Override};
 use crate::io::sha256_hex;
 use crate::io::write_atomic;
 use crate::job::LoadedJob;
+use crate::spectrum::features::BandSpec;
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -93,6 +94,15 @@ pub fn generate(campaign: &Campaign, entry: &Entry, paths: &EntryPaths) -> Resul
     if let Some(truth) = entry.files.get(&FileOverride::TruthJson) {
         table_at(&mut job, tpl, "truth")?.insert("json".into(), path_value(truth));
     }
+    if !campaign.file.truth_keys.is_empty() {
+        let keys = table_at(table_at(&mut job, tpl, "truth")?, tpl, "keys")?;
+        for (k, ptr) in &campaign.file.truth_keys {
+            keys.insert(k.name().into(), ptr.clone().into());
+        }
+    }
+    if campaign.file.bands_follow_frame_rate {
+        follow_frame_rate(campaign, entry, &mut job)?;
+    }
     let truth_bytes = match job
         .get("truth")
         .and_then(|t| t.get("json"))
@@ -136,6 +146,84 @@ pub fn generate(campaign: &Campaign, entry: &Entry, paths: &EntryPaths) -> Resul
         blade_text,
         input_sha256: sha256_hex(&hashed),
     })
+}
+
+/// Replaces the job's `[[spectrum.bands]]` by the template's bands scaled to `entry`'s frame rate
+/// (the `bands_follow_frame_rate` rule: [`scaled_band`]); the template's bands are its own or the
+/// defaults, and its frame rate is its `[recording.import] fps_hz`.
+fn follow_frame_rate(campaign: &Campaign, entry: &Entry, job: &mut toml::Table) -> Result<()> {
+    let tpl = &campaign.template_path;
+    let template: crate::job::FitJob = toml::from_str(&campaign.template_text)
+        .map_err(|e| Error::input(tpl, format!("template: {e}")))?;
+    let Some(fps_tpl) = template
+        .recording
+        .as_ref()
+        .and_then(|r| r.import.fps_hz)
+        .filter(|f| f.is_finite() && *f > 0.0)
+    else {
+        return Err(Error::input(
+            &campaign.path,
+            format!(
+                "bands_follow_frame_rate: the template {} gives no [recording.import] fps_hz to scale its bands from",
+                tpl.display()
+            ),
+        ));
+    };
+    let fps = entry
+        .overrides
+        .get(&Override::FpsHz)
+        .copied()
+        .unwrap_or(fps_tpl);
+    let mut bands = Vec::with_capacity(template.spectrum.bands.len());
+    for b in &template.spectrum.bands {
+        let scaled = scaled_band(b, fps_tpl, fps).ok_or_else(|| {
+            Error::input(
+                &campaign.path,
+                format!(
+                    "bands_follow_frame_rate: band '{}' ({}–{} Hz) starts above the Nyquist frequency {} Hz of recording {} (fps_hz = {fps})",
+                    b.name,
+                    b.range_hz[0],
+                    b.range_hz[1],
+                    0.5 * fps,
+                    entry.id
+                ),
+            )
+        })?;
+        bands.push(scaled);
+    }
+    let value = toml::Value::try_from(&bands).map_err(|e| Error::input(tpl, e.to_string()))?;
+    let spectrum = job
+        .entry("spectrum")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    match spectrum.as_table_mut() {
+        Some(t) => {
+            t.insert("bands".into(), value);
+            Ok(())
+        }
+        None => Err(Error::input(tpl, "template: expected a [spectrum] table")),
+    }
+}
+
+/// `band` of a recording at `fps_from` moved to one at `fps_to` with the same bin width: nperseg
+/// (and noverlap and nfft when given) times `fps_to/fps_from`, nperseg rounded to the nearest power
+/// of two (at least 8) as `wiperlab init`'s band rule does, the others scaled with it; the upper
+/// edge clipped at the Nyquist frequency `fps_to/2`. `None` when the band starts at or above it.
+pub fn scaled_band(band: &BandSpec, fps_from: f64, fps_to: f64) -> Option<BandSpec> {
+    let nyquist = 0.5 * fps_to;
+    if band.range_hz[0] >= nyquist {
+        return None;
+    }
+    let mut b = band.clone();
+    b.range_hz[1] = b.range_hz[1].min(nyquist);
+    if fps_to != fps_from {
+        let exact = (band.nperseg as f64 * fps_to / fps_from).max(8.0);
+        b.nperseg = 2f64.powf(exact.log2().round()) as usize;
+        let ratio = b.nperseg as f64 / band.nperseg as f64;
+        let scale = |n: usize| ((n as f64 * ratio).round() as usize).max(1);
+        b.noverlap = band.noverlap.map(|n| scale(n).min(b.nperseg - 1));
+        b.nfft = band.nfft.map(|n| scale(n).max(b.nperseg));
+    }
+    Some(b)
 }
 
 fn read(path: &Path) -> Result<String> {
@@ -320,4 +408,36 @@ pub fn describe_overrides(entry: &Entry) -> String {
         })
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The main job's bands (10,000 frames/s) at 5,000 and 20,000 frames/s keep their bin widths
+    /// (fs/nperseg = 2.44 and 19.5 Hz), and the high band stops at the slower camera's Nyquist.
+    #[test]
+    fn bands_keep_their_bin_width_and_stop_at_nyquist() {
+        let low = BandSpec::new("low", [30.0, 300.0], 4096);
+        let high = BandSpec::new("high", [500.0, 5000.0], 512);
+        let slow = scaled_band(&high, 10_000.0, 5_000.0).expect("500 Hz < 2500 Hz");
+        assert_eq!((slow.nperseg, slow.range_hz), (256, [500.0, 2500.0]));
+        let fast = scaled_band(&high, 10_000.0, 20_000.0).expect("band");
+        assert_eq!((fast.nperseg, fast.range_hz), (1024, [500.0, 5000.0]));
+        assert_eq!(scaled_band(&low, 10_000.0, 5_000.0).unwrap().nperseg, 2048);
+        // 13 kHz: 4096·1.3 = 5325, nearest power of two 4096 (log2 12.38 rounds to 12).
+        assert_eq!(scaled_band(&low, 10_000.0, 13_000.0).unwrap().nperseg, 4096);
+        // 15 kHz: 6144, log2 12.58 rounds to 13.
+        assert_eq!(scaled_band(&low, 10_000.0, 15_000.0).unwrap().nperseg, 8192);
+        let mut overlapped = high.clone();
+        overlapped.noverlap = Some(384);
+        overlapped.nfft = Some(1024);
+        let o = scaled_band(&overlapped, 10_000.0, 20_000.0).unwrap();
+        assert_eq!((o.noverlap, o.nfft), (Some(768), Some(2048)));
+        assert!(
+            scaled_band(&high, 10_000.0, 900.0).is_none(),
+            "Nyquist 450 Hz"
+        );
+        assert_eq!(scaled_band(&high, 10_000.0, 10_000.0).unwrap(), high);
+    }
 }

@@ -49,7 +49,8 @@ pub enum CampaignCommand {
         campaign: PathBuf,
     },
     /// Merge every result into <campaign dir>/<name>/campaign.csv and draw the campaign report
-    /// page <campaign dir>/<name>/report/index.html.
+    /// page <campaign dir>/<name>/report/index.html; when the recordings carry truths, also write
+    /// the calibration table calibration.md (+ CSV) (docs/campaigns.md).
     Collect {
         /// The campaign TOML (docs/campaigns.md).
         campaign: PathBuf,
@@ -117,6 +118,14 @@ pub fn run(cmd: CampaignCommand, out_dir: Option<PathBuf>) -> Result<()> {
             Ok(())
         }
         CampaignCommand::Collect { campaign } => {
+            let command = match &out_dir {
+                Some(d) => format!(
+                    "wiperlab campaign collect {} --out-dir {}",
+                    campaign.display(),
+                    d.display()
+                ),
+                None => format!("wiperlab campaign collect {}", campaign.display()),
+            };
             let c = load(&campaign)?;
             let (table, path) = crate::campaign::collect::collect(&c)?;
             let outliers = crate::campaign::collect::outliers(&table);
@@ -141,6 +150,14 @@ pub fn run(cmd: CampaignCommand, out_dir: Option<PathBuf>) -> Result<()> {
             }
             for r in table.rows.iter().filter(|r| r.state != "done") {
                 println!("  {}: {} {}", r.id, r.state, r.reason);
+            }
+            if let Some((cal, md)) = crate::campaign::calibrate::write(&c, &command)? {
+                let (known, over, _) = cal.shortfalls();
+                println!(
+                    "calibration table {} ({} parameters scored; {over} of {known} searches short of the truth)",
+                    md.display(),
+                    cal.overall.len()
+                );
             }
             Ok(())
         }
