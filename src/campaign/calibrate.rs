@@ -30,10 +30,10 @@
 
 use super::Campaign;
 use super::run::{EntryPaths, State, read_status};
-use crate::job::{Candidate, FreeParam};
 use crate::fit::SHORTFALL_TOLERANCE_NATS;
 use crate::fit::result::{FitResult, FittedParam};
 use crate::io::write_atomic;
+use crate::job::{Candidate, FreeParam};
 use crate::model::ParamId;
 use crate::{Error, Result};
 use statrs::distribution::{Binomial, ChiSquared, ContinuousCDF, DiscreteCDF, Normal};
