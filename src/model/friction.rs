@@ -9,6 +9,8 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+use super::ParamId;
+
 /// A friction law: dynamic coefficient `μ_d(|v|)` for `|v| > 0` and static coefficient `μ_s`.
 ///
 /// A blade file names the law with `law = "..."` and gives its coefficients under the keys of
@@ -216,6 +218,48 @@ impl FrictionLaw {
                 mu_s,
                 delta_s_per_m,
             } => -mu_s * delta_s_per_m / (1.0 + delta_s_per_m * v).powi(2),
+        }
+    }
+
+    /// The derivatives `∂μ_d/∂θ` of the dynamic coefficient at slip speed `speed_m_per_s` with
+    /// respect to each of the law's coefficients θ that a fit can free, by their [`ParamId`]
+    /// (closed forms; empty for Coulomb's and Leine's laws, which a fit does not free).
+    pub fn mu_slip_gradient(&self, speed_m_per_s: f64) -> Vec<(ParamId, f64)> {
+        let v = speed_m_per_s.abs();
+        match *self {
+            FrictionLaw::Exponential { a, b_s_per_m, .. } => {
+                let e = (-b_s_per_m * v).exp();
+                vec![(ParamId::A, e), (ParamId::B, -a * v * e), (ParamId::C, 1.0)]
+            }
+            FrictionLaw::ExponentialViscous { a, b_s_per_m, .. } => {
+                let e = (-b_s_per_m * v).exp();
+                vec![
+                    (ParamId::A, e),
+                    (ParamId::B, -a * v * e),
+                    (ParamId::C, 1.0),
+                    (ParamId::D, v),
+                ]
+            }
+            FrictionLaw::Stribeck {
+                a,
+                v_s_m_per_s,
+                delta,
+                ..
+            } => {
+                // With x = v/v_s and E = exp(−x^δ): ∂/∂v_s = A·E·δ·x^δ/v_s, ∂/∂δ = −A·E·x^δ·ln x
+                // (0 at x = 0, where x^δ·ln x → 0 for δ > 0).
+                let x = v / v_s_m_per_s;
+                let xd = x.powf(delta);
+                let e = (-xd).exp();
+                let x_ln_x = if x > 0.0 { xd * x.ln() } else { 0.0 };
+                vec![
+                    (ParamId::A, e),
+                    (ParamId::C, 1.0),
+                    (ParamId::Delta, -a * e * x_ln_x),
+                    (ParamId::Vs, a * e * delta * xd / v_s_m_per_s),
+                ]
+            }
+            FrictionLaw::Coulomb { .. } | FrictionLaw::Leine { .. } => Vec::new(),
         }
     }
 
@@ -591,6 +635,65 @@ mod tests {
                     (fd - slope).abs() < 1e-7 * slope.abs().max(1.0),
                     "{law:?} at {v}: {fd} against {slope}"
                 );
+            }
+        }
+    }
+
+    /// Each coefficient's derivative against a central difference in that coefficient (set
+    /// through [`ParamId::set`] on a blade carrying the law; relative step 1e-6), for every law a
+    /// fit can free, at rest and across the falling branch; exactly the laws' coefficients appear.
+    #[test]
+    fn coefficient_gradients_match_central_differences() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/data/paper/seed_experiment_blade.toml"
+        );
+        let blade: super::super::BladeParams =
+            toml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+        let laws = [
+            FrictionLaw::Exponential {
+                a: 0.8,
+                b_s_per_m: 10.0,
+                c: 0.2,
+            },
+            FrictionLaw::ExponentialViscous {
+                a: 0.8,
+                b_s_per_m: 10.0,
+                c: 0.2,
+                d_s_per_m: 0.3,
+            },
+            FrictionLaw::Stribeck {
+                a: 0.8,
+                c: 0.2,
+                v_s_m_per_s: 0.1,
+                delta: 1.7,
+            },
+        ];
+        for law in laws {
+            let mut p = blade;
+            p.friction = law;
+            let ids: Vec<ParamId> = law.mu_slip_gradient(0.1).iter().map(|g| g.0).collect();
+            let has: Vec<ParamId> = ParamId::ALL
+                .iter()
+                .copied()
+                .filter(|id| id.is_friction() && id.get(&p).is_some())
+                .collect();
+            assert_eq!(ids, has, "{law:?}");
+            for v in [0.0, 0.02, 0.1, 0.3] {
+                for (id, g) in law.mu_slip_gradient(v) {
+                    let x = id.get(&p).unwrap();
+                    let h = 1e-6 * x.abs();
+                    let at = |y: f64| {
+                        let mut q = p;
+                        id.set(&mut q, y);
+                        q.friction.mu_slip(v)
+                    };
+                    let fd = (at(x + h) - at(x - h)) / (2.0 * h);
+                    assert!(
+                        (fd - g).abs() < 1e-7 * g.abs().max(1.0),
+                        "{law:?}, {id} at {v}: {fd} against {g}"
+                    );
+                }
             }
         }
     }

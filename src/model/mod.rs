@@ -1,10 +1,12 @@
-//! Physical models: the friction law, the blade link model, the belt-oscillator benchmarks.
+//! Physical models: the friction law (and its curve over a measured slip-speed range), the blade
+//! link model, the belt-oscillator benchmarks.
 
 pub mod belt;
 pub mod benchmarks;
 pub mod blade;
 mod error;
 pub mod friction;
+pub mod friction_curve;
 pub mod modes;
 pub mod necklip;
 pub mod params;

@@ -1,0 +1,298 @@
+//! The friction law where a recording measures it: the fitted μ_d(v) over the slip speeds the
+//! fitted motion covers, with a ±1σ band from the fit's covariance, and the true law when known.
+//!
+//! A law's coefficients extrapolate: outside the slip speeds the tip actually slips at, the
+//! recording says nothing about μ_d, and two laws that agree over that range (an exponential and
+//! one with a viscous rise, say) can differ widely beyond it. The curve is what a fit determines.
+
+use serde::{Deserialize, Serialize};
+
+use super::{FrictionLaw, ParamId};
+
+/// Points of the curve's grid, evenly spaced over the measured range.
+pub const CURVE_POINTS: usize = 50;
+
+/// The percentiles of the slipping samples' |slip speed| that bound the measured range.
+pub const RANGE_PERCENTILES: [f64; 2] = [10.0, 90.0];
+
+/// μ_d(v) on the measured slip-speed range (docs/results.md, "The friction law where the recording
+/// measures it").
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FrictionCurve {
+    /// The slip speeds the fitted motion covers: the [`RANGE_PERCENTILES`] of |slip speed| over
+    /// the slipping samples of the fitted model's simulation, m/s.
+    pub measured_range_m_per_s: [f64; 2],
+    /// The percentiles that bound the range.
+    pub range_percentiles: [f64; 2],
+    /// Slipping samples the range was read from.
+    pub slip_samples: usize,
+    /// The grid: [`CURVE_POINTS`] slip speeds evenly spaced over the range, m/s.
+    pub speed_m_per_s: Vec<f64>,
+    /// The fitted law's μ_d on the grid.
+    pub mu_d: Vec<f64>,
+    /// 1σ of μ_d on the grid: the delta method `σ² = gᵀ Σ g` with `g` the law's gradient in its
+    /// fitted coefficients ([`FrictionLaw::mu_slip_gradient`]) and `Σ` their covariance from the
+    /// fit's 1σ and correlations. Empty when no coefficient of the law was fitted or their
+    /// covariance is not finite.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub mu_d_sigma: Vec<f64>,
+    /// The true law's μ_d on the grid (a job with a `[truth]` for the law); else empty.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub mu_d_true: Vec<f64>,
+    /// Root mean square over the grid of (μ_d − μ_d,true)/μ_d,true.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rms_rel_diff_to_truth: Option<f64>,
+    /// Share of the grid's points where the true μ_d lies within μ_d ± 1σ.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truth_within_band: Option<f64>,
+    /// The fitted law (its coefficients, for the curve beyond the range).
+    pub fitted_law: FrictionLaw,
+    /// The true law, when known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub true_law: Option<FrictionLaw>,
+}
+
+/// The fitted parameters' spread: each parameter's 1σ and their correlation matrix, in one order.
+#[derive(Debug, Clone, Copy)]
+pub struct Spread<'a> {
+    pub ids: &'a [ParamId],
+    pub sigma: &'a [f64],
+    /// Row-major, in the order of `ids`.
+    pub corr: &'a [Vec<f64>],
+}
+
+impl Spread<'_> {
+    /// 1σ of `μ_d(v)` of `law` by the delta method over the fitted coefficients of `law`; `None`
+    /// when the fit freed none of them or a needed 1σ or correlation is not finite.
+    pub fn mu_sigma(&self, law: &FrictionLaw, speed_m_per_s: f64) -> Option<f64> {
+        let terms: Vec<(usize, f64)> = law
+            .mu_slip_gradient(speed_m_per_s)
+            .into_iter()
+            .filter_map(|(id, g)| Some((self.ids.iter().position(|i| *i == id)?, g)))
+            .collect();
+        if terms.is_empty() {
+            return None;
+        }
+        let mut s2 = 0.0;
+        for &(i, gi) in &terms {
+            for &(j, gj) in &terms {
+                let c = self.sigma[i] * self.sigma[j] * *self.corr.get(i)?.get(j)?;
+                if !c.is_finite() {
+                    return None;
+                }
+                s2 += gi * c * gj;
+            }
+        }
+        Some(s2.max(0.0).sqrt())
+    }
+}
+
+/// The `p`-th percentile (0–100) of `sorted` (ascending, not empty), linearly interpolated between
+/// order statistics at rank `p/100·(n − 1)` (NumPy's default, Hyndman & Fan 1996 type 7).
+pub fn percentile(sorted: &[f64], p: f64) -> f64 {
+    let rank = p / 100.0 * (sorted.len() - 1) as f64;
+    let (lo, frac) = (rank.floor() as usize, rank.fract());
+    match sorted.get(lo + 1) {
+        Some(next) => sorted[lo] + frac * (next - sorted[lo]),
+        None => sorted[lo],
+    }
+}
+
+impl FrictionCurve {
+    /// The curve of the fitted `law` over the range that `slip_speeds` (|slip speed| of every
+    /// slipping sample, m/s) covers, its band from `spread`, and `truth` on the same grid. `None`
+    /// without a finite slip speed.
+    pub fn new(
+        law: FrictionLaw,
+        slip_speeds: &[f64],
+        spread: Option<Spread<'_>>,
+        truth: Option<FrictionLaw>,
+    ) -> Option<FrictionCurve> {
+        let mut sorted: Vec<f64> = slip_speeds
+            .iter()
+            .map(|v| v.abs())
+            .filter(|v| v.is_finite())
+            .collect();
+        if sorted.is_empty() {
+            return None;
+        }
+        sorted.sort_by(f64::total_cmp);
+        let range = RANGE_PERCENTILES.map(|p| percentile(&sorted, p));
+        let step = (range[1] - range[0]) / (CURVE_POINTS - 1) as f64;
+        let speed: Vec<f64> = (0..CURVE_POINTS)
+            .map(|i| range[0] + i as f64 * step)
+            .collect();
+        let mu_d: Vec<f64> = speed.iter().map(|&v| law.mu_slip(v)).collect();
+        let mu_d_sigma: Vec<f64> = spread
+            .and_then(|s| speed.iter().map(|&v| s.mu_sigma(&law, v)).collect())
+            .unwrap_or_default();
+        let mu_d_true: Vec<f64> = truth
+            .map(|t| speed.iter().map(|&v| t.mu_slip(v)).collect())
+            .unwrap_or_default();
+        let rms_rel_diff_to_truth = (!mu_d_true.is_empty()).then(|| {
+            let ss: f64 = mu_d
+                .iter()
+                .zip(&mu_d_true)
+                .map(|(m, t)| ((m - t) / t).powi(2))
+                .sum();
+            (ss / CURVE_POINTS as f64).sqrt()
+        });
+        let truth_within_band = (!mu_d_true.is_empty() && !mu_d_sigma.is_empty()).then(|| {
+            let inside = (0..CURVE_POINTS)
+                .filter(|&i| (mu_d[i] - mu_d_true[i]).abs() <= mu_d_sigma[i])
+                .count();
+            inside as f64 / CURVE_POINTS as f64
+        });
+        Some(FrictionCurve {
+            measured_range_m_per_s: range,
+            range_percentiles: RANGE_PERCENTILES,
+            slip_samples: sorted.len(),
+            speed_m_per_s: speed,
+            mu_d,
+            mu_d_sigma,
+            mu_d_true,
+            rms_rel_diff_to_truth,
+            truth_within_band,
+            fitted_law: law,
+            true_law: truth,
+        })
+    }
+
+    /// Whether `speed_m_per_s` lies inside the measured range.
+    pub fn measures(&self, speed_m_per_s: f64) -> bool {
+        let [lo, hi] = self.measured_range_m_per_s;
+        (lo..=hi).contains(&speed_m_per_s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LAW: FrictionLaw = FrictionLaw::Exponential {
+        a: 0.8,
+        b_s_per_m: 10.0,
+        c: 0.2,
+    };
+
+    /// Slip speeds 0, 0.001, …, 0.100 m/s (101 samples, in a shuffled order and with signs, as a
+    /// simulation's slip velocities come): rank 0.1·100 = 10 and 0.9·100 = 90 give the range
+    /// [0.010, 0.090] m/s exactly, the grid steps (0.09 − 0.01)/49, and the curve is the closed
+    /// form 0.8 e^(−10 v) + 0.2 there.
+    #[test]
+    fn the_curve_spans_the_slip_speeds_percentiles_with_the_laws_values() {
+        let speeds: Vec<f64> = (0..=100)
+            .map(|i| (((i * 37) % 101) as f64) * 0.001 * if i % 2 == 0 { 1.0 } else { -1.0 })
+            .collect();
+        let c = FrictionCurve::new(LAW, &speeds, None, None).unwrap();
+        assert_eq!(c.slip_samples, 101);
+        assert!((c.measured_range_m_per_s[0] - 0.010).abs() < 1e-15);
+        assert!((c.measured_range_m_per_s[1] - 0.090).abs() < 1e-15);
+        assert_eq!(c.speed_m_per_s.len(), CURVE_POINTS);
+        for (i, (&v, &mu)) in c.speed_m_per_s.iter().zip(&c.mu_d).enumerate() {
+            let v_ref = 0.010 + i as f64 * 0.080 / 49.0;
+            assert!((v - v_ref).abs() < 1e-15, "{i}: {v}");
+            assert!((mu - (0.8 * (-10.0 * v_ref).exp() + 0.2)).abs() < 1e-14);
+        }
+        assert!(c.mu_d_sigma.is_empty() && c.mu_d_true.is_empty());
+        assert!(c.measures(0.05) && !c.measures(0.005) && !c.measures(0.095));
+        // Interpolation between order statistics: the 25th percentile of [1, 2, 4, 8] is at rank
+        // 0.75, 1 + 0.75·(2 − 1).
+        assert_eq!(percentile(&[1.0, 2.0, 4.0, 8.0], 25.0), 1.75);
+        assert_eq!(percentile(&[3.0], 90.0), 3.0);
+        assert!(FrictionCurve::new(LAW, &[f64::NAN], None, None).is_none());
+    }
+
+    /// The band by the delta method against closed forms for the exponential law (σ² = gᵀΣg with
+    /// g = (e^(−Bv), −A v e^(−Bv), 1)); a fitted parameter outside the law (k1) does not enter;
+    /// the truth's rms relative difference is that of a law 2 % above everywhere.
+    #[test]
+    fn the_band_and_the_truths_difference_follow_their_closed_forms() {
+        let speeds: Vec<f64> = (0..=100).map(|i| i as f64 * 0.001).collect();
+        let ids = [ParamId::A, ParamId::C, ParamId::K1];
+        let sigma = [0.01, 0.05, 1e-3];
+        // A and C anti-correlated with equal σ: σ_μ = 0.01·(1 − e^(−Bv)) when σ_C = σ_A.
+        let anti = vec![
+            vec![1.0, -1.0, 0.5],
+            vec![-1.0, 1.0, 0.5],
+            vec![0.5, 0.5, 1.0],
+        ];
+        let same_sigma = [0.01, 0.01, 1e-3];
+        let spread = Spread {
+            ids: &ids,
+            sigma: &same_sigma,
+            corr: &anti,
+        };
+        let c = FrictionCurve::new(LAW, &speeds, Some(spread), None).unwrap();
+        for (v, s) in c.speed_m_per_s.iter().zip(&c.mu_d_sigma) {
+            assert!(
+                (s - 0.01 * (1.0 - (-10.0 * v).exp())).abs() < 1e-15,
+                "{v}: {s}"
+            );
+        }
+        // Uncorrelated A and C: σ_μ² = (0.01 e^(−Bv))² + 0.05².
+        let eye = vec![
+            vec![1.0, 0.0, 0.0],
+            vec![0.0, 1.0, 0.0],
+            vec![0.0, 0.0, 1.0],
+        ];
+        let spread = Spread {
+            ids: &ids,
+            sigma: &sigma,
+            corr: &eye,
+        };
+        let truth = FrictionLaw::Exponential {
+            a: 0.8 / 1.02,
+            b_s_per_m: 10.0,
+            c: 0.2 / 1.02,
+        };
+        let c = FrictionCurve::new(LAW, &speeds, Some(spread), Some(truth)).unwrap();
+        for (v, s) in c.speed_m_per_s.iter().zip(&c.mu_d_sigma) {
+            let e = 0.01 * (-10.0 * v).exp();
+            assert!((s - (e * e + 0.05 * 0.05).sqrt()).abs() < 1e-15);
+        }
+        assert!((c.rms_rel_diff_to_truth.unwrap() - 0.02).abs() < 1e-12);
+        // The truth is 2 % (≤ 0.02) below a μ_d ≤ 1 with σ ≥ 0.05: inside the band everywhere.
+        assert_eq!(c.truth_within_band, Some(1.0));
+        // No fitted coefficient of the law, or a NaN correlation: no band.
+        let k1_only = Spread {
+            ids: &[ParamId::K1],
+            sigma: &[1e-3],
+            corr: &[vec![1.0]],
+        };
+        let c = FrictionCurve::new(LAW, &speeds, Some(k1_only), Some(truth)).unwrap();
+        assert!(c.mu_d_sigma.is_empty() && c.truth_within_band.is_none());
+        let nan = vec![
+            vec![1.0, f64::NAN, 0.0],
+            vec![f64::NAN, 1.0, 0.0],
+            vec![0.0, 0.0, 1.0],
+        ];
+        let spread = Spread {
+            ids: &ids,
+            sigma: &sigma,
+            corr: &nan,
+        };
+        assert!(
+            FrictionCurve::new(LAW, &speeds, Some(spread), None)
+                .unwrap()
+                .mu_d_sigma
+                .is_empty()
+        );
+    }
+
+    /// The curve as the result file holds it reads back the same.
+    #[test]
+    fn the_curve_round_trips_through_toml() {
+        let speeds: Vec<f64> = (0..=20).map(|i| i as f64 * 0.01).collect();
+        let truth = FrictionLaw::ExponentialViscous {
+            a: 0.8,
+            b_s_per_m: 10.0,
+            c: 0.2,
+            d_s_per_m: 0.1,
+        };
+        let c = FrictionCurve::new(LAW, &speeds, None, Some(truth)).unwrap();
+        let text = toml::to_string_pretty(&c).unwrap();
+        let back: FrictionCurve = toml::from_str(&text).unwrap();
+        assert_eq!(back, c);
+    }
+}
