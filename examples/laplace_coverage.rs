@@ -130,6 +130,7 @@ fn main() {
             recording_path: file.clone(),
             blade: truth,
             truth: truths.iter().copied().collect(),
+            truth_friction_law: None,
             ..main.clone()
         };
         job.job.fit.models.retain(|m| m.name() == "blade2dof");

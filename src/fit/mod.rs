@@ -182,6 +182,10 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
             truth_cost,
         },
     );
+    let result = FitResult {
+        friction_curve: friction_curve(job, &result, &best),
+        ..result
+    };
     Ok(FitOutcome {
         result,
         signal: job.job.spectrum.signal,
@@ -192,6 +196,28 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         best_sim: best.sim,
         best_params: best.params,
     })
+}
+
+/// The fitted law over the slip speeds of the chosen optimum's simulation, its band from the
+/// result's 1σ and correlations, and the job's true law ([`LoadedJob::true_friction_law`]).
+fn friction_curve(
+    job: &LoadedJob,
+    r: &FitResult,
+    best: &BestModel,
+) -> Option<crate::model::friction_curve::FrictionCurve> {
+    let ids: Vec<crate::model::ParamId> = r.parameters.iter().map(|p| p.name).collect();
+    let sigma: Vec<f64> = r.parameters.iter().map(|p| p.std_error).collect();
+    let spread = crate::model::friction_curve::Spread {
+        ids: &ids,
+        sigma: &sigma,
+        corr: &r.correlation,
+    };
+    crate::model::friction_curve::FrictionCurve::new(
+        best.params.friction,
+        &best.sim.slip_speeds(),
+        Some(spread),
+        job.true_friction_law(),
+    )
 }
 
 /// The checks at the chosen optimum `best` that simulate again: the tolerance check, with its
@@ -613,6 +639,7 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         tolerance_check: a.tolerance_check,
         tracking_noise: a.tracking_noise,
         truth_cost: a.truth_cost,
+        friction_curve: None,
         history: cf.history.clone(),
     }
 }

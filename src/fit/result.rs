@@ -410,6 +410,11 @@ pub struct FitResult {
     /// short of the likelihood's maximum. `None` without a truth for every freed parameter.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub truth_cost: Option<f64>,
+    /// The fitted μ_d(v) over the slip speeds the fitted motion covers, with its ±1σ band and the
+    /// true law when known ([`crate::model::friction_curve`]); `None` when the fitted model never
+    /// slips, and in results written before this field.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_curve: Option<crate::model::friction_curve::FrictionCurve>,
     pub history: Vec<HistoryPoint>,
 }
 
@@ -583,6 +588,7 @@ mod tests {
             )),
             tracking_noise: None,
             truth_cost: None,
+            friction_curve: None,
             history: vec![HistoryPoint {
                 stage: SearchStage::Swarm,
                 restart: 1,

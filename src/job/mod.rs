@@ -14,7 +14,7 @@ pub use error::JobError;
 pub use free::FreeParam;
 
 use crate::import::ImportSpec;
-use crate::model::{BladeParams, ParamId};
+use crate::model::{BladeParams, FrictionLaw, ParamId};
 use crate::simulate::SolverOptions;
 use crate::spectrum::features::{BandSpec, SignalKind, default_bands};
 use crate::{Error, Result};
@@ -448,6 +448,11 @@ pub struct TruthSection {
     pub json: PathBuf,
     /// Parameter → JSON pointer (RFC 6901), e.g. `A = "/params/A"`.
     pub keys: BTreeMap<ParamId, String>,
+    /// JSON pointer to the true friction law, an object as a blade file's `[friction]` table
+    /// (`{"law": "exponential_viscous", "a": …}`): for a recording whose true law is not the
+    /// blade file's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_law: Option<String>,
 }
 
 /// One step of a path into a TOML document: a key of a table or an index into an array.
@@ -552,6 +557,8 @@ pub struct LoadedJob {
     pub free: Vec<(ParamId, f64, f64)>,
     /// True values of freed parameters, when the job names a truth file.
     pub truth: BTreeMap<ParamId, f64>,
+    /// The true friction law at `[truth] friction_law`, when the job names one.
+    pub truth_friction_law: Option<FrictionLaw>,
 }
 
 impl LoadedJob {
@@ -590,7 +597,7 @@ impl LoadedJob {
         check.more_recordings()?;
         check.solver()?;
         check.bands()?;
-        let truth = read_truth(dir, job.truth.as_ref())?;
+        let (truth, truth_friction_law) = read_truth(dir, job.truth.as_ref())?;
         Ok(LoadedJob {
             recording_path: match &job.recording {
                 Some(r) => dir.join(&r.file),
@@ -603,11 +610,28 @@ impl LoadedJob {
             blade,
             free,
             truth,
+            truth_friction_law,
         })
     }
 }
 
 impl LoadedJob {
+    /// The true friction law: `[truth] friction_law` when given, else the blade file's law with
+    /// every friction coefficient the job frees at its `[truth]` value; `None` when the job frees
+    /// no friction coefficient or the truth lacks one of them.
+    pub fn true_friction_law(&self) -> Option<FrictionLaw> {
+        if self.truth_friction_law.is_some() {
+            return self.truth_friction_law;
+        }
+        let mut p = self.blade;
+        let mut any = false;
+        for (id, _, _) in self.free.iter().filter(|f| f.0.is_friction()) {
+            id.set(&mut p, *self.truth.get(id)?);
+            any = true;
+        }
+        any.then_some(p.friction)
+    }
+
     /// The candidates the job asks for, or the smallest model capable of its bands.
     pub fn candidates(&self) -> Vec<Candidate> {
         if self.job.fit.models.is_empty() {
@@ -999,11 +1023,15 @@ impl Check<'_> {
     }
 }
 
-/// True values of the freed parameters from the job's `[truth]` JSON file (empty without one).
-fn read_truth(dir: &Path, truth: Option<&TruthSection>) -> Result<BTreeMap<ParamId, f64>> {
+/// True values of the freed parameters from the job's `[truth]` JSON file (empty without one), and
+/// the true friction law when `[truth] friction_law` points to one.
+fn read_truth(
+    dir: &Path,
+    truth: Option<&TruthSection>,
+) -> Result<(BTreeMap<ParamId, f64>, Option<FrictionLaw>)> {
     let mut values = BTreeMap::new();
     let Some(t) = truth else {
-        return Ok(values);
+        return Ok((values, None));
     };
     let tp = dir.join(&t.json);
     let v: serde_json::Value = serde_json::from_str(&read_text(&tp)?)
@@ -1014,12 +1042,83 @@ fn read_truth(dir: &Path, truth: Option<&TruthSection>) -> Result<BTreeMap<Param
         })?;
         values.insert(*k, x);
     }
-    Ok(values)
+    let law = match &t.friction_law {
+        None => None,
+        Some(ptr) => {
+            let at = v.pointer(ptr).ok_or_else(|| {
+                Error::input(
+                    &tp,
+                    format!("nothing at JSON pointer {ptr} (for friction_law)"),
+                )
+            })?;
+            let law = FrictionLaw::deserialize(at).map_err(|e| {
+                Error::input(&tp, format!("the friction law at JSON pointer {ptr}: {e}"))
+            })?;
+            law.validate().map_err(|e| {
+                Error::input(&tp, format!("the friction law at JSON pointer {ptr}: {e}"))
+            })?;
+            Some(law)
+        }
+    };
+    Ok((values, law))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The true law of the main job: the blade's exponential law at truth.json's A, B, C (its
+    /// `[truth]` keys); a `[truth] friction_law` pointer read from a JSON object replaces it, and
+    /// a pointer to a table that is no law is refused naming the pointer and the keys it needs.
+    #[test]
+    fn the_true_friction_law_comes_from_the_truth() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let mut job = LoadedJob::load(&root.join("fits/reversal.toml")).unwrap();
+        assert_eq!(
+            job.true_friction_law(),
+            Some(FrictionLaw::Exponential {
+                a: 0.88,
+                b_s_per_m: 69.74712740275162,
+                c: 0.56
+            })
+        );
+        job.truth.remove(&ParamId::B);
+        assert_eq!(job.true_friction_law(), None);
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("truth.json"),
+            r#"{"law": {"law": "exponential_viscous", "a": 0.8, "b_s_per_m": 10, "c": 0.2, "d_s_per_m": 0.1},
+                "bad": {"law": "stribeck", "a": 0.8}}"#,
+        )
+        .unwrap();
+        let section = |ptr: &str| TruthSection {
+            json: "truth.json".into(),
+            keys: BTreeMap::new(),
+            friction_law: Some(ptr.into()),
+        };
+        let (_, law) = read_truth(dir.path(), Some(&section("/law"))).unwrap();
+        job.truth_friction_law = law;
+        assert_eq!(
+            job.true_friction_law(),
+            Some(FrictionLaw::ExponentialViscous {
+                a: 0.8,
+                b_s_per_m: 10.0,
+                c: 0.2,
+                d_s_per_m: 0.1
+            })
+        );
+        let e = read_truth(dir.path(), Some(&section("/bad")))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("/bad") && e.contains("needs a, c, v_s_m_per_s, delta"),
+            "{e}"
+        );
+        let e = read_truth(dir.path(), Some(&section("/none")))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("nothing at JSON pointer /none"), "{e}");
+    }
 
     #[test]
     fn spans_locate_keys_tables_and_array_entries() {

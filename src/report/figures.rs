@@ -7,7 +7,7 @@ use crate::fit::result::{HistoryPoint, SearchStage};
 use crate::fit::{FitOutcome, FitResult};
 use crate::job::Objective;
 use crate::likelihood::instfreq::FreqSpeedComparison;
-use crate::model::{FrictionLaw, ParamId};
+use crate::model::FrictionLaw;
 use crate::simulate::blade::{BladeSimulation, ContactForces};
 use crate::spectrum::Spectrogram;
 use crate::spectrum::instfreq::FreqSpeedPoint;
@@ -233,7 +233,7 @@ pub fn fit_figures(
     for (d, m) in o.measured.bands.iter().zip(&o.model.bands) {
         band_psd_figure(dir, o, d, m, targets_only)?;
     }
-    friction_law_figure(dir, o)?;
+    friction_law_figure(dir, &o.result, &o.best_params.friction, max_tip_speed(o))?;
     if let Some(c) = freq_speed {
         freq_vs_speed_figure(dir, c)?;
     }
@@ -434,104 +434,151 @@ fn max_tip_speed(o: &FitOutcome) -> Option<f64> {
     (v.is_finite() && v > 0.0).then_some(v)
 }
 
-/// `μ_d(v) ± 1σ` of the seed's law at the fitted A, B, C by the delta method: `σ² = gᵀ Σ g` with
-/// `g = (e^(−Bv), −A v e^(−Bv), 1)` and `Σ` the fitted parameters' covariance (their 1σ and
-/// correlations from the result). `None` unless A, B and C were all fitted with finite 1σ and
-/// correlations.
-fn friction_sigma(r: &FitResult, v: &[f64]) -> Option<Vec<f64>> {
-    let idx = |n: ParamId| r.parameters.iter().position(|p| p.name == n);
-    let ids = [idx(ParamId::A)?, idx(ParamId::B)?, idx(ParamId::C)?];
-    let sd: Vec<f64> = ids.iter().map(|&i| r.parameters[i].std_error).collect();
-    let corr = |i: usize, j: usize| r.correlation.get(ids[i])?.get(ids[j]).copied();
-    let mut cov = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            cov[i][j] = sd[i] * sd[j] * corr(i, j).filter(|c| c.is_finite())?;
-        }
-    }
-    if sd.iter().any(|s| !s.is_finite()) {
-        return None;
-    }
-    let (a, b) = (r.parameters[ids[0]].value, r.parameters[ids[1]].value);
-    Some(delta_band(a, b, &cov, v))
-}
-
-/// The friction-law figure's title: it says whether the ±1σ band is drawn, and when A, B and C
-/// were all fitted but it is not, why (the curvature was not positive definite, so the result
-/// holds no finite 1σ or correlations for them).
-fn friction_title(r: &FitResult, band: bool) -> String {
-    let law = "dynamic friction coefficient μ_d = A e^(−B|v|) + C (seed eq. 4)";
-    let abc = [ParamId::A, ParamId::B, ParamId::C]
-        .iter()
-        .all(|n| r.parameters.iter().any(|p| p.name == *n));
-    match (band, abc) {
-        (true, _) => format!("{law}, ±1σ from the fit"),
-        (false, true) => format!("{law}; no ±1σ: the cost's curvature is not positive definite"),
-        (false, false) => format!("{law}; no ±1σ: A, B and C were not all fitted"),
-    }
-}
-
-/// `σ_μ(v) = √(gᵀ Σ g)`, `g = (e^(−Bv), −A v e^(−Bv), 1)`: the delta method's 1σ of
-/// `μ_d = A e^(−Bv) + C` for the covariance `cov` of (A, B, C).
-fn delta_band(a: f64, b: f64, cov: &[[f64; 3]; 3], v: &[f64]) -> Vec<f64> {
-    v.iter()
-        .map(|&x| {
-            let e = (-b * x).exp();
-            let g = [e, -a * x * e, 1.0];
-            let mut s2 = 0.0;
-            for i in 0..3 {
-                for j in 0..3 {
-                    s2 += g[i] * cov[i][j] * g[j];
-                }
-            }
-            s2.max(0.0).sqrt()
-        })
-        .collect()
-}
-
-/// Writes `friction_law.svg`: the fitted law over the slip speeds the model's tip reaches, with its
-/// ±1σ band (dashed) when A, B and C were fitted, and the truth when known.
-fn friction_law_figure(dir: &Path, o: &FitOutcome) -> Result<()> {
-    let v_max = max_tip_speed(o).map_or(0.2, |v| 1.05 * v);
-    let v: Vec<f64> = (0..=200).map(|i| i as f64 * v_max / 200.0).collect();
-    let mu: Vec<f64> = v
-        .iter()
-        .map(|x| o.best_params.friction.mu_slip(*x))
-        .collect();
-    let mut series = vec![Series::line("fitted", v.clone(), mu.clone())];
-    let sigma = friction_sigma(&o.result, &v);
-    if let Some(sigma) = &sigma {
-        for (label, sign) in [("fitted + 1σ", 1.0), ("fitted − 1σ", -1.0)] {
-            series.push(Series::line(
-                label,
-                v.clone(),
-                mu.iter().zip(sigma).map(|(m, s)| m + sign * s).collect(),
-            ));
-        }
-    }
-    let truth = |n: ParamId| {
-        o.result
-            .parameters
-            .iter()
-            .find(|p| p.name == n)
-            .and_then(|p| p.true_value)
+/// Writes `friction_law.svg`: the fitted law `law` from 0 to past the fastest slip speed
+/// `v_max_m_per_s` the model's tip reaches (0.2 m/s when unknown). Over the measured range (the
+/// result's [`crate::model::friction_curve::FrictionCurve`], shaded) it is solid with its ±1σ
+/// band; outside it dashed and labelled extrapolation; the true law on the same axes when known.
+///
+/// # Errors
+/// [`Error::Io`]/[`super::ReportError`] from drawing.
+pub fn friction_law_figure(
+    dir: &Path,
+    r: &FitResult,
+    law: &FrictionLaw,
+    v_max_m_per_s: Option<f64>,
+) -> Result<()> {
+    let curve = r.friction_curve.as_ref();
+    let range_hi = curve.map_or(0.0, |c| c.measured_range_m_per_s[1]);
+    let v_top = v_max_m_per_s.map_or(0.2, |v| 1.05 * v).max(1.1 * range_hi);
+    let grid: Vec<f64> = (0..=200).map(|i| i as f64 * v_top / 200.0).collect();
+    let mu = |l: &FrictionLaw, v: &[f64]| -> Vec<f64> { v.iter().map(|x| l.mu_slip(*x)).collect() };
+    let mut series = Vec::new();
+    let mut opts = ChartOpts::default();
+    let Some(c) = curve else {
+        series.push(Series::dashed(
+            "fitted law (the fitted model never slips: no measured range)",
+            grid.clone(),
+            mu(law, &grid),
+        ));
+        return line_chart(
+            &dir.join("friction_law.svg"),
+            &format!("dynamic friction coefficient μ_d(|v|), law {}", law.name()),
+            FRICTION_X_LABEL,
+            FRICTION_Y_LABEL,
+            &series,
+            &opts,
+        );
     };
-    if let (Some(a), Some(b), Some(c)) = (truth(ParamId::A), truth(ParamId::B), truth(ParamId::C)) {
-        let law = FrictionLaw::Exponential { a, b_s_per_m: b, c };
+    let [lo, hi] = c.measured_range_m_per_s;
+    let [p_lo, p_hi] = c.range_percentiles;
+    series.push(Series::line(
+        format!(
+            "fitted μ_d over the measured range ({p_lo:.0}th–{p_hi:.0}th percentile of slip speeds)"
+        ),
+        c.speed_m_per_s.clone(),
+        c.mu_d.clone(),
+    ));
+    // The law outside the range: [0, lo] and [hi, top], broken between.
+    let outside: Vec<f64> = grid
+        .iter()
+        .copied()
+        .filter(|v| *v < lo)
+        .chain([lo, f64::NAN, hi])
+        .chain(grid.iter().copied().filter(|v| *v > hi))
+        .collect();
+    series.push(Series::dashed(
+        "fitted law outside the range: extrapolation",
+        outside.clone(),
+        outside
+            .iter()
+            .map(|v| {
+                if v.is_nan() {
+                    f64::NAN
+                } else {
+                    law.mu_slip(*v)
+                }
+            })
+            .collect(),
+    ));
+    if let (Some(truth), Some(rms)) = (&c.true_law, c.rms_rel_diff_to_truth) {
         series.push(Series::line(
-            "true",
-            v.clone(),
-            v.iter().map(|x| law.mu_slip(*x)).collect(),
+            format!(
+                "true μ_d ({}; fitted lies {:.1} % rms from it over the range)",
+                truth.name(),
+                100.0 * rms
+            ),
+            grid.clone(),
+            mu(truth, &grid),
         ));
     }
+    if !c.mu_d_sigma.is_empty() {
+        opts.bands.push(super::plot::Band {
+            x: c.speed_m_per_s.clone(),
+            lo: c
+                .mu_d
+                .iter()
+                .zip(&c.mu_d_sigma)
+                .map(|(m, s)| m - s)
+                .collect(),
+            hi: c
+                .mu_d
+                .iter()
+                .zip(&c.mu_d_sigma)
+                .map(|(m, s)| m + s)
+                .collect(),
+            series: 0,
+            label: "±1σ by the delta method from the fitted covariance".into(),
+        });
+    }
+    opts.spans.push(Span {
+        lo,
+        hi,
+        label: format!("measured slip speeds {:.1}–{:.1} mm/s", 1e3 * lo, 1e3 * hi),
+    });
+    opts.y_range = Some(measured_y_range(c));
     line_chart(
         &dir.join("friction_law.svg"),
-        &friction_title(&o.result, sigma.is_some()),
-        "slip speed |v̇3| [m/s] (up to the fastest the model's tip reaches)",
-        "dynamic friction coefficient μ_d [-]",
+        &friction_title(r, law, !c.mu_d_sigma.is_empty()),
+        FRICTION_X_LABEL,
+        FRICTION_Y_LABEL,
         &series,
-        &ChartOpts::default(),
+        &opts,
     )
+}
+
+/// The friction figure's μ axis: the curve, its band and the truth over the measured range, with
+/// half their span (at least 0.01) above and below, so that the band is seen; the extrapolation
+/// leaves the box where it climbs to μ_s.
+fn measured_y_range(c: &crate::model::friction_curve::FrictionCurve) -> (f64, f64) {
+    let sigma = |i: usize| c.mu_d_sigma.get(i).copied().unwrap_or(0.0);
+    let values = (0..c.mu_d.len())
+        .flat_map(|i| [c.mu_d[i] - sigma(i), c.mu_d[i] + sigma(i)])
+        .chain(c.mu_d_true.iter().copied())
+        .filter(|v| v.is_finite());
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
+    let pad = (0.5 * (hi - lo)).max(0.01);
+    (lo - pad, hi + pad)
+}
+
+const FRICTION_X_LABEL: &str = "slip speed |v̇3| [m/s]";
+const FRICTION_Y_LABEL: &str = "dynamic friction coefficient μ_d [-]";
+
+/// The friction figure's title: the law, and whether the ±1σ band is drawn and, when not, why (no
+/// coefficient of the law was fitted, or their 1σ or correlations are not finite: the curvature
+/// was not positive definite).
+fn friction_title(r: &FitResult, law: &FrictionLaw, band: bool) -> String {
+    let head = format!("dynamic friction coefficient μ_d(|v|), law {}", law.name());
+    let fitted = law
+        .mu_slip_gradient(0.0)
+        .iter()
+        .any(|(id, _)| r.parameters.iter().any(|p| p.name == *id));
+    match (band, fitted) {
+        (true, _) => format!("{head}, ±1σ from the fit"),
+        (false, true) => format!("{head}; no ±1σ: the coefficients' covariance is not finite"),
+        (false, false) => format!("{head}; no ±1σ: no coefficient of the law was fitted"),
+    }
 }
 
 /// Writes `cost.svg`: best cost against the restart's own model evaluations, one series per restart
@@ -662,8 +709,9 @@ fn write_columns(dir: &Path, name: &str, columns: &[(&str, &[f64])]) -> Result<S
 /// `psd_<band>.csv` (`freq_hz`, `psd_measured_m2_per_hz` when there is a recording,
 /// `psd_model_m2_per_hz`; Welch one-sided density inside the band, measured and model on the same
 /// bins), `traces_measured.csv` (`t_s`, the job's signal in m, `head_y_m`; absent for a target
-/// job) and `traces_model.csv` (`t_s`, the signal in m, `head_y_m` = −u). Values as the fit
-/// computed them (no means removed).
+/// job), `traces_model.csv` (`t_s`, the signal in m, `head_y_m` = −u) and, when the fitted model
+/// slips, `friction_curve.csv` ([`friction_curve_csv`]). Values as the fit computed them (no
+/// means removed).
 ///
 /// # Errors
 /// [`Error::Io`] naming the file; [`crate::spectrum::SpectrumError`] if the signal cannot be extracted.
@@ -715,7 +763,44 @@ pub fn fit_data_files(dir: &Path, o: &FitOutcome) -> Result<Vec<String>> {
         ("head_y_m", &head),
     ];
     files.push(write_columns(dir, "traces_model.csv", &cols)?);
+    if let Some(c) = &o.result.friction_curve {
+        files.push(friction_curve_csv(dir, c)?);
+    }
     Ok(files)
+}
+
+/// Writes `friction_curve.csv`: the fitted law on the measured slip-speed range, `speed_m_per_s`,
+/// `mu_d`, then `mu_d_sigma`, `mu_d_lo`, `mu_d_hi` (±1σ) when the fit gives a band and `mu_d_true`
+/// when the truth is known.
+fn friction_curve_csv(
+    dir: &Path,
+    c: &crate::model::friction_curve::FrictionCurve,
+) -> Result<String> {
+    let lo: Vec<f64> = c
+        .mu_d
+        .iter()
+        .zip(&c.mu_d_sigma)
+        .map(|(m, s)| m - s)
+        .collect();
+    let hi: Vec<f64> = c
+        .mu_d
+        .iter()
+        .zip(&c.mu_d_sigma)
+        .map(|(m, s)| m + s)
+        .collect();
+    let mut cols: Vec<(&str, &[f64])> =
+        vec![("speed_m_per_s", &c.speed_m_per_s), ("mu_d", &c.mu_d)];
+    if !c.mu_d_sigma.is_empty() {
+        cols.extend([
+            ("mu_d_sigma", c.mu_d_sigma.as_slice()),
+            ("mu_d_lo", &lo),
+            ("mu_d_hi", &hi),
+        ]);
+    }
+    if !c.mu_d_true.is_empty() {
+        cols.push(("mu_d_true", &c.mu_d_true));
+    }
+    write_columns(dir, "friction_curve.csv", &cols)
 }
 
 /// Writes `freq_vs_speed.svg` into `dir`: ridge and stick-onset rate against the tip's mean speed
@@ -872,64 +957,73 @@ pub fn fit_summary(r: &FitResult) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{delta_band, friction_sigma, friction_title};
+    use super::friction_law_figure;
+    use crate::model::friction_curve::{FrictionCurve, Spread};
+    use crate::model::{FrictionLaw, ParamId};
 
-    /// The ±1σ band needs A, B and C fitted with finite 1σ and correlations: with uncorrelated
-    /// A, B, C it is the delta method's (at v = 0: √(σ_A² + σ_C²), B drops out); with NaN
-    /// correlations (the curvature was not positive definite) it is not drawn and the title says
-    /// why; without all three it is not drawn either.
+    const LAW: FrictionLaw = FrictionLaw::Exponential {
+        a: 0.8,
+        b_s_per_m: 10.0,
+        c: 0.2,
+    };
+
+    /// The figure of a hand-built curve (slip speeds 0–0.1 m/s, A and C fitted, a viscous truth):
+    /// it exists and names the measured range, the band's method, the extrapolation, the truth
+    /// with its rms difference, the axes, and the dashed legend sample; without a fitted
+    /// coefficient the title says there is no band.
     #[test]
-    fn friction_band_hidden_and_marked_without_positive_curvature() {
+    fn the_friction_figure_draws_the_measured_range_band_extrapolation_and_truth() {
+        let dir = tempfile::tempdir().unwrap();
         let mut r = crate::report::html::tests::result();
-        let base = r.parameters[0].clone();
-        r.parameters = [("A", 0.9, 0.03), ("B", 70.0, 5.0), ("C", 0.5, 0.04)]
-            .iter()
-            .map(|&(n, value, std_error)| crate::fit::result::FittedParam {
-                name: n.parse().unwrap(),
-                value,
-                std_error,
-                ..base.clone()
-            })
-            .collect();
-        r.correlation = (0..3)
-            .map(|i| (0..3).map(|j| if i == j { 1.0 } else { 0.0 }).collect())
-            .collect();
-        let band = friction_sigma(&r, &[0.0]).expect("a band with positive curvature");
-        assert!((band[0] - (0.03f64.powi(2) + 0.04f64.powi(2)).sqrt()).abs() < 1e-15);
-        assert!(friction_title(&r, true).ends_with("±1σ from the fit"));
-        r.correlation = vec![vec![f64::NAN; 3]; 3];
-        assert_eq!(friction_sigma(&r, &[0.0, 0.1]), None);
-        assert!(
-            friction_title(&r, false)
-                .ends_with("no ±1σ: the cost's curvature is not positive definite")
-        );
-        r.parameters.pop();
-        r.correlation = vec![vec![1.0; 2]; 2];
-        assert_eq!(friction_sigma(&r, &[0.0]), None);
-        assert!(friction_title(&r, false).ends_with("A, B and C were not all fitted"));
-    }
-
-    #[test]
-    fn friction_band_by_the_delta_method() {
-        let (a, b, v) = (0.88, 70.0, [0.0, 0.01, 0.05]);
-        // Only C uncertain: a constant band of σ_C.
-        let c_only = [[0.0; 3], [0.0; 3], [0.0, 0.0, 0.0025]];
-        for s in delta_band(a, b, &c_only, &v) {
-            assert!((s - 0.05).abs() < 1e-15);
+        let speeds: Vec<f64> = (0..=100).map(|i| i as f64 * 0.001).collect();
+        let truth = FrictionLaw::ExponentialViscous {
+            a: 0.8,
+            b_s_per_m: 10.0,
+            c: 0.2,
+            d_s_per_m: 0.5,
+        };
+        let spread = Spread {
+            ids: &[ParamId::A, ParamId::C],
+            sigma: &[0.02, 0.01],
+            corr: &[vec![1.0, 0.0], vec![0.0, 1.0]],
+        };
+        r.parameters.truncate(0);
+        r.friction_curve = FrictionCurve::new(LAW, &speeds, Some(spread), Some(truth));
+        for (name, fitted) in [("A", 0.8), ("C", 0.2)] {
+            let mut p = crate::report::html::tests::result().parameters[0].clone();
+            p.name = name.parse().unwrap();
+            p.value = fitted;
+            r.parameters.push(p);
         }
-        // Only A uncertain: σ_A e^(−Bv), which is σ_A at v = 0.
-        let a_only = [[1e-4, 0.0, 0.0], [0.0; 3], [0.0; 3]];
-        for (s, x) in delta_band(a, b, &a_only, &v).iter().zip(v) {
-            assert!((s - 1e-2 * (-b * x).exp()).abs() < 1e-15);
+        friction_law_figure(dir.path(), &r, &LAW, Some(0.167)).unwrap();
+        let svg = std::fs::read_to_string(dir.path().join("friction_law.svg")).unwrap();
+        let rms = r
+            .friction_curve
+            .as_ref()
+            .unwrap()
+            .rms_rel_diff_to_truth
+            .unwrap();
+        for label in [
+            "fitted μ_d over the measured range (10th–90th percentile of slip speeds)",
+            "measured slip speeds 10.0–90.0 mm/s",
+            "±1σ by the delta method from the fitted covariance",
+            "fitted law outside the range: extrapolation",
+            &format!(
+                "true μ_d (exponential_viscous; fitted lies {:.1} % rms from it over the range)",
+                100.0 * rms
+            ),
+            "slip speed |v̇3| [m/s]",
+            "dynamic friction coefficient μ_d [-]",
+            "law exponential, ±1σ from the fit",
+            "stroke-dasharray",
+        ] {
+            assert!(svg.contains(label), "no {label:?} in the figure");
         }
-        // A and C perfectly anti-correlated with equal σ: the band vanishes at v = 0 (μ(0) = A + C
-        // is fixed) and grows as e^(−Bv) decays: σ·(1 − e^(−Bv)).
-        let anti = [[1e-4, 0.0, -1e-4], [0.0; 3], [-1e-4, 0.0, 1e-4]];
-        for (s, x) in delta_band(a, b, &anti, &v).iter().zip(v) {
-            assert!(
-                (s - 1e-2 * (1.0 - (-b * x).exp())).abs() < 1e-12,
-                "{s} at {x}"
-            );
-        }
+        r.parameters.clear();
+        r.friction_curve = FrictionCurve::new(LAW, &speeds, None, None);
+        friction_law_figure(dir.path(), &r, &LAW, None).unwrap();
+        let svg = std::fs::read_to_string(dir.path().join("friction_law.svg")).unwrap();
+        assert!(svg.contains("no ±1σ: no coefficient of the law was fitted"));
+        assert!(!svg.contains("true μ_d"));
     }
 }

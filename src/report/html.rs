@@ -95,7 +95,8 @@ pub fn fit_figure_list(result: &FitResult) -> Vec<(String, String)> {
     }
     v.push((
         "friction_law.svg".into(),
-        "Dynamic friction coefficient μ_d(|v|) = A e^(−B|v|) + C (seed eq. 4): fitted, and the \
+        "Dynamic friction coefficient μ_d(|v|) of the blade's law: fitted, solid with its ±1σ band \
+         over the slip speeds the fitted motion covers (shaded), dashed where extrapolated; the \
          truth when known."
             .into(),
     ));
@@ -1052,6 +1053,7 @@ pub(super) mod tests {
             tolerance_check: None,
             tracking_noise: None,
             truth_cost: None,
+            friction_curve: None,
             history: vec![],
         }
     }

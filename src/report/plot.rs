@@ -70,6 +70,8 @@ pub enum SeriesStyle {
     Points,
     /// Both.
     LinePoints,
+    /// A dashed polyline, broken at NaN (e.g. a curve where it is extrapolated).
+    Dashed,
 }
 
 /// One named data series; `x` and `y` pair up index by index (extra entries of the longer one are
@@ -94,6 +96,16 @@ impl Series {
             x,
             y,
             style: SeriesStyle::Line,
+        }
+    }
+
+    /// A dashed line series.
+    pub fn dashed(label: impl Into<String>, x: Vec<f64>, y: Vec<f64>) -> Self {
+        Series {
+            label: label.into(),
+            x,
+            y,
+            style: SeriesStyle::Dashed,
         }
     }
 
@@ -141,6 +153,22 @@ pub struct ChartOpts {
     /// Shaded x intervals, each with a legend entry: e.g. the frequency bands a fit or a peak
     /// search looked at.
     pub spans: Vec<Span>,
+    /// Shaded areas between two curves, each with a legend entry: e.g. a fitted curve's ±1σ.
+    pub bands: Vec<Band>,
+}
+
+/// The area between `lo` and `hi` over `x` shaded on a [`line_chart`] in a light tint of series
+/// number `series`'s colour (under the data), and named in the legend. Points where `x`, `lo` or
+/// `hi` is not finite are left out.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Band {
+    pub x: Vec<f64>,
+    pub lo: Vec<f64>,
+    pub hi: Vec<f64>,
+    /// The series whose colour the band takes.
+    pub series: usize,
+    /// Legend text, e.g. "±1σ".
+    pub label: String,
 }
 
 /// An x interval shaded on a [`line_chart`] (in its own tint, under the data) and named in the
@@ -338,7 +366,7 @@ pub fn line_chart(
     check_ranges(path, opts)?;
     let plane = chart_plane(path, title, series, opts)?;
     let size = (FIGURE_SIZE.0 * SCALE, FIGURE_SIZE.1 * SCALE);
-    let legend = Legend::of(series, &opts.spans);
+    let legend = Legend::of(series, &opts.bands, &opts.spans);
     let mut svg = String::new();
     let labels = {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
@@ -393,6 +421,12 @@ fn chart_plane(path: &Path, title: &str, series: &[Series], opts: &ChartOpts) ->
         series
             .iter()
             .flat_map(|s| s.x.iter().copied().zip(s.y.iter().copied()))
+            .chain(opts.bands.iter().flat_map(|b| {
+                let x = b.x.iter().copied();
+                x.clone()
+                    .zip(b.lo.iter().copied())
+                    .chain(x.zip(b.hi.iter().copied()))
+            }))
             .filter(|&(x, y)| ax.valid(x) && ay.valid(y))
     };
     let extent = |it: &mut dyn Iterator<Item = f64>| {
@@ -503,6 +537,8 @@ fn shown_at_figure_size(svg: &str, size: (u32, u32)) -> String {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum Mark {
     Line,
+    /// A dashed line sample (a [`SeriesStyle::Dashed`] series).
+    Dashed,
     Point(u32),
     Cross,
     /// A shaded rectangle (a [`Span`]).
@@ -524,21 +560,25 @@ pub(crate) struct Legend {
 impl Legend {
     const ROW: u32 = px(18);
 
-    /// The legend of [`line_chart`]'s series, then its shaded spans, in the figure's width.
-    fn of(series: &[Series], spans: &[Span]) -> Legend {
+    /// The legend of [`line_chart`]'s series, then its bands and its shaded spans, in the
+    /// figure's width.
+    fn of(series: &[Series], bands: &[Band], spans: &[Span]) -> Legend {
         let lines = series.iter().enumerate().map(|(i, s)| {
-            let mark = if s.style == SeriesStyle::Points {
-                Mark::Point(px(3))
-            } else {
-                Mark::Line
+            let mark = match s.style {
+                SeriesStyle::Points => Mark::Point(px(3)),
+                SeriesStyle::Dashed => Mark::Dashed,
+                SeriesStyle::Line | SeriesStyle::LinePoints => Mark::Line,
             };
             (s.label.clone(), series_colour(i), mark)
         });
+        let areas = bands
+            .iter()
+            .map(|b| (b.label.clone(), series_colour(b.series), Mark::Swatch));
         let shaded = spans
             .iter()
             .enumerate()
             .map(|(i, s)| (s.label.clone(), span_tint(i), Mark::Swatch));
-        Legend::new(lines.chain(shaded), FIGURE_SIZE.0)
+        Legend::new(lines.chain(areas).chain(shaded), FIGURE_SIZE.0)
     }
 
     /// A legend of `items` laid out in a strip `room_px` display pixels wide.
@@ -619,6 +659,14 @@ fn legend_mark(mark: Mark, c: RGBColor, ex: u32, ey: u32) -> String {
             ex + px(20),
             px(2)
         ),
+        Mark::Dashed => format!(
+            "<line x1=\"{ex}\" y1=\"{ey}\" x2=\"{}\" y2=\"{ey}\" stroke=\"{colour}\" \
+             stroke-width=\"{}\" stroke-dasharray=\"{} {}\"/>\n",
+            ex + px(20),
+            px(2),
+            px(5),
+            px(3)
+        ),
         Mark::Swatch => format!(
             "<rect x=\"{ex}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"{colour}\" \
              fill-opacity=\"{}\" stroke=\"{colour}\" stroke-width=\"{}\"/>\n",
@@ -691,6 +739,7 @@ fn draw_xy(
         .draw()?;
 
     draw_spans(&mut chart, plane, &opts.spans)?;
+    draw_bands(&mut chart, plane, &opts.bands)?;
     for (i, s) in series.iter().enumerate() {
         draw_one_series(&mut chart, plane, i, s)?;
     }
@@ -718,6 +767,33 @@ fn draw_spans(chart: &mut XyChart<'_, '_>, plane: Plane, spans: &[Span]) -> Draw
     Ok(())
 }
 
+/// The bands as filled polygons (upper edge forward, lower edge back) in a light tint of their
+/// series' colour, each point held inside the plotting box, under the data.
+fn draw_bands(chart: &mut XyChart<'_, '_>, plane: Plane, bands: &[Band]) -> DrawResult {
+    let Plane { ax, ay, bx, by } = plane;
+    for b in bands {
+        let pts: Vec<(f64, f64, f64)> = (0..b.x.len().min(b.lo.len()).min(b.hi.len()))
+            .filter(|&i| ax.valid(b.x[i]) && ay.valid(b.lo[i]) && ay.valid(b.hi[i]))
+            .map(|i| (ax.fwd(b.x[i]), ay.fwd(b.lo[i]), ay.fwd(b.hi[i])))
+            .filter(|p| p.0 >= bx.0 && p.0 <= bx.1)
+            .collect();
+        if pts.len() < 2 {
+            continue;
+        }
+        let inside = |y: f64| y.clamp(by.0, by.1);
+        let outline: Vec<(f64, f64)> = pts
+            .iter()
+            .map(|p| (p.0, inside(p.2)))
+            .chain(pts.iter().rev().map(|p| (p.0, inside(p.1))))
+            .collect();
+        chart.draw_series(std::iter::once(Polygon::new(
+            outline,
+            series_colour(b.series).mix(SPAN_OPACITY).filled(),
+        )))?;
+    }
+    Ok(())
+}
+
 /// Series number `i` in its colour: its clipped polylines and/or a circle per visible point, as
 /// one plotters series (so the legend has one entry even when the data breaks into pieces or has
 /// none to show).
@@ -737,6 +813,12 @@ fn draw_one_series(chart: &mut XyChart<'_, '_>, plane: Plane, i: usize, s: &Seri
             .filter_map(|(&x, &y)| plane.point(x, y))
             .collect()
     };
+    if s.style == SeriesStyle::Dashed {
+        for l in lines {
+            chart.draw_series(DashedLineSeries::new(l, px(8), px(5), line_style))?;
+        }
+        return Ok(());
+    }
     let elems: Vec<DynElement<'static, SVGBackend<'_>, (f64, f64)>> = lines
         .into_iter()
         .map(|l| PathElement::new(l, line_style).into_dyn())

@@ -76,6 +76,16 @@ impl BladeSimulation {
         ]
     }
 
+    /// |slip speed| `|v̇3|` of every sample in slip (stick samples left out), m/s.
+    pub fn slip_speeds(&self) -> Vec<f64> {
+        self.phase
+            .iter()
+            .zip(&self.v3_dot_m_per_s)
+            .filter(|(ph, _)| ph.slip_dir().is_some())
+            .map(|(_, v)| v.abs())
+            .collect()
+    }
+
     /// The simulation as a canonical trace: point `head` at (v, −u), point `tip` at (v3, −(l1+l2)),
     /// in the model's frame (origin at the upright head position, y up).
     pub fn to_trace(&self) -> Trace {
