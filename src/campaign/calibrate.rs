@@ -455,12 +455,13 @@ pub fn to_markdown(c: &Calibration, notes: Option<&str>, command: &str) -> Strin
     );
     stats_table(&mut md, &c.overall);
     for (m, stats) in &c.by_model {
-        let n = c
-            .recordings
-            .iter()
-            .filter(|r| r.true_model == Some(*m))
-            .count();
-        let _ = writeln!(md, "\n### True model {m} ({n} recordings)\n");
+        let of_model = || c.recordings.iter().filter(|r| r.true_model == Some(*m));
+        let _ = writeln!(
+            md,
+            "\n### True model {m} ({} of {} recordings fitted)\n",
+            of_model().filter(|r| r.state == "done").count(),
+            of_model().count()
+        );
         stats_table(&mut md, stats);
     }
     let (known, over, max) = c.shortfalls();
@@ -521,21 +522,28 @@ pub fn to_markdown(c: &Calibration, notes: Option<&str>, command: &str) -> Strin
         num(quantile(&times, 0.9), 1),
         times.len()
     );
-    let failures: Vec<&RecordingScore> =
-        c.recordings.iter().filter(|r| r.state != "done").collect();
-    if !failures.is_empty() {
+    let failed: Vec<&RecordingScore> = c
+        .recordings
+        .iter()
+        .filter(|r| r.state == "failed")
+        .collect();
+    let missing: Vec<&str> = c
+        .recordings
+        .iter()
+        .filter(|r| r.state == "missing")
+        .map(|r| r.id.as_str())
+        .collect();
+    if !failed.is_empty() || !missing.is_empty() {
         let _ = writeln!(md, "\n## Recordings without a result\n");
-        for r in failures {
+        for r in failed {
+            let _ = writeln!(md, "- {} failed: {}", r.id, r.reason);
+        }
+        if !missing.is_empty() {
             let _ = writeln!(
                 md,
-                "- {} ({}): {}",
-                r.id,
-                r.state,
-                if r.reason.is_empty() {
-                    "not fitted"
-                } else {
-                    r.reason.as_str()
-                }
+                "- {} not fitted (or still running): {}",
+                missing.len(),
+                missing.join(", ")
             );
         }
     }
@@ -830,6 +838,60 @@ mod tests {
         assert_eq!(s.band, binomial_band(10, 0.6827));
         assert_eq!(s.band_wide, binomial_band(10, 0.95));
         assert!((s.median_abs_rel_error - 0.05).abs() < 1e-12);
+    }
+
+    /// The page of four recordings: a shoulder-free truth fitted with a shoulder (scored, its
+    /// shortfall 0.3 nats counted), a shoulder truth fitted without (not scored, in the confusion
+    /// matrix), a failure with its reason and a recording not yet fitted.
+    #[test]
+    fn markdown_counts_shortfalls_confusion_and_missing_fits() {
+        let c = |s: &str| s.parse::<Candidate>().ok();
+        let mut free = recording(&[0.5]);
+        free.id = "free".into();
+        free.true_model = c("blade2dof");
+        free.chosen = c("blade2dof+shoulder");
+        free.shortfall_nats = Some(0.3);
+        let mut shoulder = recording(&[]);
+        shoulder.id = "shoulder".into();
+        shoulder.true_model = c("blade2dof+shoulder");
+        shoulder.shortfall_nats = Some(5.0);
+        let mut failed = recording(&[]);
+        failed.id = "broken".into();
+        failed.state = "failed".into();
+        failed.reason = "simulation failed".into();
+        failed.chosen = None;
+        let mut missing = failed.clone();
+        missing.id = "later".into();
+        missing.state = "missing".into();
+        let recordings = vec![free, shoulder, failed, missing];
+        let cal = Calibration {
+            name: "t".into(),
+            campaign: PathBuf::from("t.toml"),
+            overall: param_stats(recordings.iter().filter(|r| r.model_contains_truth())),
+            by_model: Vec::new(),
+            recordings,
+        };
+        assert_eq!(
+            cal.shortfalls().0,
+            1,
+            "the shoulder truth fitted without one is not priced"
+        );
+        assert_eq!(cal.shortfalls().1, 1);
+        let md = to_markdown(&cal, Some("notes here"), "wiperlab campaign collect t.toml");
+        assert!(md.contains("notes here") && md.contains("`wiperlab campaign collect t.toml`"));
+        assert!(
+            md.contains("2 fitted, 1 failed, 1 without a result"),
+            "{md}"
+        );
+        assert!(md.contains("1 of 1 fits"), "{md}");
+        assert!(md.contains("| blade2dof | 0 | 1 |"), "{md}");
+        assert!(md.contains("| blade2dof+shoulder | 1 | 0 |"), "{md}");
+        assert!(md.contains("- broken failed: simulation failed"), "{md}");
+        assert!(
+            md.contains("- 1 not fitted (or still running): later"),
+            "{md}"
+        );
+        assert!(md.contains("| A | 1 | 1 |"), "{md}");
     }
 
     #[test]
