@@ -1135,7 +1135,8 @@ fn fit_writes_psd_and_trace_csv_with_named_columns() {
             "psd_low.csv",
             "psd_high.csv",
             "traces_measured.csv",
-            "traces_model.csv"
+            "traces_model.csv",
+            "friction_curve.csv"
         ]
     );
 }
