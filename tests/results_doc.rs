@@ -181,6 +181,11 @@ fn every_column_the_pandas_example_reads_exists() {
                 assert!(gof.contains_key(&k), "goodness_of_fit has no key {k:?}");
                 checked += 1;
             }
+            let fc = r["friction_curve"].as_table().expect("[friction_curve]");
+            for k in subscripts(&code, "fc") {
+                assert!(fc.contains_key(&k), "friction_curve has no key {k:?}");
+                checked += 1;
+            }
         }
         None => println!("skipped fits/reversal.result.toml: the main job writes it"),
     }
