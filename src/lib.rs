@@ -5,7 +5,7 @@
 //! The module tree is the pipeline; a stage uses only the stages before it (checked by
 //! `tests/architecture.rs`):
 //!
-//! Pipeline order: `error` → `names` → `io` → `trace` → `import` → `spectrum` → `model` → `simulate` → `job` → `likelihood` → `fit` → `explore` → `campaign` → `report` → `bench` → `cli`.
+//! Pipeline order: `error` → `names` → `io` → `trace` → `import` → `spectrum` → `model` → `simulate` → `job` → `likelihood` → `posterior` → `fit` → `explore` → `campaign` → `report` → `bench` → `cli`.
 //!
 //! * [`error`]: the crate's error type, shared by every stage.
 //! * [`names`]: typed names (model kinds, parameter ids, ...), each spelled once.
@@ -22,6 +22,8 @@
 //!   `wiperlab init` writes.
 //! * [`likelihood`]: the recording measured as the job asks (features per band, noise floors,
 //!   frequency against tip speed) and the calibrated likelihood that reads its spectra.
+//! * [`posterior`]: the affine-invariant ensemble sampler, its convergence diagnostics and the
+//!   posterior summary a fit reports.
 //! * [`fit`]: the friction law A, B, C and the neck stiffness fitted with `argmin`; model choice,
 //!   intervals, results.
 //! * [`explore`]: where a job's freed parameters can take the model's lines (`wiperlab explore`).
@@ -47,6 +49,7 @@ pub mod job;
 pub mod likelihood;
 pub mod model;
 pub mod names;
+pub mod posterior;
 pub mod report;
 pub mod simulate;
 pub mod spectrum;

@@ -20,6 +20,7 @@ const STAGES: &[&str] = &[
     "simulate",
     "job",
     "likelihood",
+    "posterior",
     "fit",
     "explore",
     "campaign",
