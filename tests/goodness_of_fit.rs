@@ -13,6 +13,7 @@ mod common;
 use wiperlab::fit::problem_for;
 use wiperlab::job::Candidate;
 use wiperlab::job::LoadedJob;
+use wiperlab::likelihood::misfit::{BandMisfit, describe};
 use wiperlab::likelihood::{GOODNESS_OF_FIT_LEVEL, GoodnessOfFit};
 
 /// `data/reversal/truth.json` /params: A, B (s/m), C, k1 (N·m/rad).
@@ -23,8 +24,9 @@ const TRUTH: [(&str, f64); 4] = [
     ("k1", 0.029748408887917077),
 ];
 
-/// The test of `candidate` on the shipped recording at `values` (one per freed parameter).
-fn test_at(candidate: &str, values: &[(&str, f64)]) -> GoodnessOfFit {
+/// The test of `candidate` on the shipped recording at `values` (one per freed parameter), with
+/// where its spectra depart from the recording's.
+fn test_at(candidate: &str, values: &[(&str, f64)]) -> (GoodnessOfFit, Vec<BandMisfit>) {
     let root = common::root();
     let job = LoadedJob::load(&root.join("fits/reversal.toml")).expect("the shipped job loads");
     let p = problem_for(&job, candidate.parse::<Candidate>().unwrap()).unwrap();
@@ -46,16 +48,34 @@ fn test_at(candidate: &str, values: &[(&str, f64)]) -> GoodnessOfFit {
         .as_ref()
         .expect("the recording has a likelihood");
     let g = lik.goodness_of_fit(&p, &sim).expect("the test runs");
+    let shape = lik.misfit_shape(&p, &sim).expect("the shape is measured");
     println!(
-        "{candidate} at {values:?}: excess NLL {:.2}, replicates {:.2} ± {:.2}, p {:.3}",
-        g.excess_nll_nats, g.replicate_mean_nats, g.replicate_sd_nats, g.p_value
+        "{candidate} at {values:?}: excess NLL {:.2}, replicates {:.2} ± {:.2}, p {:.3}; {}",
+        g.excess_nll_nats,
+        g.replicate_mean_nats,
+        g.replicate_sd_nats,
+        g.p_value,
+        describe(&shape).unwrap_or_default()
     );
-    g
+    (g, shape)
+}
+
+/// The recording's high-band peak frequency, Hz (its own Welch estimate, the job's bands).
+fn recording_high_peak_hz() -> f64 {
+    let job = LoadedJob::load(&common::root().join("fits/reversal.toml")).expect("job");
+    let p = problem_for(&job, "blade2dof".parse::<Candidate>().unwrap()).expect("problem");
+    let high = p
+        .measured
+        .bands
+        .iter()
+        .find(|b| b.spec.name == "high")
+        .expect("a high band");
+    high.peak.as_ref().expect("a high-band peak").freq_hz
 }
 
 #[test]
 fn the_true_blade_explains_the_recording_and_a_bent_or_missing_feature_does_not() {
-    let truth = test_at("blade2dof", &TRUTH);
+    let (truth, _) = test_at("blade2dof", &TRUTH);
     assert!(
         truth.fits(),
         "the true blade should pass at level {GOODNESS_OF_FIT_LEVEL}: {truth:?}"
@@ -66,8 +86,22 @@ fn the_true_blade_explains_the_recording_and_a_bent_or_missing_feature_does_not(
     // locked link loses contact at the true k1; at 0.01 N·m/rad it simulates the whole window.)
     let mut head_values = TRUTH;
     head_values[3].1 = 0.01;
-    let head = test_at("head1dof", &head_values);
+    let (head, shape) = test_at("head1dof", &head_values);
     assert!(!head.fits(), "{head:?}");
+    // Its misfit is said where it is: one of the high band's ranges holds the recording's neck–lip
+    // line, with more power in the recording than in the model.
+    let high = shape
+        .iter()
+        .find(|b| b.band == "high")
+        .expect("a high band");
+    assert!(high.excess_nats > 0.0, "{shape:?}");
+    let line = recording_high_peak_hz();
+    assert!(
+        high.regions
+            .iter()
+            .any(|r| r.freq_lo_hz <= line && line <= r.freq_hi_hz && r.power_ratio > 1.0),
+        "no range holds the recording's {line} Hz line: {shape:?}"
+    );
 
     // The friction law bent as a fit bends it for a missing shoulder.
     let bent = [
@@ -76,7 +110,7 @@ fn the_true_blade_explains_the_recording_and_a_bent_or_missing_feature_does_not(
         ("C", 0.56 * (1.0 - 0.086)),
         TRUTH[3],
     ];
-    let bent = test_at("blade2dof", &bent);
+    let (bent, _) = test_at("blade2dof", &bent);
     assert!(!bent.fits(), "{bent:?}");
     assert!(bent.excess_nll_nats > truth.excess_nll_nats);
 }

@@ -57,6 +57,9 @@ struct BandTerm {
     per_density: f64,
     /// The bins of the band's features the likelihood reads ([`BandTerm::new`]).
     bins: std::ops::Range<usize>,
+    /// Their frequencies, Hz, and the band's name: where a misfit is said to sit.
+    freq_hz: Vec<f64>,
+    name: String,
 }
 
 impl BandTerm {
@@ -86,6 +89,8 @@ impl BandTerm {
                 .map(|f| (std::f64::consts::TAU * f / fs_hz).cos())
                 .collect(),
             per_density: ordinate_per_density(fs_hz, &cfg),
+            freq_hz: b.freq_hz[bins.clone()].to_vec(),
+            name: b.spec.name.clone(),
             bins,
         })
     }
@@ -779,6 +784,32 @@ impl RecordingLikelihood {
         let observed = self.spectral_excess_nll(problem, sim)?;
         let replicates = self.replicate_excess_nll(problem, sim, GOODNESS_OF_FIT_REPLICATES)?;
         Ok(likelihood::GoodnessOfFit::of(observed, &replicates)?)
+    }
+
+    /// Where the simulation `sim`'s spectra depart from the recording's, band by band
+    /// ([`likelihood::misfit::band_misfit`]): what a failed goodness-of-fit test says in words.
+    ///
+    /// # Errors
+    /// Those of the model's spectra and of [`likelihood::misfit::band_misfit`].
+    pub fn misfit_shape(
+        &self,
+        problem: &SpectralProblem,
+        sim: &BladeSimulation,
+    ) -> Result<Vec<likelihood::misfit::BandMisfit>> {
+        let psd = self.model_psd(problem, sim)?;
+        self.bands
+            .iter()
+            .zip(&psd)
+            .map(|(b, s)| {
+                Ok(likelihood::misfit::band_misfit(
+                    &b.name,
+                    &b.lik,
+                    &b.freq_hz,
+                    &b.measured,
+                    s,
+                )?)
+            })
+            .collect()
     }
 
     /// The spectral excess NLL ([`RecordingLikelihood::excess_nll`]'s spectral part, nats) of

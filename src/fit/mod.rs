@@ -136,8 +136,10 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     warnings.extend(
         goodness_of_fit
             .as_ref()
-            .and_then(|g| misfit_warning(g, shoulder_listed)),
+            .and_then(|g| misfit_warning(g, shoulder_listed, || misfit_shape(&cf, &best.sim))),
     );
+    let misfit = goodness_of_fit.as_ref().is_some_and(|g| !g.fits());
+    warnings.extend(select::chosen_on_misfit(&selection.trials, misfit));
     warnings.extend(absorbing);
     warnings.extend(line_warnings(&peaks));
     warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
@@ -336,14 +338,31 @@ fn gof_ref(gof: &GoodnessOutcome) -> Option<&likelihood::GoodnessOfFit> {
     gof.as_ref().ok().and_then(Option::as_ref)
 }
 
-/// The warning of a fit whose spectra are less likely than its own noise makes likely.
-/// `shoulder_listed`: the job lists a `+shoulder` candidate; the warning then says how a known
-/// contact angle helps the search (docs/fit.md, "Shoulder contact").
-fn misfit_warning(g: &likelihood::GoodnessOfFit, shoulder_listed: bool) -> Option<FitWarning> {
-    (!g.fits()).then_some(FitWarning::Misfit {
+/// The warning of a fit whose spectra are less likely than its own noise makes likely, with
+/// where the excess sits (`shape`, asked only then). `shoulder_listed`: the job lists a
+/// `+shoulder` candidate; the warning then says how a known contact angle helps the search
+/// (docs/fit.md, "Shoulder contact").
+fn misfit_warning(
+    g: &likelihood::GoodnessOfFit,
+    shoulder_listed: bool,
+    shape: impl FnOnce() -> Vec<likelihood::misfit::BandMisfit>,
+) -> Option<FitWarning> {
+    (!g.fits()).then(|| FitWarning::Misfit {
         test: *g,
         shoulder_listed,
+        shape: shape(),
     })
+}
+
+/// Where the chosen fit's spectra depart from the recording's; empty when the likelihood cannot
+/// say (a description of a misfit already found, never a reason to fail the fit).
+fn misfit_shape(cf: &CandidateFit, sim: &BladeSimulation) -> Vec<likelihood::misfit::BandMisfit> {
+    let p = &cf.problem;
+    p.likelihood
+        .as_ref()
+        .ok()
+        .and_then(|l| l.misfit_shape(p, sim).ok())
+        .unwrap_or_default()
 }
 
 /// The chosen fit's intervals and their warnings, and whether the run was interrupted (then no
@@ -663,12 +682,13 @@ mod tests {
     fn misfit_warning_fires_below_the_level_only() {
         let replicates: Vec<f64> = (0..999).map(|i| 60.0 + 0.04 * f64::from(i)).collect();
         let above_all = likelihood::GoodnessOfFit::of(171.0, &replicates).unwrap();
-        let w = misfit_warning(&above_all, false).expect("p = 0.001 is below the level");
+        let w = misfit_warning(&above_all, false, Vec::new).expect("p = 0.001 is below the level");
         assert_eq!(
             w,
             FitWarning::Misfit {
                 test: above_all,
-                shoulder_listed: false
+                shoulder_listed: false,
+                shape: Vec::new(),
             }
         );
         assert_eq!(w.severity(), Severity::Attention);
@@ -678,7 +698,7 @@ mod tests {
             "{text}"
         );
         assert!(!text.contains("theta_c"), "{text}");
-        let with_shoulder = misfit_warning(&above_all, true)
+        let with_shoulder = misfit_warning(&above_all, true, Vec::new)
             .expect("the same test")
             .to_string();
         assert!(
@@ -686,8 +706,8 @@ mod tests {
             "{with_shoulder}"
         );
         let typical = likelihood::GoodnessOfFit::of(80.0, &replicates).unwrap();
-        assert_eq!(misfit_warning(&typical, false), None);
-        assert_eq!(misfit_warning(&typical, true), None);
+        assert_eq!(misfit_warning(&typical, false, Vec::new), None);
+        assert_eq!(misfit_warning(&typical, true, Vec::new), None);
     }
 
     /// `[fit] swarm_rtol`: the swarm stage simulates at its own tolerance (atol scaled alike),

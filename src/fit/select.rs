@@ -14,6 +14,8 @@ use super::features::BandSpec;
 use super::problem::FAILED_COST;
 use super::result::{ModelTrial, RatioTest, TrialEvidence};
 use super::search::CandidateFit;
+use super::warning::FitWarning;
+use crate::job::Candidate;
 use crate::likelihood::{self, Evidence};
 use std::sync::atomic::Ordering;
 
@@ -357,4 +359,76 @@ pub(super) fn absorbing_warnings(
         }
     }
     w
+}
+
+/// The warning of a candidate that adds structure to another listed one (`X+shoulder` over `X`)
+/// and is chosen on a fit that fails the goodness-of-fit test (`misfit`): the structure may only
+/// absorb what the model cannot explain (coloured tracking noise, a friction law the model lacks),
+/// so the choice is said, never silent.
+pub(super) fn chosen_on_misfit(trials: &[ModelTrial], misfit: bool) -> Option<FitWarning> {
+    let outline: Vec<(Candidate, bool, Option<f64>)> = trials
+        .iter()
+        .map(|t| {
+            let delta = t.evidence.as_ref().and_then(|e| e.delta_tic);
+            (t.model, t.chosen, delta)
+        })
+        .collect();
+    nested_on_misfit(&outline, misfit)
+}
+
+/// [`chosen_on_misfit`] on each trial's candidate, whether it is chosen and its ΔTIC.
+fn nested_on_misfit(trials: &[(Candidate, bool, Option<f64>)], misfit: bool) -> Option<FitWarning> {
+    let &(chosen, ..) = trials.iter().find(|t| t.1)?;
+    if !misfit || !chosen.shoulder {
+        return None;
+    }
+    let nested = Candidate {
+        shoulder: false,
+        ..chosen
+    };
+    let &(_, _, delta) = trials.iter().find(|t| t.0 == nested)?;
+    Some(FitWarning::ChosenOnMisfit {
+        chosen,
+        nested,
+        delta_tic: delta.unwrap_or(f64::NAN),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simulate::blade::ModelKind;
+
+    /// A shoulder chosen over its shoulder-free model on a failed test is said; a passed test, a
+    /// shoulder-free choice or a job without the nested candidate says nothing.
+    #[test]
+    fn a_shoulder_chosen_on_a_misfit_is_said() {
+        let free = Candidate {
+            kind: ModelKind::Blade2dof,
+            shoulder: false,
+        };
+        let shoulder = Candidate {
+            shoulder: true,
+            ..free
+        };
+        let trials = [(free, false, Some(12.5)), (shoulder, true, Some(0.0))];
+        let w = nested_on_misfit(&trials, true).expect("a warning");
+        assert_eq!(
+            w,
+            FitWarning::ChosenOnMisfit {
+                chosen: shoulder,
+                nested: free,
+                delta_tic: 12.5
+            }
+        );
+        let text = w.to_string();
+        assert!(
+            text.contains("TIC 12.5 lower") && text.contains("not confirmed"),
+            "{text}"
+        );
+        assert_eq!(nested_on_misfit(&trials, false), None);
+        let free_chosen = [(free, true, Some(0.0)), (shoulder, false, Some(1.0))];
+        assert_eq!(nested_on_misfit(&free_chosen, true), None);
+        assert_eq!(nested_on_misfit(&[(shoulder, true, None)], true), None);
+    }
 }

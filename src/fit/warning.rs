@@ -85,6 +85,9 @@ pub enum FitWarning {
         /// The job lists a `+shoulder` candidate (the sentence then says how a known contact
         /// angle helps the search).
         shoulder_listed: bool,
+        /// Where the excess sits, band by band ([`crate::likelihood::misfit`]).
+        #[serde(default)]
+        shape: Vec<crate::likelihood::misfit::BandMisfit>,
     },
     /// A parameter moves between the chosen model and another capable one by more than the larger
     /// of their 1σ.
@@ -172,6 +175,15 @@ pub enum FitWarning {
         points: Vec<TolerancePoint>,
         spread_nats: f64,
     },
+    /// A candidate that adds structure to another (a shoulder) is chosen on a fit that fails the
+    /// goodness-of-fit test: the structure may absorb the misfit rather than describe the blade.
+    ChosenOnMisfit {
+        chosen: Candidate,
+        /// The candidate it adds structure to.
+        nested: Candidate,
+        /// The nested candidate's TIC above the chosen one's.
+        delta_tic: f64,
+    },
     /// The model choice's AIC gap is smaller than the tolerance spread.
     ChoiceUnresolved {
         chosen: Candidate,
@@ -252,6 +264,7 @@ impl FitWarning {
             | ToleranceNotProbed { .. }
             | ToleranceUnresolved { .. }
             | ChoiceUnresolved { .. }
+            | ChosenOnMisfit { .. }
             | Text { .. } => Severity::Attention,
         }
     }
@@ -281,6 +294,7 @@ impl FitWarning {
             ToleranceNotProbed { .. } => "tolerance_not_probed",
             ToleranceUnresolved { .. } => "tolerance_unresolved",
             ChoiceUnresolved { .. } => "choice_unresolved",
+            ChosenOnMisfit { .. } => "chosen_on_misfit",
             FailedEvaluations { .. } => "failed_evaluations",
             NoBladeModes { .. } => "no_blade_modes",
             Text { .. } => "text",
@@ -327,7 +341,8 @@ impl fmt::Display for FitWarning {
             Misfit {
                 test,
                 shoulder_listed,
-            } => misfit(f, test, *shoulder_listed),
+                shape,
+            } => misfit(f, test, *shoulder_listed, shape),
             AbsorbsModelStructure {
                 parameter,
                 chosen,
@@ -405,6 +420,16 @@ impl fmt::Display for FitWarning {
                 aic_gap,
                 spread_nats,
             } => choice_unresolved(f, [chosen, runner_up], *aic_gap, *spread_nats),
+            ChosenOnMisfit {
+                chosen,
+                nested,
+                delta_tic,
+            } => write!(
+                f,
+                "{chosen} is chosen over {nested} (TIC {delta_tic:.1} lower) by a fit that fails \
+                 the goodness-of-fit test: what it adds to {nested} may absorb the misfit rather \
+                 than describe the blade, so it is not confirmed by this recording"
+            ),
             FailedEvaluations {
                 failed,
                 evaluations,
@@ -433,7 +458,12 @@ fn truth_more_likely(f: &mut fmt::Formatter<'_>, fit: f64, truth: f64) -> fmt::R
 
 /// [`FitWarning::Misfit`]'s sentence, with the shoulder's advice when the job lists a shoulder
 /// candidate.
-fn misfit(f: &mut fmt::Formatter<'_>, g: &GoodnessOfFit, shoulder_listed: bool) -> fmt::Result {
+fn misfit(
+    f: &mut fmt::Formatter<'_>,
+    g: &GoodnessOfFit,
+    shoulder_listed: bool,
+    shape: &[crate::likelihood::misfit::BandMisfit],
+) -> fmt::Result {
     write!(
         f,
         "the chosen model does not explain the recording's spectra to their noise: excess NLL \
@@ -447,6 +477,9 @@ fn misfit(f: &mut fmt::Formatter<'_>, g: &GoodnessOfFit, shoulder_listed: bool) 
         g.p_value,
         g.z()
     )?;
+    if let Some(words) = crate::likelihood::misfit::describe(shape) {
+        write!(f, "; {words}")?;
+    }
     if shoulder_listed {
         f.write_str(
             "; a shoulder the neck touches only at the peaks of its swing has a basin a few per \

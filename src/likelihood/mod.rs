@@ -83,6 +83,7 @@ pub mod covariance;
 mod error;
 pub mod instfreq;
 pub mod measure;
+pub mod misfit;
 
 pub use error::{MeasureError, NoHeadTrack};
 

@@ -302,8 +302,9 @@ fn goodness_of_fit_check(r: &FitResult) -> (Check, Option<String>) {
             format!(
                 "The model does not explain the recording's spectra to their noise (goodness of \
                  fit p = {:.3}): the spectra hold structure the model lacks, or the search missed \
-                 a basin.",
-                g.p_value
+                 a basin.{}",
+                g.p_value,
+                misfit_shape_words(r)
             ),
             "Fit more candidate models (e.g. with shoulder contact), check that each band holds \
              the line it is meant for, or bound a parameter known from the blade's drawing \
@@ -315,6 +316,26 @@ fn goodness_of_fit_check(r: &FitResult) -> (Check, Option<String>) {
         None if r.interrupted => none("No goodness-of-fit test: the fit was interrupted.".into()),
         None => none("No goodness-of-fit test in this result (a joint fit has none).".into()),
     }
+}
+
+/// Where the misfit sits, as a sentence after the check's (empty when the result does not say).
+fn misfit_shape_words(r: &FitResult) -> String {
+    r.warnings
+        .0
+        .iter()
+        .find_map(|w| match w {
+            FitWarning::Misfit { shape, .. } => crate::likelihood::misfit::describe(shape),
+            _ => None,
+        })
+        .map(|w| {
+            let mut c = w.chars();
+            let first: String = c
+                .next()
+                .map(|f| f.to_uppercase().collect())
+                .unwrap_or_default();
+            format!(" {first}{}.", c.as_str())
+        })
+        .unwrap_or_default()
 }
 
 /// Whether the integrator resolves the likelihood at the optimum.
@@ -573,11 +594,25 @@ mod tests {
             vec![point(1e-8, 66.8), point(1e-9, 68.4)],
             vec![],
         ));
-        let misfit = PageWarning::Fit(FitWarning::Misfit {
+        let shape = vec![crate::likelihood::misfit::BandMisfit {
+            band: "low".into(),
+            excess_nats: 120.0,
+            regions: vec![],
+        }];
+        let misfit = FitWarning::Misfit {
             test: r.goodness_of_fit.unwrap(),
             shoulder_listed: false,
-        });
-        let s = summary(&r, &[misfit, info]);
+            shape,
+        };
+        r.warnings.0.push(misfit.clone());
+        let s = summary(&r, &[PageWarning::Fit(misfit), info]);
+        assert!(
+            s.checks
+                .iter()
+                .any(|c| c.status == "bad" && c.text.contains(" The excess lies in the low band")),
+            "the check says where the misfit sits: {:?}",
+            s.checks
+        );
         assert!(!s.good);
         assert_eq!(status(&s), ["bad", "bad", "ok", "ok", "bad"]);
         assert_eq!(s.todo.len(), 3, "{:?}", s.todo);

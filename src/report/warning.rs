@@ -198,7 +198,7 @@ fn fit_headline(w: &FitWarning) -> String {
             fit_cost_nats,
             truth_cost_nats,
         } => truth_more_likely_headline(fit_cost_nats - truth_cost_nats),
-        Misfit { test, .. } => misfit_headline(test.p_value),
+        Misfit { test, shape, .. } => misfit_headline(test.p_value, shape),
         AbsorbsModelStructure {
             parameter,
             chosen,
@@ -272,6 +272,11 @@ fn fit_headline(w: &FitWarning) -> String {
             aic_gap,
             spread_nats,
         } => choice_unresolved_headline([chosen, runner_up], *aic_gap, *spread_nats),
+        ChosenOnMisfit { chosen, nested, .. } => format!(
+            "{chosen} is chosen on a fit that fails the goodness-of-fit test: what it adds to \
+             {nested} is not confirmed by this recording. Read the misfit's description before \
+             believing it."
+        ),
         FailedEvaluations {
             failed,
             evaluations,
@@ -337,12 +342,15 @@ fn widened_headline(parameter: ParamId, method: &[f64; 2], widened: &[f64; 2]) -
     )
 }
 
-/// [`FitWarning::Misfit`]'s headline, with the test's p-value.
-fn misfit_headline(p_value: f64) -> String {
+/// [`FitWarning::Misfit`]'s headline, with the test's p-value and where the excess sits.
+fn misfit_headline(p_value: f64, shape: &[crate::likelihood::misfit::BandMisfit]) -> String {
+    let words = crate::likelihood::misfit::describe(shape)
+        .map(|w| format!("; {w}"))
+        .unwrap_or_default();
     format!(
-        "The model does not explain the recording's spectra to their noise (p = {:.3}): \
-         list more candidate models, check the bands, or bound a known parameter \
-         (docs/fit.md, \"Goodness of fit\").",
+        "The model does not explain the recording's spectra to their noise (p = {:.3}{words}): \
+         list more candidate models, check the bands and the tracking noise's spectrum, or bound \
+         a known parameter (docs/fit.md, \"Goodness of fit\").",
         p_value
     )
 }
