@@ -420,6 +420,36 @@ fn job_with_a_swarm_tolerance_out_of_range() {
     assert!(!dir.join("reversal.result.toml").exists());
 }
 
+#[test]
+fn job_with_swarm_keys_beside_the_cmaes_search() {
+    let dir = temp_dir("cmaes_swarm_keys");
+    // The main job's swarm settings with `[fit.search] method = "cmaes"` added: its `particles`
+    // line is refused, naming the CMA-ES search's own keys.
+    let text = edit(
+        &job_text(),
+        "[fit.uncertainty]",
+        "[fit.search]\nmethod = \"cmaes\"\n\n[fit.uncertainty]",
+    );
+    let job = dir.write("job.toml", &text);
+    let o = run(&["fit", s(&job), "--quiet"]);
+    let msg = input_error(
+        &o,
+        &[
+            s(&job),
+            "[fit] particles belongs to the swarm search",
+            "[fit.search] population, restarts and max_evaluations",
+        ],
+    );
+    let (line, _) = line_col(&msg, &job);
+    let particles = text
+        .lines()
+        .position(|l| l.starts_with("particles"))
+        .expect("the main job sets particles")
+        + 1;
+    assert_eq!(line, particles, "{msg}");
+    assert!(!dir.join("reversal.result.toml").exists());
+}
+
 /// The first 20 lines of the sample DLTdv file with `abc` in line 5 (4th data row), column 3
 /// (`pt2_cam1_X`, header `pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y`).
 fn bad_dltdv(dir: &TempDir) -> PathBuf {

@@ -300,6 +300,7 @@ fn the_job_reference_lists_every_key_the_job_reader_accepts() {
         ("`[fit]`", "[fit]"),
         ("`[fit.weights]`", "[fit.weights]"),
         ("`[fit.shoulder]`", "[fit.shoulder]"),
+        ("`[fit.search]`", "[fit.search]"),
         ("`[fit.uncertainty]`", "[fit.uncertainty]"),
         ("`[fit.likelihood]`", "[fit.likelihood]"),
         ("`[truth]`", "[truth]"),
@@ -349,6 +350,7 @@ fn the_job_reference_lists_every_key_the_job_reader_accepts() {
             "contact_angle_scan",
             "[fit]\ncontact_angle_scan = \"zz\"",
         ),
+        ("`[fit.search]`", "method", "[fit.search]\nmethod = \"zz\""),
         (
             "`[fit.uncertainty]`",
             "method",

@@ -12,6 +12,7 @@
 
 mod error;
 pub mod evidence;
+pub mod ipop;
 /// The spectral features the fit compares (they belong to the spectrum stage).
 pub use crate::spectrum::features;
 pub mod interrupt;
@@ -97,6 +98,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let (mut best, mut gof) = chosen_goodness(&fits[selection.chosen])?;
     let chosen_name = fits[selection.chosen].candidate.to_string();
     if let Some(why) = scan::scan_reason(fit.contact_angle_scan, &chosen_name, gof_ref(&gof))
+        && fit.search.method == job::SearchMethod::Swarm
         && !interrupt::stop_requested()
     {
         // The scan's notes reach the trials' reasons through a new choice either way; the valley

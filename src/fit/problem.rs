@@ -254,7 +254,7 @@ impl SpectralProblem {
     fn stage_cost(&self, sim: &BladeSimulation, stage: SearchStage) -> Result<f64> {
         if self.objective == Objective::Likelihood
             && self.targets.is_none()
-            && stage == SearchStage::Polish
+            && stage != SearchStage::Swarm
         {
             let lik = self
                 .likelihood
@@ -322,7 +322,7 @@ impl SpectralProblem {
     pub(super) fn cost_at_stage(&self, u: &[f64], stage: SearchStage) -> f64 {
         let c = self.unrecorded_cost_at_stage(u, stage);
         let inside = u.iter().all(|x| (0.0..=1.0).contains(x));
-        if stage == SearchStage::Polish && inside && c < FAILED_COST && self.cost_is_nll() {
+        if stage != SearchStage::Swarm && inside && c < FAILED_COST && self.cost_is_nll() {
             self.near_best
                 .lock()
                 .unwrap_or_else(|e| e.into_inner())
@@ -336,7 +336,7 @@ impl SpectralProblem {
     fn unrecorded_cost_at_stage(&self, u: &[f64], stage: SearchStage) -> f64 {
         let solver = match stage {
             SearchStage::Swarm => &self.swarm_solver,
-            SearchStage::Polish => &self.solver,
+            SearchStage::Polish | SearchStage::Cmaes => &self.solver,
         };
         let outside: f64 = u
             .iter()

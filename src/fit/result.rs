@@ -21,6 +21,9 @@ named_enum! {
         Swarm => "swarm",
         /// The Nelder–Mead polish from the swarm's best particle.
         Polish => "polish",
+        /// A CMA-ES run (`[fit.search] method = "cmaes"`), on the recording's likelihood at the
+        /// job's tolerance.
+        Cmaes => "cmaes",
     }
 }
 
@@ -48,8 +51,8 @@ fn default_spread_source() -> SpreadSource {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct HistoryPoint {
     pub stage: SearchStage,
-    /// Which of the fit's independent swarm-and-polish runs (`[fit] restarts`), from 0; 0 in
-    /// results written before this field.
+    /// Which of the fit's independent swarm-and-polish runs (`[fit] restarts`), or which CMA-ES
+    /// run (`[fit.search] restarts`), from 0; 0 in results written before this field.
     #[serde(default)]
     pub restart: usize,
     pub iteration: u64,

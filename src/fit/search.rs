@@ -285,7 +285,9 @@ pub(super) fn progress_bar(job: &LoadedJob, candidates: &[Candidate]) -> indicat
             && fit.objective == job::Objective::Likelihood
             && job.job.targets.is_none();
         budget += hess_evals
-            + if adaptive {
+            + if fit.search.method == job::SearchMethod::Cmaes {
+                fit.search.max_evaluations as u64
+            } else if adaptive {
                 NESTED_WARM_POINTS * polish_budget(fit, n)
             } else {
                 restarts_budget(fit, n)
@@ -965,6 +967,10 @@ fn search(
     confirmation: Confirmation,
 ) -> Result<(Optimised, Option<String>)> {
     let fit = &job.job.fit;
+    if fit.search.method == job::SearchMethod::Cmaes {
+        let (found, note) = cmaes_search(problem, fit, fit.seed, Some(reporting))?;
+        return Ok((found, Some(note)));
+    }
     let configured = nested.is_some()
         && fit.nested_search == job::NestedSearch::Adaptive
         && fit.objective == job::Objective::Likelihood
@@ -1186,6 +1192,9 @@ pub(super) fn optimise(
     log: Option<&Reporting>,
     confirmation: Confirmation,
 ) -> Result<Optimised> {
+    if fit.search.method == job::SearchMethod::Cmaes {
+        return Ok(cmaes_search(problem, fit, seed, log)?.0);
+    }
     let restarts = fit.restarts.max(1);
     if let Some(reporting) = log {
         if restarts > 1 {
@@ -1242,6 +1251,91 @@ pub(super) fn optimise(
         cost,
         unconfirmed_ends: deferred.then(|| ends.into_iter().filter(|c| c.is_finite()).collect()),
     })
+}
+
+/// The CMA-ES search of one candidate ([`super::ipop`], `[fit.search]`): IPOP runs on the cost
+/// ([`SearchStage::Cmaes`]: the recording's likelihood at the job's tolerance) over the normalised
+/// box, seeded with `seed`. Each generation goes into the history (its run as the restart) and
+/// moves the progress bar; an interrupt stops it at the next generation with the best point so
+/// far. Returns the lowest point and a note on the runs for the candidate's reason.
+fn cmaes_search(
+    problem: &Arc<SpectralProblem>,
+    fit: &job::FitSection,
+    seed: u64,
+    log: Option<&Reporting>,
+) -> Result<(Optimised, String)> {
+    let n = problem.free.len();
+    let settings = super::ipop::Settings {
+        population: fit.search.first_population(n),
+        restarts: fit.search.restarts,
+        max_evaluations: fit.search.max_evaluations,
+        tol_fun: polish_sd(problem),
+        seed,
+    };
+    if let Some(reporting) = log {
+        reporting.stage(format_args!("CMA-ES"));
+    }
+    let cost = |u: &[f64]| problem.cost_at_stage(u, SearchStage::Cmaes);
+    let mut observe = |g: super::ipop::Generation| {
+        if let Some(reporting) = log {
+            reporting
+                .history
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .push(HistoryPoint {
+                    stage: SearchStage::Cmaes,
+                    restart: g.run,
+                    iteration: g.generation,
+                    best_cost: g.best_cost,
+                    evaluations: g.run_evaluations,
+                });
+            if g.generation == 1 {
+                reporting.stage(format_args!(
+                    "CMA-ES run {} (λ = {})",
+                    g.run + 1,
+                    g.population
+                ));
+            }
+            reporting.advance(problem.evaluations.load(Ordering::Relaxed));
+            let mut best = reporting.best.lock().unwrap_or_else(|e| e.into_inner());
+            if best.as_ref().is_none_or(|b| g.best_cost < b.1) {
+                *best = Some((g.best_u.to_vec(), g.best_cost));
+            }
+        }
+        !interrupt::stop_requested()
+    };
+    let found = super::ipop::search(n, &cost, &settings, &mut observe).ok_or_else(|| {
+        if interrupt::stop_requested() {
+            FitError::InterruptedEarly
+        } else {
+            FitError::NoRun
+        }
+    })?;
+    let ends: Vec<String> = found
+        .runs
+        .iter()
+        .map(|r| format!("{:.2}", r.cost))
+        .collect();
+    let populations: Vec<String> = found
+        .runs
+        .iter()
+        .map(|r| r.population.to_string())
+        .collect();
+    let note = format!(
+        "CMA-ES: {} run(s) of population {}, {} evaluations, run ends {} (cost)",
+        found.runs.len(),
+        populations.join(", "),
+        found.evaluations,
+        ends.join(", ")
+    );
+    let optimised = Optimised {
+        u: found.u,
+        swarm_iters: 0,
+        polish_iters: 0,
+        cost: found.cost,
+        unconfirmed_ends: None,
+    };
+    Ok((optimised, note))
 }
 
 /// Restarts `range` of [`optimise`] (the warm point `warm[r]` for restart `r`), in parallel, in

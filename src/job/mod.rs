@@ -250,6 +250,9 @@ pub struct FitSection {
     /// chosen candidate has a shoulder, none otherwise ([`FitSection::valley_polishes_for`]).
     #[serde(default)]
     pub valley_polishes: Option<usize>,
+    /// The global search of every candidate (`[fit.search]`; docs/fit.md, "Search").
+    #[serde(default)]
+    pub search: SearchSection,
     /// Confidence intervals: Laplace (from the likelihood's Fisher information) or parametric
     /// bootstrap (see [`crate::fit::bootstrap_intervals`]).
     #[serde(default)]
@@ -327,12 +330,66 @@ pub const SHOULDER_VALLEY_POLISHES: usize = 4;
 impl FitSection {
     /// The valley polishes (`[fit] valley_polishes`) for the chosen `candidate`: the job's count,
     /// or by default [`SHOULDER_VALLEY_POLISHES`] for a candidate with a shoulder and 0 otherwise.
+    /// With the CMA-ES search, none.
     pub fn valley_polishes_for(&self, candidate: Candidate) -> usize {
+        if self.search.method == SearchMethod::Cmaes {
+            return 0;
+        }
         self.valley_polishes.unwrap_or(if candidate.shoulder {
             SHOULDER_VALLEY_POLISHES
         } else {
             0
         })
+    }
+}
+
+crate::names::named_enum! {
+    /// The global search of every candidate model (docs/fit.md, "Search").
+    #[derive(Default)]
+    pub enum SearchMethod: "search method" {
+        /// Independent particle swarms (`[fit] particles`, `swarm_iterations`, `restarts`), each
+        /// followed by a Nelder–Mead polish, with the nested search, valley polishes and
+        /// contact-angle scan of docs/fit.md.
+        #[default]
+        Swarm => "swarm",
+        /// CMA-ES with restarts of increasing population (IPOP) over the normalised box, bounds
+        /// by mirroring (`[fit.search] population`, `restarts`, `max_evaluations`).
+        Cmaes => "cmaes",
+    }
+}
+
+/// `[fit.search]`: which global search fits each candidate, and its budget.
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct SearchSection {
+    /// The search (default `swarm`).
+    pub method: SearchMethod,
+    /// `cmaes`: the first run's population λ; each restart doubles it. Default (`None`):
+    /// CMA-ES's own 4 + ⌊3 ln n⌋ for n free parameters.
+    pub population: Option<usize>,
+    /// `cmaes`: at most this many restarts after the first run.
+    pub restarts: usize,
+    /// `cmaes`: model evaluations one candidate's search may spend over all its runs; a run that
+    /// would pass it is cut short.
+    pub max_evaluations: usize,
+}
+
+impl Default for SearchSection {
+    fn default() -> Self {
+        SearchSection {
+            method: SearchMethod::Swarm,
+            population: None,
+            restarts: 4,
+            max_evaluations: 4000,
+        }
+    }
+}
+
+impl SearchSection {
+    /// The first CMA-ES run's population for `n` free parameters.
+    pub fn first_population(&self, n: usize) -> usize {
+        self.population
+            .unwrap_or(4 + (3.0 * (n.max(1) as f64).ln()).floor() as usize)
     }
 }
 
@@ -441,6 +498,17 @@ fn d_restarts() -> usize {
     1
 }
 
+/// The `[fit]` keys of the swarm search, refused beside `[fit.search] method = "cmaes"`.
+const SWARM_KEYS: [&str; 7] = [
+    "particles",
+    "swarm_iterations",
+    "restarts",
+    "swarm_rtol",
+    "nested_search",
+    "contact_angle_scan",
+    "valley_polishes",
+];
+
 /// True parameter values from a JSON file (e.g. the sample's `truth.json`).
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -506,6 +574,28 @@ impl<'t> Spans<'t> {
             };
         }
         line_col(self.text, span.start)
+    }
+
+    /// Whether the document holds a value at `path`.
+    pub fn contains(&self, path: &[Key]) -> bool {
+        let Some(doc) = &self.doc else {
+            return false;
+        };
+        let mut table = doc.get_ref();
+        for (i, key) in path.iter().enumerate() {
+            let Key::Name(n) = key else { return false };
+            let Some((_, v)) = table.iter().find(|(k, _)| k.get_ref().as_ref() == *n) else {
+                return false;
+            };
+            if i + 1 == path.len() {
+                return true;
+            }
+            match v.get_ref() {
+                toml::de::DeValue::Table(t) => table = t,
+                _ => return false,
+            }
+        }
+        true
     }
 
     /// [`Error::Parse`] in `path` at the value at `key_path`.
@@ -849,9 +939,45 @@ impl Check<'_> {
         Ok(())
     }
 
+    /// `[fit.search]`: a budget CMA-ES can run with, and none of the swarm search's keys beside
+    /// the CMA-ES search (they would do nothing).
+    fn search_settings(&self) -> Result<()> {
+        let search = &self.job.fit.search;
+        let at = |key: &'static str| [Key::Name("fit"), Key::Name("search"), Key::Name(key)];
+        if search.population.is_some_and(|p| p < 2) {
+            return Err(self.error(
+                &at("population"),
+                "[fit.search] population must be >= 2 (CMA-ES samples λ points per generation)",
+            ));
+        }
+        if search.max_evaluations < 1 {
+            return Err(self.error(
+                &at("max_evaluations"),
+                "[fit.search] max_evaluations must be >= 1",
+            ));
+        }
+        if search.method == SearchMethod::Cmaes {
+            for key in SWARM_KEYS {
+                let path = [Key::Name("fit"), Key::Name(key)];
+                if self.spans.contains(&path) {
+                    return Err(self.error(
+                        &path,
+                        format!(
+                            "[fit] {key} belongs to the swarm search; with [fit.search] method = \
+                             \"cmaes\" the search is set by [fit.search] population, restarts and \
+                             max_evaluations (docs/fit.md, \"Search\")"
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Optimiser settings, candidate models and shoulder bounds.
     fn fit_settings(&self) -> Result<()> {
         let fit = &self.job.fit;
+        self.search_settings()?;
         if fit.particles < 2 {
             return Err(self.error(
                 &[Key::Name("fit"), Key::Name("particles")],

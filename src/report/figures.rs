@@ -589,7 +589,11 @@ fn cost_figure(dir: &Path, history: &[HistoryPoint], objective: Objective) -> Re
     let restarts = history.iter().map(|h| h.restart + 1).max().unwrap_or(0);
     let split = objective == Objective::Likelihood;
     let stages: &[Option<SearchStage>] = if split {
-        &[Some(SearchStage::Swarm), Some(SearchStage::Polish)]
+        &[
+            Some(SearchStage::Swarm),
+            Some(SearchStage::Polish),
+            Some(SearchStage::Cmaes),
+        ]
     } else {
         &[None]
     };
@@ -604,9 +608,12 @@ fn cost_figure(dir: &Path, history: &[HistoryPoint], objective: Objective) -> Re
             let what = match st {
                 Some(SearchStage::Swarm) => "swarm, feature cost",
                 Some(SearchStage::Polish) => "Nelder–Mead, nats",
-                None => "swarm, then Nelder–Mead",
+                Some(SearchStage::Cmaes) => "CMA-ES",
+                None => "search",
             };
-            let label = if restarts > 1 {
+            let label = if st == Some(SearchStage::Cmaes) {
+                format!("CMA-ES run {}", r + 1)
+            } else if restarts > 1 {
                 format!("restart {} ({what})", r + 1)
             } else {
                 format!("best cost ({what})")

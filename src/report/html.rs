@@ -102,7 +102,7 @@ pub fn fit_figure_list(result: &FitResult) -> Vec<(String, String)> {
     ));
     v.push((
         "cost.svg".into(),
-        "Best cost against model evaluations (particle swarm, then Nelder–Mead; with [fit] restarts, each restart starts anew, so the curve jumps up where one begins; with [fit] swarm_rtol, the swarm's costs are those of its looser tolerance).".into(),
+        "Best cost against model evaluations (particle swarm, then Nelder–Mead, or CMA-ES runs; with restarts, each starts anew, so the curve jumps up where one begins; with [fit] swarm_rtol, the swarm's costs are those of its looser tolerance).".into(),
     ));
     v
 }
@@ -532,6 +532,21 @@ struct SignalView {
 
 /// One line on the fit's settings (restarts, swarm, polish, seed, cost weights).
 fn fit_settings_line(f: &FitSection) -> String {
+    if f.search.method == crate::job::SearchMethod::Cmaes {
+        let s = &f.search;
+        return format!(
+            "CMA-ES with up to {} restarts of doubling population (first λ = {}), at most {} \
+             evaluations per candidate (seed {}); weights peak {}, level {}, shape {}",
+            s.restarts,
+            s.population
+                .map_or_else(|| "4 + ⌊3 ln n⌋".to_string(), |p| p.to_string()),
+            s.max_evaluations,
+            f.seed,
+            f.weights.peak,
+            f.weights.level,
+            f.weights.shape
+        );
+    }
     format!(
         "{} × (particle swarm {} particles × {} iterations{}, Nelder–Mead ≤ {} iterations), \
          best kept (seed {}); weights peak {}, level {}, shape {}",
