@@ -148,6 +148,12 @@ pub struct RecordingScore {
     pub wall_time_s: f64,
     /// The scored parameters (empty when the chosen model does not contain the truth's).
     pub params: Vec<Scored>,
+    /// What the recording departs from the fitted model by (`/departure` of its truth file).
+    pub departure: Option<String>,
+    /// The fitted friction law against the true one as a curve ([`super::law`]).
+    pub law: Option<super::law::LawScore>,
+    /// The goodness-of-fit test's p-value.
+    pub gof_p: Option<f64>,
 }
 
 impl RecordingScore {
@@ -291,7 +297,7 @@ pub fn calibrate(campaign: &Campaign) -> Result<Option<Calibration>> {
         let Some(truth) = campaign.truth_of(e) else {
             return Ok(None);
         };
-        let true_model = true_model(&truth.json)?;
+        let (true_model, departure) = truth_labels(&truth.json)?;
         let paths = EntryPaths::new(&out, e);
         let status = read_status(&paths);
         let mut r = RecordingScore {
@@ -303,6 +309,9 @@ pub fn calibrate(campaign: &Campaign) -> Result<Option<Calibration>> {
             shortfall_nats: None,
             wall_time_s: f64::NAN,
             params: Vec::new(),
+            departure,
+            law: None,
+            gof_p: None,
         };
         if let Some(s) = status {
             r.wall_time_s = s.wall_time_s;
@@ -340,24 +349,31 @@ pub fn calibrate(campaign: &Campaign) -> Result<Option<Calibration>> {
     }))
 }
 
-/// `/model` of the truth file at `path`, if it names one.
-fn true_model(path: &Path) -> Result<Option<Candidate>> {
+/// `/model` and `/departure` of the truth file at `path`, where it names them.
+fn truth_labels(path: &Path) -> Result<(Option<Candidate>, Option<String>)> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, "cannot read", e))?;
     let v: serde_json::Value = serde_json::from_str(&text)
         .map_err(|e| Error::parse(path, e.line(), e.column(), format!("not valid JSON: {e}")))?;
-    match v.pointer("/model").and_then(serde_json::Value::as_str) {
-        Some(name) => name
-            .parse::<Candidate>()
-            .map(Some)
-            .map_err(|e| Error::input(path, format!("/model: {e}"))),
-        None => Ok(None),
-    }
+    let departure = v
+        .pointer("/departure")
+        .and_then(serde_json::Value::as_str)
+        .map(str::to_string);
+    let model = match v.pointer("/model").and_then(serde_json::Value::as_str) {
+        Some(name) => Some(
+            name.parse::<Candidate>()
+                .map_err(|e| Error::input(path, format!("/model: {e}")))?,
+        ),
+        None => None,
+    };
+    Ok((model, departure))
 }
 
 /// Fills `r` from its fit `result`: the chosen model, the shortfall and the scored parameters.
 fn score(r: &mut RecordingScore, result: &FitResult) {
     r.chosen = Some(result.model);
     r.shortfall_nats = result.shortfall_nats();
+    r.law = super::law::LawScore::of(result);
+    r.gof_p = result.goodness_of_fit.as_ref().map(|g| g.p_value);
     if !r.model_contains_truth() {
         return;
     }
@@ -514,6 +530,7 @@ pub fn to_markdown(c: &Calibration, notes: Option<&str>, command: &str) -> Strin
             let _ = writeln!(md, "| {t} | {} |", cells.join(" | "));
         }
     }
+    super::law::law_section(&mut md, c);
     let times: Vec<f64> = c.done().map(|r| r.wall_time_s).collect();
     let _ = writeln!(
         md,
@@ -635,6 +652,10 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
         "chosen_model",
         "shortfall_nats",
         "wall_time_s",
+        "departure",
+        "law_rms_rel_diff",
+        "law_share_in_band",
+        "gof_p",
     ]
     .map(String::from)
     .to_vec();
@@ -651,6 +672,13 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
             name(r.chosen),
             r.shortfall_nats.map(csv_num).unwrap_or_default(),
             csv_num(r.wall_time_s),
+            r.departure.clone().unwrap_or_default(),
+            r.law.map(|l| csv_num(l.rms_rel_diff)).unwrap_or_default(),
+            r.law
+                .and_then(|l| l.within_band)
+                .map(csv_num)
+                .unwrap_or_default(),
+            r.gof_p.map(csv_num).unwrap_or_default(),
         ];
         for p in &params {
             match r.params.iter().find(|s| s.param == *p) {
@@ -823,6 +851,9 @@ mod tests {
                     level: 0.6827,
                 })
                 .collect(),
+            departure: None,
+            law: None,
+            gof_p: None,
         }
     }
 
@@ -892,6 +923,54 @@ mod tests {
             "{md}"
         );
         assert!(md.contains("| A | 1 | 1 |"), "{md}");
+        assert!(
+            !md.contains("Friction law over"),
+            "no law section without law scores"
+        );
+    }
+
+    /// The law section groups by departure: a viscous recording found within 3 % with a failed
+    /// test and an invented shoulder, one not found; a recording of the model itself.
+    #[test]
+    fn the_law_section_scores_curves_by_departure() {
+        use super::super::law::LawScore;
+        let c = |s: &str| s.parse::<Candidate>().ok();
+        let law = |rms, band| {
+            Some(LawScore {
+                rms_rel_diff: rms,
+                within_band: Some(band),
+            })
+        };
+        let mut a = recording(&[]);
+        a.true_model = c("blade2dof");
+        a.chosen = c("blade2dof+shoulder");
+        a.departure = Some("viscous".into());
+        a.law = law(0.02, 0.5);
+        a.gof_p = Some(0.001);
+        let mut b = a.clone();
+        b.chosen = c("blade2dof");
+        b.law = law(0.08, 0.0);
+        b.gof_p = Some(0.4);
+        let mut own = recording(&[]);
+        own.true_model = c("blade2dof");
+        own.law = law(0.004, 1.0);
+        let recordings = vec![a, b, own];
+        let cal = Calibration {
+            name: "t".into(),
+            campaign: PathBuf::from("t.toml"),
+            overall: Vec::new(),
+            by_model: Vec::new(),
+            recordings,
+        };
+        let md = to_markdown(&cal, None, "x");
+        assert!(
+            md.contains("| viscous | 2 | 2 | 1 | 5.0 % | 8.0 % | 25.0 % | 1 | 1 |"),
+            "{md}"
+        );
+        assert!(
+            md.contains("| none | 1 | 1 | 1 | 0.4 % | 0.4 % | 100.0 % | 0 | 0 |"),
+            "{md}"
+        );
     }
 
     #[test]

@@ -29,6 +29,7 @@
 pub mod calibrate;
 pub mod collect;
 mod error;
+pub mod law;
 pub mod run;
 pub mod slurm;
 
@@ -59,6 +60,10 @@ pub struct CampaignFile {
     /// whose own truth does not.
     #[serde(default)]
     pub truth_keys: BTreeMap<ParamId, String>,
+    /// JSON pointer to each recording's true friction law (the template's `[truth]
+    /// friction_law`): the fitted law is then scored as a curve over the measured slip speeds.
+    #[serde(default)]
+    pub truth_friction_law: Option<String>,
     /// Scale the template's Welch bands to each recording's frame rate (`fps_hz` column): keep
     /// each band's bin width (nperseg, and noverlap and nfft when given, times the frame-rate
     /// ratio, rounded to a power of two as `wiperlab init` does) and clip its upper edge at the
@@ -232,11 +237,13 @@ impl Campaign {
                 "a campaign template must be a fit job with a [recording] section (its file is replaced per recording)",
             ));
         }
-        if !file.truth_keys.is_empty() && template.truth.is_none() {
+        if (!file.truth_keys.is_empty() || file.truth_friction_law.is_some())
+            && template.truth.is_none()
+        {
             return Err(Error::input(
                 &path,
                 format!(
-                    "truth_keys adds to the template's [truth] keys, but the template {} has no [truth] section",
+                    "truth_keys and truth_friction_law add to the template's [truth], but the template {} has no [truth] section",
                     template_path.display()
                 ),
             ));
@@ -323,6 +330,9 @@ impl Campaign {
     pub fn truth_of(&self, entry: &Entry) -> Option<TruthSection> {
         let template: FitJob = toml::from_str(&self.template_text).ok()?;
         let mut truth = merged_truth(template.truth, &self.file.truth_keys)?;
+        if let Some(ptr) = &self.file.truth_friction_law {
+            truth.friction_law = Some(ptr.clone());
+        }
         truth.json = match entry.files.get(&FileOverride::TruthJson) {
             Some(p) => p.clone(),
             None => self

@@ -514,7 +514,8 @@ const SWARM_KEYS: [&str; 7] = [
 #[serde(deny_unknown_fields)]
 pub struct TruthSection {
     pub json: PathBuf,
-    /// Parameter → JSON pointer (RFC 6901), e.g. `A = "/params/A"`.
+    /// Parameter → JSON pointer (RFC 6901), e.g. `A = "/params/A"`. A pointer to `null` gives
+    /// the parameter no true value (the true model lacks it).
     pub keys: BTreeMap<ParamId, String>,
     /// JSON pointer to the true friction law, an object as a blade file's `[friction]` table
     /// (`{"law": "exponential_viscous", "a": …}`): for a recording whose true law is not the
@@ -1163,8 +1164,16 @@ fn read_truth(
     let v: serde_json::Value = serde_json::from_str(&read_text(&tp)?)
         .map_err(|e| Error::parse(&tp, e.line(), e.column(), format!("not valid JSON: {e}")))?;
     for (k, ptr) in &t.keys {
+        // `null`: the recording's true model has no such parameter (a friction law of another
+        // family), so the fit's value has no truth to be scored against.
+        if v.pointer(ptr).is_some_and(serde_json::Value::is_null) {
+            continue;
+        }
         let x = v.pointer(ptr).and_then(|x| x.as_f64()).ok_or_else(|| {
-            Error::input(&tp, format!("no number at JSON pointer {ptr} (for '{k}')"))
+            Error::input(
+                &tp,
+                format!("no number (or null) at JSON pointer {ptr} (for '{k}')"),
+            )
         })?;
         values.insert(*k, x);
     }
@@ -1244,6 +1253,39 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("nothing at JSON pointer /none"), "{e}");
+    }
+
+    /// A truth key pointing at `null` gives its parameter no true value (the true law lacks it);
+    /// a string there is refused naming the pointer.
+    #[test]
+    fn a_null_truth_is_no_truth() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("truth.json"),
+            r#"{"params": {"A": null, "k1": 0.03, "C": "x"}}"#,
+        )
+        .unwrap();
+        let section = |keys: &[(ParamId, &str)]| TruthSection {
+            json: "truth.json".into(),
+            keys: keys.iter().map(|(k, p)| (*k, p.to_string())).collect(),
+            friction_law: None,
+        };
+        let (values, _) = read_truth(
+            dir.path(),
+            Some(&section(&[
+                (ParamId::A, "/params/A"),
+                (ParamId::K1, "/params/k1"),
+            ])),
+        )
+        .unwrap();
+        assert_eq!(values, BTreeMap::from([(ParamId::K1, 0.03)]));
+        let e = read_truth(dir.path(), Some(&section(&[(ParamId::C, "/params/C")])))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("no number (or null) at JSON pointer /params/C"),
+            "{e}"
+        );
     }
 
     #[test]

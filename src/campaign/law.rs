@@ -1,0 +1,139 @@
+//! The friction law scored as a curve: for each fitted recording whose result knows the true law,
+//! how far the fitted μ_d(v) lies from the true one over the slip speeds the fitted motion covers
+//! (the result's `[friction_curve]`, [`crate::model::friction_curve`]) and whether the fit's ±1σ
+//! band holds it. This, not A, B, C alone, is what a recording made by a law outside the fitted
+//! family (a viscous term, a Stribeck exponent) or under a departure the model lacks (coloured or
+//! smoothed tracking noise, a distorted drive) can be scored by. Grouped by the truth file's
+//! `/departure` label ("none" for a recording made by the fitted model itself).
+
+use super::calibrate::{Calibration, RecordingScore};
+use crate::fit::result::FitResult;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+/// The rms relative difference from the true curve under which the fitted law counts as found.
+pub const LAW_TOLERANCE: f64 = 0.03;
+
+/// The fitted law of one recording against its truth.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LawScore {
+    /// Root mean square of (μ_d − μ_d,true)/μ_d,true over the measured slip speeds.
+    pub rms_rel_diff: f64,
+    /// Share of the measured speeds where the true μ_d lies within the fitted ±1σ band.
+    pub within_band: Option<f64>,
+}
+
+impl LawScore {
+    /// The score of `result`'s friction curve; `None` without a true law.
+    pub fn of(result: &FitResult) -> Option<LawScore> {
+        let c = result.friction_curve.as_ref()?;
+        Some(LawScore {
+            rms_rel_diff: c.rms_rel_diff_to_truth?,
+            within_band: c.truth_within_band,
+        })
+    }
+}
+
+/// One row of the law table: the recordings of one departure.
+struct Group<'a> {
+    fitted: Vec<&'a RecordingScore>,
+}
+
+fn median(mut x: Vec<f64>) -> f64 {
+    if x.is_empty() {
+        return f64::NAN;
+    }
+    x.sort_by(f64::total_cmp);
+    let n = x.len();
+    if n % 2 == 1 {
+        x[n / 2]
+    } else {
+        0.5 * (x[n / 2 - 1] + x[n / 2])
+    }
+}
+
+fn pct(x: f64) -> String {
+    if x.is_finite() {
+        format!("{:.1} %", 100.0 * x)
+    } else {
+        "–".into()
+    }
+}
+
+/// The law section of the calibration table: per departure, the fitted recordings, how many find
+/// the law within [`LAW_TOLERANCE`], the median and largest rms difference, the median share of
+/// speeds inside the band, shoulders chosen for shoulder-free truths, and failed goodness-of-fit
+/// tests. Nothing when no recording has a law score.
+pub fn law_section(md: &mut String, c: &Calibration) {
+    let mut groups: BTreeMap<&str, Group> = BTreeMap::new();
+    for r in c.done() {
+        let key = r.departure.as_deref().unwrap_or("none");
+        groups
+            .entry(key)
+            .or_insert_with(|| Group { fitted: Vec::new() })
+            .fitted
+            .push(r);
+    }
+    if !c.recordings.iter().any(|r| r.law.is_some()) {
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "\n## Friction law over the measured slip speeds\n\n\
+         The fitted μ_d(v) against the true law over the 10th–90th percentile of the fitted motion's \
+         slip speeds (the result's `[friction_curve]`), by the departure the recording was made with \
+         (none: the fitted model itself). Found: rms relative difference below {}. Band: the share \
+         of the range's speeds where the true μ_d lies inside the fitted ±1σ (68 % if calibrated). \
+         Invented shoulder: a shoulder chosen for a blade without one. Misfit: the goodness-of-fit \
+         test failed (p ≤ 0.01).\n",
+        pct(LAW_TOLERANCE)
+    );
+    let _ = writeln!(
+        md,
+        "| departure | fitted | law scored | found | median rms difference | largest | median share in band | invented shoulder | misfit |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
+    for (name, g) in &groups {
+        let scored: Vec<LawScore> = g.fitted.iter().filter_map(|r| r.law).collect();
+        let rms: Vec<f64> = scored.iter().map(|s| s.rms_rel_diff).collect();
+        let found = rms.iter().filter(|d| **d < LAW_TOLERANCE).count();
+        let largest = rms.iter().copied().fold(f64::NAN, f64::max);
+        let band = median(scored.iter().filter_map(|s| s.within_band).collect());
+        let invented = g
+            .fitted
+            .iter()
+            .filter(|r| {
+                r.true_model.is_some_and(|t| !t.shoulder) && r.chosen.is_some_and(|c| c.shoulder)
+            })
+            .count();
+        let misfit = g
+            .fitted
+            .iter()
+            .filter(|r| {
+                r.gof_p
+                    .is_some_and(|p| p <= crate::likelihood::GOODNESS_OF_FIT_LEVEL)
+            })
+            .count();
+        let _ = writeln!(
+            md,
+            "| {name} | {} | {} | {found} | {} | {} | {} | {invented} | {misfit} |",
+            g.fitted.len(),
+            scored.len(),
+            pct(median(rms.clone())),
+            pct(largest),
+            pct(band),
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_of_odd_even_and_empty() {
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(vec![4.0, 1.0, 2.0, 3.0]), 2.5);
+        assert!(median(Vec::new()).is_nan());
+    }
+}
