@@ -48,8 +48,12 @@ fn edit(text: &str, old: &str, new: &str) -> String {
 /// The shipped main job `fits/reversal.toml` with its relative `../data/reversal/...` paths made
 /// absolute and its `reports_dir` dropped, so that a copy works from a temp dir and writes there.
 fn job_text() -> String {
-    let text =
-        std::fs::read_to_string(root().join("fits/reversal.toml")).expect("read the main job");
+    job_text_of("fits/reversal.toml")
+}
+
+/// A shipped job (`fits/reversal.toml` or a variant of it) as [`job_text`] reads the main job.
+fn job_text_of(file: &str) -> String {
+    let text = std::fs::read_to_string(root().join(file)).expect("read the main job");
     let data = root().join("data");
     // blade, recording file and truth json
     assert_eq!(text.matches("\"../data/").count(), 3, "{text}");
@@ -726,8 +730,25 @@ fn import_describe_and_convert() {
 /// evaluation count, leaves the previous complete result untouched, and exits 130.
 #[test]
 fn sigint_stops_the_fit_and_keeps_the_previous_result() {
-    let dir = temp_dir("sigint");
-    let job = dir.write("reversal.toml", &job_text());
+    sigint_stops(&job_text(), "sigint");
+}
+
+/// As [`sigint_stops_the_fit_and_keeps_the_previous_result`], with the CMA-ES search
+/// (`fits/reversal_cmaes.toml`): the interrupted result holds the best point of the generations
+/// run so far.
+#[test]
+fn sigint_stops_the_cmaes_search() {
+    let text = job_text_of("fits/reversal_cmaes.toml");
+    assert!(text.contains("method = \"cmaes\""), "{text}");
+    // Its results under the main job's names.
+    let text = edit(&text, "name = \"reversal_cmaes\"", "name = \"reversal\"");
+    sigint_stops(&text, "sigint_cmaes");
+}
+
+/// SIGINT 4 s into the fit of the job `text`, with a previous result beside it.
+fn sigint_stops(text: &str, name: &str) {
+    let dir = temp_dir(name);
+    let job = dir.write("reversal.toml", text);
     let previous = "# a previous complete result\n";
     let complete = dir.write("reversal.result.toml", previous);
     let mut child = Command::new(wiperlab_exe())

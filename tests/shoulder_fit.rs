@@ -12,6 +12,36 @@ use wiperlab::model::{BladeParams, Shoulder};
 
 #[test]
 fn fit_prefers_and_recovers_the_shoulder() {
+    prefers_and_recovers_the_shoulder(
+        "shoulder_fit",
+        "particles = 10\nswarm_iterations = 8\npolish_iterations = 40\n",
+    );
+}
+
+/// The same with the CMA-ES search (`[fit.search] method = "cmaes"`), which also ends at least as
+/// likely as the truth (the result's shortfall is at most its 0.1-nat tolerance).
+#[test]
+fn the_cmaes_search_prefers_and_recovers_the_shoulder() {
+    let out = prefers_and_recovers_the_shoulder(
+        "shoulder_fit_cmaes",
+        "polish_iterations = 40\n[fit.search]\nmethod = \"cmaes\"\nmax_evaluations = 600\n",
+    );
+    let truth = out.result.truth_cost.expect("the truth's cost");
+    assert!(
+        out.result.cost - truth <= wiperlab::fit::SHORTFALL_TOLERANCE_NATS,
+        "cost {:.3} nats, the truth's {truth:.3}",
+        out.result.cost
+    );
+    for t in &out.result.model_trials {
+        assert!(t.reason.contains("CMA-ES: "), "{}", t.reason);
+        assert!(t.model_evaluations > 0);
+    }
+}
+
+/// Fits a recording made with a shoulder by `blade2dof` and `blade2dof+shoulder` with the search
+/// settings `search` (lines of `[fit]`, and tables after it), asserts that the shoulder is chosen
+/// and k1_contact recovered within 5 %, and returns the fit.
+fn prefers_and_recovers_the_shoulder(name: &str, search: &str) -> wiperlab::fit::FitOutcome {
     let base: BladeParams = common::true_blade();
     // Known parameters: a free neck 4x softer than the sample's, touching the shoulder at 0.06 rad
     // (|θ| reaches ~0.12-0.15 rad in slip, data/reversal/clean_10kfps.csv.gz) with k1_contact = 0.03.
@@ -28,7 +58,7 @@ fn fit_prefers_and_recovers_the_shoulder() {
         "the recording should touch the shoulder"
     );
     let case = common::write_case(
-        "shoulder_fit",
+        name,
         &sim,
         &base,
         &format!("{{\"k1\": {k1_free}, \"k1c\": {k1c}, \"theta_c\": {theta_c}}}"),
@@ -42,12 +72,9 @@ blade = "blade.toml"
 rtol = 1e-8
 atol = 1e-10
 [fit]
-particles = 10
-swarm_iterations = 8
-polish_iterations = 40
 seed = 3
 models = ["blade2dof", "blade2dof+shoulder"]
-[fit.shoulder]
+{search}[fit.shoulder]
 k1c = [0.01, 0.06]
 theta_c = [0.03, 0.1]
 [fit.parameters]
@@ -94,4 +121,5 @@ keys = {{ k1 = "/k1", k1c = "/k1c", theta_c = "/theta_c" }}
         "k1_contact off by {:+.2} %",
         100.0 * k1c_fit.rel_error.unwrap()
     );
+    out
 }
