@@ -7,6 +7,13 @@
 //! cargo run --release --example make_calibration -- --set development
 //! ```
 //!
+//! `--set departures` draws shoulder-free blades from the same prior from seeds 950,000,000 + i,
+//! each recorded with one departure from the fitted model, cycling through
+//! [`Departure::ALL`] (default 2 of each): AR(1) tracking noise, tracks smoothed by a 5-frame
+//! median (DeepLabCut's `filterpredictions` default), a viscous term in the friction law, a
+//! Stribeck law with a shape exponent, and a drive whose speed has a second harmonic; it writes
+//! `campaigns/calibration_departures.toml`, whose table scores the friction law as a curve.
+//!
 //! `--set calibration` draws from seeds 930,000,000 + i and writes `campaigns/calibration.toml`;
 //! `--set development` from seeds 710,000,000 + i and writes
 //! `campaigns/calibration_development.toml` (i = 0, 1, …: the two sets never share a seed, and
@@ -55,6 +62,8 @@ enum Set {
     Development,
     /// Seeds 930,000,000 + i: the set the calibration table reports.
     Calibration,
+    /// Seeds 950,000,000 + i: shoulder-free blades recorded with departures from the model.
+    Departures,
 }
 
 impl Set {
@@ -62,6 +71,7 @@ impl Set {
         match self {
             Set::Development => 710_000_000,
             Set::Calibration => 930_000_000,
+            Set::Departures => 950_000_000,
         }
     }
     /// The campaign's name (its file `campaigns/<name>.toml`, its table `reports/<name>/`).
@@ -69,24 +79,28 @@ impl Set {
         match self {
             Set::Development => "calibration_development",
             Set::Calibration => "calibration",
+            Set::Departures => "calibration_departures",
         }
     }
     fn dir(self) -> &'static str {
         match self {
             Set::Development => "development",
             Set::Calibration => "calibration",
+            Set::Departures => "departures",
         }
     }
     fn id_prefix(self) -> &'static str {
         match self {
             Set::Development => "dev",
             Set::Calibration => "cal",
+            Set::Departures => "dep",
         }
     }
     fn default_mix(self) -> [usize; 3] {
         match self {
             Set::Development => [18, 9, 3],
             Set::Calibration => [60, 30, 10],
+            Set::Departures => [2 * Departure::ALL.len(), 0, 0],
         }
     }
 }
@@ -141,6 +155,72 @@ impl Scene {
     }
 }
 
+/// How a departures-set recording departs from the model the main job fits.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Departure {
+    /// AR(1) tracking noise per coordinate, lag-one correlation `rho`, the camera's marginal σ.
+    Ar1 { rho: f64 },
+    /// White tracking noise, then each coordinate through a centred 5-frame median filter.
+    MedianSmoothed,
+    /// The friction law plus `D|v|`, `D` such that the term is `share` of μ_d at the median
+    /// slip speed of the recording's own slipping samples.
+    Viscous { share: f64 },
+    /// Stribeck's law `C + A e^(−(|v|/v_s)^δ)` with `v_s = 1/B`.
+    Stribeck { delta: f64 },
+    /// The drive's speed with a second harmonic, a fraction `h` of its peak.
+    Drive { h: f64 },
+}
+
+impl Departure {
+    /// The kinds, in the order the set cycles through them.
+    const ALL: [&'static str; 5] = ["ar1", "median_smoothed", "viscous", "stribeck", "drive"];
+
+    fn label(self) -> &'static str {
+        match self {
+            Departure::Ar1 { .. } => "ar1",
+            Departure::MedianSmoothed => "median_smoothed",
+            Departure::Viscous { .. } => "viscous",
+            Departure::Stribeck { .. } => "stribeck",
+            Departure::Drive { .. } => "drive",
+        }
+    }
+
+    /// Departure `i mod 5` with its size drawn from [`prior`]'s departure ranges.
+    fn draw(i: usize, rng: &mut StdRng) -> Departure {
+        match Departure::ALL[i % Departure::ALL.len()] {
+            "ar1" => Departure::Ar1 {
+                rho: uniform(rng, prior::AR1_RHO),
+            },
+            "median_smoothed" => Departure::MedianSmoothed,
+            "viscous" => Departure::Viscous {
+                share: uniform(rng, prior::VISCOUS_SHARE),
+            },
+            "stribeck" => Departure::Stribeck {
+                delta: if rng.random_bool(0.5) {
+                    uniform(rng, prior::STRIBECK_DELTA_LOW)
+                } else {
+                    uniform(rng, prior::STRIBECK_DELTA_HIGH)
+                },
+            },
+            _ => Departure::Drive {
+                h: uniform(rng, prior::DRIVE_HARMONIC)
+                    * if rng.random_bool(0.5) { 1.0 } else { -1.0 },
+            },
+        }
+    }
+
+    /// The departure's size, for the truth file.
+    fn size(self) -> serde_json::Value {
+        match self {
+            Departure::Ar1 { rho } => json!({ "rho": rho }),
+            Departure::MedianSmoothed => json!({ "median_window_frames": prior::MEDIAN_WINDOW }),
+            Departure::Viscous { share } => json!({ "share_of_mu_d_at_median_slip_speed": share }),
+            Departure::Stribeck { delta } => json!({ "delta": delta }),
+            Departure::Drive { h } => json!({ "drive_speed_harmonic": h }),
+        }
+    }
+}
+
 /// The prior box (docs/campaigns.md, "The calibration campaign", gives the physics behind each
 /// range). Friction law μ = A e^{−B|v|} + C; neck stiffnesses through the neck's natural frequency
 /// f = √(k/m_θ)/2π with the main job's blade's m_θ, so that a range of stiffness reads as a range
@@ -182,6 +262,20 @@ mod prior {
     pub const LOST_RUN_LEN: [usize; 2] = [2, 12];
     /// Redraws allowed before the generator gives up on a recording.
     pub const MAX_DRAWS: usize = 50;
+    /// Departures set: AR(1) lag-one correlation ρ ~ U(0.3, 0.8) (sub-pixel fits and autotrackers
+    /// correlate neighbouring frames).
+    pub const AR1_RHO: [f64; 2] = [0.3, 0.8];
+    /// Departures set: the median filter's window, frames (DeepLabCut `filterpredictions`).
+    pub const MEDIAN_WINDOW: usize = 5;
+    /// Departures set: the viscous term's share of μ_d at the median slip speed ~ U(3 %, 10 %).
+    pub const VISCOUS_SHARE: [f64; 2] = [0.03, 0.10];
+    /// Departures set: Stribeck's exponent δ ~ U(0.5, 0.8) or U(1.25, 2), equally likely (δ = 1
+    /// is the exponential law the fit has).
+    pub const STRIBECK_DELTA_LOW: [f64; 2] = [0.5, 0.8];
+    pub const STRIBECK_DELTA_HIGH: [f64; 2] = [1.25, 2.0];
+    /// Departures set: the drive speed's second harmonic |h| ~ U(2 %, 5 %) of the peak, either
+    /// sign.
+    pub const DRIVE_HARMONIC: [f64; 2] = [0.02, 0.05];
 }
 
 fn uniform(rng: &mut StdRng, r: [f64; 2]) -> f64 {
@@ -214,6 +308,8 @@ struct Drawn {
     max_abs_theta_rad: f64,
     /// Frames with the neck on the shoulder, as a fraction (0 without shoulder).
     touch_fraction: f64,
+    /// The departure from the fitted model it is recorded with (the departures set).
+    departure: Option<Departure>,
 }
 
 /// Draws a scene of kind `scene` from the prior on `base` (the main job's blade: its masses,
@@ -268,6 +364,7 @@ fn draw_scene(
                 draws,
                 max_abs_theta_rad: reach,
                 touch_fraction: 0.0,
+                departure: None,
             });
         };
         let reach_free = max_abs_theta(&free.0);
@@ -292,6 +389,7 @@ fn draw_scene(
                     blade: p,
                     max_abs_theta_rad: max_abs_theta(&sim),
                     touch_fraction: touching as f64 / sim.theta_rad.len() as f64,
+                    departure: None,
                     sim,
                     t0_s,
                     draws,
@@ -305,6 +403,114 @@ fn draw_scene(
         scene.label(),
         prior::MAX_DRAWS
     ))
+}
+
+/// The median |slip speed| over the slipping samples of `sim`, m/s.
+fn median_slip_speed(sim: &BladeSimulation) -> f64 {
+    let mut v = sim.slip_speeds();
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// Changes the drawn blade `d` as `dep` says (its friction law or drive) and simulates it again;
+/// a noise departure changes nothing here.
+fn apply_departure(d: &mut Drawn, dep: Departure, fps_hz: f64) -> Result<(), String> {
+    let FrictionLaw::Exponential { a, b_s_per_m: b, c } = d.blade.friction else {
+        return Err("a departure starts from the exponential law".into());
+    };
+    let simulate = |p: &BladeParams| {
+        recording::simulate_model_window(ModelKind::Blade2dof, p, fps_hz).map_err(|e| e.to_string())
+    };
+    match dep {
+        Departure::Ar1 { .. } | Departure::MedianSmoothed => return Ok(()),
+        Departure::Stribeck { delta } => {
+            d.blade.friction = FrictionLaw::Stribeck {
+                a,
+                c,
+                v_s_m_per_s: 1.0 / b,
+                delta,
+            };
+        }
+        Departure::Drive { h } => d.blade.drive_speed_harmonic = h,
+        Departure::Viscous { share } => {
+            // D·v_med = share·μ_d(v_med): D = share/(1 − share)·(A e^(−B v_med) + C)/v_med, with
+            // v_med the median slip speed of the blade's own motion, which moves with D: three
+            // fixed-point steps (make_departures measures the median settling to ~1e-4 in two).
+            let mut sim = d.sim.clone();
+            for _ in 0..3 {
+                let v_med = median_slip_speed(&sim);
+                let d_s_per_m = share / (1.0 - share) * (a * (-b * v_med).exp() + c) / v_med;
+                d.blade.friction = FrictionLaw::ExponentialViscous {
+                    a,
+                    b_s_per_m: b,
+                    c,
+                    d_s_per_m,
+                };
+                sim = simulate(&d.blade)?.0;
+            }
+        }
+    }
+    let (sim, t0_s) = simulate(&d.blade)?;
+    d.max_abs_theta_rad = max_abs_theta(&sim);
+    d.sim = sim;
+    d.t0_s = t0_s;
+    Ok(())
+}
+
+/// The tracking noise of a recording of `n` frames, pixels, per column (head x, head y, tip x,
+/// tip y): white of σ `sigma_px`, or AR(1) of marginal σ `sigma_px` for [`Departure::Ar1`]
+/// (`ε_t = ρ ε_{t−1} + η_t`, `η ~ N(0, σ²(1 − ρ²))`, started from its stationary law).
+fn tracking_noise(
+    rng: &mut StdRng,
+    n: usize,
+    sigma_px: f64,
+    dep: Option<Departure>,
+) -> Vec<[f64; 4]> {
+    let rho = match dep {
+        Some(Departure::Ar1 { rho }) => rho,
+        _ => 0.0,
+    };
+    let unit = Normal::new(0.0, 1.0).expect("a unit normal");
+    let innovation = sigma_px * (1.0 - rho * rho).sqrt();
+    let mut e: [f64; 4] = std::array::from_fn(|_| sigma_px * unit.sample(rng));
+    (0..n)
+        .map(|i| {
+            if i > 0 {
+                for x in &mut e {
+                    *x = rho * *x + innovation * unit.sample(rng);
+                }
+            }
+            e
+        })
+        .collect()
+}
+
+/// Each column of `rows` through a centred median of [`prior::MEDIAN_WINDOW`] frames over the
+/// frames it has (a lost frame, NaN, stays lost and is not part of its neighbours' medians).
+fn median_smoothed(rows: &[[f64; 4]]) -> Vec<[f64; 4]> {
+    let half = prior::MEDIAN_WINDOW / 2;
+    (0..rows.len())
+        .map(|i| {
+            std::array::from_fn(|c| {
+                if rows[i][c].is_nan() {
+                    return f64::NAN;
+                }
+                let lo = i.saturating_sub(half);
+                let hi = (i + half + 1).min(rows.len());
+                let mut w: Vec<f64> = rows[lo..hi]
+                    .iter()
+                    .map(|r| r[c])
+                    .filter(|v| !v.is_nan())
+                    .collect();
+                w.sort_by(f64::total_cmp);
+                if w.len() % 2 == 1 {
+                    w[w.len() / 2]
+                } else {
+                    0.5 * (w[w.len() / 2 - 1] + w[w.len() / 2])
+                }
+            })
+        })
+        .collect()
 }
 
 /// A camera: frame rate, scale, noise and which points are lost in which frames.
@@ -400,7 +606,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         root.join("data/reversal/blade.toml"),
     )?)?;
     let mut conditions = String::from(
-        "recording,t0_s,fps_hz,m_per_px,truth_json,blade_file,scene,noise_px,lost_frames,seed\n",
+        "recording,t0_s,fps_hz,m_per_px,truth_json,blade_file,scene,departure,noise_px,lost_frames,seed\n",
     );
     let started = Instant::now();
     let mut bytes = 0u64;
@@ -412,15 +618,38 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut rng = StdRng::seed_from_u64(seed);
         let id = format!("{}_{i:03}_{}", set.id_prefix(), scene.label());
         let mut camera = draw_camera(&mut rng);
-        let d = draw_scene(&mut rng, &base, scene, camera.fps_hz)
+        let mut d = draw_scene(&mut rng, &base, scene, camera.fps_hz)
             .map_err(|e| format!("{id} (seed {seed}): {e}"))?;
+        let departure = (set == Set::Departures).then(|| Departure::draw(i, &mut rng));
+        let id = match departure {
+            Some(dep) => format!("{}_{i:03}_{}", set.id_prefix(), dep.label()),
+            None => id,
+        };
+        if let Some(dep) = departure {
+            apply_departure(&mut d, dep, camera.fps_hz)
+                .map_err(|e| format!("{id} (seed {seed}): {e}"))?;
+            d.departure = Some(dep);
+        }
         let n = d.sim.t_s.len();
         draw_lost(&mut rng, &mut camera, n);
-        let noise = Normal::new(0.0, camera.noise_px)?;
-        let text = recording::dltdv_text_at(&d.sim, camera.m_per_px, |c, i| {
-            let e = noise.sample(&mut rng);
-            if is_lost(&camera, c, i) { f64::NAN } else { e }
-        });
+        let noise = tracking_noise(&mut rng, n, camera.noise_px, departure);
+        let mut rows: Vec<[f64; 4]> = recording::clean_px_rows(&d.sim, camera.m_per_px)
+            .into_iter()
+            .enumerate()
+            .map(|(i, clean)| {
+                std::array::from_fn(|c| {
+                    if is_lost(&camera, c, i) {
+                        f64::NAN
+                    } else {
+                        clean[c] + noise[i][c]
+                    }
+                })
+            })
+            .collect();
+        if departure == Some(Departure::MedianSmoothed) {
+            rows = median_smoothed(&rows);
+        }
+        let text = recording::dltdv_text_of_rows(&rows);
         let file = format!("{id}_xypts.csv");
         std::fs::write(out.join("recordings").join(&file), &text)?;
         bytes += text.len() as u64;
@@ -448,11 +677,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let lost_frames: usize = camera.lost.iter().map(|l| l.1).sum();
         let _ = writeln!(
             conditions,
-            "{file},{:?},{:?},{:?},truths/{id}.json,{blade_file},{},{:.4},{lost_frames},{seed}",
+            "{file},{:?},{:?},{:?},truths/{id}.json,{blade_file},{},{},{:.4},{lost_frames},{seed}",
             d.t0_s,
             camera.fps_hz,
             camera.m_per_px,
             scene.label(),
+            d.departure.map_or("none", Departure::label),
             camera.noise_px,
         );
         println!(
@@ -498,9 +728,11 @@ fn write_truth(
     seed: u64,
     set: Set,
 ) -> Result<(), Box<dyn std::error::Error>> {
+    // A, B, C are the fitted law's coefficients only when the true law is that law; else null:
+    // the recording's law is scored as a curve (`/friction_law`), not coefficient by coefficient.
     let (a, b, c) = match d.blade.friction {
-        FrictionLaw::Exponential { a, b_s_per_m, c } => (a, b_s_per_m, c),
-        other => return Err(format!("unexpected friction law {other:?}").into()),
+        FrictionLaw::Exponential { a, b_s_per_m, c } => (json!(a), json!(b_s_per_m), json!(c)),
+        _ => (json!(null), json!(null), json!(null)),
     };
     // A scene without shoulder is the shoulder model whose contact changes nothing (k1c = k1)
     // and is never reached (θ_c = 1 rad): its true θ_c and k1c let a fit that chose a shoulder
@@ -514,6 +746,9 @@ fn write_truth(
         "model": scene.model(),
         "params": { "A": a, "B": b, "C": c, "k1": d.blade.k1_nm_per_rad, "theta_c": theta_c, "k1c": k1c },
         "scored": if scene == Scene::Shoulder { json!(["A", "B", "C", "k1", "theta_c", "k1c"]) } else { json!(["A", "B", "C", "k1"]) },
+        "friction_law": d.blade.friction,
+        "departure": d.departure.map(Departure::label),
+        "departure_size": d.departure.map(Departure::size),
         "blade": d.blade,
         "seed": seed,
         "draws": d.draws,
@@ -571,6 +806,16 @@ fn write_campaign(
             mix.iter().sum::<usize>(),
             set.seed_base()
         ),
+        Set::Departures => format!(
+            "**Departures set** ({} shoulder-free recordings, seeds {} + i), each made with one departure \
+             from the fitted model (AR(1) or median-smoothed tracking noise, a viscous term or a Stribeck \
+             exponent in the friction law, a drive speed with a second harmonic; `/departure` of each \
+             truth file). A, B, C are scored only where the true law is the fitted one; the friction law \
+             is scored as a curve over the measured slip speeds. Recordings: \
+             `cargo run --release --example make_calibration -- {args}`.\n",
+            mix.iter().sum::<usize>(),
+            set.seed_base()
+        ),
         Set::Calibration => format!(
             "**Calibration set** ({} recordings, seeds {} + i): every hyperparameter of the search and \
              of the intervals is chosen on the development set (campaigns/calibration_development.toml, \
@@ -581,6 +826,13 @@ fn write_campaign(
             set.seed_base(),
             Set::Development.seed_base()
         ),
+    };
+    let law = if set == Set::Departures {
+        "# Each recording's true friction law (its truth file's /friction_law): the fitted law is\n\
+         # scored as a curve over the measured slip speeds.\n\
+         truth_friction_law = \"/friction_law\"\n\n"
+    } else {
+        ""
     };
     let text = format!(
         "# Simulation-based calibration of the main job ({} set): {} shoulder-free, {} shoulder and {} head-only\n\
@@ -597,6 +849,7 @@ fn write_campaign(
          notes = \"\"\"\n{notes}\"\"\"\n\
          # The cameras run at 5–20 kHz: the main job's bands keep their bin widths at each frame rate.\n\
          bands_follow_frame_rate = true\n\n\
+         {law}\
          [truth_keys]               # the main job's [truth] names A, B, C and k1; a shoulder's are added\n\
          theta_c = \"/params/theta_c\"\n\
          k1c = \"/params/k1c\"\n\n\
@@ -611,5 +864,6 @@ fn write_campaign(
     );
     let path = campaigns.join(format!("{name}.toml"));
     std::fs::write(&path, text)?;
+
     Ok(path)
 }

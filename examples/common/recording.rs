@@ -85,19 +85,37 @@ pub fn dltdv_text_at(
     m_per_px: f64,
     mut noise_px: impl FnMut(usize, usize) -> f64,
 ) -> String {
-    let mut csv = String::from("pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y\n");
+    let rows: Vec<[f64; 4]> = clean_px_rows(sim, m_per_px)
+        .into_iter()
+        .enumerate()
+        .map(|(i, clean)| std::array::from_fn(|c| clean[c] + noise_px(c, i)))
+        .collect();
+    dltdv_text_of_rows(&rows)
+}
+
+/// The noiseless pixel coordinates of every frame through a camera of `m_per_px` metres per pixel:
+/// `x_px = X0 + (x − a)/S`, `y_px = Y0 − y/S` (y down) for the head (x = v, y = −u) and the lip
+/// tip (x = v3, y = −reach, the glass), columns head x, head y, tip x, tip y.
+pub fn clean_px_rows(sim: &BladeSimulation, m_per_px: f64) -> Vec<[f64; 4]> {
     let px_x = |x: f64| ORIGIN_PX.0 + (x - X_ORIGIN_M) / m_per_px;
     let px_y = |y: f64| ORIGIN_PX.1 - y / m_per_px;
-    for i in 0..sim.t_s.len() {
-        let clean = [
-            px_x(sim.v_m[i]),
-            px_y(-sim.u_m[i]),
-            px_x(sim.v3_m[i]),
-            px_y(-sim.reach_m),
-        ];
-        let row: Vec<String> = (0..4)
-            .map(|c| format!("{:.4}", clean[c] + noise_px(c, i)))
-            .collect();
+    (0..sim.t_s.len())
+        .map(|i| {
+            [
+                px_x(sim.v_m[i]),
+                px_y(-sim.u_m[i]),
+                px_x(sim.v3_m[i]),
+                px_y(-sim.reach_m),
+            ]
+        })
+        .collect()
+}
+
+/// Pixel rows (head x, head y, tip x, tip y) as DLTdv8 text, `%.4f`, NaN for a lost point.
+pub fn dltdv_text_of_rows(rows: &[[f64; 4]]) -> String {
+    let mut csv = String::from("pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,pt2_cam1_Y\n");
+    for r in rows {
+        let row: Vec<String> = r.iter().map(|v| format!("{v:.4}")).collect();
         let _ = writeln!(csv, "{}", row.join(","));
     }
     csv

@@ -589,13 +589,13 @@ impl Files<'_> {
                     ))
                 })?;
                 for (k, ptr) in self.truth.map(|t| &t.keys).into_iter().flatten() {
+                    // A number, or null for a parameter the true model lacks (job::TruthSection).
                     if json
                         .pointer(ptr)
-                        .and_then(serde_json::Value::as_f64)
-                        .is_none()
+                        .is_none_or(|v| !(v.is_f64() || v.is_i64() || v.is_u64() || v.is_null()))
                     {
                         return Err(at(format!(
-                            "column {name}: {} has no number at JSON pointer {ptr} (the template's [truth] key for '{k}')",
+                            "column {name}: {} has no number (or null) at JSON pointer {ptr} (the template's [truth] key for '{k}')",
                             path.display()
                         )));
                     }

@@ -81,6 +81,11 @@ pub struct BladeParams {
     pub drive_a_m: f64,
     /// Drive angular frequency ω, rad/s.
     pub drive_omega_rad_per_s: f64,
+    /// Second harmonic of the drive's speed, a fraction `h` of its peak `aω`: the head moves as
+    /// `v = a(1 − cos ωt) + (h·a/2)·sin 2ωt`, speed `aω(sin ωt + h·cos 2ωt)` (0: the paper's
+    /// drive). A real wiper linkage's speed departs from a sine by a few per cent.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub drive_speed_harmonic: f64,
     /// Optional shoulder contact: past a contact angle the neck bears on the blade's shoulder and
     /// stiffens (absent: a single neck stiffness `k1`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -203,6 +208,11 @@ impl BladeParams {
                 });
             }
         }
+        if !self.drive_speed_harmonic.is_finite() || self.drive_speed_harmonic.abs() >= 0.5 {
+            return Err(super::ParamError::DriveHarmonic {
+                value: self.drive_speed_harmonic,
+            });
+        }
         if let Some(sh) = self.shoulder {
             for (name, value) in [
                 ("contact_angle_rad", sh.contact_angle_rad),
@@ -238,11 +248,25 @@ pub enum StickForm {
     Reduced,
 }
 
-/// The drive `v = a(1 − cos ωt)` and its first two derivatives.
+/// The drive `v = a(1 − cos ωt) + (h·a/2)·sin 2ωt` and its first two derivatives
+/// ([`BladeParams::drive_speed_harmonic`]).
 #[inline]
-fn drive(a: f64, w: f64, t: f64) -> (f64, f64, f64) {
+fn drive(a: f64, w: f64, h: f64, t: f64) -> (f64, f64, f64) {
     let (s, c) = (w * t).sin_cos();
-    (a * (1.0 - c), a * w * s, a * w * w * c)
+    let (v, vd, vdd) = (a * (1.0 - c), a * w * s, a * w * w * c);
+    if h == 0.0 {
+        return (v, vd, vdd);
+    }
+    let (s2, c2) = (2.0 * s * c, c * c - s * s);
+    (
+        v + 0.5 * h * a * s2,
+        vd + h * a * w * c2,
+        vdd - 2.0 * h * a * w * w * s2,
+    )
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// The blade as a hybrid stick–slip system; state `[θ, φ, θ̇, φ̇]` (rad, rad/s).
@@ -311,7 +335,12 @@ impl Blade {
 
     /// Head horizontal position, velocity, acceleration at `t`.
     pub fn drive(&self, t: f64) -> (f64, f64, f64) {
-        drive(self.params.drive_a_m, self.params.drive_omega_rad_per_s, t)
+        drive(
+            self.params.drive_a_m,
+            self.params.drive_omega_rad_per_s,
+            self.params.drive_speed_harmonic,
+            t,
+        )
     }
 
     /// Head drop u = l1(1 − cos θ) + l2(1 − cos φ), m.
@@ -946,5 +975,42 @@ impl StickSlipModel<4> for LockedBlade {
             self.contact_position(t, y),
             self.slip_velocity(t, y)
         )
+    }
+}
+
+#[cfg(test)]
+mod drive_tests {
+    use super::drive;
+
+    /// The drive's velocity and acceleration are its position's derivatives (central differences,
+    /// step 1e-6 of a period, error O(step²)); h = 0 is the paper's `a(1 − cos ωt)`, and the speed
+    /// departs from `aω sin ωt` by `h·aω·cos 2ωt`.
+    #[test]
+    fn the_drive_and_its_derivatives_agree() {
+        let (a, w) = (0.02, 6.0);
+        for h in [0.0, 0.04, -0.03] {
+            for t in [0.1, 0.5, 0.9, 1.3] {
+                let dt = 1e-6 * std::f64::consts::TAU / w;
+                let (v, vd, vdd) = drive(a, w, h, t);
+                let (vp, vdp, _) = drive(a, w, h, t + dt);
+                let (vm, vdm, _) = drive(a, w, h, t - dt);
+                assert!(
+                    ((vp - vm) / (2.0 * dt) - vd).abs() < 1e-9 * a * w,
+                    "h {h} t {t}"
+                );
+                assert!(
+                    ((vdp - vdm) / (2.0 * dt) - vdd).abs() < 1e-7 * a * w * w,
+                    "h {h} t {t}"
+                );
+                let plain = a * (1.0 - (w * t).cos());
+                let speed = a * w * (w * t).sin();
+                if h == 0.0 {
+                    assert_eq!((v, vd), (plain, speed));
+                } else {
+                    let dev = vd - speed - h * a * w * (2.0 * w * t).cos();
+                    assert!(dev.abs() < 1e-15, "{dev}");
+                }
+            }
+        }
     }
 }

@@ -17,6 +17,12 @@ pub enum ParamError {
         value: f64,
         strictly: bool,
     },
+    /// The drive's speed harmonic outside `|h| < 0.5`: a linkage departs from a sine by a few per
+    /// cent; at half the peak speed the drive is no longer a perturbed sine.
+    #[error(
+        "blade parameter drive_speed_harmonic = {value} must be finite with |h| < 0.5 (a fraction of the drive's peak speed aω)"
+    )]
+    DriveHarmonic { value: f64 },
     /// A shoulder parameter (`shoulder.<name>`) that must be finite and > 0.
     #[error("blade parameter shoulder.{name} = {value} must be finite and > 0")]
     Shoulder { name: &'static str, value: f64 },
