@@ -6,7 +6,8 @@
 //! step size [`SIGMA0`]; run `r` samples `λ₀·2^r` points per generation (Auger & Hansen 2005,
 //! "A restart CMA evolution strategy with increasing population size", CEC). The runs go on until
 //! `restarts + 1` runs are done or the evaluation budget is spent, and the lowest point of all is
-//! kept.
+//! kept. A run ends on CMA-ES's own criteria or when its best cost has fallen by no more than
+//! `tol_fun` over its last `10 + ⌈30 n / λ⌉` generations ([`stagnated`]).
 //!
 //! **Bounds.** CMA-ES samples the whole of ℝⁿ; the cost is read at the point mirrored into the box
 //! ([`mirror`]: each coordinate reflected at 0 and 1, periodically). The search then sees a
@@ -121,12 +122,16 @@ pub fn search(
         };
         let mut run_best: Option<(Vec<f64>, f64)> = None;
         let mut generations = 0;
+        // The run's best cost after each generation, for its stagnation.
+        let mut bests: Vec<f64> = Vec::new();
+        let window = stagnation_window(n, population);
         let run_evaluations = loop {
             let end = cma.next_parallel();
             generations += 1;
             if let Some(b) = cma.overall_best_individual() {
                 let u: Vec<f64> = b.point.iter().map(|&v| mirror(v)).collect();
                 run_best = Some((u, b.value));
+                bests.push(b.value);
             }
             let done = cma.function_evals();
             if let Some((u, c)) = &run_best {
@@ -150,6 +155,7 @@ pub fn search(
                     break done;
                 }
                 Some(_) => break done,
+                None if stagnated(&bests, window, settings.tol_fun) => break done,
                 None => {}
             }
         };
@@ -172,6 +178,22 @@ pub fn search(
         runs,
         evaluations,
     })
+}
+
+/// The generations over which a run's best cost must fall by more than `tol_fun` to go on:
+/// `10 + ⌈30 n / λ⌉`, the history CMA-ES's own TolFun reads (Hansen 2016, appendix B.3).
+fn stagnation_window(n: usize, population: usize) -> usize {
+    10 + (30 * n).div_ceil(population.max(1))
+}
+
+/// Whether a run whose best cost after each generation is `bests` has stagnated: its best fell by
+/// no more than `tol` over the last `window` generations. CMA-ES's own TolFun also asks that one
+/// generation's costs span less than `tol`, which a cost with failed evaluations (a fixed high
+/// cost) or ripples deeper than `tol` never meets, so a run in a basin it cannot leave would go on
+/// until its spread shrinks to [`TOL_X`]; a new run of twice the population does more with those
+/// evaluations.
+fn stagnated(bests: &[f64], window: usize, tol: f64) -> bool {
+    bests.len() > window && bests[bests.len() - 1 - window] - bests[bests.len() - 1] <= tol
 }
 
 #[cfg(test)]
@@ -270,6 +292,19 @@ mod tests {
         .expect("one generation");
         assert_eq!(stopped.runs.len(), 1);
         assert_eq!(stopped.evaluations, 3 * 8);
+    }
+
+    #[test]
+    fn a_run_stagnates_when_its_best_stops_falling() {
+        // Window 3: the best 10 → 9.96 over the last three generations is no fall beyond 0.05.
+        assert!(stagnated(&[12.0, 10.0, 9.99, 9.98, 9.96], 3, 0.05));
+        assert!(!stagnated(&[12.0, 10.0, 9.99, 9.98, 9.94], 3, 0.05));
+        assert!(
+            !stagnated(&[10.0, 10.0, 10.0], 3, 0.05),
+            "too short to tell"
+        );
+        assert_eq!(stagnation_window(4, 8), 25);
+        assert_eq!(stagnation_window(6, 9), 30);
     }
 
     #[test]
