@@ -364,7 +364,7 @@ const FIT_FIGURES: [&str; 6] = [
 
 /// The figures `wiperlab fit` writes only when the data allow (src/report/html.rs
 /// `OPTIONAL_FIGURES`).
-const OPTIONAL_FIGURES: [&str; 1] = ["freq_vs_speed.svg"];
+const OPTIONAL_FIGURES: [&str; 2] = ["freq_vs_speed.svg", "posterior_corner.svg"];
 
 /// The SVGs of a fit's report directory, checked to be every always-written figure plus only
 /// known optional ones.

@@ -34,8 +34,8 @@ pub use result::{
 pub use search::{NESTED_GLOBAL_GAIN_NATS, problem_for};
 pub use select::aic;
 pub use uncertainty::{
-    ProfileStart, bootstrap_intervals, identifiability_warnings, laplace_intervals,
-    profile_intervals_at, widen_to_near_best,
+    MIN_ESS, ProfileStart, RHAT_LIMIT, bootstrap_intervals, identifiability_warnings,
+    laplace_intervals, posterior_tempering, profile_intervals_at, widen_to_near_best,
 };
 pub use warning::{FitWarning, Severity, Warnings};
 
@@ -119,7 +119,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     }
     let mut parameters = fitted_parameters(job, &cf);
     let peaks = peak_comparisons(&cf, &best.features)?;
-    let (intervals, mut warnings, interrupted) = chosen_intervals(&cf, &best, fit, &pb)?;
+    let (intervals, mut warnings, interrupted, posterior) = chosen_intervals(&cf, &best, fit, &pb)?;
     if let Some(intervals) = intervals {
         for (p, iv) in parameters.iter_mut().zip(intervals) {
             p.interval = Some(iv);
@@ -188,6 +188,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     );
     let result = FitResult {
         friction_curve: friction_curve(job, &result, &best),
+        posterior,
         ..result
     };
     Ok(FitOutcome {
@@ -374,18 +375,18 @@ fn chosen_intervals(
     best: &BestModel,
     fit: &job::FitSection,
     pb: &Option<indicatif::ProgressBar>,
-) -> Result<(Option<Vec<result::Interval>>, Vec<FitWarning>, bool)> {
+) -> Result<ChosenIntervals> {
     if let (Some(pb), true) = (
         pb,
         fit.uncertainty.method() == job::UncertaintyMethod::Bootstrap,
     ) {
         pb.set_message("bootstrap");
     }
-    let (intervals, mut warnings) = if interrupt::stop_requested() {
-        (None, Vec::new())
+    let (intervals, mut warnings, posterior) = if interrupt::stop_requested() {
+        (None, Vec::new(), None)
     } else {
         match uncertainty::intervals(cf, &best.sim, fit, pb) {
-            Err(_) if interrupt::stop_requested() => (None, Vec::new()),
+            Err(_) if interrupt::stop_requested() => (None, Vec::new(), None),
             other => other?,
         }
     };
@@ -393,8 +394,16 @@ fn chosen_intervals(
     if interrupted {
         warnings.push(FitWarning::Interrupted);
     }
-    Ok((intervals, warnings, interrupted))
+    Ok((intervals, warnings, interrupted, posterior))
 }
+
+/// [`chosen_intervals`]' intervals, warnings, interrupt and posterior sample.
+type ChosenIntervals = (
+    Option<Vec<result::Interval>>,
+    Vec<FitWarning>,
+    bool,
+    Option<crate::posterior::PosteriorSummary>,
+);
 
 /// The chosen candidate's best fit simulated again at the polish's tolerance.
 struct BestModel {
@@ -661,6 +670,7 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         tracking_noise: a.tracking_noise,
         truth_cost: a.truth_cost,
         friction_curve: None,
+        posterior: None,
         history: cf.history.clone(),
     }
 }

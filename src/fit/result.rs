@@ -101,6 +101,15 @@ pub enum IntervalMethod {
     },
     /// From the cost's curvature at the optimum.
     Curvature,
+    /// The 15.87 % and 84.13 % quantiles of a posterior sample (`[fit.uncertainty] method = "mcmc"`,
+    /// docs/fit.md, "Uncertainty"; the sample and its diagnostics are the result's `posterior`).
+    Mcmc {
+        walkers: usize,
+        steps: usize,
+        burn_in: usize,
+        /// The factor the log-likelihood was multiplied by.
+        tempering: f64,
+    },
     /// Laplace's approximation: ±1σ of the estimate's sandwich covariance `F⁻¹ V F⁻¹` at the fit,
     /// with `F` the Fisher information of the recording's likelihood and `V` the variance of its
     /// gradient under the recording's noise ([`crate::fit::evidence::at_fit`]), mapped through
@@ -128,6 +137,17 @@ impl std::fmt::Display for IntervalMethod {
             ),
             IntervalMethod::Profile { .. } => f.write_str("profile likelihood"),
             IntervalMethod::Curvature => f.write_str("curvature"),
+            IntervalMethod::Mcmc {
+                walkers,
+                steps,
+                burn_in,
+                tempering,
+            } => write!(
+                f,
+                "posterior quantiles 15.87–84.13 % of an affine-invariant ensemble sample \
+                 ({walkers} walkers × {steps} steps, {burn_in} burn-in) of the likelihood \
+                 raised to the power {tempering:.3} (k/tr(F⁻¹V)), flat on the search's coordinates"
+            ),
             IntervalMethod::Laplace {
                 fisher_step_u,
                 noise_replicates: 0,
@@ -418,6 +438,10 @@ pub struct FitResult {
     /// slips, and in results written before this field.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction_curve: Option<crate::model::friction_curve::FrictionCurve>,
+    /// The posterior sample of `[fit.uncertainty] method = "mcmc"`: quantiles, diagnostics and
+    /// thinned draws; `None` for the other methods.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub posterior: Option<crate::posterior::PosteriorSummary>,
     pub history: Vec<HistoryPoint>,
 }
 
@@ -592,6 +616,7 @@ mod tests {
             tracking_noise: None,
             truth_cost: None,
             friction_curve: None,
+            posterior: None,
             history: vec![HistoryPoint {
                 stage: SearchStage::Swarm,
                 restart: 1,

@@ -12,6 +12,7 @@ use super::warning::{End, FitWarning};
 use crate::Result;
 use crate::job::FreeParam;
 use crate::job::{self, NoiseSpectrum, UncertaintyMethod};
+use crate::posterior::PosteriorSummary;
 use crate::simulate::blade::BladeSimulation;
 use crate::spectrum::stats::quantile_sorted;
 use rand::SeedableRng;
@@ -23,19 +24,55 @@ use std::sync::{Arc, Mutex};
 /// ([`laplace_intervals`], no further fits), the profile likelihood ([`profile_intervals`], a few
 /// conditional polishes per parameter) or the parametric bootstrap ([`bootstrap_intervals`]).
 /// A target job gets a warning instead: its targets carry no measurement noise. Returns the
-/// intervals (in the order of the freed parameters) and warnings.
+/// intervals (in the order of the freed parameters), warnings, and with `mcmc` the posterior sample
+/// ([`mcmc_intervals`]).
 ///
 /// # Errors
-/// As [`bootstrap_intervals`].
+/// As [`bootstrap_intervals`] and [`mcmc_intervals`].
 pub(super) fn intervals(
     cf: &CandidateFit,
     best_sim: &BladeSimulation,
     fit: &job::FitSection,
     pb: &Option<indicatif::ProgressBar>,
-) -> Result<(Option<Vec<Interval>>, Vec<FitWarning>)> {
+) -> Result<Intervals> {
     if cf.problem.targets.is_some() {
-        return Ok((None, vec![FitWarning::TargetJobIntervals]));
+        return Ok((None, vec![FitWarning::TargetJobIntervals], None));
     }
+    if fit.uncertainty.method() == UncertaintyMethod::Mcmc {
+        return Ok(match &cf.evidence {
+            Ok(nll) => {
+                let (iv, w, post) = mcmc_intervals(cf, nll.effective_parameters, fit, pb)?;
+                (Some(iv), w, Some(post))
+            }
+            Err(why) => (None, vec![no_intervals(UncertaintyMethod::Mcmc, why)], None),
+        });
+    }
+    let (iv, w) = other_intervals(cf, best_sim, fit, pb)?;
+    Ok((iv, w, None))
+}
+
+/// [`intervals`]' intervals, warnings and posterior sample.
+pub(super) type Intervals = (
+    Option<Vec<Interval>>,
+    Vec<FitWarning>,
+    Option<PosteriorSummary>,
+);
+
+/// [`FitWarning::NoIntervals`] of `method`, for `why`.
+fn no_intervals(method: UncertaintyMethod, why: &impl std::fmt::Display) -> FitWarning {
+    FitWarning::NoIntervals {
+        method,
+        reason: why.to_string(),
+    }
+}
+
+/// [`intervals`] by Laplace, the profile or the bootstrap.
+fn other_intervals(
+    cf: &CandidateFit,
+    best_sim: &BladeSimulation,
+    fit: &job::FitSection,
+    pb: &Option<indicatif::ProgressBar>,
+) -> Result<(Option<Vec<Interval>>, Vec<FitWarning>)> {
     match fit.uncertainty.method() {
         UncertaintyMethod::Laplace => match &cf.evidence {
             Ok(_) => {
@@ -44,13 +81,7 @@ pub(super) fn intervals(
                 warnings.extend(near_best_of(cf, &mut intervals));
                 Ok((Some(intervals), warnings))
             }
-            Err(why) => Ok((
-                None,
-                vec![FitWarning::NoIntervals {
-                    method: UncertaintyMethod::Laplace,
-                    reason: why.to_string(),
-                }],
-            )),
+            Err(why) => Ok((None, vec![no_intervals(UncertaintyMethod::Laplace, why)])),
         },
         UncertaintyMethod::Profile => match &cf.evidence {
             Ok(_) => {
@@ -58,22 +89,138 @@ pub(super) fn intervals(
                 warnings.extend(near_best_of(cf, &mut intervals));
                 Ok((Some(intervals), warnings))
             }
-            Err(why) => Ok((
-                None,
-                vec![FitWarning::NoIntervals {
-                    method: UncertaintyMethod::Profile,
-                    reason: why.to_string(),
-                }],
-            )),
+            Err(why) => Ok((None, vec![no_intervals(UncertaintyMethod::Profile, why)])),
         },
         UncertaintyMethod::Bootstrap if fit.uncertainty.bootstrap == 0 => {
             Ok((None, vec![FitWarning::NoBootstrapReplicates]))
         }
+        // [`intervals`] samples the posterior itself.
+        UncertaintyMethod::Mcmc => Ok((None, Vec::new())),
         UncertaintyMethod::Bootstrap => {
             let intervals = bootstrap_intervals(&cf.problem, &cf.best_u, best_sim, fit)?;
             Ok((Some(intervals), Vec::new()))
         }
     }
+}
+
+/// Split R̂ above which [`mcmc_intervals`] warns that the chains have not mixed (Vehtari, Gelman,
+/// Simpson, Carpenter & Bürkner 2021, *Bayesian Analysis* 16:2, §4: 1.01).
+pub const RHAT_LIMIT: f64 = 1.01;
+
+/// Effective draws below which [`mcmc_intervals`] warns (Vehtari et al. 2021, §4: 400, enough
+/// for a 95 % interval's ends to a few per cent of the posterior's spread).
+pub const MIN_ESS: f64 = 400.0;
+
+/// The power the likelihood is raised to before sampling: `k/tr(F⁻¹V)`, Ribatet, Cooley &
+/// Davison's magnitude adjustment of a composite likelihood (2012, *Statistica Sinica* 22:813,
+/// §3.2), with `tr(F⁻¹V)` Takeuchi's effective number of parameters at the fit. Near the optimum
+/// the tempered posterior's covariance is then `F⁻¹·tr(F⁻¹V)/k`: where `V = μF` it is the sandwich
+/// `F⁻¹VF⁻¹` exactly, otherwise its average scale. 1 without a finite positive trace.
+pub fn posterior_tempering(k: usize, effective_parameters: Option<f64>) -> f64 {
+    match effective_parameters {
+        Some(t) if t.is_finite() && t > 0.0 => k as f64 / t,
+        _ => 1.0,
+    }
+}
+
+/// Intervals from a posterior sample of the chosen fit ([`crate::posterior`]): the affine-invariant
+/// ensemble sampler on `−w·NLL(u)`, `w` = [`posterior_tempering`], over the search's normalised
+/// coordinates `u ∈ [0, 1]ᵏ` (a flat prior there: uniform in θ, or in ln θ for a parameter
+/// searched on a log scale); a simulation that fails counts as zero density. The walkers start
+/// in a Gaussian ball of the sandwich covariance around the fit (a 0.01 ball where it has no
+/// finite 1σ), kept inside the box. Each interval is the 15.87–84.13 % quantiles; warnings name a
+/// parameter whose chains have not mixed ([`RHAT_LIMIT`], [`MIN_ESS`]) or whose posterior spans
+/// most of its search range. Costs `walkers × (steps + 1)` simulations, a walker half's in
+/// parallel.
+///
+/// # Errors
+/// [`crate::posterior::PosteriorError`] for too few walkers for the freed parameters or a start
+/// whose simulations mostly fail.
+pub(super) fn mcmc_intervals(
+    cf: &CandidateFit,
+    effective_parameters: Option<f64>,
+    fit: &job::FitSection,
+    pb: &Option<indicatif::ProgressBar>,
+) -> Result<(Vec<Interval>, Vec<FitWarning>, PosteriorSummary)> {
+    let s = &fit.uncertainty;
+    let w = posterior_tempering(cf.free.len(), effective_parameters);
+    let inside = |u: &[f64]| u.iter().all(|x| (0.0..=1.0).contains(x));
+    let log_density = |u: &[f64]| match inside(u).then(|| cf.problem.cost_at(u)) {
+        Some(c) if c < super::FAILED_COST => -w * c,
+        _ => f64::NEG_INFINITY,
+    };
+    let spread = crate::likelihood::covariance::cholesky_of_covariance(&cf.sigma_u, &cf.corr);
+    let k = cf.free.len();
+    let l = spread.unwrap_or_else(|| nalgebra::DMatrix::identity(k, k) * 0.01);
+    let start =
+        crate::posterior::ensemble::gaussian_ball_with(&cf.best_u, &l, s.walkers, s.seed, inside);
+    let settings = crate::posterior::EnsembleSettings {
+        walkers: s.walkers,
+        steps: s.steps,
+        stretch: 2.0,
+        seed: s.seed,
+    };
+    if let Some(bar) = pb {
+        bar.inc_length((s.walkers * (s.steps + 1)) as u64);
+        bar.inc(s.walkers as u64);
+        bar.set_message("posterior sample (MCMC)");
+    }
+    // Without a terminal the bar is hidden: a line every 50 steps instead, as the search prints.
+    let piped = !std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let started = std::time::Instant::now();
+    let chains = crate::posterior::sample(log_density, start, &settings, |step| {
+        if let Some(bar) = pb {
+            bar.inc(s.walkers as u64);
+            if piped && (step + 1) % 50 == 0 {
+                let t = started.elapsed().as_secs();
+                eprintln!(
+                    "progress: posterior sample: {}/{} steps, {t} s",
+                    step + 1,
+                    s.steps
+                );
+            }
+        }
+        !super::interrupt::stop_requested()
+    })?;
+    let names: Vec<_> = cf.free.iter().map(|f| f.name).collect();
+    let burn_in = s.burn_in.min(chains.steps().saturating_sub(1));
+    let post = PosteriorSummary::new(&names, &chains, burn_in, 1.0, w, |i, u| cf.free[i].value(u));
+    let method = IntervalMethod::Mcmc {
+        walkers: s.walkers,
+        steps: chains.steps(),
+        burn_in,
+        tempering: w,
+    };
+    let mut warnings = Vec::new();
+    let intervals = post
+        .parameters
+        .iter()
+        .map(|p| {
+            if p.r_hat.is_nan() || p.r_hat > RHAT_LIMIT || p.ess.is_nan() || p.ess < MIN_ESS {
+                let (parameter, r_hat, ess) = (p.name, p.r_hat, p.ess);
+                warnings.push(FitWarning::PosteriorUnconverged {
+                    parameter,
+                    r_hat,
+                    ess,
+                });
+            }
+            if !p.determined {
+                warnings.push(FitWarning::PosteriorSpansBounds {
+                    parameter: p.name,
+                    span_fraction: p.span_fraction,
+                    interval: [p.quantiles[0], p.quantiles[4]],
+                });
+            }
+            Interval {
+                lo: p.quantiles[1],
+                hi: p.quantiles[3],
+                level: 0.6827,
+                method: method.clone(),
+                widened_from: None,
+            }
+        })
+        .collect();
+    Ok((intervals, warnings, post))
 }
 
 /// Laplace intervals (68.27 %): `[θ(u − σ_u), θ(u + σ_u)]` for each freed parameter, with `σ_u`
@@ -792,6 +939,17 @@ mod tests {
     /// `μ` times the exact one: `μ·(x − u0)²/(2σ²)`.
     fn quadratic_rise(u0: f64, sigma: f64, mu: f64) -> impl FnMut(f64) -> f64 {
         move |x| mu * (x - u0).powi(2) / (2.0 * sigma * sigma)
+    }
+
+    #[test]
+    fn the_tempered_posterior_has_the_sandwich_covariance_where_v_is_proportional_to_f() {
+        // Closed form: with V = μF, tr(F⁻¹V) = μk, w = 1/μ, and exp(−w·NLL) of a quadratic NLL
+        // has covariance F⁻¹/w = μF⁻¹ = F⁻¹VF⁻¹.
+        let (k, mu) = (4, 0.275);
+        assert!((posterior_tempering(k, Some(mu * k as f64)) - 1.0 / mu).abs() < 1e-12);
+        assert_eq!(posterior_tempering(k, None), 1.0);
+        assert_eq!(posterior_tempering(k, Some(0.0)), 1.0);
+        assert_eq!(posterior_tempering(k, Some(f64::NAN)), 1.0);
     }
 
     #[test]

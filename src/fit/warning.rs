@@ -164,6 +164,23 @@ pub enum FitWarning {
         method: UncertaintyMethod,
         reason: String,
     },
+    /// The posterior sample's chains have not mixed for a parameter: split R̂ above
+    /// [`crate::fit::RHAT_LIMIT`] or fewer effective draws than [`crate::fit::MIN_ESS`].
+    PosteriorUnconverged {
+        parameter: ParamId,
+        r_hat: f64,
+        ess: f64,
+    },
+    /// The parameter's 95 % posterior interval spans more than
+    /// [`crate::posterior::UNDETERMINED_SPAN`] of its search range: the recording does not
+    /// determine it within the bounds.
+    PosteriorSpansBounds {
+        parameter: ParamId,
+        /// Fraction of the search range (normalised coordinates).
+        span_fraction: f64,
+        /// The 95 % interval, the parameter's unit.
+        interval: [f64; 2],
+    },
     /// A target job has no intervals: its targets carry no measurement noise.
     TargetJobIntervals,
     /// `[fit.uncertainty] bootstrap = 0` with the bootstrap method.
@@ -260,6 +277,8 @@ impl FitWarning {
             | ProfileOpen { .. }
             | ProfileMoreLikely { .. }
             | ShortOfBestEvaluation { .. }
+            | PosteriorUnconverged { .. }
+            | PosteriorSpansBounds { .. }
             | NoIntervals { .. }
             | ToleranceNotProbed { .. }
             | ToleranceUnresolved { .. }
@@ -287,6 +306,8 @@ impl FitWarning {
             ProfileMoreLikely { .. } => "profile_more_likely",
             WidenedInterval { .. } => "widened_interval",
             ShortOfBestEvaluation { .. } => "short_of_best_evaluation",
+            PosteriorUnconverged { .. } => "posterior_unconverged",
+            PosteriorSpansBounds { .. } => "posterior_spans_bounds",
             ContactRidge { .. } => "contact_ridge",
             NoIntervals { .. } => "no_intervals",
             TargetJobIntervals => "target_job_intervals",
@@ -311,7 +332,9 @@ impl FitWarning {
             | ProfileAtBound { parameter, .. }
             | ProfileOpen { parameter, .. }
             | ProfileMoreLikely { parameter, .. }
-            | WidenedInterval { parameter, .. } => Some(*parameter),
+            | WidenedInterval { parameter, .. }
+            | PosteriorUnconverged { parameter, .. }
+            | PosteriorSpansBounds { parameter, .. } => Some(*parameter),
             _ => None,
         }
     }
@@ -401,6 +424,29 @@ impl fmt::Display for FitWarning {
                 widened,
             } => widened_interval(f, *parameter, *rise_limit_nats, [points, method, widened]),
             ShortOfBestEvaluation { gain_nats } => short_of_best_evaluation(f, *gain_nats),
+            PosteriorUnconverged {
+                parameter,
+                r_hat,
+                ess,
+            } => write!(
+                f,
+                "the posterior sample of {parameter} has not converged: split R̂ {r_hat:.3} \
+                 (limit {}), {ess:.0} effective draws (at least {}); run more steps or walkers",
+                super::RHAT_LIMIT,
+                super::MIN_ESS
+            ),
+            PosteriorSpansBounds {
+                parameter,
+                span_fraction,
+                interval,
+            } => write!(
+                f,
+                "{parameter} is not determined by this recording: its 95 % posterior interval \
+                 [{:.6}, {:.6}] spans {:.0} % of its search range",
+                interval[0],
+                interval[1],
+                100.0 * span_fraction
+            ),
             ContactRidge { k1_lo, k1_hi } => contact_ridge(f, *k1_lo, *k1_hi),
             NoIntervals { method, reason } => no_intervals(f, *method, reason),
             TargetJobIntervals => {
@@ -634,6 +680,7 @@ fn no_intervals(
         UncertaintyMethod::Laplace => write!(f, "no Laplace intervals: {reason}"),
         UncertaintyMethod::Profile => write!(f, "no profile-likelihood intervals: {reason}"),
         UncertaintyMethod::Bootstrap => write!(f, "no bootstrap intervals: {reason}"),
+        UncertaintyMethod::Mcmc => write!(f, "no posterior (MCMC) intervals: {reason}"),
     }
 }
 

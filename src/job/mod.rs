@@ -428,6 +428,10 @@ crate::names::named_enum! {
         /// every step, to where the likelihood has dropped by the sandwich-calibrated 68.27 %
         /// threshold (a few conditional polishes per side).
         Profile => "profile",
+        /// A posterior sample of the likelihood tempered by its calibrated scale, from an
+        /// affine-invariant ensemble sampler (`walkers` × `steps` simulations): quantile intervals
+        /// with convergence diagnostics.
+        Mcmc => "mcmc",
     }
 }
 
@@ -444,8 +448,14 @@ pub struct UncertaintySection {
     pub full_refit: bool,
     /// Nelder–Mead iterations of a polish-only replicate.
     pub polish_iterations: u64,
-    /// Seed of the replicates' noise.
+    /// Seed of the replicates' noise, and of the ensemble sampler's moves.
     pub seed: u64,
+    /// `method = "mcmc"`: walkers of the ensemble (even, at least twice the freed parameters).
+    pub walkers: usize,
+    /// `method = "mcmc"`: steps of every walker, burn-in included.
+    pub steps: usize,
+    /// `method = "mcmc"`: steps discarded at the start of every walker's chain.
+    pub burn_in: usize,
 }
 
 impl UncertaintySection {
@@ -468,6 +478,9 @@ impl Default for UncertaintySection {
             full_refit: true,
             polish_iterations: 30,
             seed: 7,
+            walkers: 32,
+            steps: 1000,
+            burn_in: 300,
         }
     }
 }
@@ -990,6 +1003,28 @@ impl Check<'_> {
                 &[Key::Name("fit"), Key::Name("restarts")],
                 "[fit] restarts must be >= 1 (independent swarm + polish runs, the best kept)",
             ));
+        }
+        let u = &fit.uncertainty;
+        if u.method() == UncertaintyMethod::Mcmc {
+            let at = |key| [Key::Name("fit"), Key::Name("uncertainty"), Key::Name(key)];
+            if u.walkers < 4 || u.walkers % 2 == 1 {
+                return Err(self.error(
+                    &at("walkers"),
+                    format!(
+                        "[fit.uncertainty] walkers must be even and at least twice the freed parameters (got {})",
+                        u.walkers
+                    ),
+                ));
+            }
+            if u.burn_in >= u.steps {
+                return Err(self.error(
+                    &at("burn_in"),
+                    format!(
+                        "[fit.uncertainty] burn_in ({}) must be fewer than steps ({}): the chains keep the steps after it",
+                        u.burn_in, u.steps
+                    ),
+                ));
+            }
         }
         for (i, m) in fit.models.iter().enumerate() {
             if m.shoulder && fit.shoulder.is_none() {

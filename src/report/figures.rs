@@ -242,7 +242,50 @@ pub fn fit_figures(
         .fit_settings
         .as_ref()
         .map_or(Objective::Features, |f| f.objective);
+    if let Some(post) = &o.result.posterior {
+        posterior_figure(dir, &o.result, post)?;
+    }
     cost_figure(dir, &o.result.history, objective)
+}
+
+/// `posterior_corner.svg`: the corner plot of a posterior sample's draws, each parameter's
+/// 68.27 % interval, fit and truth.
+///
+/// # Errors
+/// As [`crate::report::plot::corner_plot`].
+pub fn posterior_figure(
+    dir: &Path,
+    r: &FitResult,
+    post: &crate::posterior::PosteriorSummary,
+) -> Result<()> {
+    let axes: Vec<crate::report::plot::CornerAxis> = post
+        .parameters
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let fitted = r.parameters.iter().find(|f| f.name == p.name);
+            let unit = p.name.unit();
+            crate::report::plot::CornerAxis {
+                label: if unit == "-" {
+                    p.name.to_string()
+                } else {
+                    format!("{} ({unit})", p.name)
+                },
+                draws: post.draws.iter().map(|d| d[i]).collect(),
+                fit: fitted.map_or(f64::NAN, |f| f.value),
+                truth: fitted.and_then(|f| f.true_value),
+                interval: [p.quantiles[1], p.quantiles[3]],
+            }
+        })
+        .collect();
+    crate::report::plot::corner_plot(
+        &dir.join("posterior_corner.svg"),
+        &format!(
+            "posterior sample: {} walkers × {} steps ({} burn-in), likelihood^{:.2}",
+            post.walkers, post.steps, post.burn_in, post.tempering
+        ),
+        &axes,
+    )
 }
 
 /// A signal in mm with its mean over the finite samples removed, so measured (camera frame) and

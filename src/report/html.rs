@@ -109,12 +109,22 @@ pub fn fit_figure_list(result: &FitResult) -> Vec<(String, String)> {
 
 /// Figures `wiperlab fit` writes only when the data allow (file name, caption); shown after
 /// [`fit_figure_list`] when present, never reported missing.
-pub const OPTIONAL_FIGURES: &[(&str, &str)] = &[(
-    "freq_vs_speed.svg",
-    "Instantaneous frequency against the lip tip's mean speed: spectrogram ridge and \
-     1/stick-onset interval, measured and fitted model (written when the recording has a tip \
-     point and an estimate in the band).",
-)];
+pub const OPTIONAL_FIGURES: &[(&str, &str)] = &[
+    (
+        "freq_vs_speed.svg",
+        "Instantaneous frequency against the lip tip's mean speed: spectrogram ridge and \
+         1/stick-onset interval, measured and fitted model (written when the recording has a tip \
+         point and an estimate in the band).",
+    ),
+    (
+        "posterior_corner.svg",
+        "Posterior sample ([fit.uncertainty] method = \"mcmc\"): each parameter's histogram on \
+         the diagonal with its 68.27 % interval dashed, each pair's draws below it; the fit in \
+         black, the truth in red when known. A histogram that fills its axis from bound to bound \
+         is a parameter the recording does not determine; a thin curved cloud is a ridge the \
+         recording determines only as a combination.",
+    ),
+];
 
 /// A number with `sig` significant digits: plain for 1e-3 ≤ |x| < 1e5, else scientific; "—" for
 /// NaN, "±∞" spelled out.
@@ -203,6 +213,9 @@ struct IntervalView {
     hi: String,
     /// The method's own ends when the interval was widened to points the fit evaluated.
     widened_from: Option<String>,
+    /// With a posterior sample: its 95 % interval, and "not determined by this recording" when
+    /// it spans most of the search range.
+    posterior_note: Option<String>,
     level_pct: String,
     footnote: usize,
 }
@@ -219,6 +232,27 @@ struct ParamView {
     determined: bool,
     true_value: String,
     rel_error: String,
+}
+
+/// The posterior sample's 95 % interval of `name`, with the verdict when the recording does not
+/// determine it; `None` without a posterior sample.
+fn posterior_note(r: &FitResult, name: crate::model::ParamId) -> Option<String> {
+    let p = r
+        .posterior
+        .as_ref()?
+        .parameters
+        .iter()
+        .find(|p| p.name == name)?;
+    let [lo, .., hi] = p.quantiles;
+    let verdict = if p.determined {
+        String::new()
+    } else {
+        format!(
+            ": not determined by this recording (the posterior spans {:.0} % of the search range)",
+            100.0 * p.span_fraction
+        )
+    };
+    Some(format!("95 %: [{}, {}]{verdict}", num(lo, 4), num(hi, 4)))
 }
 
 /// Parameter rows and the interval methods their footnotes number (each method named once).
@@ -239,6 +273,7 @@ fn parameter_rows(r: &FitResult) -> (Vec<ParamView>, Vec<String>) {
                     widened_from: i
                         .widened_from
                         .map(|[lo, hi]| format!("[{}, {}]", num(lo, 4), num(hi, 4))),
+                    posterior_note: posterior_note(r, p.name),
                     level_pct: format!("{:.0}", 100.0 * i.level),
                     footnote: methods.iter().position(|m| *m == method).unwrap_or(0) + 1,
                 }
@@ -1069,6 +1104,7 @@ pub(super) mod tests {
             tracking_noise: None,
             truth_cost: None,
             friction_curve: None,
+            posterior: None,
             history: vec![],
         }
     }
@@ -1233,6 +1269,48 @@ pub(super) mod tests {
             html.contains(
                 "<td>[0.02800, 0.03200] (68 %)<sup>1</sup><br><span class=\"note\">widened from \
                  [0.02900, 0.03100]</span></td>"
+            ),
+            "{html}"
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn a_parameter_the_posterior_spreads_over_its_bounds_is_called_not_determined() {
+        let dir = std::env::temp_dir().join(format!("wiperlab_html_post_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut r = result();
+        let name = r.parameters[0].name;
+        r.posterior = Some(crate::posterior::PosteriorSummary {
+            walkers: 8,
+            steps: 10,
+            burn_in: 2,
+            acceptance_fraction: 0.3,
+            tempering: 1.0,
+            evaluations: 88,
+            parameters: vec![crate::posterior::ParamPosterior {
+                name,
+                quantiles: [0.01, 0.02, 0.03, 0.04, 0.05],
+                r_hat: 1.0,
+                autocorr_steps: 1.0,
+                ess: 64.0,
+                span_fraction: 0.8,
+                determined: false,
+            }],
+            draws: Vec::new(),
+        });
+        let paths = ReportPaths {
+            job: dir.join("job.toml"),
+            result: dir.join("unit.result.toml"),
+            recording: dir.join("rec.csv"),
+            dir: dir.clone(),
+        };
+        let html = std::fs::read_to_string(write_report(&r, &paths).unwrap().path).unwrap();
+        assert!(
+            html.contains(
+                "<span class=\"note\">95 %: [0.01000, 0.05000]: not determined by this recording \
+                 (the posterior spans 80 % of the search range)</span>"
             ),
             "{html}"
         );

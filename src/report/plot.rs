@@ -23,10 +23,12 @@
 //!
 //! The report stage computes nothing: pass it spectra and traces computed upstream.
 
+mod corner;
 mod png;
 mod scatter;
 mod ticks;
 
+pub use corner::{CornerAxis, corner_plot};
 pub use scatter::{Category, Panel, Target, scatter_panels};
 
 use std::path::Path;

@@ -254,6 +254,14 @@ fn fit_headline(w: &FitWarning) -> String {
              short of its own best point; refit with more restarts or polish iterations."
         ),
         ContactRidge { k1_lo, k1_hi } => contact_ridge_headline(*k1_lo, *k1_hi),
+        PosteriorUnconverged { parameter, .. } => format!(
+            "The posterior sample of {parameter} has not converged: its interval is not yet \
+             reliable; run more steps or walkers."
+        ),
+        PosteriorSpansBounds { parameter, .. } => format!(
+            "{parameter} is not determined by this recording: its posterior spans most of its \
+             search range, so its interval is the bounds you gave, not a measurement."
+        ),
         NoIntervals { method, .. } => no_intervals_headline(*method),
         TargetJobIntervals => {
             "No intervals: a target job's targets carry no measurement noise.".into()
@@ -420,6 +428,7 @@ fn no_intervals_headline(method: UncertaintyMethod) -> String {
             UncertaintyMethod::Laplace => "Laplace",
             UncertaintyMethod::Profile => "profile-likelihood",
             UncertaintyMethod::Bootstrap => "bootstrap",
+            UncertaintyMethod::Mcmc => "posterior (MCMC)",
         }
     )
 }
