@@ -6,7 +6,7 @@
 //! smoothed tracking noise, a distorted drive) can be scored by. Grouped by the truth file's
 //! `/departure` label ("none" for a recording made by the fitted model itself).
 
-use super::calibrate::{Calibration, RecordingScore};
+use super::calibrate::{Calibration, RecordingScore, pct, quantile};
 use crate::fit::result::FitResult;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -34,45 +34,16 @@ impl LawScore {
     }
 }
 
-/// One row of the law table: the recordings of one departure.
-struct Group<'a> {
-    fitted: Vec<&'a RecordingScore>,
-}
-
-fn median(mut x: Vec<f64>) -> f64 {
-    if x.is_empty() {
-        return f64::NAN;
-    }
-    x.sort_by(f64::total_cmp);
-    let n = x.len();
-    if n % 2 == 1 {
-        x[n / 2]
-    } else {
-        0.5 * (x[n / 2 - 1] + x[n / 2])
-    }
-}
-
-fn pct(x: f64) -> String {
-    if x.is_finite() {
-        format!("{:.1} %", 100.0 * x)
-    } else {
-        "–".into()
-    }
-}
-
 /// The law section of the calibration table: per departure, the fitted recordings, how many find
 /// the law within [`LAW_TOLERANCE`], the median and largest rms difference, the median share of
 /// speeds inside the band, shoulders chosen for shoulder-free truths, and failed goodness-of-fit
 /// tests. Nothing when no recording has a law score.
 pub fn law_section(md: &mut String, c: &Calibration) {
-    let mut groups: BTreeMap<&str, Group> = BTreeMap::new();
+    // The fitted recordings of each departure: one row each.
+    let mut groups: BTreeMap<&str, Vec<&RecordingScore>> = BTreeMap::new();
     for r in c.done() {
         let key = r.departure.as_deref().unwrap_or("none");
-        groups
-            .entry(key)
-            .or_insert_with(|| Group { fitted: Vec::new() })
-            .fitted
-            .push(r);
+        groups.entry(key).or_default().push(r);
     }
     if !c.recordings.iter().any(|r| r.law.is_some()) {
         return;
@@ -93,21 +64,19 @@ pub fn law_section(md: &mut String, c: &Calibration) {
         "| departure | fitted | law scored | found | median rms difference | largest | median share in band | invented shoulder | misfit |"
     );
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
-    for (name, g) in &groups {
-        let scored: Vec<LawScore> = g.fitted.iter().filter_map(|r| r.law).collect();
+    for (name, fitted) in &groups {
+        let scored: Vec<LawScore> = fitted.iter().filter_map(|r| r.law).collect();
         let rms: Vec<f64> = scored.iter().map(|s| s.rms_rel_diff).collect();
         let found = rms.iter().filter(|d| **d < LAW_TOLERANCE).count();
         let largest = rms.iter().copied().fold(f64::NAN, f64::max);
-        let band = median(scored.iter().filter_map(|s| s.within_band).collect());
-        let invented = g
-            .fitted
+        let band: Vec<f64> = scored.iter().filter_map(|s| s.within_band).collect();
+        let invented = fitted
             .iter()
             .filter(|r| {
                 r.true_model.is_some_and(|t| !t.shoulder) && r.chosen.is_some_and(|c| c.shoulder)
             })
             .count();
-        let misfit = g
-            .fitted
+        let misfit = fitted
             .iter()
             .filter(|r| {
                 r.gof_p
@@ -117,23 +86,11 @@ pub fn law_section(md: &mut String, c: &Calibration) {
         let _ = writeln!(
             md,
             "| {name} | {} | {} | {found} | {} | {} | {} | {invented} | {misfit} |",
-            g.fitted.len(),
+            fitted.len(),
             scored.len(),
-            pct(median(rms.clone())),
+            pct(quantile(&rms, 0.5)),
             pct(largest),
-            pct(band),
+            pct(quantile(&band, 0.5)),
         );
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn median_of_odd_even_and_empty() {
-        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(vec![4.0, 1.0, 2.0, 3.0]), 2.5);
-        assert!(median(Vec::new()).is_nan());
     }
 }
