@@ -392,7 +392,7 @@ fn score(r: &mut RecordingScore, result: &FitResult) {
     }
 }
 
-fn pct(x: f64) -> String {
+pub(super) fn pct(x: f64) -> String {
     if x.is_finite() {
         format!("{:.1} %", 100.0 * x)
     } else {
@@ -437,6 +437,50 @@ fn stats_table(md: &mut String, stats: &[ParamStats]) {
             pct(s.median_abs_rel_error),
             pct(s.p90_abs_rel_error),
         );
+    }
+}
+
+/// The model-choice section: the confusion matrix, true model × chosen model (nothing when no
+/// recording names its true model).
+fn confusion_section(md: &mut String, c: &Calibration) {
+    let confusion = c.confusion();
+    if confusion.is_empty() {
+        return;
+    }
+    {
+        let mut chosen: Vec<&String> = confusion.keys().map(|k| &k.1).collect();
+        chosen.sort();
+        chosen.dedup();
+        let mut truths: Vec<&String> = confusion.keys().map(|k| &k.0).collect();
+        truths.sort();
+        truths.dedup();
+        let _ = writeln!(
+            md,
+            "\n## Model choice\n\nRows: the model that made the recording; columns: the model the fit chose (fitted recordings).\n"
+        );
+        let _ = writeln!(
+            md,
+            "| true \\ chosen | {} |",
+            chosen
+                .iter()
+                .map(|s| s.as_str())
+                .collect::<Vec<_>>()
+                .join(" | ")
+        );
+        let _ = writeln!(md, "|---|{}", "---|".repeat(chosen.len()));
+        for t in &truths {
+            let cells: Vec<String> = chosen
+                .iter()
+                .map(|ch| {
+                    confusion
+                        .get(&((*t).clone(), (*ch).clone()))
+                        .copied()
+                        .unwrap_or(0)
+                        .to_string()
+                })
+                .collect();
+            let _ = writeln!(md, "| {t} | {} |", cells.join(" | "));
+        }
     }
 }
 
@@ -494,42 +538,7 @@ pub fn to_markdown(c: &Calibration, notes: Option<&str>, command: &str) -> Strin
         },
         num(max, 3)
     );
-    let confusion = c.confusion();
-    if !confusion.is_empty() {
-        let mut chosen: Vec<&String> = confusion.keys().map(|k| &k.1).collect();
-        chosen.sort();
-        chosen.dedup();
-        let mut truths: Vec<&String> = confusion.keys().map(|k| &k.0).collect();
-        truths.sort();
-        truths.dedup();
-        let _ = writeln!(
-            md,
-            "\n## Model choice\n\nRows: the model that made the recording; columns: the model the fit chose (fitted recordings).\n"
-        );
-        let _ = writeln!(
-            md,
-            "| true \\ chosen | {} |",
-            chosen
-                .iter()
-                .map(|s| s.as_str())
-                .collect::<Vec<_>>()
-                .join(" | ")
-        );
-        let _ = writeln!(md, "|---|{}", "---|".repeat(chosen.len()));
-        for t in &truths {
-            let cells: Vec<String> = chosen
-                .iter()
-                .map(|ch| {
-                    confusion
-                        .get(&((*t).clone(), (*ch).clone()))
-                        .copied()
-                        .unwrap_or(0)
-                        .to_string()
-                })
-                .collect();
-            let _ = writeln!(md, "| {t} | {} |", cells.join(" | "));
-        }
-    }
+    confusion_section(&mut md, c);
     super::law::law_section(&mut md, c);
     let times: Vec<f64> = c.done().map(|r| r.wall_time_s).collect();
     let _ = writeln!(

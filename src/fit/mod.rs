@@ -128,20 +128,10 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     if let Some(pb) = &pb {
         pb.finish_and_clear();
     }
-    let goodness_of_fit = gof.unwrap_or_else(|e| {
-        warnings.push(FitWarning::NoGoodnessOfFit {
-            reason: e.to_string(),
-        });
-        None
-    });
     let shoulder_listed = candidates.iter().any(|c| c.shoulder);
-    warnings.extend(
-        goodness_of_fit
-            .as_ref()
-            .and_then(|g| misfit_warning(g, shoulder_listed, || misfit_shape(&cf, &best.sim))),
-    );
-    let misfit = goodness_of_fit.as_ref().is_some_and(|g| !g.fits());
-    warnings.extend(select::chosen_on_misfit(&selection.trials, misfit));
+    let (goodness_of_fit, gof_warnings) =
+        goodness_warnings(gof, &cf, &best.sim, &selection.trials, shoulder_listed);
+    warnings.extend(gof_warnings);
     warnings.extend(absorbing);
     warnings.extend(line_warnings(&peaks));
     warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
@@ -355,6 +345,33 @@ fn misfit_warning(
         shoulder_listed,
         shape: shape(),
     })
+}
+
+/// The goodness-of-fit test's outcome as the result keeps it, with its warnings: that it could
+/// not run, or a misfit (where it sits, and a shoulder chosen on it).
+fn goodness_warnings(
+    gof: GoodnessOutcome,
+    cf: &CandidateFit,
+    sim: &BladeSimulation,
+    trials: &[result::ModelTrial],
+    shoulder_listed: bool,
+) -> (Option<likelihood::GoodnessOfFit>, Vec<FitWarning>) {
+    let g = match gof {
+        Ok(g) => g,
+        Err(e) => {
+            let reason = e.to_string();
+            return (None, vec![FitWarning::NoGoodnessOfFit { reason }]);
+        }
+    };
+    let mut warnings = Vec::new();
+    if let Some(w) = g
+        .as_ref()
+        .and_then(|g| misfit_warning(g, shoulder_listed, || misfit_shape(cf, sim)))
+    {
+        warnings.push(w);
+        warnings.extend(select::chosen_on_misfit(trials, true));
+    }
+    (g, warnings)
 }
 
 /// Where the chosen fit's spectra depart from the recording's; empty when the likelihood cannot

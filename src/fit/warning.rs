@@ -428,33 +428,16 @@ impl fmt::Display for FitWarning {
                 parameter,
                 r_hat,
                 ess,
-            } => write!(
-                f,
-                "the posterior sample of {parameter} has not converged: split R̂ {r_hat:.3} \
-                 (limit {}), {ess:.0} effective draws (at least {}); run more steps or walkers",
-                super::RHAT_LIMIT,
-                super::MIN_ESS
-            ),
+            } => posterior_unconverged(f, *parameter, *r_hat, *ess),
             PosteriorSpansBounds {
                 parameter,
                 span_fraction,
                 interval,
-            } => write!(
-                f,
-                "{parameter} is not determined by this recording: its 95 % posterior interval \
-                 [{:.6}, {:.6}] spans {:.0} % of its search range",
-                interval[0],
-                interval[1],
-                100.0 * span_fraction
-            ),
+            } => posterior_spans_bounds(f, *parameter, *span_fraction, *interval),
             ContactRidge { k1_lo, k1_hi } => contact_ridge(f, *k1_lo, *k1_hi),
             NoIntervals { method, reason } => no_intervals(f, *method, reason),
-            TargetJobIntervals => {
-                f.write_str("no intervals for a target job: targets carry no measurement noise")
-            }
-            NoBootstrapReplicates => {
-                f.write_str("no bootstrap intervals: [fit.uncertainty] bootstrap = 0 replicates")
-            }
+            TargetJobIntervals => f.write_str(TARGET_JOB_INTERVALS),
+            NoBootstrapReplicates => f.write_str(NO_BOOTSTRAP_REPLICATES),
             ToleranceNotProbed { failures } => tolerance_not_probed(f, failures),
             ToleranceUnresolved {
                 points,
@@ -469,13 +452,8 @@ impl fmt::Display for FitWarning {
             ChosenOnMisfit {
                 chosen,
                 nested,
-                delta_tic,
-            } => write!(
-                f,
-                "{chosen} is chosen over {nested} (TIC {delta_tic:.1} lower) by a fit that fails \
-                 the goodness-of-fit test: what it adds to {nested} may absorb the misfit rather \
-                 than describe the blade, so it is not confirmed by this recording"
-            ),
+                delta_tic: d,
+            } => chosen_on_misfit(f, chosen, nested, *d),
             FailedEvaluations {
                 failed,
                 evaluations,
@@ -719,6 +697,62 @@ fn tolerance_unresolved(
          (docs/fit.md, \"Tolerance check\")",
         crate::names::join(&at, ", "),
         spread_nats
+    )
+}
+
+/// [`FitWarning::TargetJobIntervals`]'s sentence.
+const TARGET_JOB_INTERVALS: &str =
+    "no intervals for a target job: targets carry no measurement noise";
+
+/// [`FitWarning::NoBootstrapReplicates`]'s sentence.
+const NO_BOOTSTRAP_REPLICATES: &str =
+    "no bootstrap intervals: [fit.uncertainty] bootstrap = 0 replicates";
+
+/// [`FitWarning::PosteriorUnconverged`]'s sentence.
+fn posterior_unconverged(
+    f: &mut fmt::Formatter<'_>,
+    parameter: ParamId,
+    r_hat: f64,
+    ess: f64,
+) -> fmt::Result {
+    write!(
+        f,
+        "the posterior sample of {parameter} has not converged: split R̂ {r_hat:.3} (limit {}), \
+         {ess:.0} effective draws (at least {}); run more steps or walkers",
+        super::RHAT_LIMIT,
+        super::MIN_ESS
+    )
+}
+
+/// [`FitWarning::PosteriorSpansBounds`]'s sentence.
+fn posterior_spans_bounds(
+    f: &mut fmt::Formatter<'_>,
+    parameter: ParamId,
+    span_fraction: f64,
+    interval: [f64; 2],
+) -> fmt::Result {
+    write!(
+        f,
+        "{parameter} is not determined by this recording: its 95 % posterior interval \
+         [{:.6}, {:.6}] spans {:.0} % of its search range",
+        interval[0],
+        interval[1],
+        100.0 * span_fraction
+    )
+}
+
+/// [`FitWarning::ChosenOnMisfit`]'s sentence.
+fn chosen_on_misfit(
+    f: &mut fmt::Formatter<'_>,
+    chosen: &Candidate,
+    nested: &Candidate,
+    delta_tic: f64,
+) -> fmt::Result {
+    write!(
+        f,
+        "{chosen} is chosen over {nested} (TIC {delta_tic:.1} lower) by a fit that fails the \
+         goodness-of-fit test: what it adds to {nested} may absorb the misfit rather than \
+         describe the blade, so it is not confirmed by this recording"
     )
 }
 
