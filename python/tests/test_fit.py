@@ -148,6 +148,9 @@ def test_fit_equals_cli(run_cli, tmp_path):
 def test_ctrl_c_keeps_best_so_far_and_next_fit_runs(tmp_path):
     # A long search (150 swarm iterations), interrupted by SIGINT (what Ctrl-C sends) after 2 s.
     job = write_job(tmp_path / "long", swarm=150)
+    # Python's own Ctrl-C handler, also where the suite was started with SIGINT ignored (as a
+    # background job of a non-interactive shell is, which Python then leaves ignored).
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(2.0, os.kill, (os.getpid(), signal.SIGINT))
     timer.start()
     started = time.monotonic()
@@ -156,6 +159,7 @@ def test_ctrl_c_keeps_best_so_far_and_next_fit_runs(tmp_path):
             wiperlab.fit(job, progress=False)
     finally:
         timer.cancel()
+        signal.signal(signal.SIGINT, previous)
     # The fit stopped soon after the signal, not after its 150 iterations.
     assert time.monotonic() - started < 60
     interrupted = job.with_name("small.interrupted.result.toml")
