@@ -561,30 +561,24 @@ impl RecordingLikelihood {
     }
 
     /// The response's derivatives at `u` by central differences of step `h` (one-sided at a bound
-    /// of the box): `2k` simulations.
+    /// of the box, or where a displaced simulation fails: [`difference_column`]): `2k` simulations,
+    /// and one more at `u` when a side fails.
     fn jacobian(&self, problem: &SpectralProblem, u: &[f64], h: f64) -> Result<Jacobian> {
         use rayon::prelude::*;
+        let response_at = |p: &[f64]| -> Result<Vec<f64>> {
+            self.response(problem, &problem.simulate(&problem.params_at(p))?)
+        };
+        let center = std::sync::OnceLock::<Option<Vec<f64>>>::new();
         let columns: Vec<Vec<f64>> = (0..u.len())
             .into_par_iter()
             .map(|i| {
-                let (lo, hi) = ((u[i] - h).max(0.0), (u[i] + h).min(1.0));
-                let at = |v: f64| -> Result<Vec<f64>> {
+                let at = |v: f64| {
                     let mut p = u.to_vec();
                     p[i] = v;
-                    self.response(problem, &problem.simulate(&problem.params_at(&p))?)
+                    response_at(&p)
                 };
-                let (a, b) = (at(lo)?, at(hi)?);
-                if a.len() != b.len() {
-                    return Err(likelihood::LikelihoodError::LengthMismatch {
-                        measured: a.len(),
-                        model: b.len(),
-                    }
-                    .into());
-                }
-                Ok(b.iter()
-                    .zip(&a)
-                    .map(|(y1, y0)| (y1 - y0) / (hi - lo))
-                    .collect())
+                let center = || center.get_or_init(|| response_at(u).ok()).clone();
+                difference_column(at, center, u[i], h)
             })
             .collect::<Result<_>>()?;
         Ok(Jacobian { columns })
@@ -937,6 +931,61 @@ pub const GOODNESS_OF_FIT_REPLICATES: usize = 999;
 
 /// Seed of the first noise replicate ([`RecordingLikelihood::variability`]).
 pub const NOISE_SEED: u64 = 0x05ee_d0f7_015e;
+
+/// One column of a Jacobian: the derivative of the response `at(v)` with respect to one
+/// normalised coordinate at `u_i` (inside `[0, 1]`), by central differences of step `h`.
+///
+/// Where one side's simulation fails or loses samples (a displaced point beyond the model's
+/// validity, e.g. a lip that loses contact with the glass), the derivative is the one-sided
+/// difference between the other side and `center()` (the response at `u_i`), first-order instead
+/// of second-order accurate (Nocedal & Wright 2006, *Numerical Optimization*, §8.1). Where both
+/// sides fail, the same is tried at `h/4` before giving up.
+///
+/// # Errors
+/// The first side's error (or a length mismatch) when no step gives a difference.
+fn difference_column(
+    at: impl Fn(f64) -> Result<Vec<f64>>,
+    center: impl Fn() -> Option<Vec<f64>>,
+    u_i: f64,
+    h: f64,
+) -> Result<Vec<f64>> {
+    let mut first_error = None;
+    for step in [h, 0.25 * h] {
+        let (lo, hi) = ((u_i - step).max(0.0), (u_i + step).min(1.0));
+        let (a, b) = (at(lo), at(hi));
+        if let (Ok(a), Ok(b)) = (&a, &b)
+            && a.len() == b.len()
+        {
+            return Ok(slope(a, lo, b, hi));
+        }
+        if let Some(c) = center() {
+            let fits = |r: &Result<Vec<f64>>| matches!(r, Ok(r) if r.len() == c.len());
+            if hi > u_i && fits(&b) {
+                return Ok(slope(&c, u_i, b.as_ref().expect("checked"), hi));
+            }
+            if lo < u_i && fits(&a) {
+                return Ok(slope(a.as_ref().expect("checked"), lo, &c, u_i));
+            }
+        }
+        first_error.get_or_insert(match (a, b) {
+            (Err(e), _) | (_, Err(e)) => e,
+            (Ok(a), Ok(b)) => likelihood::LikelihoodError::LengthMismatch {
+                measured: a.len(),
+                model: b.len(),
+            }
+            .into(),
+        });
+    }
+    Err(first_error.expect("two steps were tried"))
+}
+
+/// `(r1 − r0)/(v1 − v0)` component by component.
+fn slope(r0: &[f64], v0: f64, r1: &[f64], v1: f64) -> Vec<f64> {
+    r1.iter()
+        .zip(r0)
+        .map(|(y1, y0)| (y1 - y0) / (v1 - v0))
+        .collect()
+}
 
 /// The response's derivatives in the normalised coordinates: one column per coordinate.
 struct Jacobian {
@@ -1329,6 +1378,52 @@ type ReplicateSpectra = (Vec<Vec<f64>>, Vec<Vec<f64>>);
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A response `[v², v³]` whose "simulation" fails outside `[lo, hi]` (a model losing contact
+    /// there), for [`difference_column`].
+    fn cut_response(lo: f64, hi: f64) -> impl Fn(f64) -> Result<Vec<f64>> {
+        move |v: f64| {
+            if (lo..=hi).contains(&v) {
+                Ok(vec![v * v, v * v * v])
+            } else {
+                Err(likelihood::LikelihoodError::LengthMismatch {
+                    measured: 0,
+                    model: 1,
+                }
+                .into())
+            }
+        }
+    }
+
+    /// Closed forms: the central difference of v² is exactly 2u, the backward difference
+    /// (v² at u minus v² at u − h, over h) exactly 2u − h, and of v³ 3u² − 3uh + h².
+    #[test]
+    fn a_failed_side_gives_the_one_sided_difference_from_the_centre() {
+        let (u, h) = (0.4, 3e-3);
+        let both = difference_column(cut_response(0.0, 1.0), || None, u, h).unwrap();
+        assert!((both[0] - 2.0 * u).abs() < 1e-12, "{both:?}");
+        let f = cut_response(0.0, u + 1e-4);
+        let centre = || Some(vec![u * u, u * u * u]);
+        let back = difference_column(&f, centre, u, h).unwrap();
+        assert!((back[0] - (2.0 * u - h)).abs() < 1e-12, "{back:?}");
+        let cube = 3.0 * u * u - 3.0 * u * h + h * h;
+        assert!((back[1] - cube).abs() < 1e-12, "{back:?} against {cube}");
+        // Without the centre's response there is no one-sided difference: the error stays.
+        assert!(difference_column(&f, || None, u, h).is_err());
+    }
+
+    #[test]
+    fn both_sides_failing_retry_at_a_quarter_step_then_give_up() {
+        let (u, h) = (0.4, 3e-3);
+        // Valid within ±1e-3 of u: the step h fails on both sides, h/4 = 7.5e-4 does not.
+        let near = cut_response(u - 1e-3, u + 1e-3);
+        let d = difference_column(near, || None, u, h).unwrap();
+        assert!((d[0] - 2.0 * u).abs() < 1e-12, "{d:?}");
+        // Valid only at u itself: no step works, and the simulation's error is returned.
+        let only = cut_response(u, u);
+        let centre = || Some(vec![u * u, u * u * u]);
+        assert!(difference_column(only, centre, u, h).is_err());
+    }
 
     /// The likelihood of a pure-noise recording `x` at 10 kHz over the main job's bands (low
     /// 30–300 Hz at nperseg 4096, high 500–5000 Hz at 512), read with the noise spectrum `kind`;
