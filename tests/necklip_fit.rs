@@ -18,8 +18,9 @@ fn necklip_is_fitted_but_not_chosen_for_a_low_band() {
     let tmp = common::temp_dir("necklip_fit");
     let dir = tmp.path();
     // The main job's recording and bands (fits/reversal.toml) on the true blade, with a tiny
-    // optimiser budget: this checks the plumbing, not the fitted values (docs/fit.md, "Which model the
-    // scene needs"). Here blade2dof also has the lower cost, so what shows the rule is the reason.
+    // optimiser budget and the swarm's looser tolerance (rtol 1e-6): this checks the plumbing, not
+    // the fitted values (docs/fit.md, "Which model the scene needs"). Here blade2dof also has the
+    // lower cost, so what shows the rule is the reason.
     let job = format!(
         r#"name = "necklip_fit"
 blade = "{root}/data/reversal/blade_true.toml"
@@ -27,8 +28,8 @@ blade = "{root}/data/reversal/blade_true.toml"
 {recording}
 {spectrum}
 [solver]
-rtol = 1e-8
-atol = 1e-10
+rtol = 1e-6
+atol = 1e-8
 
 [fit]
 particles = 2
