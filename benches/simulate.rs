@@ -127,6 +127,7 @@ fn cost(c: &mut Criterion) {
         failure_causes: Default::default(),
         first_failure: Mutex::new(None),
         near_best: Mutex::new(Default::default()),
+        prior: Default::default(),
     };
     problem.likelihood = Ok(Arc::new(
         RecordingLikelihood::new(&problem, &x, false).expect("likelihood"),

@@ -673,7 +673,7 @@ fn modes_cases() -> Vec<Case> {
 fn fit_cases() -> Vec<Case> {
     let j = |edits: &[(&str, &str)]| vec![("job.toml", job(edits))];
     let fit = &["fit", "$D/job.toml", "--quiet"][..];
-    vec![
+    let mut cases = vec![
         case(
             "fit: no such job",
             vec![],
@@ -914,6 +914,91 @@ fn fit_cases() -> Vec<Case> {
             j(&[]),
             &["report", "$D/job.toml", "--quiet"],
             &["--refit"],
+        ),
+    ];
+    cases.extend(prior_cases());
+    cases
+}
+
+/// `[fit.priors]` a user can get wrong: each names the job file (or the rig file) with its line
+/// and the key.
+fn prior_cases() -> Vec<Case> {
+    let fit = &["fit", "$D/job.toml", "--quiet"][..];
+    let with = |priors: &str| job(&[("[truth]", &format!("[fit.priors]\n{priors}\n\n[truth]"))]);
+    let rig = "[fit.priors.friction_curve]\nfile = \"rig.csv\"\nspeed_column = \"v\"\n\
+               coefficient_column = \"mu\"";
+    vec![
+        case(
+            "fit: a prior on a parameter the job does not fit",
+            vec![(
+                "job.toml",
+                with("c0 = { normal = { mean = 2.0, sd = 0.5 } }"),
+            )],
+            fit,
+            &["$D/job.toml:", "c0", "does not fit"],
+        ),
+        case(
+            "fit: a prior with a zero sd",
+            vec![(
+                "job.toml",
+                with("k1 = { normal = { mean = 0.03, sd = 0.0 } }"),
+            )],
+            fit,
+            &["$D/job.toml:", "k1", "sd must be > 0"],
+        ),
+        case(
+            "fit: a log-normal prior on a parameter whose bounds include 0",
+            vec![(
+                "job.toml",
+                job(&[
+                    ("C = [0.1, 1.0]", "C = [0.1, 1.0]\nc0 = [0.0, 5.0]"),
+                    (
+                        "[truth]",
+                        "[fit.priors]\nc0 = { lognormal = { median = 2.0, sd_log = 0.3 } }\n\n[truth]",
+                    ),
+                ]),
+            )],
+            fit,
+            &["$D/job.toml:", "c0", "log-normal", "<= 0"],
+        ),
+        case(
+            "fit: an unknown prior family",
+            vec![("job.toml", with("k1 = { uniform = { lower = 0.01 } }"))],
+            fit,
+            &["$D/job.toml:", "k1", "`normal` or `lognormal`"],
+        ),
+        case(
+            "fit: priors beside the features objective",
+            vec![(
+                "job.toml",
+                job(&[
+                    ("restarts = 5 ", "objective = \"features\"\nrestarts = 5 "),
+                    (
+                        "[truth]",
+                        "[fit.priors]\nk1 = { normal = { mean = 0.03, sd = 0.01 } }\n\n[truth]",
+                    ),
+                ]),
+            )],
+            fit,
+            &["$D/job.toml:", "[fit.priors]", "likelihood"],
+        ),
+        case(
+            "fit: a rig curve without the coefficient's 1σ",
+            vec![
+                ("job.toml", with(rig)),
+                ("rig.csv", "v,mu\n0.01,0.5\n".into()),
+            ],
+            fit,
+            &["$D/job.toml:", "friction_curve", "sd_column"],
+        ),
+        case(
+            "fit: a rig curve with a cell that is no number",
+            vec![
+                ("job.toml", with(&format!("{rig}\nsd = 0.05"))),
+                ("rig.csv", "v,mu\n0.01,0.5\n0.02,x\n".into()),
+            ],
+            fit,
+            &["$D/rig.csv:3:", "'mu'", "'x'"],
         ),
     ]
 }

@@ -1085,9 +1085,14 @@ pub fn at_fit_smoothed(problem: &SpectralProblem, u: &[f64]) -> Result<LocalFit>
 
 /// [`at_fit`] and [`at_fit_smoothed`].
 fn local_fit(problem: &SpectralProblem, u: &[f64], spread: Spread) -> Result<LocalFit> {
-    let (mut nll, info, var) = information(problem, u, spread)?;
-    let var = var.expect("asked for");
+    let (mut nll, mut info, var) = information(problem, u, spread)?;
+    let mut var = var.expect("asked for");
+    // Model choice reads the likelihood's own penalty; the prior's information then adds to both
+    // sides of the sandwich as a pseudo-observation's (docs/fit.md, "Priors").
     nll.effective_parameters = Some(effective_parameters(&info, &var));
+    let prior = problem.prior.information_u(&problem.free, &problem.base, u);
+    info += &prior;
+    var += prior;
     let (sigma_u, corr) = sandwich_covariance(&info, &var);
     let (curvature_sigma_u, curvature_corr) = covariance(&info);
     Ok(LocalFit {
@@ -1107,7 +1112,9 @@ fn local_fit(problem: &SpectralProblem, u: &[f64], spread: Spread) -> Result<Loc
 /// As [`at_fit`].
 pub fn curvature_at(problem: &SpectralProblem, u: &[f64]) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
     let (_, info, _) = information(problem, u, Spread::CurvatureOnly)?;
-    Ok(covariance(&info))
+    Ok(covariance(
+        &(info + problem.prior.information_u(&problem.free, &problem.base, u)),
+    ))
 }
 
 /// The NLL, the Fisher information and (unless `spread` is [`Spread::CurvatureOnly`]) the

@@ -284,7 +284,7 @@ fn truth_cost(job: &LoadedJob, cf: &CandidateFit) -> Option<f64> {
     for fp in &p.free {
         fp.name.set(&mut params, *job.truth.get(&fp.name)?);
     }
-    p.total_cost(&p.simulate(&params).ok()?).ok()
+    Some(p.total_cost(&p.simulate(&params).ok()?).ok()? + p.prior.nats(&params))
 }
 
 /// The warning of a fit whose cost `cost` lies above the truth's own `truth_cost` by more than
@@ -435,7 +435,7 @@ impl BestModel {
         let params = cf.problem.params_at(&cf.best_u);
         let sim = cf.problem.simulate(&params)?;
         let features = cf.problem.model_features(&sim)?;
-        let cost = cf.problem.total_cost(&sim)?;
+        let cost = cf.problem.total_cost(&sim)? + cf.problem.prior.nats(&params);
         Ok(BestModel {
             params,
             sim,
@@ -646,6 +646,13 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         .filter(|p| !p.determined)
         .map(|p| p.name)
         .collect();
+    let priors = (!cf.problem.prior.is_empty()).then(|| {
+        let intervals: Vec<_> = (a.parameters.iter())
+            .map(|p| (p.name, p.interval.as_ref().map(|i| [i.lo, i.hi])))
+            .collect();
+        let at_fit = cf.problem.params_at(&cf.best_u);
+        (cf.problem.prior).report(&at_fit, &intervals, job.rig_curve.as_ref())
+    });
     FitResult {
         job: job.name.clone(),
         recording: job.recording_path.display().to_string(),
@@ -688,6 +695,7 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         truth_cost: a.truth_cost,
         friction_curve: None,
         posterior: None,
+        priors,
         history: cf.history.clone(),
     }
 }

@@ -71,6 +71,9 @@ pub struct SpectralProblem {
     /// The polish-stage evaluations found about as likely as the best one
     /// ([`EvaluatedNearBest`]), which the intervals read.
     pub near_best: Mutex<EvaluatedNearBest>,
+    /// `[fit.priors]`' terms that read this candidate's freed parameters (empty: flat; a joint
+    /// fit's other recordings have none, the main one carries them once).
+    pub prior: Arc<crate::likelihood::prior::Prior>,
 }
 
 /// How far above the lowest cost seen (nats) [`EvaluatedNearBest`] keeps a point: above the
@@ -287,7 +290,10 @@ impl SpectralProblem {
         let p = self.params_at(u);
         self.counted(|| {
             let s = self.simulate_with(&p, solver)?;
-            Ok((self.total_cost(&s)?, s.transitions.len()))
+            Ok((
+                self.total_cost(&s)? + self.prior.nats(&p),
+                s.transitions.len(),
+            ))
         })
     }
 
@@ -349,7 +355,8 @@ impl SpectralProblem {
         let p = self.params_at(u);
         let c = self
             .counted(|| self.stage_cost(&self.simulate_with(&p, solver)?, stage))
-            .unwrap_or(FAILED_COST);
+            .unwrap_or(FAILED_COST)
+            + self.prior.nats(&p);
         let joint: f64 = self
             .others
             .iter()

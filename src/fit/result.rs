@@ -442,6 +442,10 @@ pub struct FitResult {
     /// thinned draws; `None` for the other methods.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub posterior: Option<crate::posterior::PosteriorSummary>,
+    /// The job's priors beside the fit (`[fit.priors]`): each prior with the fitted value and
+    /// interval, the rig curve's points with the fitted μ_d, and the prior's nats in `cost`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub priors: Option<crate::likelihood::prior::PriorsReport>,
     pub history: Vec<HistoryPoint>,
 }
 
@@ -617,6 +621,30 @@ mod tests {
             truth_cost: None,
             friction_curve: None,
             posterior: None,
+            priors: Some(crate::likelihood::prior::PriorsReport {
+                nats_at_fit: 0.6,
+                parameters: vec![crate::likelihood::prior::ParamPriorReport {
+                    name: ParamId::ThetaC,
+                    prior: crate::job::ParamPrior::Normal {
+                        mean: 0.08,
+                        sd: 0.01,
+                    },
+                    prior_interval: [0.07, 0.09],
+                    value: 0.085,
+                    interval: Some([0.08, 0.09]),
+                    z: 0.5,
+                }],
+                friction_curve: Some(crate::likelihood::prior::RigCurveReport {
+                    file: "rig.csv".into(),
+                    points: vec![crate::likelihood::prior::RigPointReport {
+                        speed_m_per_s: 0.075,
+                        coefficient: 0.17,
+                        sd: 0.008,
+                        mu_d_fit: 0.18,
+                        z: 1.25,
+                    }],
+                }),
+            }),
             history: vec![HistoryPoint {
                 stage: SearchStage::Swarm,
                 restart: 1,

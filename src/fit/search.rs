@@ -11,6 +11,7 @@ use crate::job::Candidate;
 use crate::job::FreeParam;
 use crate::job::{self, LoadedJob};
 use crate::likelihood::measure::{Measurement, measure, measure_recording, necklip_view};
+use crate::likelihood::prior::Prior;
 use crate::model::BladeParams;
 use crate::model::ParamId;
 use crate::simulate::SolverOptions;
@@ -367,6 +368,8 @@ pub(super) fn build_problem(
         problem_of(job, candidate, recording, &free, evaluations.clone())
     };
     let mut main = build(meas, base, String::new())?;
+    let priors = &job.job.fit.priors;
+    main.prior = Arc::new(Prior::new(priors, job.rig_curve.as_ref(), &free));
     let dir = job.path.parent().unwrap_or(std::path::Path::new("."));
     for more in &job.job.more_recordings {
         let m = measure_recording(job, &dir.join(&more.file), &more.import)?;
@@ -454,6 +457,7 @@ fn problem_of(
         failure_causes: Default::default(),
         first_failure: Mutex::new(None),
         near_best: Mutex::new(Default::default()),
+        prior: Default::default(),
     };
     p.likelihood = if p.targets.is_some() {
         Err(super::NoLikelihood::TargetJob)

@@ -126,7 +126,8 @@ pub fn posterior_tempering(k: usize, effective_parameters: Option<f64>) -> f64 {
 /// Intervals from a posterior sample of the chosen fit ([`crate::posterior`]): the affine-invariant
 /// ensemble sampler on `−w·NLL(u)`, `w` = [`posterior_tempering`], over the search's normalised
 /// coordinates `u ∈ [0, 1]ᵏ` (a flat prior there: uniform in θ, or in ln θ for a parameter
-/// searched on a log scale); a simulation that fails counts as zero density. The walkers start
+/// searched on a log scale; times `[fit.priors]`' untempered,
+/// [`crate::likelihood::prior::Prior::log_posterior`]); a simulation that fails counts as zero density. The walkers start
 /// in a Gaussian ball of the sandwich covariance around the fit (a 0.01 ball where it has no
 /// finite 1σ), kept inside the box. Each interval is the 15.87–84.13 % quantiles; warnings name a
 /// parameter whose chains have not mixed ([`RHAT_LIMIT`], [`MIN_ESS`]) or whose posterior spans
@@ -145,8 +146,12 @@ pub(super) fn mcmc_intervals(
     let s = &fit.uncertainty;
     let w = posterior_tempering(cf.free.len(), effective_parameters);
     let inside = |u: &[f64]| u.iter().all(|x| (0.0..=1.0).contains(x));
+    // The likelihood tempered, the prior not, as a density in θ (or ln θ): docs/fit.md, "Priors".
+    let prior = &cf.problem.prior;
     let log_density = |u: &[f64]| match inside(u).then(|| cf.problem.cost_at(u)) {
-        Some(c) if c < super::FAILED_COST => -w * c,
+        Some(c) if c < super::FAILED_COST => {
+            prior.log_posterior(c, w, &cf.free, &cf.problem.base, u)
+        }
         _ => f64::NEG_INFINITY,
     };
     let spread = crate::likelihood::covariance::cholesky_of_covariance(&cf.sigma_u, &cf.corr);
@@ -735,6 +740,8 @@ pub fn bootstrap_intervals(
         .map(|r| {
             let mut rng = rand::rngs::StdRng::seed_from_u64(settings.seed.wrapping_add(r as u64));
             let mut rep = references[0].replicate(problem, &mut rng)?;
+            let at_fit = problem.params_at(best_u);
+            rep.prior = Arc::new(problem.prior.replicate(&at_fit, &mut rng));
             for (o, src) in problem.others.iter().zip(&references[1..]) {
                 rep.others.push(src.replicate(o, &mut rng)?);
             }
@@ -871,6 +878,7 @@ impl ReplicateSource {
             failure_causes: problem.failure_causes.clone(),
             first_failure: Mutex::new(None),
             near_best: Mutex::new(Default::default()),
+            prior: problem.prior.clone(),
         })
         .map(|mut rep| {
             // The replicate's own likelihood: its measured ordinates and noise, the recording's

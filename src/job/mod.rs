@@ -7,11 +7,15 @@
 mod candidate;
 mod error;
 mod free;
+pub mod prior;
+pub mod rig;
 pub mod template;
 
 pub use candidate::{Candidate, NECK_BAND_MIN_HZ, smallest_capable_model};
 pub use error::JobError;
 pub use free::FreeParam;
+pub use prior::{FrictionCurvePrior, ParamPrior, PriorsSection};
+pub use rig::{RigCurve, RigPoint};
 
 use crate::import::ImportSpec;
 use crate::model::{BladeParams, FrictionLaw, ParamId};
@@ -260,6 +264,9 @@ pub struct FitSection {
     /// The likelihood that model choice and Laplace intervals read ([`crate::fit::evidence`]).
     #[serde(default)]
     pub likelihood: LikelihoodSection,
+    /// What the user knows before the recording (`[fit.priors]`; docs/fit.md, "Priors").
+    #[serde(default, skip_serializing_if = "PriorsSection::is_empty")]
+    pub priors: PriorsSection,
 }
 
 /// Which terms the recording's likelihood has (docs/fit.md, "Likelihood").
@@ -663,6 +670,8 @@ pub struct LoadedJob {
     pub truth: BTreeMap<ParamId, f64>,
     /// The true friction law at `[truth] friction_law`, when the job names one.
     pub truth_friction_law: Option<FrictionLaw>,
+    /// The rig curve of `[fit.priors.friction_curve]`, as read.
+    pub rig_curve: Option<RigCurve>,
 }
 
 impl LoadedJob {
@@ -701,6 +710,7 @@ impl LoadedJob {
         check.more_recordings()?;
         check.solver()?;
         check.bands()?;
+        let rig_curve = check.priors(&free, dir)?;
         let (truth, truth_friction_law) = read_truth(dir, job.truth.as_ref())?;
         Ok(LoadedJob {
             recording_path: match &job.recording {
@@ -715,6 +725,7 @@ impl LoadedJob {
             free,
             truth,
             truth_friction_law,
+            rig_curve,
         })
     }
 }

@@ -84,6 +84,7 @@ mod error;
 pub mod instfreq;
 pub mod measure;
 pub mod misfit;
+pub mod prior;
 
 pub use error::{MeasureError, NoHeadTrack};
 

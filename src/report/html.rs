@@ -1105,6 +1105,7 @@ pub(super) mod tests {
             truth_cost: None,
             friction_curve: None,
             posterior: None,
+            priors: None,
             history: vec![],
         }
     }
