@@ -492,7 +492,13 @@ pub fn friction_law_figure(
 ) -> Result<()> {
     let curve = r.friction_curve.as_ref();
     let range_hi = curve.map_or(0.0, |c| c.measured_range_m_per_s[1]);
-    let v_top = v_max_m_per_s.map_or(0.2, |v| 1.05 * v).max(1.1 * range_hi);
+    let rig = r.priors.as_ref().and_then(|p| p.friction_curve.as_ref());
+    let rig_hi = rig.map_or(0.0, |c| {
+        c.points.iter().map(|p| p.speed_m_per_s).fold(0.0, f64::max)
+    });
+    let v_top = (v_max_m_per_s.map_or(0.2, |v| 1.05 * v))
+        .max(1.1 * range_hi)
+        .max(1.05 * rig_hi);
     let grid: Vec<f64> = (0..=200).map(|i| i as f64 * v_top / 200.0).collect();
     let mu = |l: &FrictionLaw, v: &[f64]| -> Vec<f64> { v.iter().map(|x| l.mu_slip(*x)).collect() };
     let mut series = Vec::new();
@@ -503,6 +509,7 @@ pub fn friction_law_figure(
             grid.clone(),
             mu(law, &grid),
         ));
+        rig_points(rig, &mut series, &mut opts);
         return line_chart(
             &dir.join("friction_law.svg"),
             &format!("dynamic friction coefficient μ_d(|v|), law {}", law.name()),
@@ -578,7 +585,14 @@ pub fn friction_law_figure(
         hi,
         label: format!("measured slip speeds {:.1}–{:.1} mm/s", 1e3 * lo, 1e3 * hi),
     });
-    opts.y_range = Some(measured_y_range(c));
+    let (y_lo, y_hi) = measured_y_range(c);
+    opts.y_range = Some(match rig_points(rig, &mut series, &mut opts) {
+        Some((lo, hi)) => (
+            y_lo.min(lo - 0.05 * (hi - lo)),
+            y_hi.max(hi + 0.05 * (hi - lo)),
+        ),
+        None => (y_lo, y_hi),
+    });
     line_chart(
         &dir.join("friction_law.svg"),
         &friction_title(r, law, !c.mu_d_sigma.is_empty()),
@@ -587,6 +601,40 @@ pub fn friction_law_figure(
         &series,
         &opts,
     )
+}
+
+/// The rig curve of `[fit.priors.friction_curve]` as points with ±1σ error bars, added to `series`
+/// and `opts`; the lowest and highest ends of its bars, when there is one.
+fn rig_points(
+    rig: Option<&crate::likelihood::prior::RigCurveReport>,
+    series: &mut Vec<Series>,
+    opts: &mut ChartOpts,
+) -> Option<(f64, f64)> {
+    let c = rig?;
+    let name = c.file.file_name().map(|n| n.to_string_lossy().into_owned());
+    series.push(Series::points(
+        format!(
+            "rig curve μ ± 1σ, the prior on μ_d ({})",
+            name.unwrap_or_default()
+        ),
+        c.points.iter().map(|p| p.speed_m_per_s).collect(),
+        c.points.iter().map(|p| p.coefficient).collect(),
+    ));
+    opts.error_bars.push(super::plot::ErrorBars {
+        x: c.points.iter().map(|p| p.speed_m_per_s).collect(),
+        y: c.points.iter().map(|p| p.coefficient).collect(),
+        sd: c.points.iter().map(|p| p.sd).collect(),
+        series: series.len() - 1,
+    });
+    let lo = c
+        .points
+        .iter()
+        .map(|p| p.coefficient - p.sd)
+        .fold(f64::INFINITY, f64::min);
+    let hi = (c.points.iter())
+        .map(|p| p.coefficient + p.sd)
+        .fold(f64::NEG_INFINITY, f64::max);
+    (lo <= hi).then_some((lo, hi))
 }
 
 /// The friction figure's μ axis: the curve, its band and the truth over the measured range, with
@@ -1069,6 +1117,29 @@ mod tests {
         ] {
             assert!(svg.contains(label), "no {label:?} in the figure");
         }
+        // A rig curve: its points in the legend, each with a whisker and two caps.
+        let lines = |svg: &str| svg.matches("<polyline").count();
+        let before = lines(&svg);
+        let point = |v: f64, mu: f64| crate::likelihood::prior::RigPointReport {
+            speed_m_per_s: v,
+            coefficient: mu,
+            sd: 0.02,
+            mu_d_fit: LAW.mu_slip(v),
+            z: 0.0,
+        };
+        r.priors = Some(crate::likelihood::prior::PriorsReport {
+            nats_at_fit: 0.0,
+            parameters: Vec::new(),
+            friction_curve: Some(crate::likelihood::prior::RigCurveReport {
+                file: "data/rig.csv".into(),
+                points: vec![point(0.03, 0.75), point(0.06, 0.6)],
+            }),
+        });
+        friction_law_figure(dir.path(), &r, &LAW, Some(0.167)).unwrap();
+        let svg = std::fs::read_to_string(dir.path().join("friction_law.svg")).unwrap();
+        assert!(svg.contains("rig curve μ ± 1σ, the prior on μ_d (rig.csv)"));
+        assert_eq!(lines(&svg), before + 6, "two whiskers, four caps");
+        r.priors = None;
         r.parameters.clear();
         r.friction_curve = FrictionCurve::new(LAW, &speeds, None, None);
         friction_law_figure(dir.path(), &r, &LAW, None).unwrap();

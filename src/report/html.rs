@@ -684,6 +684,84 @@ struct PageView<'a> {
     signal: Option<SignalView>,
     fit_settings: Option<String>,
     settings: &'a str,
+    /// `[fit.priors]` beside the fit, when the job gave any.
+    priors: Option<PriorsView>,
+}
+
+/// The priors' section: each parameter prior beside the fit, and the rig curve's points.
+#[derive(Serialize)]
+struct PriorsView {
+    nats: String,
+    parameters: Vec<PriorRow>,
+    rig_file: String,
+    rig: Vec<RigRow>,
+}
+
+#[derive(Serialize)]
+struct PriorRow {
+    name: String,
+    meaning: &'static str,
+    prior: String,
+    prior_interval: String,
+    value: String,
+    interval: String,
+    z: String,
+}
+
+#[derive(Serialize)]
+struct RigRow {
+    speed: String,
+    coefficient: String,
+    sd: String,
+    mu_d: String,
+    z: String,
+}
+
+/// The result's priors as the page shows them.
+fn priors_view(r: &FitResult) -> Option<PriorsView> {
+    use crate::job::ParamPrior;
+    let p = r.priors.as_ref()?;
+    let pair = |[lo, hi]: [f64; 2]| format!("[{}, {}]", num(lo, 4), num(hi, 4));
+    let parameters = (p.parameters.iter())
+        .map(|q| PriorRow {
+            name: q.name.to_string(),
+            meaning: q.name.meaning(),
+            prior: match q.prior {
+                ParamPrior::Normal { mean, sd } => {
+                    format!("normal, mean {}, sd {}", num(mean, 4), num(sd, 3))
+                }
+                ParamPrior::Lognormal { median, sd_log } => {
+                    format!(
+                        "log-normal, median {}, sd_log {}",
+                        num(median, 4),
+                        num(sd_log, 3)
+                    )
+                }
+            },
+            prior_interval: pair(q.prior_interval),
+            value: num(q.value, 4),
+            interval: q.interval.map_or_else(|| "—".into(), pair),
+            z: num(q.z, 3),
+        })
+        .collect();
+    let curve = p.friction_curve.as_ref();
+    Some(PriorsView {
+        nats: num(p.nats_at_fit, 4),
+        parameters,
+        rig_file: curve.map_or_else(String::new, |c| c.file.display().to_string()),
+        rig: curve.map_or_else(Vec::new, |c| {
+            c.points
+                .iter()
+                .map(|q| RigRow {
+                    speed: num(q.speed_m_per_s, 4),
+                    coefficient: num(q.coefficient, 4),
+                    sd: num(q.sd, 3),
+                    mu_d: num(q.mu_d_fit, 4),
+                    z: num(q.z, 3),
+                })
+                .collect()
+        }),
+    })
 }
 
 /// The settings part of the view: bands, signal and fit settings as the result records them.
@@ -789,6 +867,7 @@ fn page_view<'a>(
         signal,
         fit_settings,
         settings: &r.settings,
+        priors: priors_view(r),
     }
 }
 
@@ -1273,6 +1352,63 @@ pub(super) mod tests {
             ),
             "{html}"
         );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// A result with priors shows each prior beside the fitted value and interval, and the rig
+    /// curve's points beside the fitted μ_d, in the priors section.
+    #[test]
+    fn priors_are_shown_beside_the_fit() {
+        use crate::likelihood::prior::{
+            ParamPriorReport, PriorsReport, RigCurveReport, RigPointReport,
+        };
+        let dir = std::env::temp_dir().join(format!("wiperlab_html_prior_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut r = result();
+        r.priors = Some(PriorsReport {
+            nats_at_fit: 1.25,
+            parameters: vec![ParamPriorReport {
+                name: crate::model::ParamId::ThetaC,
+                prior: crate::job::ParamPrior::Normal {
+                    mean: 0.08,
+                    sd: 0.01,
+                },
+                prior_interval: [0.07, 0.09],
+                value: 0.085,
+                interval: Some([0.08, 0.09]),
+                z: 0.5,
+            }],
+            friction_curve: Some(RigCurveReport {
+                file: "rig.csv".into(),
+                points: vec![RigPointReport {
+                    speed_m_per_s: 0.075,
+                    coefficient: 0.17,
+                    sd: 0.008,
+                    mu_d_fit: 0.18,
+                    z: 1.25,
+                }],
+            }),
+        });
+        let paths = ReportPaths {
+            job: dir.join("job.toml"),
+            result: dir.join("unit.result.toml"),
+            recording: dir.join("rec.csv"),
+            dir: dir.clone(),
+        };
+        let html = std::fs::read_to_string(write_report(&r, &paths).unwrap().path).unwrap();
+        for row in [
+            "here 1.250 nats at the fit",
+            "<td class=\"l\">normal, mean 0.08000, sd 0.0100</td><td>[0.07000, 0.09000]</td>\
+             <td>0.08500</td><td>[0.08000, 0.09000]</td><td>0.500</td>",
+            "<code>rig.csv</code>",
+            "<tr><td>0.07500</td><td>0.1700</td><td>0.00800</td><td>0.1800</td><td>1.25</td></tr>",
+        ] {
+            assert!(html.contains(row), "no {row:?} in {html}");
+        }
+        r.priors = None;
+        let html = std::fs::read_to_string(write_report(&r, &paths).unwrap().path).unwrap();
+        assert!(!html.contains("id=\"priors\""));
         std::fs::remove_dir_all(&dir).ok();
     }
 

@@ -157,6 +157,19 @@ pub struct ChartOpts {
     pub spans: Vec<Span>,
     /// Shaded areas between two curves, each with a legend entry: e.g. a fitted curve's ±1σ.
     pub bands: Vec<Band>,
+    /// Vertical ±1σ whiskers at points, over the data.
+    pub error_bars: Vec<ErrorBars>,
+}
+
+/// Vertical whiskers from `y − sd` to `y + sd` at each `x`, capped, in series number `series`'s
+/// colour on a [`line_chart`]: that series (of style points) draws the points and names them in
+/// the legend. Points where `x`, `y` or `sd` is not finite are left out.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ErrorBars {
+    pub x: Vec<f64>,
+    pub y: Vec<f64>,
+    pub sd: Vec<f64>,
+    pub series: usize,
 }
 
 /// The area between `lo` and `hi` over `x` shaded on a [`line_chart`] in a light tint of series
@@ -745,6 +758,7 @@ fn draw_xy(
     for (i, s) in series.iter().enumerate() {
         draw_one_series(&mut chart, plane, i, s)?;
     }
+    draw_error_bars(&mut chart, plane, &opts.error_bars)?;
     draw_vlines(&mut chart, plane, &opts.vlines)?;
     draw_markers(&mut chart, plane, &opts.markers)?;
     Ok(place_labels(&chart, plane, series, &opts.markers))
@@ -830,6 +844,33 @@ fn draw_one_series(chart: &mut XyChart<'_, '_>, plane: Plane, i: usize, s: &Seri
         )
         .collect();
     chart.draw_series(elems)?;
+    Ok(())
+}
+
+/// The error bars' whiskers and caps inside the x range, each end held inside the plotting box.
+fn draw_error_bars(chart: &mut XyChart<'_, '_>, plane: Plane, bars: &[ErrorBars]) -> DrawResult {
+    let Plane { ax, ay, bx, by } = plane;
+    let cap = 0.006 * (bx.1 - bx.0);
+    for b in bars {
+        let style = series_colour(b.series).stroke_width(px(2));
+        for ((&x, &y), &sd) in b.x.iter().zip(&b.y).zip(&b.sd) {
+            let (lo, hi) = (y - sd, y + sd);
+            if !(ax.valid(x) && ay.valid(lo) && ay.valid(hi)) {
+                continue;
+            }
+            let xp = ax.fwd(x);
+            if xp < bx.0 || xp > bx.1 {
+                continue;
+            }
+            let [l, h] = [lo, hi].map(|v| ay.fwd(v).clamp(by.0, by.1));
+            let segments = [
+                vec![(xp, l), (xp, h)],
+                vec![(xp - cap, l), (xp + cap, l)],
+                vec![(xp - cap, h), (xp + cap, h)],
+            ];
+            chart.draw_series(segments.into_iter().map(|s| PathElement::new(s, style)))?;
+        }
+    }
     Ok(())
 }
 
