@@ -237,6 +237,10 @@ fn a_jobs_priors_enter_the_cost_and_the_curvature() {
     );
     let job = main_job_with(dir.path(), &priors);
     assert_eq!(job.rig_curve.as_ref().unwrap().points.len(), 3);
+    // The settings the result records read back the same.
+    let text = toml::to_string_pretty(&job.job.fit).unwrap();
+    let back: wiperlab::job::FitSection = toml::from_str(&text).unwrap();
+    assert_eq!(back, job.job.fit, "{text}");
     let cands = job.candidates();
     let shoulder = *cands.iter().find(|c| c.shoulder).unwrap();
     let blade = *cands.iter().find(|c| c.name() == "blade2dof").unwrap();
