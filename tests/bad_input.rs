@@ -735,6 +735,47 @@ fn fit_cases() -> Vec<Case> {
             ],
         ),
         case(
+            "fit: an unknown friction law in [fit] laws",
+            j(&[(
+                "\nmodels = [",
+                "\nlaws = [\"exponential\", \"stribek\"]\nmodels = [",
+            )]),
+            fit,
+            &[
+                "$D/job.toml:",
+                "[fit] laws",
+                "'stribek'",
+                "known: exponential, exponential_viscous, stribeck",
+            ],
+        ),
+        case(
+            "fit: a friction parameter no law in [fit] laws has",
+            j(&[
+                (
+                    "\nmodels = [",
+                    "\nlaws = [\"exponential\", \"exponential_viscous\"]\nmodels = [",
+                ),
+                ("C = [0.1, 1.0]", "C = [0.1, 1.0]\ndelta = [0.5, 2.0]"),
+            ]),
+            fit,
+            &[
+                "$D/job.toml:",
+                "'delta'",
+                "[fit] laws",
+                "exponential_viscous (A, B, C, D)",
+                "law \"stribeck\"",
+            ],
+        ),
+        case(
+            "fit: a law named in [fit] models instead of [fit] laws",
+            j(&[(
+                "\"blade2dof\", \"blade2dof+shoulder\"]",
+                "\"blade2dof@stribeck\"]",
+            )]),
+            fit,
+            &["$D/job.toml:", "blade2dof@stribeck", "[fit] laws"],
+        ),
+        case(
             "fit: lip mass freed beside the k1 it holds",
             j(&[("C = [0.1, 1.0]", "C = [0.1, 1.0]\nlip_mass = [1e-4, 1e-3]")]),
             fit,

@@ -110,7 +110,8 @@ keys = {{ k1 = "/k1", k1c = "/k1c", theta_c = "/theta_c" }}
         out.result.model,
         wiperlab::job::Candidate {
             kind: wiperlab::simulate::blade::ModelKind::Blade2dof,
-            shoulder: true
+            shoulder: true,
+            law: None,
         }
     );
     let k1c_fit = out

@@ -121,6 +121,7 @@ pub fn explored_candidate(job: &LoadedJob) -> Candidate {
     job.job.fit.models.first().copied().unwrap_or(Candidate {
         kind: smallest_capable_model(&job.job.spectrum.bands),
         shoulder: false,
+        law: None,
     })
 }
 

@@ -278,6 +278,10 @@ pub struct ModelTrial {
     /// The trial in likelihood units (absent for a target job, which has no likelihood).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub evidence: Option<TrialEvidence>,
+    /// The friction law at the trial's optimum: its name (`law`) and every coefficient, fitted or
+    /// held at the blade file's value (absent in results written before it was kept).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<crate::model::FrictionLaw>,
 }
 
 /// One candidate's fit in likelihood units ([`crate::fit::evidence`], docs/fit.md, "Likelihood").
@@ -334,6 +338,7 @@ fn default_model() -> Candidate {
     Candidate {
         kind: ModelKind::Blade2dof,
         shoulder: false,
+        law: None,
     }
 }
 
@@ -529,7 +534,7 @@ mod tests {
 
     fn sample_trial() -> ModelTrial {
         ModelTrial {
-            model: "head1dof".parse().unwrap(),
+            model: "head1dof@exponential_viscous".parse().unwrap(),
             parameters: vec![ParamId::K0],
             cost: 3.0,
             wall_time_s: 0.1,
@@ -556,6 +561,12 @@ mod tests {
                     df: 2,
                     p_value: 0.78,
                 }),
+            }),
+            friction: Some(crate::model::FrictionLaw::ExponentialViscous {
+                a: 0.8,
+                b_s_per_m: 70.0,
+                c: 0.56,
+                d_s_per_m: 0.36,
             }),
         }
     }

@@ -102,7 +102,7 @@ pub(super) fn scan_contact_angle(
         let c = fits[i].candidate;
         let Some(s) = fits
             .iter()
-            .position(|f| c.shoulder && !f.candidate.shoulder && f.candidate.kind == c.kind)
+            .position(|f| c.shoulder && !f.candidate.shoulder && c.extends(&f.candidate))
         else {
             continue;
         };

@@ -274,13 +274,11 @@ pub(super) fn progress_bar(job: &LoadedJob, candidates: &[Candidate]) -> indicat
     let fit = &job.job.fit;
     let mut budget = 0u64;
     for (i, c) in candidates.iter().enumerate() {
-        let n = job.free.len() + if c.shoulder { 2 } else { 0 };
+        let n = job.freed(*c).map_or(job.free.len(), |(_, free)| free.len());
         // The curvature's stencil, or the likelihood's settling steps and its Fisher information.
         let hess_evals = (1 + 2 * n + 2 * n * n.saturating_sub(1))
             .max(super::evidence::settle_evaluations(n)) as u64;
-        let nested = candidates[..i]
-            .iter()
-            .any(|f| c.shoulder && f.kind == c.kind && !f.shoulder);
+        let nested = candidates[..i].iter().any(|f| c.extends(f));
         let adaptive = nested
             && fit.nested_search == job::NestedSearch::Adaptive
             && fit.objective == job::Objective::Likelihood
@@ -333,12 +331,8 @@ pub(super) fn fit_candidates(
 ) -> Result<Vec<CandidateFit>> {
     let mut fits: Vec<CandidateFit> = Vec::new();
     for (i, c) in candidates.iter().enumerate() {
-        let nested = fits
-            .iter()
-            .find(|f| c.shoulder && f.candidate.kind == c.kind && !f.candidate.shoulder);
-        let base_of_later = candidates[i + 1..]
-            .iter()
-            .any(|l| l.shoulder && l.kind == c.kind && !c.shoulder);
+        let nested = fits.iter().find(|f| c.extends(&f.candidate));
+        let base_of_later = candidates[i + 1..].iter().any(|l| l.extends(c));
         let confirmation = if candidates.len() > 1 && !base_of_later {
             Confirmation::Deferred
         } else {
@@ -508,11 +502,13 @@ pub(super) fn fit_candidate(
     reporting.stage(format_args!("swarm"));
     let (main, free) = build_problem(job, meas, candidate)?;
     let problem = Arc::new(main);
-    let warm = nested.map_or_else(Vec::new, |smaller| nested_warm_points(smaller, &free));
+    let warm = nested.map_or_else(Vec::new, |smaller| {
+        nested_warm_points(smaller, candidate, &free)
+    });
     let (found, search_note) = search(
         job,
         &problem,
-        nested.map(|s| s.search_cost),
+        nested.map(|s| (s.search_cost, candidate.nested_phrase(&s.candidate))),
         &warm,
         &reporting,
         confirmation,
@@ -701,13 +697,15 @@ fn keep_nested_above(
     pb: &Option<indicatif::ProgressBar>,
 ) -> Result<()> {
     for i in 0..fits.len() {
-        let (s, l) = (&fits[smaller].candidate, &fits[i].candidate);
-        if !(l.shoulder && !s.shoulder && l.kind == s.kind) {
+        if !fits[i].candidate.extends(&fits[smaller].candidate) {
             continue;
         }
         let larger = fits.remove(i);
         let small = &fits[if smaller < i { smaller } else { smaller - 1 }];
-        let Some(warm) = nested_warm_points(small, &larger.free).into_iter().next() else {
+        let Some(warm) = nested_warm_points(small, larger.candidate, &larger.free)
+            .into_iter()
+            .next()
+        else {
             fits.insert(i, larger);
             continue;
         };
@@ -750,9 +748,10 @@ fn keep_the_smaller_optimum(
         unconfirmed_ends: None,
     };
     let kept = format!(
-        "its settled optimum ({:.3} nats) was less likely than the model without shoulder's, so \
-         it keeps that model's optimum ({at_warm:.3} nats)",
-        fit.cost
+        "its settled optimum ({:.3} nats) was less likely than {}'s, so it keeps that model's \
+         optimum ({at_warm:.3} nats)",
+        fit.cost,
+        fit.candidate.nested_phrase(&smaller.candidate)
     );
     add_note(note, kept);
     let mut kept_fit = finish(
@@ -961,11 +960,11 @@ pub(super) fn confirm_deferred(
 /// The search of one candidate: [`nested_search`] for a nested candidate searched adaptively (a
 /// likelihood to gauge the local gain by), else [`optimise`]'s restarts. Returns [`optimise`]'s
 /// tuple and the nested search's note. `nested`: the cost where the smaller model's search ended,
-/// for a nested candidate.
+/// and how the reasons name that model, for a nested candidate.
 fn search(
     job: &LoadedJob,
     problem: &Arc<SpectralProblem>,
-    nested: Option<f64>,
+    nested: Option<(f64, String)>,
     warm: &[Vec<f64>],
     reporting: &Reporting,
     confirmation: Confirmation,
@@ -1006,8 +1005,8 @@ pub const NESTED_GLOBAL_GAIN_NATS: f64 = 0.1;
 /// The adaptive search of a nested candidate: Nelder–Mead polishes from each of `warm` (in
 /// parallel), then [`optimise`]'s global search only when the best of them lowers the cost (the
 /// recording's NLL, nats) by more than [`NESTED_GLOBAL_GAIN_NATS`] below the first warm point (the
-/// smaller model's optimum) or below `smaller_search_cost`, where the smaller model's own search
-/// ended, whichever is lower. The warm point is the smaller model's settled optimum, at the centre
+/// smaller model's optimum) or below the cost in `smaller`, where the smaller model's own search
+/// ended, whichever is lower (its phrase names that model in the note). The warm point is the smaller model's settled optimum, at the centre
 /// of the likelihood's bowl, where a polish descends by a ripple's depth (about 0.05–0.1 nats on the
 /// main job) without any help from the shoulder; the gain is therefore read polish end against
 /// polish end. Returns [`optimise`]'s tuple and a note for the model-choice reason.
@@ -1015,14 +1014,16 @@ fn nested_search(
     problem: &Arc<SpectralProblem>,
     fit: &job::FitSection,
     warm: &[Vec<f64>],
-    smaller_search_cost: Option<f64>,
+    smaller: Option<(f64, String)>,
     reporting: &Reporting,
     confirmation: Confirmation,
 ) -> Result<(Optimised, Option<String>)> {
     use rayon::prelude::*;
     reporting.stage(format_args!("local search"));
     let at_warm = warm.first().map_or(f64::INFINITY, |w| problem.cost_at(w));
-    let base = at_warm.min(smaller_search_cost.unwrap_or(f64::INFINITY));
+    let (smaller_search_cost, smaller) =
+        smaller.unwrap_or((f64::INFINITY, "the smaller model".into()));
+    let base = at_warm.min(smaller_search_cost);
     let observer = |r: usize| SearchObserver {
         stage: SearchStage::Polish,
         restart: r,
@@ -1059,8 +1060,7 @@ fn nested_search(
     let gain = base - cost;
     if gain <= NESTED_GLOBAL_GAIN_NATS || interrupt::stop_requested() {
         let note = format!(
-            "local search only: it ended {gain:.3} nats below the model without shoulder's \
-             search, not more than {NESTED_GLOBAL_GAIN_NATS} nats: its extra parameters do \
+            "local search only: it ended {gain:.3} nats below {smaller}'s search, not more than {NESTED_GLOBAL_GAIN_NATS} nats: its extra parameters do \
              nothing near that model's optimum, so no global search"
         );
         let found = Optimised {
@@ -1077,8 +1077,8 @@ fn nested_search(
     }
     let mut global = optimise(problem, fit, fit.seed, warm, Some(reporting), confirmation)?;
     let note = format!(
-        "global search: the local search ended {gain:.3} nats below the model without \
-         shoulder's search (> {NESTED_GLOBAL_GAIN_NATS})"
+        "global search: the local search ended {gain:.3} nats below {smaller}'s search (> \
+         {NESTED_GLOBAL_GAIN_NATS})"
     );
     global.polish_iters += polish_iters;
     if cost <= global.cost {
@@ -1101,8 +1101,18 @@ fn nested_search(
 /// `(k1_contact − k1)·θ_c` matters, any free k1 moves the neck alike while θ_c is small). Without
 /// it the global search on the confusion table's neck resting on a shoulder (0.025 rad) stops
 /// short of the truth's likelihood and chooses blade2dof; with it the shoulder model is chosen.
-fn nested_warm_points(smaller: &CandidateFit, free: &[FreeParam]) -> Vec<Vec<f64>> {
-    let params = smaller.problem.params_at(&smaller.best_u);
+///
+/// A candidate nested by its law (`X@exponential` in `X@exponential_viscous` or `X@stribeck`)
+/// starts from the one point where its law is `X`'s: D = 0, or δ = 1 with v_s = 1/B.
+fn nested_warm_points(
+    smaller: &CandidateFit,
+    larger: Candidate,
+    free: &[FreeParam],
+) -> Vec<Vec<f64>> {
+    let mut params = smaller.problem.params_at(&smaller.best_u);
+    if let Some(f) = larger.law.and_then(|l| params.friction.as_kind(l)) {
+        params.friction = f;
+    }
     let first: Vec<f64> = free
         .iter()
         .map(|fp| {
@@ -1129,6 +1139,9 @@ fn nested_warm_points(smaller: &CandidateFit, free: &[FreeParam]) -> Vec<Vec<f64
         })
         .collect();
     let mut points = vec![first.clone()];
+    if smaller.candidate.shoulder {
+        return points;
+    }
     let (Some(i), Some(abs_theta)) = (
         free.iter().position(|fp| fp.name == ParamId::ThetaC),
         sorted_abs_theta(smaller),

@@ -68,20 +68,8 @@ fn evidences(fits: &[CandidateFit]) -> Option<Vec<Option<Evidence>>> {
 pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) -> Selection {
     let evidence = evidences(fits);
     let (aics, scores) = criteria(fits, bands, evidence.as_deref());
-    let best = (0..fits.len())
-        .min_by(|&a, &b| scores[a].total_cmp(&scores[b]))
-        .unwrap_or(0);
-    let near = |i: usize| {
-        evidence.is_some()
-            && scores[i].is_finite()
-            && scores[i] - scores[best] <= INDISTINGUISHABLE_TIC
-    };
-    let chosen = (0..fits.len())
-        .filter(|&i| near(i))
-        .min_by(|&a, &b| {
-            (fits[a].free.len().cmp(&fits[b].free.len())).then(scores[a].total_cmp(&scores[b]))
-        })
-        .unwrap_or(best);
+    let ks: Vec<usize> = fits.iter().map(|f| f.free.len()).collect();
+    let chosen = simplest_near_best(&scores, &ks, evidence.is_some());
     let scored = Scored {
         aics: &aics,
         scores: &scores,
@@ -104,9 +92,27 @@ pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) ->
                 None => scored.reason(fits, i, bands, listed),
             },
             evidence: scored.trial_evidence(fits, i),
+            friction: Some(f.problem.params_at(&f.best_u).friction),
         })
         .collect();
     Selection { chosen, trials }
+}
+
+/// The candidate [`choose`] reports from `scores` (TIC, +∞ where it cannot be chosen) and `ks`
+/// (freed parameters): the one with the fewest parameters among those within
+/// [`INDISTINGUISHABLE_TIC`] of the lowest score (the lower score between equals), or the lowest
+/// when the scores are not in likelihood units (`likelihood` false).
+fn simplest_near_best(scores: &[f64], ks: &[usize], likelihood: bool) -> usize {
+    let best = (0..scores.len())
+        .min_by(|&a, &b| scores[a].total_cmp(&scores[b]))
+        .unwrap_or(0);
+    let near = |i: usize| {
+        likelihood && scores[i].is_finite() && scores[i] - scores[best] <= INDISTINGUISHABLE_TIC
+    };
+    (0..scores.len())
+        .filter(|&i| near(i))
+        .min_by(|&a, &b| ks[a].cmp(&ks[b]).then(scores[a].total_cmp(&scores[b])))
+        .unwrap_or(best)
 }
 
 /// How far each candidate's score (the TIC [`choose`] chooses by) lies above the lowest, as
@@ -173,16 +179,12 @@ impl Scored<'_> {
         self.evidence.and_then(|e| e[i])
     }
 
-    /// The likelihood-ratio test of candidate `i` against the candidate it nests (`X` for
-    /// `X+shoulder`), when both have evidence.
+    /// The likelihood-ratio test of candidate `i` against the first candidate it nests
+    /// ([`Candidate::extends`]: `X` for `X+shoulder`, `X@exponential` for
+    /// `X@exponential_viscous`), when both have evidence.
     fn ratio_test(&self, fits: &[CandidateFit], i: usize) -> Option<RatioTest> {
         let c = fits[i].candidate;
-        if !c.shoulder {
-            return None;
-        }
-        let j = fits
-            .iter()
-            .position(|f| f.candidate.kind == c.kind && !f.candidate.shoulder)?;
+        let j = fits.iter().position(|f| c.extends(&f.candidate))?;
         let t = likelihood::likelihood_ratio_test(&self.of(j)?, &self.of(i)?).ok()?;
         Some(RatioTest {
             against: fits[j].candidate,
@@ -257,6 +259,16 @@ impl Scored<'_> {
                     )
                 })
                 .unwrap_or_default();
+            if next < self.scores[i] {
+                return format!(
+                    "{} = {:.2} ({lnl}k = {k}), {:.2} above the lowest, within \
+                     {INDISTINGUISHABLE_TIC}: the candidates there are not distinguishable by this \
+                     recording, and this one has the fewest parameters{lrt}",
+                    self.criterion(),
+                    self.scores[i],
+                    self.scores[i] - next
+                );
+            }
             return if next.is_finite() {
                 format!(
                     "lowest {} = {:.2} ({lnl}k = {k}); next best {next:.2}{lrt}",
@@ -399,6 +411,33 @@ mod tests {
     use super::*;
     use crate::simulate::blade::ModelKind;
 
+    /// The choice among friction laws: `X@exponential` (k = 4) against `X@exponential_viscous`
+    /// (k = 5, D freed). The viscous law contains the exponential one (D = 0), so its NLL is at
+    /// most the smaller's; its TIC wins only by more than [`INDISTINGUISHABLE_TIC`]: 1.5 lower is
+    /// not distinguishable and the exponential law (fewer parameters) is reported, 2.5 lower
+    /// chooses the viscous law. A candidate that cannot be chosen (+∞) never is, and without a
+    /// likelihood the lowest score wins whatever its parameters.
+    #[test]
+    fn a_law_within_the_margin_of_the_best_gives_way_to_the_simpler() {
+        let ks = [4, 5];
+        assert_eq!(simplest_near_best(&[100.0, 98.5], &ks, true), 0);
+        assert_eq!(simplest_near_best(&[100.0, 98.0], &ks, true), 0);
+        assert_eq!(simplest_near_best(&[100.0, 97.5], &ks, true), 1);
+        assert_eq!(simplest_near_best(&[97.0, 100.0], &ks, true), 0);
+        assert_eq!(simplest_near_best(&[100.0, 98.5], &ks, false), 1);
+        // Stribeck (k = 6) beside them: the two within 2 of the best, the fewest parameters.
+        assert_eq!(
+            simplest_near_best(&[103.0, 101.5, 100.0], &[4, 5, 6], true),
+            1
+        );
+        assert_eq!(
+            simplest_near_best(&[f64::INFINITY, 101.0, 100.0], &[4, 5, 6], true),
+            1
+        );
+        // Equal parameter counts: the lower TIC.
+        assert_eq!(simplest_near_best(&[100.0, 99.0], &[5, 5], true), 1);
+    }
+
     /// A shoulder chosen over its shoulder-free model on a failed test is said; a passed test, a
     /// shoulder-free choice or a job without the nested candidate says nothing.
     #[test]
@@ -406,6 +445,7 @@ mod tests {
         let free = Candidate {
             kind: ModelKind::Blade2dof,
             shoulder: false,
+            law: None,
         };
         let shoulder = Candidate {
             shoulder: true,

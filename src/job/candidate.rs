@@ -1,6 +1,7 @@
 //! The model hierarchy a fit chooses from: candidates ([`Candidate`]) and which bands each can
 //! produce.
 
+use crate::model::LawKind;
 use crate::simulate::blade::ModelKind;
 use crate::spectrum::features::BandSpec;
 use serde::Serialize;
@@ -11,15 +12,19 @@ use serde::Serialize;
 /// and ~900 Hz; free neck 195 Hz).
 pub const NECK_BAND_MIN_HZ: f64 = 150.0;
 
-/// One candidate of the model hierarchy: a model kind, with or without shoulder contact.
+/// One candidate of the model hierarchy: a model kind, with or without shoulder contact, and the
+/// friction law it is fitted with.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Candidate {
     pub kind: ModelKind,
     pub shoulder: bool,
+    /// The friction law when the job compares laws (`[fit] laws`); `None`: the blade file's law.
+    pub law: Option<LawKind>,
 }
 
 impl Candidate {
-    /// Every candidate a job may list, smallest first.
+    /// Every model a job may list in `[fit] models`, smallest first, each with the blade file's
+    /// law.
     pub fn all() -> Vec<Candidate> {
         ModelKind::ALL
             .iter()
@@ -29,16 +34,55 @@ impl Candidate {
                 } else {
                     &[false]
                 };
-                shoulders
-                    .iter()
-                    .map(move |&shoulder| Candidate { kind, shoulder })
+                shoulders.iter().map(move |&shoulder| Candidate {
+                    kind,
+                    shoulder,
+                    law: None,
+                })
             })
             .collect()
     }
 
-    /// The name used in jobs and reports: the model's name, with `+shoulder` when it has one.
+    /// The name used in jobs and reports: the model's name, with `+shoulder` when it has one and
+    /// `@<law>` when the job compares friction laws (`blade2dof+shoulder@exponential_viscous`).
     pub fn name(&self) -> String {
         self.to_string()
+    }
+
+    /// Every candidate the job's `models` and `laws` make: each model with each law (models in
+    /// their order, laws nested first: [`LawKind`]'s order), or the models as they are when
+    /// `laws` is empty (each with the blade file's law).
+    pub fn with_laws(models: &[Candidate], laws: &[LawKind]) -> Vec<Candidate> {
+        if laws.is_empty() {
+            return models.to_vec();
+        }
+        let mut laws = laws.to_vec();
+        laws.sort();
+        laws.dedup();
+        models
+            .iter()
+            .flat_map(|m| {
+                laws.iter().map(move |&law| Candidate {
+                    law: Some(law),
+                    ..*m
+                })
+            })
+            .collect()
+    }
+
+    /// Whether this candidate contains `smaller` as a special case, one step up the hierarchy:
+    /// the same model and law with the shoulder added, or the same model and shoulder with a law
+    /// that contains the smaller one's ([`LawKind::contains`]). The smaller model's optimum is then
+    /// a point of this one's parameter space (the shoulder above every angle the neck reaches,
+    /// D = 0, δ = 1 with v_s = 1/B), where its search starts and which its fit cannot end below.
+    pub fn extends(&self, smaller: &Candidate) -> bool {
+        if self.kind != smaller.kind {
+            return false;
+        }
+        let shoulder_added = self.shoulder && !smaller.shoulder && self.law == smaller.law;
+        let law_widened = self.shoulder == smaller.shoulder
+            && matches!((self.law, smaller.law), (Some(l), Some(s)) if l.contains(s));
+        shoulder_added || law_widened
     }
 
     /// Whether this candidate takes one of `bands` from the recording's head track (the neck/lip
@@ -76,8 +120,23 @@ impl Candidate {
     }
 }
 
+impl Candidate {
+    /// How reasons name `smaller`, a candidate this one [extends](Candidate::extends): "the model
+    /// without shoulder" when this one adds the shoulder, else its name.
+    pub fn nested_phrase(&self, smaller: &Candidate) -> String {
+        if self.shoulder && !smaller.shoulder {
+            "the model without shoulder".into()
+        } else {
+            smaller.to_string()
+        }
+    }
+}
+
 /// Suffix of a candidate's name that adds shoulder contact.
 pub(super) const SHOULDER_SUFFIX: &str = "+shoulder";
+
+/// What separates a candidate's model from its friction law in its name.
+pub const LAW_SEPARATOR: char = '@';
 
 impl std::fmt::Display for Candidate {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -85,24 +144,33 @@ impl std::fmt::Display for Candidate {
         if self.shoulder {
             f.write_str(SHOULDER_SUFFIX)?;
         }
+        if let Some(law) = self.law {
+            write!(f, "{LAW_SEPARATOR}{law}")?;
+        }
         Ok(())
     }
 }
 
 impl std::str::FromStr for Candidate {
     type Err = crate::names::UnknownName;
-    /// Parses a model name with an optional `+shoulder` (the head model has no shoulder).
+    /// Parses a model name with an optional `+shoulder` (the head model has no shoulder) and an
+    /// optional `@<law>`.
     fn from_str(name: &str) -> std::result::Result<Self, Self::Err> {
-        let (base, shoulder) = match name.strip_suffix(SHOULDER_SUFFIX) {
+        let (model, law) = match name.split_once(LAW_SEPARATOR) {
+            Some((model, law)) => (model, Some(law.parse::<LawKind>()?)),
+            None => (name, None),
+        };
+        let (base, shoulder) = match model.strip_suffix(SHOULDER_SUFFIX) {
             Some(base) => (base, true),
-            None => (name, false),
+            None => (model, false),
         };
         Candidate::all()
             .into_iter()
             .find(|c| c.shoulder == shoulder && c.kind.name() == base)
+            .map(|c| Candidate { law, ..c })
             .ok_or_else(|| crate::names::UnknownName {
                 kind: "model",
-                given: name.to_string(),
+                given: model.to_string(),
                 known: Candidate::all()
                     .iter()
                     .map(|c| c.to_string())
@@ -141,6 +209,7 @@ pub fn smallest_capable_model(bands: &[BandSpec]) -> ModelKind {
             Candidate {
                 kind,
                 shoulder: false,
+                law: None,
             }
             .cannot_produce(bands)
             .is_none()

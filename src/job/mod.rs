@@ -7,6 +7,7 @@
 mod candidate;
 mod error;
 mod free;
+pub mod laws;
 pub mod prior;
 pub mod rig;
 pub mod template;
@@ -18,7 +19,7 @@ pub use prior::{FrictionCurvePrior, ParamPrior, PriorsSection};
 pub use rig::{RigCurve, RigPoint};
 
 use crate::import::ImportSpec;
-use crate::model::{BladeParams, FrictionLaw, ParamId};
+use crate::model::{BladeParams, FrictionLaw, LawKind, ParamId};
 use crate::simulate::SolverOptions;
 use crate::spectrum::features::{BandSpec, SignalKind, default_bands};
 use crate::{Error, Result};
@@ -236,6 +237,15 @@ pub struct FitSection {
     /// fitted and the one with the lowest Akaike criterion (cost + 2k) is reported.
     #[serde(default)]
     pub models: Vec<Candidate>,
+    /// Friction laws compared as candidates ([`LawKind`]; docs/fit.md, "Which friction law"):
+    /// each model of `models` is fitted with each law and all are ranked together. Empty (the
+    /// default): the blade file's law only.
+    #[serde(
+        default,
+        skip_serializing_if = "Vec::is_empty",
+        deserialize_with = "d_laws"
+    )]
+    pub laws: Vec<LawKind>,
     /// Bounds of the shoulder-contact parameters freed by the `+shoulder` candidates.
     #[serde(default)]
     pub shoulder: Option<ShoulderBounds>,
@@ -502,6 +512,17 @@ pub struct ShoulderBounds {
     pub theta_c: [f64; 2],
 }
 
+/// `[fit] laws`: law names, an unknown one refused with the key and the known laws.
+fn d_laws<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Vec<LawKind>, D::Error> {
+    Vec::<String>::deserialize(d)?
+        .iter()
+        .map(|n| {
+            n.parse()
+                .map_err(|e| serde::de::Error::custom(format!("[fit] laws: {e}")))
+        })
+        .collect()
+}
+
 fn d_particles() -> usize {
     12
 }
@@ -747,30 +768,42 @@ impl LoadedJob {
         any.then_some(p.friction)
     }
 
-    /// The candidates the job asks for, or the smallest model capable of its bands.
+    /// The candidates the job asks for, or the smallest model capable of its bands, each with
+    /// each of `[fit] laws` ([`Candidate::with_laws`]).
     pub fn candidates(&self) -> Vec<Candidate> {
-        if self.job.fit.models.is_empty() {
+        let models = if self.job.fit.models.is_empty() {
             vec![Candidate {
                 kind: smallest_capable_model(&self.job.spectrum.bands),
                 shoulder: false,
+                law: None,
             }]
         } else {
             self.job.fit.models.clone()
-        }
+        };
+        Candidate::with_laws(&models, &self.job.fit.laws)
     }
 
     /// The base parameters and the freed ones of `candidate`: the job's, and for a shoulder candidate
-    /// the shoulder's two, started at the middle of their `[fit.shoulder]` bounds.
+    /// the shoulder's two, started at the middle of their `[fit.shoulder]` bounds. With a law
+    /// ([`Candidate::law`]), the blade's law written as that law and the law's coefficients
+    /// ([`laws::law_free`]).
     ///
     /// # Errors
     /// [`JobError::ShoulderBounds`] for a shoulder candidate without `[fit.shoulder]` bounds.
     pub fn freed(&self, candidate: Candidate) -> Result<(BladeParams, Vec<FreeParam>)> {
         let mut base = self.blade;
-        let mut free: Vec<FreeParam> = self
-            .free
-            .iter()
-            .map(|&(n, lo, hi)| FreeParam::new(n, lo, hi))
-            .collect();
+        let mut free: Vec<FreeParam> = match candidate.law {
+            Some(law) => {
+                base.friction = laws::base_law(&base.friction, law)
+                    .map_err(|m| self.error_at(&[Key::Name("fit"), Key::Name("laws")], m))?;
+                laws::law_free(&self.free, law)
+            }
+            None => self
+                .free
+                .iter()
+                .map(|&(n, lo, hi)| FreeParam::new(n, lo, hi))
+                .collect(),
+        };
         if candidate.shoulder {
             let sb = self.job.fit.shoulder.ok_or(JobError::ShoulderBounds)?;
             base.shoulder = Some(crate::model::Shoulder {
@@ -835,6 +868,12 @@ impl Check<'_> {
         blade_path: &Path,
     ) -> Result<Vec<(ParamId, f64, f64)>> {
         let mut free = Vec::new();
+        for &law in &self.job.fit.laws {
+            laws::base_law(&blade.friction, law).map_err(|m| {
+                let at = [Key::Name("fit"), Key::Name("laws")];
+                self.error(&at, format!("{m} (blade file {})", blade_path.display()))
+            })?;
+        }
         for (&id, &[lo, hi]) in &self.job.fit.parameters {
             let at = [
                 Key::Name("fit"),
@@ -850,7 +889,11 @@ impl Check<'_> {
                     ),
                 ));
             }
-            if id.get(blade).is_none() {
+            if !self.job.fit.laws.is_empty() {
+                if let Some(m) = laws::no_listed_law_has(id, &self.job.fit.laws) {
+                    return Err(self.error(&at, m));
+                }
+            } else if id.get(blade).is_none() {
                 return Err(self.error(
                     &at,
                     format!(
@@ -1038,6 +1081,15 @@ impl Check<'_> {
             }
         }
         for (i, m) in fit.models.iter().enumerate() {
+            if let Some(law) = m.law {
+                return Err(self.error(
+                    &[Key::Name("fit"), Key::Name("models"), Key::Index(i)],
+                    format!(
+                        "[fit] models lists \"{m}\": name the model alone and the law in [fit] \
+                         laws = [\"{law}\", ...]"
+                    ),
+                ));
+            }
             if m.shoulder && fit.shoulder.is_none() {
                 return Err(self.error(
                     &[Key::Name("fit"), Key::Name("models"), Key::Index(i)],
@@ -1384,6 +1436,50 @@ mod tests {
         }
         let e = "head1dof+shoulder".parse::<Candidate>().unwrap_err();
         assert!(e.to_string().contains("known: head1dof, necklip"), "{e}");
+        // Each model with each law, models in the job's order, laws nested first (duplicates
+        // once); every name reads back as its candidate.
+        let models: Vec<Candidate> = ["blade2dof", "blade2dof+shoulder"]
+            .iter()
+            .map(|n| n.parse().unwrap())
+            .collect();
+        let laws = [
+            LawKind::Stribeck,
+            LawKind::Exponential,
+            LawKind::ExponentialViscous,
+            LawKind::Exponential,
+        ];
+        let all = Candidate::with_laws(&models, &laws);
+        let names: Vec<String> = all.iter().map(Candidate::name).collect();
+        assert_eq!(
+            names,
+            [
+                "blade2dof@exponential",
+                "blade2dof@exponential_viscous",
+                "blade2dof@stribeck",
+                "blade2dof+shoulder@exponential",
+                "blade2dof+shoulder@exponential_viscous",
+                "blade2dof+shoulder@stribeck",
+            ]
+        );
+        for c in &all {
+            assert_eq!(c.name().parse::<Candidate>(), Ok(*c));
+            let text = toml::to_string(&BTreeMap::from([("m", c)])).unwrap();
+            let back: BTreeMap<String, Candidate> = toml::from_str(&text).unwrap();
+            assert_eq!(back["m"], *c);
+        }
+        assert_eq!(Candidate::with_laws(&models, &[]), models);
+        let e = "blade2dof@viscous".parse::<Candidate>().unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("known: exponential, exponential_viscous, stribeck"),
+            "{e}"
+        );
+        // Each extends the one before it by one step: a law (D, or δ and v_s) or the shoulder.
+        let extends = |a: usize, b: usize| all[a].extends(&all[b]);
+        assert!(extends(1, 0) && extends(2, 0) && extends(3, 0) && extends(4, 1));
+        assert!(extends(4, 3) && extends(5, 3) && extends(5, 2));
+        assert!(!extends(2, 1) && !extends(0, 1) && !extends(4, 0) && !extends(0, 0));
+        assert!(!models[1].extends(&all[0]) && models[1].extends(&models[0]));
     }
 
     #[test]

@@ -346,6 +346,84 @@ impl FrictionLaw {
     }
 }
 
+crate::names::named_enum! {
+    /// The friction laws a fit can free and compare as candidates (`[fit] laws`, docs/job.md):
+    /// the kinds of [`FrictionLaw`] whose coefficients a fit can move. Declared nested first: the
+    /// exponential law is the viscous form at D = 0 and Stribeck's at δ = 1, v_s = 1/B.
+    pub enum LawKind: "friction law" {
+        /// [`FrictionLaw::Exponential`].
+        Exponential => "exponential",
+        /// [`FrictionLaw::ExponentialViscous`].
+        ExponentialViscous => "exponential_viscous",
+        /// [`FrictionLaw::Stribeck`].
+        Stribeck => "stribeck",
+    }
+}
+
+impl LawKind {
+    /// The law's coefficients a fit can free, in [`ParamId`] order.
+    pub fn coefficients(self) -> &'static [ParamId] {
+        match self {
+            LawKind::Exponential => &[ParamId::A, ParamId::B, ParamId::C],
+            LawKind::ExponentialViscous => &[ParamId::A, ParamId::B, ParamId::C, ParamId::D],
+            LawKind::Stribeck => &[ParamId::A, ParamId::C, ParamId::Delta, ParamId::Vs],
+        }
+    }
+
+    /// Whether the law contains `smaller` as a special case (the viscous form at D = 0 and
+    /// Stribeck's at δ = 1 contain the exponential law); a law does not contain itself.
+    pub fn contains(self, smaller: LawKind) -> bool {
+        smaller == LawKind::Exponential && self != LawKind::Exponential
+    }
+}
+
+impl FrictionLaw {
+    /// The law's kind, when a fit can free its coefficients (not Coulomb's or Leine's).
+    pub fn kind(&self) -> Option<LawKind> {
+        match self {
+            FrictionLaw::Exponential { .. } => Some(LawKind::Exponential),
+            FrictionLaw::ExponentialViscous { .. } => Some(LawKind::ExponentialViscous),
+            FrictionLaw::Stribeck { .. } => Some(LawKind::Stribeck),
+            FrictionLaw::Coulomb { .. } | FrictionLaw::Leine { .. } => None,
+        }
+    }
+
+    /// This law written as a law of kind `kind`, with the same μ_s, C and A: the exponential law
+    /// becomes the viscous form with D = 0 and Stribeck's with δ = 1, v_s = 1/B (the same curve,
+    /// [`LawKind::contains`]); from a larger law the extra term is dropped (D, or δ with
+    /// B = 1/v_s). `None` for Coulomb's and Leine's laws.
+    pub fn as_kind(&self, kind: LawKind) -> Option<FrictionLaw> {
+        let (a, b_s_per_m, c) = match *self {
+            FrictionLaw::Exponential { a, b_s_per_m, c }
+            | FrictionLaw::ExponentialViscous {
+                a, b_s_per_m, c, ..
+            } => (a, b_s_per_m, c),
+            FrictionLaw::Stribeck {
+                a, c, v_s_m_per_s, ..
+            } => (a, 1.0 / v_s_m_per_s, c),
+            FrictionLaw::Coulomb { .. } | FrictionLaw::Leine { .. } => return None,
+        };
+        if self.kind() == Some(kind) {
+            return Some(*self);
+        }
+        Some(match kind {
+            LawKind::Exponential => FrictionLaw::Exponential { a, b_s_per_m, c },
+            LawKind::ExponentialViscous => FrictionLaw::ExponentialViscous {
+                a,
+                b_s_per_m,
+                c,
+                d_s_per_m: 0.0,
+            },
+            LawKind::Stribeck => FrictionLaw::Stribeck {
+                a,
+                c,
+                v_s_m_per_s: 1.0 / b_s_per_m,
+                delta: 1.0,
+            },
+        })
+    }
+}
+
 /// Reads a `[friction]` table: `law = "..."` and the law's coefficients as numbers, with errors
 /// that name the keys each law needs ([`FrictionLaw::from_coefficients`]).
 impl<'de> Deserialize<'de> for FrictionLaw {
@@ -559,6 +637,57 @@ mod tests {
         assert!((law.mu_slip_slope(0.0) - (-8.0 + 0.3)).abs() < 1e-12);
         // Past the minimum the coefficient rises again: at 1 m/s it is 0.8·e^{−10} + 0.2 + 0.3.
         assert!((law.mu_slip(1.0) - (0.8 * (-10.0f64).exp() + 0.5)).abs() < 1e-15);
+    }
+
+    /// The exponential law written as each law a fit compares ([`FrictionLaw::as_kind`]) is the
+    /// same curve: the viscous form at D = 0 bitwise (the same operations plus 0), Stribeck's at
+    /// δ = 1, v_s = 1/B to round-off (B·v against v/(1/B)); back to the exponential law it is the
+    /// law it came from. A larger law drops its extra term; Coulomb's law has no such form.
+    #[test]
+    fn nested_laws_reduce_to_the_exponential_law() {
+        let exponential = FrictionLaw::Exponential {
+            a: 0.88,
+            b_s_per_m: 69.7,
+            c: 0.56,
+        };
+        let viscous = exponential.as_kind(LawKind::ExponentialViscous).unwrap();
+        let stribeck = exponential.as_kind(LawKind::Stribeck).unwrap();
+        assert_eq!(viscous.kind(), Some(LawKind::ExponentialViscous));
+        assert_eq!(stribeck.kind(), Some(LawKind::Stribeck));
+        for v in [0.0, 1e-3, 0.0386, 0.1, 0.168, 0.5] {
+            assert_eq!(viscous.mu_slip(v), exponential.mu_slip(v));
+            let (x, y) = (stribeck.mu_slip(v), exponential.mu_slip(v));
+            assert!(
+                (x - y).abs() <= 2.0 * f64::EPSILON * y,
+                "{v}: {x} against {y}"
+            );
+        }
+        for law in [viscous, stribeck, exponential] {
+            let back = law.as_kind(LawKind::Exponential).unwrap();
+            assert_eq!(back.kind(), Some(LawKind::Exponential));
+            assert_eq!(back.mu_static(), exponential.mu_static());
+            assert!(
+                (back.mu_slip(0.1) - exponential.mu_slip(0.1)).abs() < 1e-15,
+                "{law:?}"
+            );
+        }
+        let with_d = FrictionLaw::ExponentialViscous {
+            a: 0.88,
+            b_s_per_m: 69.7,
+            c: 0.56,
+            d_s_per_m: 0.36,
+        };
+        assert_eq!(with_d.as_kind(LawKind::Exponential), Some(exponential));
+        assert_eq!(with_d.as_kind(LawKind::ExponentialViscous), Some(with_d));
+        let coulomb = FrictionLaw::Coulomb {
+            mu_s: 0.6,
+            mu_k: 0.4,
+        };
+        assert_eq!(coulomb.as_kind(LawKind::Exponential), None);
+        assert_eq!(coulomb.kind(), None);
+        assert!(LawKind::Stribeck.contains(LawKind::Exponential));
+        assert!(!LawKind::Exponential.contains(LawKind::Exponential));
+        assert!(!LawKind::Stribeck.contains(LawKind::ExponentialViscous));
     }
 
     /// Stribeck's law at its speed v_s is C + A/e for every δ (closed form), falls to C at speed

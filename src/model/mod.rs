@@ -14,5 +14,5 @@ pub mod stick_slip;
 
 pub use blade::{Blade, BladeParams, Shoulder, StickForm};
 pub use error::{ParamError, TrackError};
-pub use friction::FrictionLaw;
+pub use friction::{FrictionLaw, LawKind};
 pub use params::ParamId;

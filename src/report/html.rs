@@ -356,6 +356,8 @@ fn peak_rows(r: &FitResult) -> Vec<PeakView> {
 #[derive(Serialize)]
 struct TrialView {
     model: String,
+    /// The friction law at the trial's optimum with its coefficients ([`law_cell`]).
+    law: String,
     parameters: String,
     cost: String,
     wall_time_s: String,
@@ -458,8 +460,18 @@ fn short_reason(r: &FitResult, t: &crate::fit::ModelTrial) -> String {
             .iter()
             .filter(|o| !o.chosen)
             .any(|o| o.evidence.as_ref().is_some_and(|e| e.delta_aic.is_finite()));
+        let lower = r.model_trials.iter().any(|o| {
+            o.evidence
+                .as_ref()
+                .and_then(|e| e.delta_tic)
+                .is_some_and(|d| d < 0.0)
+        });
         return match (r.model_trials.len(), compared) {
             (1, _) => "the only model fitted".into(),
+            (_, true) if lower => format!(
+                "the fewest parameters within {} of the lowest TIC",
+                crate::fit::select::INDISTINGUISHABLE_TIC
+            ),
             (_, true) => "lowest AIC".into(),
             (_, false) => "the only candidate that produced every band".into(),
         };
@@ -476,6 +488,14 @@ fn short_reason(r: &FitResult, t: &crate::fit::ModelTrial) -> String {
     {
         why.push(format!("imposes band '{}' from the head track", b.name));
     }
+    let near = crate::fit::select::INDISTINGUISHABLE_TIC;
+    if let Some(d) = t.evidence.as_ref().and_then(|e| e.delta_tic)
+        && d.abs() <= near
+    {
+        why.push(format!(
+            "not distinguishable by this recording (TIC within {near}); more parameters"
+        ));
+    }
     match t.evidence.as_ref().and_then(|e| e.lrt.as_ref()) {
         Some(l) if l.p_value < 0.05 => {
             why.push("a gain beyond chance, but not worth its parameters".into())
@@ -487,11 +507,29 @@ fn short_reason(r: &FitResult, t: &crate::fit::ModelTrial) -> String {
     why.join("; ")
 }
 
+/// A trial's friction law and its coefficients under their blade-file keys (docs/blade.md), e.g.
+/// `exponential_viscous (a 0.880, b_s_per_m 69.7, c 0.560, d_s_per_m 0.357)`; `—` in results
+/// without it.
+fn law_cell(t: &crate::fit::ModelTrial) -> String {
+    let Some(law) = &t.friction else {
+        return "—".into();
+    };
+    let Ok(toml::Value::Table(table)) = toml::Value::try_from(law) else {
+        return law.name().into();
+    };
+    let coefficients: Vec<String> = table
+        .iter()
+        .filter_map(|(k, v)| Some(format!("{k} {}", num(v.as_float()?, 3))))
+        .collect();
+    format!("{} ({})", law.name(), coefficients.join(", "))
+}
+
 fn trial_rows(r: &FitResult) -> Vec<TrialView> {
     r.model_trials
         .iter()
         .map(|t| TrialView {
             model: t.model.to_string(),
+            law: law_cell(t),
             parameters: crate::names::join(&t.parameters, ", "),
             cost: num(t.cost, 5),
             wall_time_s: num(t.wall_time_s, 3),
@@ -1484,6 +1522,7 @@ pub(super) mod tests {
             chosen,
             reason: "the fit's own sentence, with every number".into(),
             evidence: Some(e),
+            friction: None,
         };
         let lrt = |p_value: f64| RatioTest {
             against: "blade2dof".parse().unwrap(),
@@ -1508,10 +1547,40 @@ pub(super) mod tests {
         );
         assert_eq!(rows[2].lrt, "0.901");
         assert_eq!(rows[0].lrt, "—");
-        r.model_trials[2].evidence = Some(evidence(1.5, Some(lrt(0.01))));
+        r.model_trials[2].evidence = Some(evidence(2.5, Some(lrt(0.01))));
         assert_eq!(
             trial_rows(&r)[2].short_reason,
             "a gain beyond chance, but not worth its parameters"
+        );
+        r.model_trials[2].evidence = Some(evidence(1.5, Some(lrt(0.01))));
+        assert_eq!(
+            trial_rows(&r)[2].short_reason,
+            "not distinguishable by this recording (TIC within 2); more parameters; a gain beyond \
+             chance, but not worth its parameters"
+        );
+        // Laws as candidates: the viscous law 1.2 below the chosen exponential one, which has
+        // fewer parameters; the law column names each law with its coefficients.
+        let mut laws = r.clone();
+        laws.model_trials = vec![
+            trial("blade2dof@exponential", true, evidence(0.0, None)),
+            trial("blade2dof@exponential_viscous", false, evidence(-1.2, None)),
+        ];
+        laws.model_trials[1].friction = Some(crate::model::FrictionLaw::ExponentialViscous {
+            a: 0.88,
+            b_s_per_m: 69.7,
+            c: 0.56,
+            d_s_per_m: 0.3567,
+        });
+        let rows = trial_rows(&laws);
+        assert_eq!(
+            rows[0].short_reason,
+            "the fewest parameters within 2 of the lowest TIC"
+        );
+        assert!(rows[1].short_reason.starts_with("not distinguishable"));
+        assert_eq!(rows[0].law, "—");
+        assert_eq!(
+            rows[1].law,
+            "exponential_viscous (a 0.880, b_s_per_m 69.7, c 0.560, d_s_per_m 0.357)"
         );
         // The full sentence stays on the page, folded under the short one.
         let prov = Provenance {

@@ -80,10 +80,17 @@ fn model_words(r: &FitResult) -> String {
     match next {
         Some((t, ("TIC", d))) if d <= near => format!(
             "{named}, chosen by TIC among {} candidates; {} is not distinguishable by this \
-             recording (TIC {d:+.1}, within {near}), and the model with fewer parameters is \
+             recording (TIC {d:+.1}, within {near}), and the {} with fewer parameters is \
              reported.",
             r.model_trials.len(),
-            t.model
+            t.model,
+            if t.model.law != r.model.law
+                && (t.model.kind, t.model.shoulder) == (r.model.kind, r.model.shoulder)
+            {
+                "friction law"
+            } else {
+                "model"
+            }
         ),
         Some((t, (name, d))) => format!(
             "{named}, chosen by {name} among {} candidates; the next best, {}, has a {name} \

@@ -38,14 +38,17 @@ pub struct Scene {
 const BLADE: Candidate = Candidate {
     kind: ModelKind::Blade2dof,
     shoulder: false,
+    law: None,
 };
 const BLADE_ON_SHOULDER: Candidate = Candidate {
     kind: ModelKind::Blade2dof,
     shoulder: true,
+    law: None,
 };
 const HEAD: Candidate = Candidate {
     kind: ModelKind::Head1dof,
     shoulder: false,
+    law: None,
 };
 
 pub const SCENES: [Scene; 9] = [
