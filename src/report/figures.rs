@@ -491,14 +491,8 @@ pub fn friction_law_figure(
     v_max_m_per_s: Option<f64>,
 ) -> Result<()> {
     let curve = r.friction_curve.as_ref();
-    let range_hi = curve.map_or(0.0, |c| c.measured_range_m_per_s[1]);
     let rig = r.priors.as_ref().and_then(|p| p.friction_curve.as_ref());
-    let rig_hi = rig.map_or(0.0, |c| {
-        c.points.iter().map(|p| p.speed_m_per_s).fold(0.0, f64::max)
-    });
-    let v_top = (v_max_m_per_s.map_or(0.2, |v| 1.05 * v))
-        .max(1.1 * range_hi)
-        .max(1.05 * rig_hi);
+    let v_top = speed_axis_top(r, v_max_m_per_s);
     let grid: Vec<f64> = (0..=200).map(|i| i as f64 * v_top / 200.0).collect();
     let mu = |l: &FrictionLaw, v: &[f64]| -> Vec<f64> { v.iter().map(|x| l.mu_slip(*x)).collect() };
     let mut series = Vec::new();
@@ -601,6 +595,20 @@ pub fn friction_law_figure(
         &series,
         &opts,
     )
+}
+
+/// The friction figure's last slip speed: past the fastest slip speed `v_max_m_per_s` the model's
+/// tip reaches (0.2 m/s when unknown), the measured range and the rig curve's points.
+fn speed_axis_top(r: &FitResult, v_max_m_per_s: Option<f64>) -> f64 {
+    let range_hi = (r.friction_curve.as_ref()).map_or(0.0, |c| c.measured_range_m_per_s[1]);
+    let rig_hi = (r.priors.as_ref())
+        .and_then(|p| p.friction_curve.as_ref())
+        .map_or(0.0, |c| {
+            c.points.iter().map(|p| p.speed_m_per_s).fold(0.0, f64::max)
+        });
+    (v_max_m_per_s.map_or(0.2, |v| 1.05 * v))
+        .max(1.1 * range_hi)
+        .max(1.05 * rig_hi)
 }
 
 /// The rig curve of `[fit.priors.friction_curve]` as points with ±1σ error bars, added to `series`
