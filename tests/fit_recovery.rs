@@ -165,3 +165,71 @@ polish_iterations = 4
     );
     assert_eq!(r.first_failure.is_some(), chosen.failed_evaluations > 0);
 }
+
+/// Friction laws as candidates (`[fit] laws`) on a recording the exponential law made: the
+/// default model fitted with each law (`blade2dof@exponential`, `blade2dof@exponential_viscous`,
+/// D freed in its default [0, 2] s/m beside the job's C and k1). The viscous law contains the
+/// exponential one at D = 0, where its search starts, so its fit ends no less likely; the truth has
+/// D = 0, so the extra parameter cannot buy a TIC lower by more than 2 except by chance (for a
+/// likelihood-ratio statistic on one degree of freedom, well under 1 % of recordings), and the
+/// exponential law, with fewer parameters, is reported with its curve.
+#[test]
+fn a_law_the_recording_does_not_need_is_not_chosen() {
+    let base: BladeParams = common::true_blade();
+    let (sim, t0) = common::recording_of(&base).unwrap();
+    let case = common::write_case("fit_laws", &sim, &base, "{}", &mut || 0.0);
+    let dir = case.path();
+    let job = format!(
+        r#"name = "laws"
+blade = "blade.toml"
+{recording}[fit]
+particles = 8
+swarm_iterations = 6
+polish_iterations = 25
+seed = 3
+laws = ["exponential_viscous", "exponential"]
+[fit.parameters]
+C = [0.3, 0.8]
+k1 = [0.01, 0.05]
+"#,
+        recording = common::dltdv_recording("rec_xypts.csv", t0),
+    );
+    std::fs::write(dir.join("job.toml"), job).unwrap();
+    let loaded = LoadedJob::load(&dir.join("job.toml")).unwrap();
+    let out = run_fit(&loaded, false).unwrap();
+    let r = &out.result;
+    let names: Vec<String> = r.model_trials.iter().map(|t| t.model.name()).collect();
+    assert_eq!(
+        names,
+        ["blade2dof@exponential", "blade2dof@exponential_viscous"]
+    );
+    let (exp, visc) = (&r.model_trials[0], &r.model_trials[1]);
+    for t in &r.model_trials {
+        eprintln!(
+            "{}: cost {:.4}, ΔTIC {:?}, {:?}; {}",
+            t.model,
+            t.cost,
+            t.evidence.as_ref().and_then(|e| e.delta_tic),
+            t.friction,
+            t.reason
+        );
+    }
+    use wiperlab::model::ParamId;
+    assert_eq!(exp.parameters, [ParamId::C, ParamId::K1]);
+    assert_eq!(visc.parameters, [ParamId::C, ParamId::D, ParamId::K1]);
+    assert!(matches!(
+        exp.friction,
+        Some(FrictionLaw::Exponential { .. })
+    ));
+    assert!(matches!(
+        visc.friction,
+        Some(FrictionLaw::ExponentialViscous { d_s_per_m, .. }) if (0.0..=2.0).contains(&d_s_per_m)
+    ));
+    assert!(visc.cost <= exp.cost + 1e-9, "{} > {}", visc.cost, exp.cost);
+    assert!(exp.chosen && !visc.chosen);
+    assert_eq!(r.model.name(), "blade2dof@exponential");
+    let lrt = visc.evidence.as_ref().and_then(|e| e.lrt.as_ref()).unwrap();
+    assert_eq!((lrt.against, lrt.df), (exp.model, 1));
+    let curve = r.friction_curve.as_ref().expect("the chosen law's curve");
+    assert!(matches!(curve.fitted_law, FrictionLaw::Exponential { .. }));
+}
