@@ -547,6 +547,58 @@ mod tests {
         );
     }
 
+    /// Laws as candidates: the chosen exponential law with the viscous one 1.2 below it in TIC is
+    /// "not distinguishable", and the sentence says the friction law with fewer parameters is
+    /// reported; a shoulder in the same place is a model.
+    #[test]
+    fn an_indistinguishable_law_is_said_in_words() {
+        let mut r = crate::report::html::tests::result();
+        let trial = |model: &str, chosen: bool, delta_tic: f64| crate::fit::ModelTrial {
+            model: model.parse().unwrap(),
+            parameters: vec![ParamId::K1],
+            cost: 78.3,
+            wall_time_s: 4.0,
+            model_evaluations: 10,
+            failed_evaluations: 0,
+            chosen,
+            reason: String::new(),
+            evidence: Some(crate::fit::TrialEvidence {
+                log_likelihood_nats: 5805.8,
+                spectral_nll_nats: vec![],
+                time_nll_nats: None,
+                residual_rms_m: 1e-5,
+                n_effective: 1e3,
+                effective_parameters: None,
+                tic: Some(delta_tic),
+                delta_tic: Some(delta_tic),
+                aic: delta_tic,
+                bic: delta_tic,
+                delta_aic: delta_tic,
+                delta_bic: delta_tic,
+                lrt: None,
+            }),
+            friction: None,
+        };
+        r.model = "blade2dof@exponential".parse().unwrap();
+        r.model_trials = vec![
+            trial("blade2dof@exponential", true, 0.0),
+            trial("blade2dof@exponential_viscous", false, -1.2),
+        ];
+        let words = model_words(&r);
+        assert!(
+            words.contains(
+                "blade2dof@exponential_viscous is not distinguishable by this recording (TIC \
+                 -1.2, within 2), and the friction law with fewer parameters is reported"
+            ),
+            "{words}"
+        );
+        r.model_trials[1].model = "blade2dof+shoulder@exponential".parse().unwrap();
+        assert!(
+            model_words(&r).contains("the model with fewer parameters"),
+            "{words}"
+        );
+    }
+
     #[test]
     fn a_good_fit_says_so_and_a_doubtful_one_says_what_to_do() {
         // The report's unit result: k1 with an interval, B undetermined, no test, no check.
