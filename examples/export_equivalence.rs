@@ -4,7 +4,7 @@
 //! `data/reversal/wiper_reversal_sample_xypts.csv`, the main job `fits/reversal.toml`) and as a
 //! Tracker export (metres, seconds: `wiper_reversal_sample_tracker.txt`,
 //! `fits/reversal_tracker.toml`). The two differ by their number formats only (at most 3e-3 px,
-//! `tests/import.rs`). Both jobs are fitted with the main job's settings and the candidate it
+//! `tests/suite/import.rs`). Both jobs are fitted with the main job's settings and the candidate it
 //! chooses (`blade2dof`: its restarts are seeded independently of the other candidates, so its fit
 //! is the main job's), and A, B, C and k1 must agree within 1 %.
 //!

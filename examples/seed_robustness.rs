@@ -6,7 +6,7 @@
 //! independent generator made the recording with), read through the job's `[truth]` section.
 //!
 //! The table goes to `reports/seeds/table.md` (and `.csv`). It takes about 10 minutes on 2 idle
-//! cores (the test suite runs seed 1, the shipped job, in `tests/cli.rs`):
+//! cores (the test suite runs seed 1, the shipped job, in `tests/suite/cli.rs`):
 //!
 //! ```sh
 //! cargo run --release --example seed_robustness

@@ -3,7 +3,7 @@
 //! A windshield-wiper blade's measured motion beside a physical model of it.
 //!
 //! The module tree is the pipeline; a stage uses only the stages before it (checked by
-//! `tests/architecture.rs`):
+//! `tests/suite/architecture.rs`):
 //!
 //! Pipeline order: `error` → `names` → `io` → `trace` → `import` → `spectrum` → `model` → `simulate` → `job` → `likelihood` → `posterior` → `fit` → `explore` → `campaign` → `report` → `bench` → `cli`.
 //!

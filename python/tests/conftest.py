@@ -1,7 +1,7 @@
 """Shared helpers of the Python package's tests: where the repository, the shipped data and the
 ``wiperlab`` command line are.
 
-``tests/python.rs`` runs this suite with ``WIPERLAB_BIN`` set to the command it built; run by hand
+``tests/suite/python.rs`` runs this suite with ``WIPERLAB_BIN`` set to the command it built; run by hand
 (``python -m pytest python/tests`` from the repository, the package installed), the suite uses
 ``target/release/wiperlab``.
 """

@@ -2,7 +2,7 @@
 //!
 //! Every method runs over a range of tolerances or steps on two problems, and is compared with a
 //! tight-tolerance event-driven reference (rtol 1e-13, checked against closed forms and an
-//! independent RK4 + Hénon solution to ~1e-12 in `tests/stick_slip_benchmarks.rs`):
+//! independent RK4 + Hénon solution to ~1e-12 in `tests/suite/stick_slip_benchmarks.rs`):
 //! - `belt`: Leine's block on a belt (physics.md §3.3) from stick at x = 0 over 30 s (2.5 cycles);
 //!   observable x.
 //! - `blade-burst`: the default blade (`data/reversal/blade_true.toml`) from its first stick onset

@@ -736,7 +736,7 @@ mod tests {
     fn xy_suffixes() {
         assert_eq!(xy_suffix("B/h/X"), Some(("B/h", true)));
         assert_eq!(xy_suffix("Knee Y"), Some(("Knee", false)));
-        // A multi-byte last character (a case tests/import_fuzz.rs found) has no suffix, no panic.
+        // A multi-byte last character (a case tests/suite/import_fuzz.rs found) has no suffix, no panic.
         assert_eq!(xy_suffix("B/h/ø"), None);
         assert_eq!(xy_suffix("X"), None);
     }

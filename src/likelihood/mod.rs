@@ -20,7 +20,7 @@
 //! exact variance of the estimate for white Gaussian noise at frequencies at least a main lobe away
 //! from 0 and Nyquist (where the periodogram of a real series is χ²₁ instead of χ²₂; see
 //! [`interior_bin`]), and the Gamma law with that variance is Welch's and Percival & Walden's
-//! approximation. `tests/likelihood.rs` checks the mean and variance of `P̂/S` against it on white
+//! approximation. `tests/suite/likelihood.rs` checks the mean and variance of `P̂/S` against it on white
 //! noise and on an AR(1) process.
 //!
 //! The negative log-likelihood of one bin, including every constant (so that it is a true NLL in

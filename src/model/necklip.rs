@@ -12,7 +12,7 @@
 //! tip constraint (Baumgarte too): `[θ̈, φ̈, N, f]` from a 4×4 system.
 //!
 //! With the full model's own `u(t)` prescribed, this model reproduces the full model's θ and φ
-//! (`tests/necklip.rs`): the head's dynamics enter only through `u`. What it drops is the head's
+//! (`tests/suite/necklip.rs`): the head's dynamics enter only through `u`. What it drops is the head's
 //! response to the tip: the low component is imposed from the data, not explained, so the fit
 //! compares it on the high band.
 //!
@@ -22,7 +22,7 @@
 //! ([`PrescribedHead::segments`], a guard of [`FLIP_GUARD_OF_REACH`] of the reach around the sign
 //! change of `d`) and the run after it starts from the state the tracks give
 //! ([`NeckLip::state_from_tracks`]). On the sample's blade the guard is 20 ms, and the neck angle
-//! after the flip stays within 2.8e-4 rad of the full model's (`tests/necklip.rs`).
+//! after the flip stays within 2.8e-4 rad of the full model's (`tests/suite/necklip.rs`).
 
 use super::TrackError;
 use super::blade::{Blade, BladeParams, Dynamics, StickForm};

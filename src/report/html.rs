@@ -19,7 +19,7 @@
 //! loaded or failed), counts the `<img class="figure">` elements whose `naturalWidth` is 0 and
 //! writes the outcome into `#figure-check` (`data-status="ok"` or `"broken"`, `data-loaded`,
 //! `data-total`, `data-broken` = the failing `src`s separated by spaces). A reader sees it as a
-//! line at the end of the page; `tests/report_browser.rs` reads it from headless Chromium's DOM.
+//! line at the end of the page; `tests/suite/report_browser.rs` reads it from headless Chromium's DOM.
 
 use crate::fit::features::SignalKind;
 use crate::fit::result::FitResult;

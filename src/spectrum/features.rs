@@ -87,7 +87,7 @@ impl BandSpec {
 /// one changes as the parameters move: the peak jumps by ~2 % between neighbouring parameter sets
 /// and the cost surface gets steps. With 512 samples (19.5 Hz bins) the envelope is one hump
 /// and the cost has no steps (docs/fit.md, "Restarts"), and the model-made recordings of
-/// `tests/fit_recovery.rs`, `shoulder_fit.rs` and `joint_fit.rs` are recovered as well or better
+/// `tests/suite/fit_recovery.rs`, `shoulder_fit.rs` and `joint_fit.rs` are recovered as well or better
 /// (docs/validation.md, "Spectra against tolerance"). A job that wants the finer estimate names its bands.
 pub fn default_bands() -> Vec<BandSpec> {
     vec![

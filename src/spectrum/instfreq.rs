@@ -33,7 +33,7 @@
 //! `enter_sigmas·σ_v` (default 2) and ends where it rises above `leave_sigmas·σ_v` (default 4); the
 //! hysteresis stops noise from splitting one long stick into many. On the shipped sample (σ = 0.1 px
 //! = 1.5 µm) this gives σ̂ = 1.49 µm, thresholds of 5.6 (enter) and 11.3 mm/s (leave), and finds most true onsets within
-//! ±0.3 ms; the numbers are measured in `tests/instfreq.rs` and stated in docs/spectra.md. Two kinds of
+//! ±0.3 ms; the numbers are measured in `tests/suite/instfreq.rs` and stated in docs/spectra.md. Two kinds of
 //! onset are missed. One is an onset entered below the threshold (the long stick through the
 //! reversal). The other is a stick much shorter than the 7-sample slope window (0.7 ms at 10 kfps)
 //! between fast slips, which the slope averages away; most misses on the sample are of this kind,

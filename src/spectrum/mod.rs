@@ -3,7 +3,7 @@
 //! One estimator serves measured and simulated traces alike (physics.md §4, "compare like with
 //! like"). Conventions follow `scipy.signal.welch` exactly (see [`welch`](welch::welch) and
 //! `shared/crates.md` §5), so results can be cross-checked in Python; the parity tests in
-//! `tests/spectrum.rs` hold to 1e-10 relative.
+//! `tests/suite/spectrum.rs` hold to 1e-10 relative.
 //!
 //! * [`window`]: periodic and symmetric Hann windows, their sums.
 //! * [`welch`](mod@welch): [`WelchConfig`], [`WelchPlan`] (plan once, process many), [`welch()`],

@@ -14,7 +14,7 @@
 //!
 //! Because `ln PSD = 2 ln|X| + const`, `p` is the same whether the parabola is fitted to the PSD, to
 //! `|X|` or to dB. The estimate is biased except at bin centres and bin midpoints; for a Hann window
-//! without zero-padding the bias is below 0.02 bin (measured in `tests/spectrum.rs`), and it shrinks
+//! without zero-padding the bias is below 0.02 bin (measured in `tests/suite/spectrum.rs`), and it shrinks
 //! roughly tenfold per doubling of `nfft` (Smith, "Bias of Parabolic Peak Interpolation").
 
 /// One interpolated spectral peak.

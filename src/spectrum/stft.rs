@@ -17,7 +17,7 @@
 //!
 //! This equals `scipy.signal.spectrogram(x, fs, window='hann', nperseg, noverlap, nfft,
 //! detrend='constant', scaling='density', mode='psd')` (checked against a fixture in
-//! `tests/spectrum.rs`), transposed to `[time][freq]`.
+//! `tests/suite/spectrum.rs`), transposed to `[time][freq]`.
 
 use super::SpectrumError;
 use super::peaks::find_peak;

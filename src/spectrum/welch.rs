@@ -7,7 +7,7 @@
 //! [`welch`] reproduces `scipy.signal.welch(x, fs, window, nperseg, noverlap, nfft, detrend, scaling,
 //! average)` with SciPy's names and defaults (`window='hann'`, `noverlap=nperseg//2`,
 //! `nfft=nperseg`, `detrend='constant'`, `scaling='density'`, `average='mean'`; SciPy 1.17; checked
-//! against fixtures to 1e-10 relative in `tests/spectrum.rs`, for every window, both scalings and
+//! against fixtures to 1e-10 relative in `tests/suite/spectrum.rs`, for every window, both scalings and
 //! both averages):
 //!
 //! * **Window**: periodic Hann of length `nperseg` by default ([`Window`]: also Hamming, Blackman,

@@ -4,7 +4,7 @@
 //! sample: data/reversal/README.md) and 1 % of the frames dropped in runs of 1–3 (the job fills up
 //! to 5), each with a job that fits it with the main job's settings (`fits/reversal.toml`: bands,
 //! solver, swarm, 5 restarts, the three candidates, A, B, C, k1 and the shoulder's bounds) and
-//! Laplace intervals. Used by `tests/model_choice.rs` and `examples/model_choice.rs` (the
+//! Laplace intervals. Used by `tests/suite/model_choice.rs` and `examples/model_choice.rs` (the
 //! confusion table).
 
 use rand::{Rng, SeedableRng};
@@ -70,7 +70,7 @@ pub const SCENES: [Scene; 9] = [
         shoulder: None,
         hd_scale: 1.0,
     },
-    // Free neck 4x softer than the sample's, touching at 0.06 rad (tests/shoulder_fit.rs's scene):
+    // Free neck 4x softer than the sample's, touching at 0.06 rad (tests/suite/shoulder_fit.rs's scene):
     // measured, 2 switches, the neck enters contact once and stays.
     Scene {
         name: "soft neck on a shoulder at 0.06 rad",

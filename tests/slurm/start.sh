@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Used by tests/campaign.rs (the Slurm test); state under $1 (default /tmp/wiperlab-slurm).
+# Used by tests/suite/campaign.rs (the Slurm test); state under $1 (default /tmp/wiperlab-slurm).
 # Starts a one-node Slurm (munged, slurmctld, slurmd) on localhost for tests. Needs root.
 set -euo pipefail
 STATE=${1:-/tmp/wiperlab-slurm}
