@@ -250,11 +250,17 @@ impl FrictionCurvePrior {
     }
 }
 
-/// The bounds of every parameter a candidate of the job may fit: `[fit.parameters]`, and the
-/// shoulder's two from `[fit.shoulder]` when a `+shoulder` candidate is listed.
+/// The bounds of every parameter a candidate of the job may fit: `[fit.parameters]`, the
+/// coefficients a law of `[fit] laws` adds with its default bounds, and the shoulder's two from
+/// `[fit.shoulder]` when a `+shoulder` candidate is listed.
 fn fittable(job: &super::FitJob, free: &[(ParamId, f64, f64)]) -> BTreeMap<ParamId, [f64; 2]> {
     let mut out: BTreeMap<ParamId, [f64; 2]> =
         free.iter().map(|&(id, lo, hi)| (id, [lo, hi])).collect();
+    for &law in &job.fit.laws {
+        for f in super::laws::law_free(free, law) {
+            out.entry(f.name).or_insert([f.lower, f.upper]);
+        }
+    }
     if let Some(sb) = job.fit.shoulder
         && job.fit.models.iter().any(|m| m.shoulder)
     {
@@ -298,8 +304,8 @@ impl Check<'_> {
                     &at,
                     format!(
                         "[fit.priors] {id}: the job does not fit '{id}' ({}); a prior is given \
-                         only for a parameter of [fit.parameters] (or k1c, theta_c of a listed \
-                         +shoulder candidate)",
+                         only for a parameter of [fit.parameters], a coefficient of a law in \
+                         [fit] laws, or k1c, theta_c of a listed +shoulder candidate",
                         id.meaning()
                     ),
                 ));

@@ -431,3 +431,36 @@ fn a_lognormal_prior_is_sampled_with_its_own_density_on_either_scale() {
         );
     }
 }
+
+/// A prior may name a coefficient that a law of `[fit] laws` adds (D of `exponential_viscous`,
+/// bounded by default from 0): accepted with that law listed, refused without it, and a
+/// log-normal prior on it refused since its bounds include 0.
+#[test]
+fn a_prior_on_a_listed_laws_coefficient() {
+    let dir = temp_dir("priors_laws");
+    let text = std::fs::read_to_string(root().join("fits/reversal.toml"))
+        .unwrap()
+        .replace(
+            "\"../data/",
+            &format!("\"{}/", root().join("data").display()),
+        )
+        .replace("reports_dir = \"../reports\"", "");
+    let load = |laws: &str, prior: &str| {
+        let job = text.replace("[fit.uncertainty]", &format!("{laws}\n[fit.uncertainty]"));
+        let path = write(
+            dir.path(),
+            "job.toml",
+            &format!("{job}\n[fit.priors]\n{prior}\n"),
+        );
+        LoadedJob::load(&path)
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+    };
+    let laws = "laws = [\"exponential\", \"exponential_viscous\"]";
+    let normal = "D = { normal = { mean = 0.0, sd = 0.2 } }";
+    assert_eq!(load(laws, normal), Ok(()));
+    let e = load("", normal).unwrap_err();
+    assert!(e.contains("does not fit 'D'"), "{e}");
+    let e = load(laws, "D = { lognormal = { median = 0.1, sd_log = 0.5 } }").unwrap_err();
+    assert!(e.contains("log-normal") && e.contains("<= 0"), "{e}");
+}
