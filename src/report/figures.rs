@@ -611,6 +611,30 @@ fn speed_axis_top(r: &FitResult, v_max_m_per_s: Option<f64>) -> f64 {
         .max(1.05 * rig_hi)
 }
 
+/// The summary's line on `[fit.priors]`: the prior's share of the cost and how far the fit lies
+/// from each prior, in the prior's standard deviations (empty without priors).
+fn prior_lines(r: &FitResult) -> String {
+    let Some(p) = &r.priors else {
+        return String::new();
+    };
+    let mut terms: Vec<String> = (p.parameters.iter())
+        .map(|q| format!("{} z {:+.2}", q.name, q.z))
+        .collect();
+    if let Some(c) = &p.friction_curve {
+        let worst = c.points.iter().map(|q| q.z.abs()).fold(0.0, f64::max);
+        terms.push(format!(
+            "rig curve {} points, largest |z| {worst:.2}",
+            c.points.len()
+        ));
+    }
+    format!(
+        "  priors: {:.2} nats of the cost; {} (z: the fit's distance from each prior in its \
+         standard deviations; |z| > 2: the recording disagrees with it)\n",
+        p.nats_at_fit,
+        terms.join(", ")
+    )
+}
+
 /// The rig curve of `[fit.priors.friction_curve]` as points with ±1σ error bars, added to `series`
 /// and `opts`; the lowest and highest ends of its bars, when there is one.
 fn rig_points(
@@ -1044,6 +1068,7 @@ pub fn fit_summary(r: &FitResult) -> String {
             if short > 0.0 { "less" } else { "more" }
         );
     }
+    s.push_str(&prior_lines(r));
     if !r.undetermined.is_empty() {
         let _ = writeln!(
             s,
@@ -1147,7 +1172,15 @@ mod tests {
         let svg = std::fs::read_to_string(dir.path().join("friction_law.svg")).unwrap();
         assert!(svg.contains("rig curve μ ± 1σ, the prior on μ_d (rig.csv)"));
         assert_eq!(lines(&svg), before + 6, "two whiskers, four caps");
+        assert!(
+            crate::report::figures::fit_summary(&r).contains(
+                "  priors: 0.00 nats of the cost; rig curve 2 points, largest |z| 0.00 (z:"
+            ),
+            "{}",
+            crate::report::figures::fit_summary(&r)
+        );
         r.priors = None;
+        assert!(!crate::report::figures::fit_summary(&r).contains("priors:"));
         r.parameters.clear();
         r.friction_curve = FrictionCurve::new(LAW, &speeds, None, None);
         friction_law_figure(dir.path(), &r, &LAW, None).unwrap();
