@@ -115,10 +115,11 @@ pub struct Exploration {
     pub threads: usize,
 }
 
-/// The candidate the exploration simulates: the job's first listed model, else the smallest one
-/// that can produce its bands (as `wiperlab fit` without `models`).
+/// The candidate the exploration simulates: the job's first candidate ([`LoadedJob::candidates`]:
+/// its first listed model, else the smallest one that can produce its bands, as `wiperlab fit`
+/// without `models`; with its first law when `[fit] laws` lists some).
 pub fn explored_candidate(job: &LoadedJob) -> Candidate {
-    job.job.fit.models.first().copied().unwrap_or(Candidate {
+    job.candidates().first().copied().unwrap_or(Candidate {
         kind: smallest_capable_model(&job.job.spectrum.bands),
         shoulder: false,
         law: None,
