@@ -331,7 +331,7 @@ impl Scored<'_> {
 /// produce every band by more than the larger of their 1σ (both from the likelihood's Fisher
 /// information): the parameter is then absorbing structure that one model has and the other has
 /// not (e.g. a friction law bent to stand in for a missing shoulder), and its value depends on the
-/// model more than on the data.
+/// model more than on the data. Only candidates with the chosen one's friction law are compared.
 pub(super) fn absorbing_warnings(
     fits: &[CandidateFit],
     chosen: usize,
@@ -343,7 +343,9 @@ pub(super) fn absorbing_warnings(
     }
     let mut w = Vec::new();
     for (j, o) in fits.iter().enumerate() {
+        // Another law's coefficients are other quantities (B against v_s, C beside D|v|).
         if j == chosen
+            || o.candidate.law != c.candidate.law
             || o.evidence.is_err()
             || o.cost >= FAILED_COST
             || o.candidate.cannot_produce(bands).is_some()
