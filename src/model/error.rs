@@ -1,5 +1,6 @@
-//! Parameters the model cannot run with: [`ParamError`], naming the parameter and its value; and
-//! recorded tracks the neck/lip model cannot be driven by: [`TrackError`].
+//! Parameters the model cannot run with: [`ParamError`], naming the parameter and its value; a
+//! friction table whose law or keys are wrong: [`FrictionTableError`]; and recorded tracks the
+//! neck/lip model cannot be driven by: [`TrackError`].
 
 /// A blade or friction parameter that is not finite or not physical. Always an input error: the
 /// parameters come from the user's blade file or job.
@@ -103,4 +104,56 @@ pub enum TrackError {
         sigma_s: f64,
         finite: usize,
     },
+}
+
+/// A friction table (`[friction]` of a blade file, or a truth's law) whose law or keys are wrong
+/// ([`crate::model::FrictionLaw::from_coefficients`]). `known` lists the law's own keys.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum FrictionTableError {
+    /// A law name that is none of [`crate::model::FrictionLaw::LAWS`].
+    #[error(
+        "unknown friction law `{law}` (known: {}); the keys each needs: {}",
+        known_laws(),
+        law_keys()
+    )]
+    UnknownLaw { law: String },
+    /// A key the law does not have.
+    #[error("friction law `{law}` has no key `{key}` (known: {}){}", known.join(", "), missing_suffix(missing))]
+    UnknownKey {
+        law: &'static str,
+        key: String,
+        known: Vec<&'static str>,
+        missing: Vec<&'static str>,
+    },
+    /// Keys the law needs that the table lacks.
+    #[error("friction law `{law}` needs {}{}", known.join(", "), missing_suffix(missing))]
+    MissingKeys {
+        law: &'static str,
+        known: Vec<&'static str>,
+        missing: Vec<&'static str>,
+    },
+}
+
+/// The laws' names, comma-separated.
+fn known_laws() -> String {
+    crate::model::FrictionLaw::LAWS.map(|(n, _)| n).join(", ")
+}
+
+/// Each law with its keys: `exponential (a, b_s_per_m, c); …`.
+fn law_keys() -> String {
+    crate::model::FrictionLaw::LAWS
+        .iter()
+        .map(|(n, k)| format!("{n} ({})", k.join(", ")))
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// `; missing a, b` for missing keys, nothing without.
+fn missing_suffix(missing: &[&str]) -> String {
+    if missing.is_empty() {
+        String::new()
+    } else {
+        format!("; missing {}", missing.join(", "))
+    }
 }

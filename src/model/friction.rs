@@ -10,6 +10,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use super::ParamId;
+use super::error::FrictionTableError;
 
 /// A friction law: dynamic coefficient `μ_d(|v|)` for `|v| > 0` and static coefficient `μ_s`.
 ///
@@ -72,47 +73,37 @@ impl FrictionLaw {
     /// The law called `law` with the coefficients `values` (keyed as in a blade file).
     ///
     /// # Errors
-    /// A message naming the laws and their keys for an unknown law, and the keys the law needs for
-    /// a missing or unknown key.
+    /// [`FrictionTableError`] naming the laws and their keys for an unknown law, and the keys the
+    /// law needs for a missing or unknown key.
     pub fn from_coefficients(
         law: &str,
         values: &BTreeMap<String, f64>,
-    ) -> Result<FrictionLaw, String> {
-        let Some((name, keys)) = Self::LAWS.iter().find(|(n, _)| *n == law) else {
-            let laws: Vec<String> = Self::LAWS
-                .iter()
-                .map(|(n, k)| format!("{n} ({})", k.join(", ")))
-                .collect();
-            return Err(format!(
-                "unknown friction law `{law}` (known: {}); the keys each needs: {}",
-                Self::LAWS.map(|(n, _)| n).join(", "),
-                laws.join("; ")
-            ));
+    ) -> Result<FrictionLaw, FrictionTableError> {
+        let Some(&(name, keys)) = Self::LAWS.iter().find(|(n, _)| *n == law) else {
+            return Err(FrictionTableError::UnknownLaw { law: law.into() });
         };
-        let missing: Vec<&str> = keys
+        let missing: Vec<&'static str> = keys
             .iter()
             .copied()
             .filter(|k| !values.contains_key(*k))
             .collect();
-        let missing = if missing.is_empty() {
-            String::new()
-        } else {
-            format!("; missing {}", missing.join(", "))
-        };
         if let Some(extra) = values.keys().find(|k| !keys.contains(&k.as_str())) {
-            return Err(format!(
-                "friction law `{name}` has no key `{extra}` (known: {}){missing}",
-                keys.join(", ")
-            ));
+            return Err(FrictionTableError::UnknownKey {
+                law: name,
+                key: extra.clone(),
+                known: keys.to_vec(),
+                missing,
+            });
         }
         if !missing.is_empty() {
-            return Err(format!(
-                "friction law `{name}` needs {}{missing}",
-                keys.join(", ")
-            ));
+            return Err(FrictionTableError::MissingKeys {
+                law: name,
+                known: keys.to_vec(),
+                missing,
+            });
         }
         let v = |k: &str| values[k];
-        Ok(match *name {
+        Ok(match name {
             "exponential" => FrictionLaw::Exponential {
                 a: v("a"),
                 b_s_per_m: v("b_s_per_m"),

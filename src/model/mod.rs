@@ -13,6 +13,6 @@ pub mod params;
 pub mod stick_slip;
 
 pub use blade::{Blade, BladeParams, Shoulder, StickForm};
-pub use error::{ParamError, TrackError};
+pub use error::{FrictionTableError, ParamError, TrackError};
 pub use friction::{FrictionLaw, LawKind};
 pub use params::ParamId;
