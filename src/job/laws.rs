@@ -82,16 +82,28 @@ pub fn no_listed_law_has(id: ParamId, laws: &[LawKind]) -> Option<String> {
     ))
 }
 
-/// The blade file's `law` written as each of `laws` ([`FrictionLaw::as_kind`]), or why it cannot
-/// be (Coulomb's and Leine's laws have no coefficient a fit frees).
-pub fn base_law(law: &FrictionLaw, kind: LawKind) -> Result<FrictionLaw, String> {
-    law.as_kind(kind).ok_or_else(|| {
-        format!(
-            "[fit] laws: the blade file's law `{}` cannot be fitted as `{kind}`; give the blade an \
-             {} law",
-            law.name(),
-            crate::names::join(LawKind::ALL, ", ")
-        )
+/// A blade file's friction law that `[fit] laws` cannot write as one of its laws (Coulomb's and
+/// Leine's laws have no coefficient a fit frees).
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "[fit] laws: the blade file's law `{law}` cannot be fitted as `{kind}`; give the blade an {} law",
+    crate::names::join(LawKind::ALL, ", ")
+)]
+pub struct LawNotFittable {
+    /// The blade file's law.
+    pub law: &'static str,
+    /// The law the job lists.
+    pub kind: LawKind,
+}
+
+/// The blade file's `law` written as `kind` ([`FrictionLaw::as_kind`]).
+///
+/// # Errors
+/// [`LawNotFittable`] when it cannot be.
+pub fn base_law(law: &FrictionLaw, kind: LawKind) -> Result<FrictionLaw, LawNotFittable> {
+    law.as_kind(kind).ok_or(LawNotFittable {
+        law: law.name(),
+        kind,
     })
 }
 

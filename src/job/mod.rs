@@ -794,8 +794,9 @@ impl LoadedJob {
         let mut base = self.blade;
         let mut free: Vec<FreeParam> = match candidate.law {
             Some(law) => {
-                base.friction = laws::base_law(&base.friction, law)
-                    .map_err(|m| self.error_at(&[Key::Name("fit"), Key::Name("laws")], m))?;
+                base.friction = laws::base_law(&base.friction, law).map_err(|e| {
+                    self.error_at(&[Key::Name("fit"), Key::Name("laws")], e.to_string())
+                })?;
                 laws::law_free(&self.free, law)
             }
             None => self
@@ -869,9 +870,9 @@ impl Check<'_> {
     ) -> Result<Vec<(ParamId, f64, f64)>> {
         let mut free = Vec::new();
         for &law in &self.job.fit.laws {
-            laws::base_law(&blade.friction, law).map_err(|m| {
+            laws::base_law(&blade.friction, law).map_err(|e| {
                 let at = [Key::Name("fit"), Key::Name("laws")];
-                self.error(&at, format!("{m} (blade file {})", blade_path.display()))
+                self.error(&at, format!("{e} (blade file {})", blade_path.display()))
             })?;
         }
         for (&id, &[lo, hi]) in &self.job.fit.parameters {

@@ -34,20 +34,39 @@ struct RawPriors {
     parameters: BTreeMap<String, toml::Value>,
 }
 
+/// A `[fit.priors]` entry that is no prior: its key names no parameter, or its value is no
+/// normal or log-normal table.
+#[derive(Debug, thiserror::Error)]
+pub enum PriorEntryError {
+    /// The key names no parameter.
+    #[error("[fit.priors] {0}")]
+    UnknownParameter(#[from] crate::names::UnknownName),
+    /// The value is not a prior table; `message` is the TOML reader's.
+    #[error(
+        "[fit.priors] {key}: {message} (write {key} = {{ normal = {{ mean = M, sd = S }} }} \
+         or {key} = {{ lognormal = {{ median = M, sd_log = S }} }}, in {meaning})"
+    )]
+    NotAPrior {
+        key: String,
+        message: String,
+        meaning: &'static str,
+    },
+}
+
 impl TryFrom<RawPriors> for PriorsSection {
-    type Error = String;
-    fn try_from(raw: RawPriors) -> std::result::Result<Self, String> {
+    type Error = PriorEntryError;
+    fn try_from(raw: RawPriors) -> std::result::Result<Self, PriorEntryError> {
         let mut parameters = BTreeMap::new();
         for (key, value) in raw.parameters {
-            let id: ParamId = key.parse().map_err(|e| format!("[fit.priors] {e}"))?;
-            let prior: ParamPrior = value.try_into().map_err(|e: toml::de::Error| {
-                format!(
-                    "[fit.priors] {key}: {} (write {key} = {{ normal = {{ mean = M, sd = S }} }} \
-                     or {key} = {{ lognormal = {{ median = M, sd_log = S }} }}, in {})",
-                    e.message(),
-                    id.meaning()
-                )
-            })?;
+            let id: ParamId = key.parse()?;
+            let prior: ParamPrior =
+                value
+                    .try_into()
+                    .map_err(|e: toml::de::Error| PriorEntryError::NotAPrior {
+                        message: e.message().to_string(),
+                        meaning: id.meaning(),
+                        key,
+                    })?;
             parameters.insert(id, prior);
         }
         Ok(PriorsSection {
