@@ -369,7 +369,7 @@ fn goodness_warnings(
         .and_then(|g| misfit_warning(g, shoulder_listed, || misfit_shape(cf, sim)))
     {
         warnings.push(w);
-        warnings.extend(select::chosen_on_misfit(trials, true));
+        warnings.extend(select::chosen_on_misfit(trials));
     }
     (g, warnings)
 }

@@ -376,10 +376,11 @@ pub(super) fn absorbing_warnings(
 }
 
 /// The warning of a candidate that adds structure to another listed one (`X+shoulder` over `X`)
-/// and is chosen on a fit that fails the goodness-of-fit test (`misfit`): the structure may only
-/// absorb what the model cannot explain (coloured tracking noise, a friction law the model lacks),
-/// so the choice is said, never silent.
-pub(super) fn chosen_on_misfit(trials: &[ModelTrial], misfit: bool) -> Option<FitWarning> {
+/// and is chosen on a fit that fails the goodness-of-fit test (the caller's condition): the
+/// structure may only absorb what the model cannot explain (coloured tracking noise, a friction
+/// law the model lacks), so the choice is said, never silent. `None` when the chosen candidate
+/// adds no structure or its nested candidate was not listed.
+pub(super) fn chosen_on_misfit(trials: &[ModelTrial]) -> Option<FitWarning> {
     let outline: Vec<(Candidate, bool, Option<f64>)> = trials
         .iter()
         .map(|t| {
@@ -387,13 +388,13 @@ pub(super) fn chosen_on_misfit(trials: &[ModelTrial], misfit: bool) -> Option<Fi
             (t.model, t.chosen, delta)
         })
         .collect();
-    nested_on_misfit(&outline, misfit)
+    nested_on_misfit(&outline)
 }
 
 /// [`chosen_on_misfit`] on each trial's candidate, whether it is chosen and its ΔTIC.
-fn nested_on_misfit(trials: &[(Candidate, bool, Option<f64>)], misfit: bool) -> Option<FitWarning> {
+fn nested_on_misfit(trials: &[(Candidate, bool, Option<f64>)]) -> Option<FitWarning> {
     let &(chosen, ..) = trials.iter().find(|t| t.1)?;
-    if !misfit || !chosen.shoulder {
+    if !chosen.shoulder {
         return None;
     }
     let nested = Candidate {
@@ -440,8 +441,8 @@ mod tests {
         assert_eq!(simplest_near_best(&[100.0, 99.0], &[5, 5], true), 1);
     }
 
-    /// A shoulder chosen over its shoulder-free model on a failed test is said; a passed test, a
-    /// shoulder-free choice or a job without the nested candidate says nothing.
+    /// A shoulder chosen over its shoulder-free model is said (the caller asks only on a failed
+    /// test); a shoulder-free choice or a job without the nested candidate says nothing.
     #[test]
     fn a_shoulder_chosen_on_a_misfit_is_said() {
         let free = Candidate {
@@ -454,7 +455,7 @@ mod tests {
             ..free
         };
         let trials = [(free, false, Some(12.5)), (shoulder, true, Some(0.0))];
-        let w = nested_on_misfit(&trials, true).expect("a warning");
+        let w = nested_on_misfit(&trials).expect("a warning");
         assert_eq!(
             w,
             FitWarning::ChosenOnMisfit {
@@ -468,9 +469,8 @@ mod tests {
             text.contains("TIC 12.5 lower") && text.contains("not confirmed"),
             "{text}"
         );
-        assert_eq!(nested_on_misfit(&trials, false), None);
         let free_chosen = [(free, true, Some(0.0)), (shoulder, false, Some(1.0))];
-        assert_eq!(nested_on_misfit(&free_chosen, true), None);
-        assert_eq!(nested_on_misfit(&[(shoulder, true, None)], true), None);
+        assert_eq!(nested_on_misfit(&free_chosen), None);
+        assert_eq!(nested_on_misfit(&[(shoulder, true, None)]), None);
     }
 }
