@@ -196,11 +196,11 @@ fn confusion_table(only: &[usize]) -> Result<bool, Box<dyn std::error::Error>> {
                 }
             }
         }
-        // The chosen fit's goodness of fit (docs/fit.md, "Goodness of fit").
+        // The chosen fit's goodness of fit (docs/likelihood.md, "Goodness of fit").
         let gof_p = r
             .goodness_of_fit
             .map_or("—".to_string(), |g| format!("{:.3}", g.p_value));
-        // The chosen optimum's cost spread over rtol, rtol/10, rtol/100 (docs/fit.md, "Tolerance
+        // The chosen optimum's cost spread over rtol, rtol/10, rtol/100 (docs/likelihood.md, "Tolerance
         // check").
         let spread = r
             .tolerance_check

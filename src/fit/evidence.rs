@@ -1088,7 +1088,7 @@ fn local_fit(problem: &SpectralProblem, u: &[f64], spread: Spread) -> Result<Loc
     let (mut nll, mut info, var) = information(problem, u, spread)?;
     let mut var = var.expect("asked for");
     // Model choice reads the likelihood's own penalty; the prior's information then adds to both
-    // sides of the sandwich as a pseudo-observation's (docs/fit.md, "Priors").
+    // sides of the sandwich as a pseudo-observation's (docs/priors.md, "Priors").
     nll.effective_parameters = Some(effective_parameters(&info, &var));
     let prior = problem.prior.information_u(&problem.free, &problem.base, u);
     info += &prior;
@@ -1233,7 +1233,7 @@ pub fn settle(
 /// Why: the stick–slip likelihood is rough at a scale far below its intervals. On the main job's
 /// fit its cost jitters by about 0.05 nats between points σ/50 apart, while its bowl rises by
 /// tenths of a nat to nats at ±σ/2, so a Nelder–Mead polish stops in whichever ripple it meets,
-/// and two swarm seeds ended up to 0.4 of an interval's width apart (docs/fit.md, "Uncertainty"). A
+/// and two swarm seeds ended up to 0.4 of an interval's width apart (docs/validation.md, "Settling"). A
 /// quadratic fitted over a design one standard deviation wide sees the bowl, not the ripples
 /// (response-surface methodology: Box & Wilson 1951, *J. R. Stat. Soc. B* 13:1; as a filter of a
 /// rough objective, Kelley 2011, *Implicit Filtering*, SIAM, ch. 1), and the Laplace interval
@@ -1525,7 +1525,7 @@ mod tests {
 
     /// A bowl `0.5 (u − m)ᵀ Σ⁻¹ (u − m)` with σ = (0.01, 0.02) and correlation 0.5, plus (with
     /// `ripple`) `0.05 (sin(2π·7 u₀/σ₀) + cos(2π·7 u₁/σ₁))`: ripples of 0.05 nats at σ/7, the
-    /// main job's likelihood's scale (docs/fit.md, "Uncertainty").
+    /// main job's likelihood's scale (docs/fit.md, "Settling").
     fn rippled_bowl(ripple: f64) -> impl Fn(&[Vec<f64>]) -> Vec<f64> {
         let (m, sigma, rho) = ([0.4, 0.6], [0.01, 0.02], 0.5);
         move |pts: &[Vec<f64>]| {

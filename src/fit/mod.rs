@@ -334,7 +334,7 @@ fn gof_ref(gof: &GoodnessOutcome) -> Option<&likelihood::GoodnessOfFit> {
 /// The warning of a fit whose spectra are less likely than its own noise makes likely, with
 /// where the excess sits (`shape`, asked only then). `shoulder_listed`: the job lists a
 /// `+shoulder` candidate; the warning then says how a known contact angle helps the search
-/// (docs/fit.md, "Shoulder contact").
+/// (docs/model-choice.md, "Shoulder contact").
 fn misfit_warning(
     g: &likelihood::GoodnessOfFit,
     shoulder_listed: bool,

@@ -102,7 +102,7 @@ pub enum IntervalMethod {
     /// From the cost's curvature at the optimum.
     Curvature,
     /// The 15.87 % and 84.13 % quantiles of a posterior sample (`[fit.uncertainty] method = "mcmc"`,
-    /// docs/fit.md, "Uncertainty"; the sample and its diagnostics are the result's `posterior`).
+    /// docs/uncertainty.md, "Uncertainty"; the sample and its diagnostics are the result's `posterior`).
     Mcmc {
         walkers: usize,
         steps: usize,
@@ -215,7 +215,7 @@ pub struct FittedParam {
     pub std_error: f64,
     /// 1σ from the likelihood's Fisher information alone (`F⁻¹`, the width of the likelihood's
     /// bowl), when the fit has a likelihood; `std_error` is the estimate's spread, the sandwich
-    /// `F⁻¹ V F⁻¹` (docs/fit.md, "Uncertainty").
+    /// `F⁻¹ V F⁻¹` (docs/uncertainty.md, "Uncertainty").
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fisher_std_error: Option<f64>,
     /// False when the data do not pin the parameter down (1σ wider than 10 % of its search range,
@@ -284,7 +284,7 @@ pub struct ModelTrial {
     pub friction: Option<crate::model::FrictionLaw>,
 }
 
-/// One candidate's fit in likelihood units ([`crate::fit::evidence`], docs/fit.md, "Likelihood").
+/// One candidate's fit in likelihood units ([`crate::fit::evidence`], docs/likelihood.md, "Likelihood").
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TrialEvidence {
     /// `ln L` at the candidate's fit, nats.

@@ -7,10 +7,10 @@
 //!
 //! A shoulder that the neck touches only at the peaks of its swing stiffens it while
 //! |θ| > θ_c, for a fraction of each swing that changes steeply with θ_c: the likelihood's basin is
-//! then a few per cent wide in θ_c and in the friction law (docs/fit.md, "Shoulder contact"),
+//! then a few per cent wide in θ_c and in the friction law (docs/model-choice.md, "Shoulder contact"),
 //! and the default search over the whole contact-angle range ends where a model without the
 //! shoulder bends the law to mimic it. Bounds on θ_c of ±4–10 % around the confusion table's
-//! 0.12 rad shoulder let the default search reach the truth's basin, ±17 % did not (docs/fit.md,
+//! 0.12 rad shoulder let the default search reach the truth's basin, ±17 % did not (docs/model-choice.md,
 //! "Shoulder contact"). The scan covers θ_c from the median to the largest |θ| of the same model's
 //! motion without shoulder at its optimum (where a shoulder is crossed at the swing's peaks; a neck
 //! resting on its shoulder, θ_c below the median, has a wide basin the default search reaches) in
@@ -30,7 +30,7 @@ use crate::model::ParamId;
 use std::sync::atomic::Ordering;
 
 /// The width of one slice of θ_c on the log scale: 0.2 (±10 % about its centre), the widest
-/// bounds with which the search reached the often-crossed shoulder's basin (docs/fit.md, "Shoulder
+/// bounds with which the search reached the often-crossed shoulder's basin (docs/model-choice.md, "Shoulder
 /// contact": ±4 %, ±5 % and ±10 % did, ±17 % did not).
 pub const SLICE_LOG_WIDTH: f64 = 0.2;
 

@@ -1094,7 +1094,7 @@ fn nested_search(
 /// next two put θ_c at the median and the 90th percentile of |θ| in the smaller model's simulation
 /// (inside the contact-angle bounds): the same motion, but a polish from there feels k1_contact at
 /// once, while from the first it must first bring θ_c into the range the neck visits. On the
-/// confusion table's often-crossed shoulder (docs/fit.md) the search from the first point alone
+/// confusion table's often-crossed shoulder (docs/validation.md, "Model choice") the search from the first point alone
 /// does not leave blade2dof's optimum. The last reads X's stiffness as that of a neck resting on the
 /// shoulder: k1_contact = X's k1, θ_c at the 10th percentile of |θ|, and the free k1 halfway (log
 /// scale) between its lower bound and X's k1 (along the resting neck's ridge, where only
@@ -1867,7 +1867,7 @@ mod tests {
         // The main job's five restarts (fits/reversal.result.toml's history): three ends within
         // 0.11 nats of the best, one in another basin 9 nats up.
         assert!(confirmed(&[78.2596, 78.2834, 78.1798, 87.1792, 78.2786]));
-        // The confusion table's head-only scene (docs/fit.md): the best end 7.7 nats below the
+        // The confusion table's head-only scene (docs/validation.md, "Model choice"): the best end 7.7 nats below the
         // next one, a basin one restart of five found.
         assert!(!confirmed(&[106.30, 70.82, 79.32, 78.55, 78.58]));
         // The threshold is CONFIRM_NATS, failed runs (infinite cost) confirm nothing, and a single

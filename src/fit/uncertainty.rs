@@ -146,7 +146,7 @@ pub(super) fn mcmc_intervals(
     let s = &fit.uncertainty;
     let w = posterior_tempering(cf.free.len(), effective_parameters);
     let inside = |u: &[f64]| u.iter().all(|x| (0.0..=1.0).contains(x));
-    // The likelihood tempered, the prior not, as a density in θ (or ln θ): docs/fit.md, "Priors".
+    // The likelihood tempered, the prior not, as a density in θ (or ln θ): docs/priors.md, "Priors".
     let prior = &cf.problem.prior;
     let log_density = |u: &[f64]| match inside(u).then(|| cf.problem.cost_at(u)) {
         Some(c) if c < super::FAILED_COST => {
@@ -237,7 +237,7 @@ pub(super) fn mcmc_intervals(
 /// Asymptotically (many effectively independent bins, a smooth likelihood) this is the interval of
 /// the likelihood's maximiser (White 1982, *Econometrica* 50:1, Theorem 3.2, for a likelihood
 /// whose law is not exactly the data's), which the fit's estimate is with the default `[fit]
-/// objective = "likelihood"`; its coverage is measured in docs/fit.md, "Uncertainty".
+/// objective = "likelihood"`; its coverage is measured in docs/validation.md, "Intervals".
 pub fn laplace_intervals(free: &[FreeParam], best_u: &[f64], sigma_u: &[f64]) -> Vec<Interval> {
     free.iter()
         .zip(best_u)
@@ -269,7 +269,7 @@ pub fn laplace_intervals(free: &[FreeParam], best_u: &[f64], sigma_u: &[f64]) ->
 pub const PROFILE_MAX_STEPS: usize = 8;
 
 /// The profile walk's first step, normalised units, at least: a parameter whose 1σ is smaller
-/// still starts here (ripples of the likelihood are finer than that, docs/fit.md, "Uncertainty").
+/// still starts here (ripples of the likelihood are finer than that, docs/fit.md, "Settling").
 pub const PROFILE_MIN_STEP_U: f64 = 0.005;
 
 /// The profile walk's first step, normalised units, at the most (an undetermined parameter's 1σ
@@ -634,7 +634,7 @@ pub const PROFILE_68_NATS: f64 = 0.5;
 /// `k1c·θ − (k1c − k1)·θ_c` (docs/model.md, "Shoulder contact"), so a neck that rarely leaves the
 /// shoulder shows the spectra `(k1c − k1)·θ_c`, not k1 and θ_c apart; the Fisher information at
 /// the fit sees the stick–slip likelihood's ripples there and can call both determined
-/// (docs/fit.md, "Shoulder contact"). Each point
+/// (docs/model-choice.md, "Shoulder contact"). Each point
 /// `k1' = f·k1`, `θ_c' = (k1c − k1)·θ_c / (k1c − k1')` for f in [`RIDGE_K1_FACTORS`] inside the
 /// search box is evaluated with the other parameters held; one whose cost is within
 /// [`PROFILE_68_NATS`] of the fit's lies inside the 68.27 % profile-likelihood region (holding the
@@ -708,13 +708,13 @@ fn widen_along_ridge(
 ///    features, and re-runs the estimator: the whole fit (its restarts of swarm and polish,
 ///    `full_refit = true`) or only a
 ///    Nelder–Mead polish from the optimum (cheaper, but blind to the swarm's own scatter, so the
-///    intervals come out too narrow: docs/fit.md, "Uncertainty"); replicates run in parallel with rayon;
+///    intervals come out too narrow: docs/uncertainty.md, "Uncertainty"); replicates run in parallel with rayon;
 /// 4. the interval is the basic bootstrap interval `[2θ̂ − q(84.13 %), 2θ̂ − q(15.87 %)]` of the
 ///    replicates' estimates `θ*` (Davison & Hinkley 1997, eq. 5.6), which corrects the replicates' bias.
 ///
 /// What it covers: the spread from tracking noise and spectral estimation. What it does not: the
 /// optimiser ending in a different local minimum of the (rough) stick–slip cost surface, which can
-/// be larger (docs/fit.md, "Uncertainty").
+/// be larger (docs/uncertainty.md, "What they measure").
 ///
 /// # Errors
 /// [`Error::Fit`] when argmin fails; simulation failures inside replicates count as failed

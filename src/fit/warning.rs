@@ -508,7 +508,7 @@ fn misfit(
         f.write_str(
             "; a shoulder the neck touches only at the peaks of its swing has a basin a few per \
              cent wide in theta_c that the search can miss: bounding [fit.shoulder] theta_c to a \
-             contact angle known from the blade's drawing lets it find one (docs/fit.md, \
+             contact angle known from the blade's drawing lets it find one (docs/model-choice.md, \
              \"Shoulder contact\")",
         )?;
     }
@@ -667,7 +667,7 @@ fn tolerance_not_probed(f: &mut fmt::Formatter<'_>, failures: &[String]) -> fmt:
     write!(
         f,
         "the tolerance check did not run: every probe failed ({}), so it is not known whether \
-         the integrator resolves the likelihood at the optimum (docs/fit.md, \"Tolerance \
+         the integrator resolves the likelihood at the optimum (docs/likelihood.md, \"Tolerance \
          check\")",
         failures.join("; ")
     )
@@ -694,7 +694,7 @@ fn tolerance_unresolved(
          more than the {SPREAD_WARN_NATS} nats of a 1σ interval); the stick–slip sequence hangs \
          on grazing events, so the cost surface is rough at that depth, cost differences below \
          it do not tell parameter sets apart and the intervals understate the uncertainty \
-         (docs/fit.md, \"Tolerance check\")",
+         (docs/likelihood.md, \"Tolerance check\")",
         crate::names::join(&at, ", "),
         spread_nats
     )
@@ -767,7 +767,7 @@ fn choice_unresolved(
         f,
         "the choice of {chosen} over {runner_up} (ΔAIC {aic_gap:.2}, {:.2} nats) is smaller \
          than the {spread_nats:.2} nats the chosen optimum's cost moves between solver \
-         tolerances: the integrator does not resolve it (docs/fit.md, \"Tolerance check\")",
+         tolerances: the integrator does not resolve it (docs/likelihood.md, \"Tolerance check\")",
         aic_gap.abs() / 2.0
     )
 }

@@ -237,7 +237,7 @@ pub struct FitSection {
     /// fitted and the one with the lowest Akaike criterion (cost + 2k) is reported.
     #[serde(default)]
     pub models: Vec<Candidate>,
-    /// Friction laws compared as candidates ([`LawKind`]; docs/fit.md, "Which friction law"):
+    /// Friction laws compared as candidates ([`LawKind`]; docs/model-choice.md, "Which friction law"):
     /// each model of `models` is fitted with each law and all are ranked together. Empty (the
     /// default): the blade file's law only.
     #[serde(
@@ -274,12 +274,12 @@ pub struct FitSection {
     /// The likelihood that model choice and Laplace intervals read ([`crate::fit::evidence`]).
     #[serde(default)]
     pub likelihood: LikelihoodSection,
-    /// What the user knows before the recording (`[fit.priors]`; docs/fit.md, "Priors").
+    /// What the user knows before the recording (`[fit.priors]`; docs/priors.md, "Priors").
     #[serde(default, skip_serializing_if = "PriorsSection::is_empty")]
     pub priors: PriorsSection,
 }
 
-/// Which terms the recording's likelihood has (docs/fit.md, "Likelihood").
+/// Which terms the recording's likelihood has (docs/likelihood.md, "Likelihood").
 #[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Default)]
 #[serde(deny_unknown_fields, default)]
 pub struct LikelihoodSection {
@@ -293,7 +293,7 @@ pub struct LikelihoodSection {
 }
 
 crate::names::named_enum! {
-    /// The tracking noise's spectrum in the likelihood (docs/fit.md, "Likelihood";
+    /// The tracking noise's spectrum in the likelihood (docs/likelihood.md, "Likelihood";
     /// [`crate::spectrum::noise`]).
     #[derive(Default)]
     pub enum NoiseSpectrum: "noise spectrum" {
@@ -323,8 +323,8 @@ crate::names::named_enum! {
 }
 
 crate::names::named_enum! {
-    /// How a nested candidate (`X+shoulder`, fitted after `X`) is searched (docs/fit.md, "Which
-    /// model the scene needs").
+    /// How a nested candidate (`X+shoulder`, fitted after `X`) is searched (docs/fit.md, "Nested
+    /// candidates").
     pub enum NestedSearch: "nested search" {
         /// Nelder–Mead polishes from `X`'s optimum (θ_c at its bound, the median and the 90th
         /// percentile of |θ|; and X's k1 as the contact stiffness with θ_c at the 10th) first; the

@@ -1,7 +1,7 @@
 //! `[fit.priors]`: what a user knows about the fitted parameters before the recording, as the job
 //! states it. A prior per parameter (normal, or log-normal for a positive magnitude) in the
 //! parameter's own SI units, and a friction-rig curve μ(v) as a prior on the friction law
-//! ([`FrictionCurvePrior`], read by [`super::rig`]). How they enter the fit: docs/fit.md, "Priors".
+//! ([`FrictionCurvePrior`], read by [`super::rig`]). How they enter the fit: docs/priors.md, "Priors".
 
 use super::rig::{self, RigCurve};
 use super::{Check, Key, Objective};

@@ -1,5 +1,5 @@
 //! What a user knows, as a negative log prior in nats beside the recording's NLL
-//! (`[fit.priors]`, [`crate::job::prior`]; docs/fit.md, "Priors").
+//! (`[fit.priors]`, [`crate::job::prior`]; docs/priors.md, "Priors").
 //!
 //! Every prior term is a Gaussian pseudo-observation: a prediction `g(θ)` of the fitted
 //! parameters, an observed value `y` and its 1σ `s`, entering as `z²/2` with `z = (g(θ) − y)/s`:
@@ -14,7 +14,7 @@
 //! posterior). As pseudo-observations they have a Gauss–Newton information `JᵀJ` in the search's
 //! coordinates ([`Prior::information_u`]), exact for a prior linear in the coordinate, and a score
 //! whose variance is the same `JᵀJ`: the Laplace interval adds it to both `F` and `V` of the
-//! sandwich (docs/fit.md, "Priors").
+//! sandwich (docs/priors.md, "Priors").
 
 use crate::job::{FreeParam, ParamPrior, PriorsSection, RigCurve, RigPoint};
 use crate::model::{BladeParams, ParamId};

@@ -5,7 +5,7 @@
 //!
 //! The sampler is generic over a log-density closure on `ℝᵈ`; what density the fit samples (its
 //! likelihood, tempered, on the search's normalised coordinates) is the fit's business
-//! (`crate::fit`, docs/fit.md, "Uncertainty").
+//! (`crate::fit`, docs/uncertainty.md, "Uncertainty").
 
 pub mod diagnostics;
 pub mod ensemble;
@@ -61,8 +61,8 @@ pub struct PosteriorSummary {
     pub burn_in: usize,
     /// Accepted proposals over all proposals, burn-in included.
     pub acceptance_fraction: f64,
-    /// The factor the log-likelihood was multiplied by before sampling (docs/fit.md,
-    /// "Uncertainty").
+    /// The factor the log-likelihood was multiplied by before sampling
+    /// (docs/uncertainty.md, "Posterior sample").
     pub tempering: f64,
     /// Log-density evaluations (model simulations).
     pub evaluations: usize,

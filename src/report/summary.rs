@@ -315,7 +315,7 @@ fn goodness_of_fit_check(r: &FitResult) -> (Check, Option<String>) {
             ),
             "Fit more candidate models (e.g. with shoulder contact), check that each band holds \
              the line it is meant for, or bound a parameter known from the blade's drawing \
-             (docs/fit.md, \"Goodness of fit\").",
+             (docs/likelihood.md, \"Goodness of fit\").",
         ),
         None if r.target_job => {
             none("No goodness-of-fit test: a target job has no measurement noise.".into())
@@ -365,7 +365,7 @@ fn tolerance_check(r: &FitResult) -> (Check, Option<String>) {
                          moves {} nats over {rtols}): the intervals understate the uncertainty.",
                         num(t.spread_nats, 2)
                     ),
-                    "Tighten [solver] rtol tenfold and refit (docs/fit.md, \"Tolerance check\").",
+                    "Tighten [solver] rtol tenfold and refit (docs/likelihood.md, \"Tolerance check\").",
                 ),
                 Verdict::NotProbed => bad(
                     "The tolerance check could not run: every tighter simulation failed.".into(),

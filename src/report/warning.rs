@@ -358,7 +358,7 @@ fn misfit_headline(p_value: f64, shape: &[crate::likelihood::misfit::BandMisfit]
     format!(
         "The model does not explain the recording's spectra to their noise (p = {:.3}{words}): \
          list more candidate models, check the bands and the tracking noise's spectrum, or bound \
-         a known parameter (docs/fit.md, \"Goodness of fit\").",
+         a known parameter (docs/likelihood.md, \"Goodness of fit\").",
         p_value
     )
 }

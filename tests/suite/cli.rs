@@ -238,7 +238,7 @@ fn main_job_end_to_end() {
     );
     // In likelihood units: every trial has its log-likelihood; the shoulder candidate ends at
     // blade2dof's parameters (above), so its ln L is the same, the likelihood-ratio statistic 0 and
-    // its AIC higher by exactly 2 × its 2 extra parameters (docs/fit.md, "Which model the scene
+    // its AIC higher by exactly 2 × its 2 extra parameters (docs/model-choice.md, "Which model the scene
     // needs"). The head model, which cannot make the high band, is far less likely.
     let evidence =
         |m: &str| trials.iter().find(|t| t["model"] == m).expect("trial")["evidence"].clone();
@@ -289,7 +289,7 @@ fn main_job_end_to_end() {
         // The fit must find the truth's basin: the sample was made by an independent
         // implementation with these parameters (truth.json), so what is left is tracking noise and
         // the two implementations' differences. Measured: A −0.37 %, B +0.06 %, C −0.76 %,
-        // k1 −1.15 % (docs/fit.md, "What the main job finds"); a single swarm (restarts = 1) ended at B +29.5 %, C −12.4 %, k1 −11 % (CHANGELOG.md, "Main job: restarts and a coarser high band").
+        // k1 −1.15 % (docs/validation.md, "The main job"); a single swarm (restarts = 1) ended at B +29.5 %, C −12.4 %, k1 −11 % (CHANGELOG.md, "Main job: restarts and a coarser high band").
         assert!(
             rel.abs() <= 0.05,
             "{name}: fitted {value} against the true {true_value} ({:+.2} %)",

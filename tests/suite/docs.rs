@@ -418,17 +418,19 @@ fn sections(markdown: &str) -> Vec<String> {
         .collect()
 }
 
-/// Comments and job files cite a part of the manual as `docs/NAME.md, "Heading"`; each such
-/// heading (or the start of one, or a bold label) exists, so a reader who follows it lands.
+/// Comments, job files and the report template cite a part of the manual as
+/// `docs/NAME.md, "Heading"`; each such heading (or the start of one, or a bold label) exists, so a
+/// reader who follows it lands.
 #[test]
 fn cited_sections_of_the_docs_exist() {
     let mut checked = Vec::new();
-    for dir in ["src", "benches", "examples"] {
+    for dir in ["src", "tests", "benches", "examples"] {
         files(&root().join(dir), ".rs", &mut checked);
     }
-    for dir in ["src", "fits", "campaigns"] {
+    for dir in ["src", "fits", "campaigns", "data"] {
         files(&root().join(dir), ".toml", &mut checked);
     }
+    files(&root().join("src"), ".html", &mut checked);
     let mut cited = 0;
     for f in &checked {
         // Comment markers at line starts removed, so a citation may run over two lines.
@@ -449,7 +451,10 @@ fn cited_sections_of_the_docs_exist() {
             let Some((name, after)) = rest.split_once(".md, \"") else {
                 continue;
             };
-            if !name.chars().all(|c| c.is_ascii_lowercase() || c == '_') {
+            if !name
+                .chars()
+                .all(|c| c.is_ascii_lowercase() || c == '_' || c == '-')
+            {
                 continue;
             }
             let Some((quoted, _)) = after.split_once('"') else {

@@ -1,5 +1,5 @@
 //! The goodness-of-fit test of a fit's spectra (`RecordingLikelihood::goodness_of_fit`,
-//! docs/fit.md, "Goodness of fit") on the shipped recording: the model at the true parameters
+//! docs/likelihood.md, "Goodness of fit") on the shipped recording: the model at the true parameters
 //! explains it to its noise, and a model that lacks a feature of the recording, or a friction law
 //! bent away from it, does not.
 //!

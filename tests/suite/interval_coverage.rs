@@ -187,7 +187,7 @@ fn bootstrap_intervals_cover_the_truth_at_their_rate() {
 /// against 16.4 expected. With the Fisher information alone (before the sandwich) they would be
 /// about 2.3 times too wide: the Whittle likelihood lets the deterministic stick–slip signal's
 /// ordinates scatter like a random process's, several times more than they do under tracking noise
-/// (docs/fit.md, "Uncertainty").
+/// (docs/uncertainty.md, "Uncertainty").
 #[test]
 fn laplace_intervals_cover_the_truth_at_their_rate() {
     coverage(

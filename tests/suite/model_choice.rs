@@ -64,7 +64,7 @@ fn the_spectra_do_not_tell_k1_from_theta_c_along_the_contact_moment_ridge() {
     assert!(off > 1.92, "k1 ×2 off the ridge: ΔNLL {off:+.2} nats");
 }
 
-/// The tolerance check (`wiperlab::fit::tolerance`, docs/fit.md "Tolerance check") tells a
+/// The tolerance check (`wiperlab::fit::tolerance`, docs/likelihood.md, "Tolerance check") tells a
 /// likelihood the integrator resolves from one it does not. At the shipped recording's truth
 /// (`data/reversal/truth.json`) the main job's blade2dof costs the same to well under 0.5 nats at
 /// rtol 1e-8, 1e-9 and 1e-10 (a smooth motion converges as the tolerance tightens). On the 0.12 rad

@@ -19,7 +19,7 @@ fn necklip_is_fitted_but_not_chosen_for_a_low_band() {
     let dir = tmp.path();
     // The main job's recording and bands (fits/reversal.toml) on the true blade, with a tiny
     // optimiser budget and the swarm's looser tolerance (rtol 1e-6): this checks the plumbing, not
-    // the fitted values (docs/fit.md, "Which model the scene needs"). Here blade2dof also has the
+    // the fitted values (docs/model-choice.md, "Which model the scene needs"). Here blade2dof also has the
     // lower cost, so what shows the rule is the reason.
     let job = format!(
         r#"name = "necklip_fit"
