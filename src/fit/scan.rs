@@ -10,8 +10,8 @@
 //! then a few per cent wide in θ_c and in the friction law (docs/model-choice.md, "Shoulder contact"),
 //! and the default search over the whole contact-angle range ends where a model without the
 //! shoulder bends the law to mimic it. Bounds on θ_c of ±4–10 % around the confusion table's
-//! 0.12 rad shoulder let the default search reach the truth's basin, ±17 % did not (docs/model-choice.md,
-//! "Shoulder contact"). The scan covers θ_c from the median to the largest |θ| of the same model's
+//! 0.12 rad shoulder let the default search reach the truth's basin, ±17 % did not (docs/validation.md,
+//! "Model choice"). The scan covers θ_c from the median to the largest |θ| of the same model's
 //! motion without shoulder at its optimum (where a shoulder is crossed at the swing's peaks; a neck
 //! resting on its shoulder, θ_c below the median, has a wide basin the default search reaches) in
 //! overlapping slices of [`SLICE_LOG_WIDTH`] on the log scale.
@@ -30,8 +30,8 @@ use crate::model::ParamId;
 use std::sync::atomic::Ordering;
 
 /// The width of one slice of θ_c on the log scale: 0.2 (±10 % about its centre), the widest
-/// bounds with which the search reached the often-crossed shoulder's basin (docs/model-choice.md, "Shoulder
-/// contact": ±4 %, ±5 % and ±10 % did, ±17 % did not).
+/// bounds with which the search reached the often-crossed shoulder's basin (docs/validation.md, "Model
+/// choice": ±4 %, ±5 % and ±10 % did, ±17 % did not).
 pub const SLICE_LOG_WIDTH: f64 = 0.2;
 
 /// At most this many slices per candidate: each costs a whole search of it.
