@@ -1,13 +1,17 @@
-//! `wiperlab campaign` as a lab runs it, on the shipped example campaign (`campaigns/example.toml`:
-//! six model-made recordings in `data/campaign/`, written by `examples/make_campaign.rs`, truth in
-//! `data/campaign/truth.csv`):
-//! * a local run fits every recording, collects them into `campaign.csv`, skips finished
-//!   recordings on a rerun, refits the one whose recording changed, and records a failure without
-//!   stopping the others;
+//! `wiperlab campaign` as a lab runs it, on copies of the shipped example campaign's recordings
+//! (`campaigns/example.toml`: six model-made recordings in `data/campaign/`, written by
+//! `examples/make_campaign.rs`, truth in `data/campaign/truth.csv`):
+//! * a local run fits every readable recording while an unreadable one fails alone, collects them
+//!   into `campaign.csv`, skips finished recordings on a rerun and refits the one whose recording
+//!   changed;
 //! * the same campaign through a real one-node Slurm (`tests/slurm/start.sh`: munged, slurmctld
 //!   and slurmd on localhost; needs root and Debian's `slurm-wlm` and `munge`) gives the same
 //!   collected values as the local run. Without Slurm the test says it skipped, unless
 //!   WIPERLAB_REQUIRE_SLURM=1 (CI), where that is a failure.
+//!
+//! Each fit of the example template costs seconds of CPU, so the local test fits two recordings
+//! (and refits one) and the Slurm test, which compares two runs of the same job rather than their
+//! accuracy, fits with a tiny search.
 
 use crate::common;
 use crate::common::{ok, root, run, s, temp_dir};
@@ -17,9 +21,20 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
+/// The search of the fit template a test campaign uses.
+#[derive(Clone, Copy)]
+enum Search {
+    /// The example template as shipped (3 restarts of an 8-particle swarm, 25 Nelder–Mead
+    /// iterations): the fits recover C and k1.
+    Example,
+    /// The example template with a tiny search (4 particles, 1 swarm iteration, 3 Nelder–Mead
+    /// iterations, 1 restart): a complete fit and result in about a second, far from the optimum.
+    Tiny,
+}
+
 /// Copies `recordings` (file names in data/campaign/) and their conditions rows into `dir`, and
-/// writes `dir/c.toml`: the example campaign's template on those copies.
-fn campaign_copy(dir: &Path, recordings: &[&str]) -> PathBuf {
+/// writes `dir/c.toml`: the example campaign's template, with `search`, on those copies.
+fn campaign_copy(dir: &Path, recordings: &[&str], search: Search) -> PathBuf {
     let data = root().join("data/campaign");
     let table = std::fs::read_to_string(data.join("conditions.csv")).expect("conditions.csv");
     let mut lines = table.lines();
@@ -35,9 +50,42 @@ fn campaign_copy(dir: &Path, recordings: &[&str]) -> PathBuf {
         );
     }
     std::fs::write(dir.join("conditions.csv"), rows.join("\n") + "\n").expect("write table");
+    let shipped = root().join("campaigns/example_template.toml");
+    let template = match search {
+        Search::Example => shipped,
+        Search::Tiny => {
+            let text = std::fs::read_to_string(&shipped)
+                .expect("example template")
+                .replace(
+                    "\"../data/",
+                    &format!("\"{}/", root().join("data").display()),
+                );
+            let mut replaced = 0;
+            let tiny: Vec<&str> = text
+                .lines()
+                .map(|l| {
+                    let tiny_value = match l.split(' ').next() {
+                        Some("particles") => "particles = 4",
+                        Some("swarm_iterations") => "swarm_iterations = 1",
+                        Some("polish_iterations") => "polish_iterations = 3",
+                        Some("restarts") => "restarts = 1",
+                        _ => return l,
+                    };
+                    replaced += 1;
+                    tiny_value
+                })
+                .collect();
+            assert_eq!(
+                replaced, 4,
+                "the example template's search keys moved:\n{text}"
+            );
+            let path = dir.join("tiny_template.toml");
+            std::fs::write(&path, tiny.join("\n") + "\n").expect("write template");
+            path
+        }
+    };
     let campaign = format!(
-        "template = {:?}\nrecordings = [\"*_xypts.csv\"]\nconditions = \"conditions.csv\"\n",
-        root().join("campaigns/example_template.toml")
+        "template = {template:?}\nrecordings = [\"*_xypts.csv\"]\nconditions = \"conditions.csv\"\n"
     );
     let path = dir.join("c.toml");
     std::fs::write(&path, campaign).expect("write campaign");
@@ -80,31 +128,58 @@ fn num(row: &BTreeMap<String, String>, col: &str) -> f64 {
         .unwrap_or_else(|| panic!("no number in column {col}: {row:?}"))
 }
 
+/// Runs `campaign run` with `args` on a campaign with a recording that cannot be read, and returns
+/// its standard output, whose summary line reads e.g. "campaign 'c': 2 fitted, 0 skipped (…), 1
+/// failed". A failed recording is a failed computation: the run exits with 1.
+fn run_with_a_failure(args: &[&str]) -> String {
+    let o = run(&[&["campaign", "run"], args].concat());
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{out}\n{err}");
+    out
+}
+
 #[test]
 fn local_campaign_fits_collects_skips_and_survives_a_failure() {
     let dir = temp_dir("local");
-    // Two compounds at two sweep speeds: every condition varies, with four fits.
-    let all = [
-        "hard_fast_xypts.csv",
-        "hard_slow_xypts.csv",
-        "soft_fast_xypts.csv",
-        "soft_slow_xypts.csv",
-    ];
-    let c = campaign_copy(dir.path(), &all);
-    let cs = c.to_str().expect("UTF-8 path");
-    let out = ok(
-        &run(&["campaign", "run", cs, "--jobs", "2"]),
-        "campaign run",
+    // Two compounds at two sweep speeds, so that every condition varies (compound, sweep, t0_s,
+    // drive speed), and a third recording that cannot be read.
+    let c = campaign_copy(
+        dir.path(),
+        &[
+            "hard_normal_xypts.csv",
+            "hard_slow_xypts.csv",
+            "soft_fast_xypts.csv",
+        ],
+        Search::Example,
     );
-    assert!(out.contains("4 fitted, 0 skipped"), "{out}");
+    std::fs::write(
+        dir.path().join("hard_slow_xypts.csv"),
+        "pt1_cam1_X,pt1_cam1_Y\n1,x\n",
+    )
+    .expect("break a recording");
+    let cs = c.to_str().expect("UTF-8 path");
+    // The unreadable recording fails alone: the others are fitted in the same run, which then
+    // exits with 1.
+    let out = run_with_a_failure(&[cs, "--jobs", "2"]);
+    assert!(
+        out.contains("2 fitted, 0 skipped") && out.contains("1 failed"),
+        "{out}"
+    );
     ok(&run(&["campaign", "collect", cs]), "campaign collect");
     let rows = read_table(&dir.path().join("c/campaign.csv"));
-    assert_eq!(rows.len(), 4);
-    // The report page lists every recording and draws each parameter against each varying
-    // condition (compound, sweep, t0_s, drive speed) and the friction laws.
+    assert_eq!(rows.len(), 3);
+    let bad = rows
+        .iter()
+        .find(|r| r["id"] == "hard_slow_xypts")
+        .expect("row of the broken recording");
+    assert_eq!(bad["state"], "failed");
+    assert!(bad["reason"].contains("hard_slow_xypts.csv"), "{bad:?}");
+    // The report page lists every recording (the broken one among the failures) and draws each
+    // parameter against each varying condition and the friction laws.
     let page =
         std::fs::read_to_string(dir.path().join("c/report/index.html")).expect("report page");
-    for id in ["hard_fast_xypts", "soft_slow_xypts"] {
+    for id in ["hard_normal_xypts", "soft_fast_xypts", "hard_slow_xypts"] {
         assert!(page.contains(id), "{id} missing from the report page");
     }
     for fig in [
@@ -128,7 +203,12 @@ fn local_campaign_fits_collects_skips_and_survives_a_failure() {
         "repeat is 1 everywhere"
     );
     let truth = truth();
-    for row in &rows {
+    let fitted: Vec<_> = rows
+        .iter()
+        .filter(|r| r["id"] != "hard_slow_xypts")
+        .collect();
+    assert_eq!(fitted.len(), 2);
+    for row in fitted {
         assert_eq!(row["state"], "done", "{row:?}");
         let (c_true, k1_true) = truth[&format!("{}.csv", row["id"])];
         let (c, k1) = (num(row, "C"), num(row, "k1"));
@@ -147,52 +227,37 @@ fn local_campaign_fits_collects_skips_and_survives_a_failure() {
         assert!(["soft", "hard"].contains(&row["compound"].as_str()));
         assert!(num(row, "drive_omega_rad_per_s") > 0.0 && num(row, "t0_s") > 0.0);
     }
-    // A rerun skips every recording (same content hashes); a changed recording is refitted.
-    let out = ok(&run(&["campaign", "run", cs]), "campaign rerun");
-    assert!(out.contains("0 fitted, 4 skipped"), "{out}");
-    let changed = dir.path().join("soft_slow_xypts.csv");
+    // A rerun skips both fitted recordings (same content hashes) and tries the failed one again.
+    let out = run_with_a_failure(&[cs]);
+    assert!(
+        out.contains("0 fitted, 2 skipped") && out.contains("1 failed"),
+        "{out}"
+    );
+    // A changed recording is refitted alone.
+    let changed = dir.path().join("soft_fast_xypts.csv");
     let mut text = std::fs::read_to_string(&changed).expect("read copy");
     let last = text.lines().last().expect("a row").to_string();
     text.push_str(&last);
     text.push('\n');
     std::fs::write(&changed, text).expect("append a frame");
-    let out = ok(&run(&["campaign", "run", cs]), "campaign after a change");
-    assert!(out.contains("1 fitted, 3 skipped"), "{out}");
-    // A recording that cannot be read fails alone, with its reason in the table.
-    std::fs::write(
-        dir.path().join("hard_slow_xypts.csv"),
-        "pt1_cam1_X,pt1_cam1_Y\n1,x\n",
-    )
-    .expect("break a recording");
-    let o = run(&["campaign", "run", cs]);
-    let out = String::from_utf8_lossy(&o.stdout);
-    assert_eq!(
-        o.status.code(),
-        Some(1),
-        "a failed recording is a failed computation"
-    );
+    let out = run_with_a_failure(&[cs]);
     assert!(
-        out.contains("0 fitted, 3 skipped") && out.contains("1 failed"),
+        out.contains("1 fitted, 1 skipped") && out.contains("1 failed"),
         "{out}"
     );
     ok(
         &run(&["campaign", "collect", cs]),
-        "collect after a failure",
+        "collect after the refit",
     );
     let rows = read_table(&dir.path().join("c/campaign.csv"));
-    let bad = rows
-        .iter()
-        .find(|r| r["id"] == "hard_slow_xypts")
-        .expect("row of the broken recording");
-    assert_eq!(bad["state"], "failed");
-    assert!(bad["reason"].contains("hard_slow_xypts.csv"), "{bad:?}");
-    assert_eq!(rows.iter().filter(|r| r["state"] == "done").count(), 3);
+    assert_eq!(rows.iter().filter(|r| r["state"] == "done").count(), 2);
+    assert_eq!(rows.iter().filter(|r| r["state"] == "failed").count(), 1);
 }
 
 #[test]
 fn campaign_errors_name_the_file_and_line() {
     let dir = temp_dir("errors");
-    let c = campaign_copy(dir.path(), &["soft_fast_xypts.csv"]);
+    let c = campaign_copy(dir.path(), &["soft_fast_xypts.csv"], Search::Example);
     let cs = c.to_str().expect("UTF-8 path");
     // A conditions row naming a recording the campaign does not have: file, line, the name.
     let table = dir.path().join("conditions.csv");
@@ -422,12 +487,13 @@ fn slurm_array_gives_the_local_results() {
         .output()
         .expect("run tests/slurm/start.sh");
     ok(&start, "starting Slurm");
-    // An array of two tasks, both running at once (--max-parallel 2).
-    let two = ["hard_normal_xypts.csv", "soft_slow_xypts.csv"];
+    // An array of two tasks, both running at once (--max-parallel 2). The test compares two runs
+    // of the same job, so a tiny search suffices; the local test checks the fits' accuracy.
+    let two = ["hard_fast_xypts.csv", "soft_fast_xypts.csv"];
     let via_slurm = temp_dir("slurm");
     let local = temp_dir("slurm_local");
-    let cs = campaign_copy(via_slurm.path(), &two);
-    let cl = campaign_copy(local.path(), &two);
+    let cs = campaign_copy(via_slurm.path(), &two, Search::Tiny);
+    let cl = campaign_copy(local.path(), &two, Search::Tiny);
     let (cs, cl) = (cs.to_str().expect("path"), cl.to_str().expect("path"));
     let out = ok(
         &run(&[
