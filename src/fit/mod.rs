@@ -653,6 +653,8 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         let at_fit = cf.problem.params_at(&cf.best_u);
         (cf.problem.prior).report(&at_fit, &intervals, job.rig_curve.as_ref())
     });
+    let mut warnings = a.warnings;
+    warnings.extend(priors.iter().flat_map(warning::prior_warnings));
     FitResult {
         job: job.name.clone(),
         recording: job.recording_path.display().to_string(),
@@ -679,7 +681,7 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         solver_atol: job.job.solver.atol,
         transitions_in_best_model: a.transitions,
         model_trials: a.trials,
-        warnings: a.warnings,
+        warnings,
         input_sha256: a.input_sha256,
         settings,
         target_job: job.job.targets.is_some(),

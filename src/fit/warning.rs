@@ -19,6 +19,7 @@ use super::uncertainty::{PROFILE_68_NATS, PROFILE_MAX_STEPS};
 use crate::job::Candidate;
 use crate::job::UncertaintyMethod;
 use crate::likelihood::GoodnessOfFit;
+use crate::likelihood::prior::{ParamConflict, PriorsReport, RigConflict};
 use crate::model::ParamId;
 use crate::names::named_enum;
 use crate::simulate::failure::FailureCause;
@@ -219,6 +220,11 @@ pub enum FitWarning {
     },
     /// The blade's modes at the fitted parameters could not be computed.
     NoBladeModes { reason: String },
+    /// A parameter fitted beyond [`crate::likelihood::prior::PRIOR_CONFLICT_Z`] standard
+    /// deviations of its `[fit.priors]` prior.
+    PriorConflict(ParamConflict),
+    /// The fitted law misses the `[fit.priors.friction_curve]` rig curve as a whole.
+    RigCurveConflict(RigConflict),
     /// A warning read from a result written before warnings had kinds: its sentence only.
     Text { text: String },
 }
@@ -284,6 +290,8 @@ impl FitWarning {
             | ToleranceUnresolved { .. }
             | ChoiceUnresolved { .. }
             | ChosenOnMisfit { .. }
+            | PriorConflict(_)
+            | RigCurveConflict(_)
             | Text { .. } => Severity::Attention,
         }
     }
@@ -318,6 +326,8 @@ impl FitWarning {
             ChosenOnMisfit { .. } => "chosen_on_misfit",
             FailedEvaluations { .. } => "failed_evaluations",
             NoBladeModes { .. } => "no_blade_modes",
+            PriorConflict(_) => "prior_conflict",
+            RigCurveConflict(_) => "rig_curve_conflict",
             Text { .. } => "text",
         }
     }
@@ -335,9 +345,19 @@ impl FitWarning {
             | WidenedInterval { parameter, .. }
             | PosteriorUnconverged { parameter, .. }
             | PosteriorSpansBounds { parameter, .. } => Some(*parameter),
+            PriorConflict(c) => Some(c.parameter),
             _ => None,
         }
     }
+}
+
+/// Where the fit disagrees with the job's priors ([`PriorsReport::parameter_conflicts`],
+/// [`PriorsReport::rig_conflict`]).
+pub fn prior_warnings(priors: &PriorsReport) -> Vec<FitWarning> {
+    let params = priors.parameter_conflicts().into_iter();
+    (params.map(FitWarning::PriorConflict))
+        .chain(priors.rig_conflict().map(FitWarning::RigCurveConflict))
+        .collect()
 }
 
 /// `name`'s line in `band` as the line warnings name it.
@@ -463,6 +483,8 @@ impl fmt::Display for FitWarning {
             NoBladeModes { reason } => {
                 write!(f, "no blade modes at the fitted parameters: {reason}")
             }
+            PriorConflict(c) => c.fmt(f),
+            RigCurveConflict(c) => c.fmt(f),
             Text { text } => f.write_str(text),
         }
     }
@@ -959,6 +981,15 @@ mod tests {
                 bound: End::Upper,
                 value: 0.15,
             },
+            FitWarning::PriorConflict(ParamConflict {
+                parameter: ParamId::ThetaC,
+                prior: crate::job::ParamPrior::Lognormal {
+                    median: 0.08,
+                    sd_log: 0.1,
+                },
+                value: 0.1,
+                z: 2.23,
+            }),
         ]
         .into();
         #[derive(Serialize, Deserialize)]
@@ -976,6 +1007,11 @@ mod tests {
         let details = t["warning_details"].as_array().unwrap();
         assert_eq!(details[0]["severity"].as_str(), Some("information"));
         assert_eq!(details[1]["warning"]["kind"].as_str(), Some("on_bound"));
+        assert_eq!(
+            details[2]["warning"]["kind"].as_str(),
+            Some("prior_conflict")
+        );
+        assert_eq!(details[2]["severity"].as_str(), Some("attention"));
         let back: Holder = toml::from_str(&text).unwrap();
         assert_eq!(back.w, w);
         // A result without details: each sentence as text, needing attention.

@@ -302,6 +302,154 @@ pub struct RigPointReport {
     pub z: f64,
 }
 
+/// |z| beyond which the fit and a prior disagree: two prior standard deviations, outside which a
+/// value falls with probability 4.55 % (two-sided) when the prior is right, the usual 5 % level.
+pub const PRIOR_CONFLICT_Z: f64 = 2.0;
+
+/// The two-sided tail probability of [`PRIOR_CONFLICT_Z`] under a standard normal, `erfc(2/√2)`:
+/// the level at which the rig curve as a whole disagrees ([`PriorsReport::rig_conflict`]).
+pub fn prior_conflict_level() -> f64 {
+    statrs::function::erf::erfc(PRIOR_CONFLICT_Z / std::f64::consts::SQRT_2)
+}
+
+/// A parameter fitted more than [`PRIOR_CONFLICT_Z`] prior standard deviations from its prior's
+/// centre (on the log scale for a log-normal prior): the recording pulls it away from the prior.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ParamConflict {
+    pub parameter: ParamId,
+    pub prior: ParamPrior,
+    /// The fitted value, the parameter's unit.
+    pub value: f64,
+    /// `(θ − mean)/sd`, or `(ln θ − ln median)/sd_log`.
+    pub z: f64,
+}
+
+/// A rig curve the fitted law misses as a whole: `Σ z_i²` over its `n` points beyond what a χ²
+/// with `n` degrees of freedom exceeds with probability [`prior_conflict_level`]
+/// ([`PriorsReport::rig_conflict`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RigConflict {
+    pub file: PathBuf,
+    pub points: usize,
+    /// `Σ z_i²` at the fit.
+    pub chi2: f64,
+    /// `P(χ²_n ≥ chi2)`.
+    pub p_value: f64,
+    /// `√(Σ z_i²/n)`.
+    pub rms_z: f64,
+    /// The point farthest from the fitted law: its slip speed (m/s), coefficient and z.
+    pub worst_speed_m_per_s: f64,
+    pub worst_coefficient: f64,
+    pub worst_z: f64,
+}
+
+impl PriorsReport {
+    /// The parameters whose fitted value lies beyond [`PRIOR_CONFLICT_Z`] of their prior.
+    pub fn parameter_conflicts(&self) -> Vec<ParamConflict> {
+        (self.parameters.iter())
+            .filter(|p| p.z.abs() > PRIOR_CONFLICT_Z)
+            .map(|p| ParamConflict {
+                parameter: p.name,
+                prior: p.prior,
+                value: p.value,
+                z: p.z,
+            })
+            .collect()
+    }
+
+    /// The rig curve, when the fitted law misses it as a whole. Its points are read together, not
+    /// one by one: of 20 points that each sit where the prior puts them, one is expected beyond
+    /// |z| = 2, so a per-point check would warn on a good fit. `Σ z_i²` over `n` independent
+    /// points is χ² with `n` degrees of freedom when the rig's μ is the blade's μ_d, and the
+    /// curve disagrees when it reaches a value that χ²_n exceeds with probability
+    /// [`prior_conflict_level`], the same level as |z| > [`PRIOR_CONFLICT_Z`] for one parameter
+    /// (for one point the two are the same check). At the fit the law is pulled toward the
+    /// points, so `Σ z_i²` is below its value at the blade's true law and the check errs on the
+    /// quiet side.
+    pub fn rig_conflict(&self) -> Option<RigConflict> {
+        let curve = self.friction_curve.as_ref()?;
+        let n = curve.points.len();
+        let chi2: f64 = curve.points.iter().map(|p| p.z * p.z).sum();
+        let p_value = statrs::distribution::ChiSquared::new(n as f64)
+            .ok()
+            .map(|d| statrs::distribution::ContinuousCDF::sf(&d, chi2))?;
+        if p_value.is_nan() || p_value >= prior_conflict_level() {
+            return None;
+        }
+        let worst = (curve.points.iter()).max_by(|a, b| a.z.abs().total_cmp(&b.z.abs()))?;
+        Some(RigConflict {
+            file: curve.file.clone(),
+            points: n,
+            chi2,
+            p_value,
+            rms_z: (chi2 / n as f64).sqrt(),
+            worst_speed_m_per_s: worst.speed_m_per_s,
+            worst_coefficient: worst.coefficient,
+            worst_z: worst.z,
+        })
+    }
+}
+
+/// `x` to 4 significant digits, written as short as that allows.
+fn short(x: f64) -> f64 {
+    format!("{x:.3e}").parse().unwrap_or(x)
+}
+
+/// ` unit` for a parameter with one, nothing for a dimensionless one.
+fn with_unit(id: ParamId) -> String {
+    match id.unit() {
+        "-" => String::new(),
+        u => format!(" {u}"),
+    }
+}
+
+impl std::fmt::Display for ParamConflict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (id, unit) = (self.parameter, with_unit(self.parameter));
+        let (prior, from) = match self.prior {
+            ParamPrior::Normal { mean, sd } => (
+                format!("normal, mean {mean}{unit}, sd {sd}{unit}"),
+                "its prior's mean",
+            ),
+            ParamPrior::Lognormal { median, sd_log } => (
+                format!("log-normal, median {median}{unit}, sd_log {sd_log}"),
+                "its prior's median on the log scale",
+            ),
+        };
+        write!(
+            f,
+            "{id} = {}{unit} lies z = {:+.2} prior standard deviations from {from} ({prior}; \
+             [fit.priors]): the recording pulls {id} away from the prior, so either the prior or \
+             the model is wrong for this blade",
+            short(self.value),
+            self.z
+        )
+    }
+}
+
+impl std::fmt::Display for RigConflict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the fitted law's μ_d misses the rig curve {} as a whole: Σz² = {:.1} over {} points \
+             (rms z {:.2}; P(χ²_{} ≥ Σz²) = {:.2e}, below the {:.3} of |z| > {PRIOR_CONFLICT_Z}), \
+             worst at {} m/s where the rig has μ = {} and z = {:+.2}: the recording pulls the \
+             friction law away from the rig's μ(v), so either the prior or the model is wrong \
+             for this blade",
+            self.file.display(),
+            self.chi2,
+            self.points,
+            self.rms_z,
+            self.points,
+            self.p_value,
+            prior_conflict_level(),
+            short(self.worst_speed_m_per_s),
+            short(self.worst_coefficient),
+            self.worst_z
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -468,5 +616,126 @@ mod tests {
         // Without a freed friction coefficient the curve reads nothing.
         let k1_only = [FreeParam::new(ParamId::K1, 0.005, 0.15)];
         assert!(Prior::new(&section, Some(&rig), &k1_only).is_empty());
+    }
+
+    /// The report of `prior` at θ_c = `theta_c` (and k1 = `k1`) on the test blade.
+    fn conflicts_at(prior: ParamPrior, id: ParamId, value: f64) -> Vec<ParamConflict> {
+        let free = [FreeParam::new(id, 0.005, 0.2)];
+        let prior = Prior::new(&priors(&[(id, prior)]), None, &free);
+        let mut p = blade();
+        id.set(&mut p, value);
+        prior.report(&p, &[], None).parameter_conflicts()
+    }
+
+    /// A normal prior warns from |z| > 2 on, not at 1.9 (z = (θ − mean)/sd, closed form), on
+    /// either side, and the warning names the prior and the fitted value with their units.
+    #[test]
+    fn a_normal_prior_conflicts_beyond_two_sds() {
+        let prior = ParamPrior::Normal {
+            mean: 0.08,
+            sd: 0.01,
+        };
+        assert!(conflicts_at(prior, ParamId::ThetaC, 0.08 + 1.9 * 0.01).is_empty());
+        assert!(conflicts_at(prior, ParamId::ThetaC, 0.08 - 1.9 * 0.01).is_empty());
+        let c = conflicts_at(prior, ParamId::ThetaC, 0.08 + 2.1 * 0.01);
+        assert_eq!(c.len(), 1);
+        assert_eq!(c[0].parameter, ParamId::ThetaC);
+        assert!((c[0].z - 2.1).abs() < 1e-9 && (c[0].value - 0.101).abs() < 1e-12);
+        assert_eq!(
+            c[0].to_string(),
+            "theta_c = 0.101 rad lies z = +2.10 prior standard deviations from its prior's mean \
+             (normal, mean 0.08 rad, sd 0.01 rad; [fit.priors]): the recording pulls theta_c \
+             away from the prior, so either the prior or the model is wrong for this blade"
+        );
+        let below = conflicts_at(prior, ParamId::ThetaC, 0.08 - 2.1 * 0.01);
+        assert!(below.len() == 1 && (below[0].z + 2.1).abs() < 1e-9);
+    }
+
+    /// A log-normal prior reads z on the log scale, `(ln θ − ln median)/sd_log`: θ =
+    /// median·e^(±2.1·sd_log) warns, median·e^(1.9·sd_log) does not, although on the linear
+    /// scale the upper value is farther from the median than the lower one.
+    #[test]
+    fn a_lognormal_prior_conflicts_beyond_two_sds_of_the_log() {
+        let (median, sd_log) = (0.02, 0.3);
+        let prior = ParamPrior::Lognormal { median, sd_log };
+        let at = |z: f64| conflicts_at(prior, ParamId::K1, median * (z * sd_log).exp());
+        assert!(at(1.9).is_empty() && at(-1.9).is_empty());
+        for z in [2.1, -2.1] {
+            let c = at(z);
+            assert_eq!(c.len(), 1, "z = {z}");
+            assert!((c[0].z - z).abs() < 1e-9, "{} vs {z}", c[0].z);
+        }
+        assert!(at(2.1)[0].to_string().starts_with(
+            "k1 = 0.03755 N·m/rad lies z = +2.10 prior standard deviations from its prior's \
+             median on the log scale (log-normal, median 0.02 N·m/rad, sd_log 0.3;"
+        ));
+    }
+
+    /// The rig curve's report with points at the given z on the test blade's law (each point's
+    /// coefficient μ_d(v) − z·s, so that its z is `z`).
+    fn rig_report(zs: &[f64]) -> PriorsReport {
+        let free = [FreeParam::new(ParamId::A, 0.2, 1.5)];
+        let p = blade();
+        let sd = 0.05;
+        let points = (zs.iter().enumerate())
+            .map(|(i, z)| {
+                let v = 0.01 * (i + 1) as f64;
+                RigPoint {
+                    speed_m_per_s: v,
+                    coefficient: p.friction.mu_slip(v) - z * sd,
+                    sd,
+                    rows: 1,
+                    group: None,
+                    line: 2 + i as u64,
+                }
+            })
+            .collect();
+        let rig = RigCurve {
+            file: "rig.csv".into(),
+            points,
+        };
+        let mut section = priors(&[]);
+        section.friction_curve = Some(
+            toml::from_str(
+                "file = 'rig.csv'\nspeed_column = 'v'\ncoefficient_column = 'mu'\nsd = 0.05",
+            )
+            .unwrap(),
+        );
+        Prior::new(&section, Some(&rig), &free).report(&p, &[], Some(&rig))
+    }
+
+    /// The rig curve disagrees when Σz² over its n points passes the χ²_n value exceeded with the
+    /// probability of |z| > 2. One point: the same as |z| > 2. Two points: χ²_2's tail is
+    /// e^(−x/2) (closed form), so two points at z = 1.9 (Σz² = 7.22, tail e^(−3.61) = 0.027 <
+    /// 0.0455) disagree together though each lies within 2, and two at 1.5 (Σz² = 4.5, tail
+    /// e^(−2.25) = 0.105) do not.
+    #[test]
+    fn a_rig_curve_conflicts_as_a_whole_at_the_level_of_two_sds() {
+        assert!((prior_conflict_level() - 0.0455003).abs() < 1e-6);
+        assert!(rig_report(&[1.9]).rig_conflict().is_none());
+        let one = rig_report(&[-2.1])
+            .rig_conflict()
+            .expect("one point at z = −2.1");
+        assert_eq!(one.points, 1);
+        assert!((one.chi2 - 4.41).abs() < 1e-9 && (one.worst_z + 2.1).abs() < 1e-9);
+        assert!(rig_report(&[1.5, -1.5]).rig_conflict().is_none());
+        let two = rig_report(&[1.9, 1.9])
+            .rig_conflict()
+            .expect("two points at z = 1.9");
+        assert!((two.chi2 - 7.22).abs() < 1e-9);
+        assert!(
+            (two.p_value - (-3.61f64).exp()).abs() < 1e-12,
+            "{}",
+            two.p_value
+        );
+        assert!((two.rms_z - 1.9).abs() < 1e-9);
+        assert!(two.to_string().starts_with(
+            "the fitted law's μ_d misses the rig curve rig.csv as a whole: Σz² = 7.2 over 2 \
+             points (rms z 1.90;"
+        ));
+        // No rig curve: nothing to disagree with.
+        let mut none = rig_report(&[3.0]);
+        none.friction_curve = None;
+        assert!(none.rig_conflict().is_none());
     }
 }

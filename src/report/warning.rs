@@ -294,6 +294,17 @@ fn fit_headline(w: &FitWarning) -> String {
         NoBladeModes { .. } => {
             "The blade's modes could not be computed at the fitted parameters.".into()
         }
+        PriorConflict(c) => format!(
+            "{} is fitted {:+.1} prior standard deviations from its [fit.priors] prior: the \
+             recording disagrees with the prior; check the prior's value, or the model.",
+            c.parameter, c.z
+        ),
+        RigCurveConflict(c) => format!(
+            "The fitted friction law misses the rig curve as a whole (rms z {:.2} over {} \
+             points): the recording disagrees with the rig's μ(v); check the rig's sd and \
+             conditions, or the friction law.",
+            c.rms_z, c.points
+        ),
         Text { text } => text.clone(),
     }
 }
