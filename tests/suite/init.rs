@@ -10,7 +10,8 @@ use crate::common::{root, run_in, temp_dir};
 use std::process::Output;
 use tempfile::TempDir;
 
-use wiperlab::job::LoadedJob;
+use wiperlab::job::{LoadedJob, ParamPrior};
+use wiperlab::model::ParamId;
 
 /// A fresh temp dir holding a copy of the sample recording as `rec_xypts.csv`; removed on drop.
 fn scratch(name: &str) -> TempDir {
@@ -142,6 +143,36 @@ fn with_the_sample_settings_the_filled_in_template_loads_like_the_main_job() {
         loaded.free.iter().map(|f| f.0).collect::<Vec<_>>(),
         main.free.iter().map(|f| f.0).collect::<Vec<_>>()
     );
+    assert!(
+        loaded.job.fit.priors.is_empty(),
+        "the priors are commented out"
+    );
+    // Uncommenting the [fit.priors] example, the template's last lines, gives a job that loads
+    // with the priors it shows.
+    let (before, example) = filled
+        .split_once("# [fit.priors]\n")
+        .unwrap_or_else(|| panic!("no [fit.priors] example in\n{filled}"));
+    let mut with_priors = format!("{before}[fit.priors]\n");
+    for line in example.lines() {
+        let setting = line.strip_prefix("# ");
+        with_priors += setting.unwrap_or_else(|| panic!("{line:?} is not commented out"));
+        with_priors += "\n";
+    }
+    std::fs::write(&job, &with_priors).expect("write the job with priors");
+    let loaded = LoadedJob::load(&job).unwrap_or_else(|e| panic!("{e}\n{with_priors}"));
+    let priors = &loaded.job.fit.priors.parameters;
+    assert_eq!(
+        priors.get(&ParamId::K1),
+        Some(&ParamPrior::Lognormal {
+            median: 0.01,
+            sd_log: 0.5
+        })
+    );
+    assert_eq!(
+        priors.get(&ParamId::C),
+        Some(&ParamPrior::Normal { mean: 0.3, sd: 0.1 })
+    );
+    assert_eq!(priors.len(), 2);
 }
 
 #[test]
