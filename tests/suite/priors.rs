@@ -10,7 +10,7 @@ use crate::common;
 use crate::common::{root, shared, temp_dir, write};
 use wiperlab::job::{FreeParam, ParamPrior, PriorsSection};
 use wiperlab::job::{FrictionCurvePrior, LoadedJob, rig};
-use wiperlab::likelihood::prior::Prior;
+use wiperlab::likelihood::prior::{Prior, PriorTerm};
 use wiperlab::model::{BladeParams, ParamId};
 
 fn spec(toml_text: &str) -> FrictionCurvePrior {
@@ -463,4 +463,79 @@ fn a_prior_on_a_listed_laws_coefficient() {
     assert!(e.contains("does not fit 'D'"), "{e}");
     let e = load(laws, "D = { lognormal = { median = 0.1, sd_log = 0.5 } }").unwrap_err();
     assert!(e.contains("log-normal") && e.contains("<= 0"), "{e}");
+}
+
+/// With several `[fit] laws`, a prior on one law's coefficient applies to the candidates whose law
+/// has that coefficient and is left out of the others, without an error: D's prior only to
+/// `exponential_viscous`, B's to the two exponential laws and not to Stribeck's (which fits v_s in
+/// B's place), v_s's only to Stribeck's, and k1's (every candidate fits k1) to all. Checked on the
+/// cost problems a fit builds for the main job's `blade2dof` with each law; D's term at D = 1 s/m
+/// (u = 0.5 of its default bounds [0, 2] s/m, a linear scale) has the closed form
+/// z = (1 − 0)/0.2 = 5.
+#[test]
+fn a_prior_on_one_laws_coefficient_applies_to_that_laws_candidates() {
+    let dir = temp_dir("priors_per_law");
+    let text = std::fs::read_to_string(root().join("fits/reversal.toml"))
+        .unwrap()
+        .replace(
+            "\"../data/",
+            &format!("\"{}/", root().join("data").display()),
+        )
+        .replace("reports_dir = \"../reports\"", "")
+        .replace(
+            "[fit.uncertainty]",
+            "laws = [\"exponential\", \"exponential_viscous\", \"stribeck\"]\n[fit.uncertainty]",
+        );
+    let priors = "[fit.priors]\n\
+                  D = { normal = { mean = 0.0, sd = 0.2 } }\n\
+                  B = { normal = { mean = 70.0, sd = 20.0 } }\n\
+                  v_s = { lognormal = { median = 0.014, sd_log = 0.5 } }\n\
+                  k1 = { lognormal = { median = 0.03, sd_log = 0.5 } }\n";
+    let path = write(dir.path(), "job.toml", &format!("{text}\n{priors}"));
+    let job = LoadedJob::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let expected = [
+        ("blade2dof@exponential", vec![ParamId::B, ParamId::K1]),
+        (
+            "blade2dof@exponential_viscous",
+            vec![ParamId::B, ParamId::D, ParamId::K1],
+        ),
+        ("blade2dof@stribeck", vec![ParamId::Vs, ParamId::K1]),
+    ];
+    let cands = job.candidates();
+    for (name, ids) in expected {
+        let c = *cands
+            .iter()
+            .find(|c| c.name() == name)
+            .unwrap_or_else(|| panic!("no candidate {name} in {cands:?}"));
+        let p = wiperlab::fit::problem_for(&job, c).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let mut got: Vec<ParamId> = (p.prior.terms.iter())
+            .map(|t| match t {
+                PriorTerm::Parameter { id, .. } => *id,
+                PriorTerm::Rig(_) => panic!("no rig curve in this job"),
+            })
+            .collect();
+        got.sort();
+        let mut want = ids.clone();
+        want.sort();
+        assert_eq!(got, want, "{name}");
+        // Every term reads a parameter the candidate frees.
+        for id in &got {
+            assert!(p.free.iter().any(|f| f.name == *id), "{name}: {id}");
+        }
+        if p.free.iter().any(|f| f.name == ParamId::D) {
+            let at = p.params_at(&vec![0.5; p.free.len()]);
+            assert_eq!(at.friction.name(), "exponential_viscous", "{name}");
+            assert!(
+                (ParamId::D.get(&at).unwrap() - 1.0).abs() < 1e-12,
+                "D at u = 0.5"
+            );
+            let d = p
+                .prior
+                .terms
+                .iter()
+                .find(|t| matches!(t, PriorTerm::Parameter { id, .. } if *id == ParamId::D));
+            let z = d.expect("D's term").z(&at);
+            assert!((z - 5.0).abs() < 1e-12, "{name}: z = {z}");
+        }
+    }
 }
