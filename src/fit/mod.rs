@@ -64,8 +64,8 @@ pub struct FitOutcome {
 }
 
 /// Runs the job in stages: measure the recording (or read the targets), search each candidate
-/// model (particle swarm, Nelder–Mead, curvature: [`search`]), choose among them by [`aic`]
-/// ([`select`]), attach intervals and warnings to the chosen fit ([`uncertainty`]), and assemble
+/// model (particle swarm, Nelder–Mead, curvature: [`search`]), choose among them by TIC (target
+/// jobs: [`aic`]; [`select`]), attach intervals and warnings to the chosen fit ([`uncertainty`]), and assemble
 /// the [`FitResult`].
 ///
 /// `progress`: show a progress bar on stderr (hidden automatically when stderr is not a terminal),
@@ -246,13 +246,13 @@ fn optimum_checks(
 /// The chosen trial's name, the name of the trial with the TIC nearest to it among the others, and
 /// that TIC's distance above the chosen one's (`None` without two trials in likelihood units).
 fn runner_up(trials: &[result::ModelTrial]) -> Option<(Candidate, Candidate, f64)> {
-    let aic = |t: &result::ModelTrial| t.evidence.as_ref().and_then(|e| e.tic);
+    let tic = |t: &result::ModelTrial| t.evidence.as_ref().and_then(|e| e.tic);
     let chosen = trials.iter().find(|t| t.chosen)?;
-    let chosen_aic = aic(chosen)?;
+    let chosen_tic = tic(chosen)?;
     trials
         .iter()
         .filter(|t| !t.chosen)
-        .filter_map(|t| Some((t, aic(t)? - chosen_aic)))
+        .filter_map(|t| Some((t, tic(t)? - chosen_tic)))
         .filter(|(_, gap)| gap.is_finite())
         .min_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
         .map(|(t, gap)| (chosen.model, t.model, gap))

@@ -867,16 +867,16 @@ pub(super) struct Unconfirmed {
 pub const DEFERRED_CONFIRM_MARGIN_NATS: f64 = 5.0;
 
 /// Why a candidate's deferred confirmation need not run ([`confirm_deferred`]), or `None` when it
-/// must: `ends` are its search ends' finite costs (nats), `aic_gap` its score minus the chosen
+/// must: `ends` are its search ends' finite costs (nats), `score_gap` its score (TIC) minus the chosen
 /// candidate's (+∞ when it cannot be chosen). It is skipped when the candidate trails by more than
-/// the spread of its ends plus [`DEFERRED_CONFIRM_MARGIN_NATS`] (in nats: half the AIC gap).
-fn confirmation_skipped(ends: &[f64], aic_gap: f64) -> Option<String> {
+/// the spread of its ends plus [`DEFERRED_CONFIRM_MARGIN_NATS`] (in nats: half the TIC gap).
+fn confirmation_skipped(ends: &[f64], score_gap: f64) -> Option<String> {
     let (lo, hi) = ends
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &c| {
             (lo.min(c), hi.max(c))
         });
-    let behind_nats = 0.5 * aic_gap;
+    let behind_nats = 0.5 * score_gap;
     if behind_nats.is_nan() || behind_nats <= (hi - lo) + DEFERRED_CONFIRM_MARGIN_NATS {
         return None;
     }
@@ -898,18 +898,18 @@ fn confirmation_skipped(ends: &[f64], aic_gap: f64) -> Option<String> {
 /// Runs the deferred second batch of restarts (`R..2R`) of each candidate whose best end is
 /// unconfirmed, unless its AIC trails the chosen candidate's by more than
 /// `2 · (spread of its ends + DEFERRED_CONFIRM_MARGIN_NATS)` or it cannot be chosen: then more
-/// restarts of it could not change the choice, and its reason says so. `aic_gaps[i]`: candidate
+/// restarts of it could not change the choice, and its reason says so. `score_gaps[i]`: candidate
 /// `i`'s score minus the chosen one's ([`super::select::score_gaps`]; +∞ when it cannot be chosen).
 /// A batch that ends below the candidate's search end replaces it, and the candidate is settled
 /// anew.
 pub(super) fn confirm_deferred(
     job: &LoadedJob,
     fits: &mut [CandidateFit],
-    aic_gaps: &[f64],
+    score_gaps: &[f64],
     pb: &Option<indicatif::ProgressBar>,
 ) -> Result<()> {
     let fit = &job.job.fit;
-    for (f, &gap) in fits.iter_mut().zip(aic_gaps) {
+    for (f, &gap) in fits.iter_mut().zip(score_gaps) {
         let Some(unconfirmed) = f.unconfirmed.take() else {
             continue;
         };

@@ -58,7 +58,7 @@ fn evidences(fits: &[CandidateFit]) -> Option<Vec<Option<Evidence>>> {
     (complete && e.iter().any(Option::is_some)).then_some(e)
 }
 
-/// Chooses by AIC among the candidates that produced a model and can be compared: with the
+/// Chooses by TIC (target jobs: `cost + 2k`) among the candidates that produced a model and can be compared: with the
 /// recording's likelihood, every candidate but one that imposes a band from the head track (the
 /// neck/lip model's low band, whose fit there proves nothing), since a model without a mode a band
 /// needs is judged by how well it explains that band (on a head-only recording the high band holds
@@ -67,11 +67,11 @@ fn evidences(fits: &[CandidateFit]) -> Option<Vec<Option<Evidence>>> {
 /// was the only one).
 pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) -> Selection {
     let evidence = evidences(fits);
-    let (aics, scores) = criteria(fits, bands, evidence.as_deref());
+    let (crit, scores) = criteria(fits, bands, evidence.as_deref());
     let ks: Vec<usize> = fits.iter().map(|f| f.free.len()).collect();
     let chosen = simplest_near_best(&scores, &ks, evidence.is_some());
     let scored = Scored {
-        aics: &aics,
+        crit: &crit,
         scores: &scores,
         chosen,
         evidence: evidence.as_deref(),
@@ -135,7 +135,7 @@ fn criteria(
     bands: &[BandSpec],
     evidence: Option<&[Option<Evidence>]>,
 ) -> (Vec<f64>, Vec<f64>) {
-    let aics: Vec<f64> = fits
+    let crit: Vec<f64> = fits
         .iter()
         .enumerate()
         .map(|(i, f)| match evidence {
@@ -155,19 +155,20 @@ fn criteria(
     let scores: Vec<f64> = (0..fits.len())
         .map(|i| {
             if capable[i] || !any_capable {
-                aics[i]
+                crit[i]
             } else {
                 f64::INFINITY
             }
         })
         .collect();
-    (aics, scores)
+    (crit, scores)
 }
 
 /// The candidates' criteria, for the reasons.
 struct Scored<'a> {
-    aics: &'a [f64],
-    /// AIC where the candidate can be chosen, else infinity.
+    /// Every candidate's criterion: TIC with a likelihood, else `cost + 2k`.
+    crit: &'a [f64],
+    /// The criterion where the candidate can be chosen, else infinity.
     scores: &'a [f64],
     chosen: usize,
     /// Every candidate's evidence, when the comparison is in likelihood units.
@@ -291,11 +292,11 @@ impl Scored<'_> {
         let name = self.criterion().split(' ').next().unwrap_or("AIC");
         let mut r = format!(
             "{name} {:.2} ({lnl}k = {k}{penalty}), {:+.2} against the chosen model",
-            self.aics[i],
-            self.aics[i] - self.aics[self.chosen]
+            self.crit[i],
+            self.crit[i] - self.crit[self.chosen]
         );
         if self.evidence.is_some()
-            && (self.aics[i] - self.aics[self.chosen]).abs() <= INDISTINGUISHABLE_TIC
+            && (self.crit[i] - self.crit[self.chosen]).abs() <= INDISTINGUISHABLE_TIC
             && self.scores[i].is_finite()
         {
             r.push_str(&format!(

@@ -161,21 +161,21 @@ impl ToleranceCheck {
     }
 
     /// The warning of a model choice the integrator does not resolve: `chosen` over `runner_up`,
-    /// whose AIC is `aic_gap` above the chosen one's (`aic_gap / 2` nats of log-likelihood once
+    /// whose TIC is `tic_gap` above the chosen one's (`tic_gap / 2` nats of log-likelihood once
     /// the penalties are counted), when the optimum's cost spreads by more than that; `None`
     /// otherwise.
     pub fn choice_warning(
         &self,
         chosen: Candidate,
         runner_up: Candidate,
-        aic_gap: f64,
+        tic_gap: f64,
     ) -> Option<FitWarning> {
-        let gap_nats = aic_gap.abs() / 2.0;
-        (aic_gap.is_finite() && self.spread_nats > gap_nats).then_some(
+        let gap_nats = tic_gap.abs() / 2.0;
+        (tic_gap.is_finite() && self.spread_nats > gap_nats).then_some(
             FitWarning::ChoiceUnresolved {
                 chosen,
                 runner_up,
-                aic_gap,
+                tic_gap,
                 spread_nats: self.spread_nats,
             },
         )
@@ -227,7 +227,7 @@ mod tests {
     fn a_choice_closer_than_the_spread_warns() {
         let apart =
             ToleranceCheck::of(vec![point(1e-8, 66.8, 168), point(1e-9, 68.0, 170)], vec![]);
-        // 1.2 nats of spread against ΔAIC 2.0 (1.0 nat): unresolved; against ΔAIC 3.0: resolved.
+        // 1.2 nats of spread against ΔTIC 2.0 (1.0 nat): unresolved; against ΔTIC 3.0: resolved.
         let (a, b): (Candidate, Candidate) = (
             "blade2dof".parse().unwrap(),
             "blade2dof+shoulder".parse().unwrap(),
@@ -240,7 +240,7 @@ mod tests {
         );
         assert!(
             w.to_string()
-                .contains("blade2dof over blade2dof+shoulder (ΔAIC 2.00, 1.00 nats)"),
+                .contains("blade2dof over blade2dof+shoulder (ΔTIC 2.00, 1.00 nats)"),
             "{w}"
         );
         assert!(apart.choice_warning(a, b, 3.0).is_none());

@@ -202,11 +202,11 @@ pub enum FitWarning {
         /// The nested candidate's TIC above the chosen one's.
         delta_tic: f64,
     },
-    /// The model choice's AIC gap is smaller than the tolerance spread.
+    /// The model choice's TIC gap is smaller than the tolerance spread.
     ChoiceUnresolved {
         chosen: Candidate,
         runner_up: Candidate,
-        aic_gap: f64,
+        tic_gap: f64,
         spread_nats: f64,
     },
     /// More than [`FAILED_WARN_FRACTION`] of the chosen model's evaluations failed.
@@ -466,9 +466,9 @@ impl fmt::Display for FitWarning {
             ChoiceUnresolved {
                 chosen,
                 runner_up,
-                aic_gap,
+                tic_gap,
                 spread_nats,
-            } => choice_unresolved(f, [chosen, runner_up], *aic_gap, *spread_nats),
+            } => choice_unresolved(f, [chosen, runner_up], *tic_gap, *spread_nats),
             ChosenOnMisfit {
                 chosen,
                 nested,
@@ -782,15 +782,15 @@ fn chosen_on_misfit(
 fn choice_unresolved(
     f: &mut fmt::Formatter<'_>,
     [chosen, runner_up]: [&Candidate; 2],
-    aic_gap: f64,
+    tic_gap: f64,
     spread_nats: f64,
 ) -> fmt::Result {
     write!(
         f,
-        "the choice of {chosen} over {runner_up} (ΔAIC {aic_gap:.2}, {:.2} nats) is smaller \
+        "the choice of {chosen} over {runner_up} (ΔTIC {tic_gap:.2}, {:.2} nats) is smaller \
          than the {spread_nats:.2} nats the chosen optimum's cost moves between solver \
          tolerances: the integrator does not resolve it (docs/likelihood.md, \"Tolerance check\")",
-        aic_gap.abs() / 2.0
+        tic_gap.abs() / 2.0
     )
 }
 

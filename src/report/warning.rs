@@ -277,9 +277,9 @@ fn fit_headline(w: &FitWarning) -> String {
         ChoiceUnresolved {
             chosen,
             runner_up,
-            aic_gap,
+            tic_gap,
             spread_nats,
-        } => choice_unresolved_headline([chosen, runner_up], *aic_gap, *spread_nats),
+        } => choice_unresolved_headline([chosen, runner_up], *tic_gap, *spread_nats),
         ChosenOnMisfit { chosen, nested, .. } => format!(
             "{chosen} is chosen on a fit that fails the goodness-of-fit test: what it adds to \
              {nested} is not confirmed by this recording. Read the misfit's description before \
@@ -411,11 +411,11 @@ fn tolerance_unresolved_headline(spread_nats: f64) -> String {
 /// [`FitWarning::ChoiceUnresolved`]'s headline: `chosen` over `runner_up`.
 fn choice_unresolved_headline(
     [chosen, runner_up]: [&Candidate; 2],
-    aic_gap: f64,
+    tic_gap: f64,
     spread_nats: f64,
 ) -> String {
     format!(
-        "The choice of {chosen} over {runner_up} (ΔAIC {aic_gap:.2}) is within the {} nats \
+        "The choice of {chosen} over {runner_up} (ΔTIC {tic_gap:.2}) is within the {} nats \
          the cost moves between solver tolerances: tighten [solver] rtol and refit.",
         num(spread_nats, 2)
     )
