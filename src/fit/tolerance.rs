@@ -12,6 +12,7 @@
 //! smaller than the spread do not tell parameter sets apart, and intervals read from the local
 //! curvature at the 0.5-nat scale understate the uncertainty. The check costs two simulations.
 
+use super::select::INDISTINGUISHABLE_TIC;
 use super::{FitWarning, SpectralProblem};
 use crate::job::Candidate;
 use serde::{Deserialize, Serialize};
@@ -161,17 +162,20 @@ impl ToleranceCheck {
     }
 
     /// The warning of a model choice the integrator does not resolve: `chosen` over `runner_up`,
-    /// whose TIC is `tic_gap` above the chosen one's (`tic_gap / 2` nats of log-likelihood once
-    /// the penalties are counted), when the optimum's cost spreads by more than that; `None`
-    /// otherwise.
+    /// whose TIC is `tic_gap` above the chosen one's, when moving that gap by the TIC the
+    /// optimum's cost spreads over (`2·spread_nats`) could carry it across
+    /// [`INDISTINGUISHABLE_TIC`], the margin at which the choice turns from "distinguishable" to
+    /// "not distinguishable, the simpler reported" or back; `None` otherwise. Two candidates with
+    /// the same optimum (a shoulder the motion never reaches: gap 0) are not distinguishable at
+    /// any tolerance, so a spread smaller than the margin leaves that verdict as it is.
     pub fn choice_warning(
         &self,
         chosen: Candidate,
         runner_up: Candidate,
         tic_gap: f64,
     ) -> Option<FitWarning> {
-        let gap_nats = tic_gap.abs() / 2.0;
-        (tic_gap.is_finite() && self.spread_nats > gap_nats).then_some(
+        let to_margin = (tic_gap.abs() - INDISTINGUISHABLE_TIC).abs();
+        (tic_gap.is_finite() && 2.0 * self.spread_nats > to_margin).then_some(
             FitWarning::ChoiceUnresolved {
                 chosen,
                 runner_up,
@@ -227,12 +231,14 @@ mod tests {
     fn a_choice_closer_than_the_spread_warns() {
         let apart =
             ToleranceCheck::of(vec![point(1e-8, 66.8, 168), point(1e-9, 68.0, 170)], vec![]);
-        // 1.2 nats of spread against ΔTIC 2.0 (1.0 nat): unresolved; against ΔTIC 3.0: resolved.
+        // 1.2 nats of spread moves the TIC by up to 2.4: ΔTIC 2.0 (at the margin of 2) and 4.0
+        // (2.0 above it) can cross it, unresolved; ΔTIC 5.0 (3.0 above) and 0.0 (two equal
+        // optima, 2.0 inside) with a 0.9-nat spread cannot, resolved.
         let (a, b): (Candidate, Candidate) = (
             "blade2dof".parse().unwrap(),
             "blade2dof+shoulder".parse().unwrap(),
         );
-        let w = apart.choice_warning(a, b, 2.0).expect("1.2 nats > 1.0");
+        let w = apart.choice_warning(a, b, 2.0).expect("2.4 > 0");
         assert!(
             matches!(w, FitWarning::ChoiceUnresolved { chosen, runner_up, .. }
                 if chosen == a && runner_up == b),
@@ -240,10 +246,15 @@ mod tests {
         );
         assert!(
             w.to_string()
-                .contains("blade2dof over blade2dof+shoulder (ΔTIC 2.00, 1.00 nats)"),
+                .contains("blade2dof over blade2dof+shoulder (ΔTIC 2.00) lies 0.00 from"),
             "{w}"
         );
-        assert!(apart.choice_warning(a, b, 3.0).is_none());
+        assert!(apart.choice_warning(a, b, 4.0).is_some());
+        assert!(apart.choice_warning(a, b, 5.0).is_none());
+        let close =
+            ToleranceCheck::of(vec![point(1e-8, 66.8, 168), point(1e-9, 67.7, 170)], vec![]);
+        assert!(close.choice_warning(a, b, 0.0).is_none());
+        assert!(close.choice_warning(a, b, 1.5).is_some());
         assert!(apart.choice_warning(a, b, f64::INFINITY).is_none());
     }
 

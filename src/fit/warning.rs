@@ -14,6 +14,7 @@
 //! recording and in the model, model evaluations that failed where the lip tip would leave the
 //! glass).
 
+use super::select::INDISTINGUISHABLE_TIC;
 use super::tolerance::{SPREAD_WARN_NATS, TolerancePoint};
 use super::uncertainty::{PROFILE_68_NATS, PROFILE_MAX_STEPS};
 use crate::job::Candidate;
@@ -787,10 +788,13 @@ fn choice_unresolved(
 ) -> fmt::Result {
     write!(
         f,
-        "the choice of {chosen} over {runner_up} (ΔTIC {tic_gap:.2}, {:.2} nats) is smaller \
-         than the {spread_nats:.2} nats the chosen optimum's cost moves between solver \
-         tolerances: the integrator does not resolve it (docs/likelihood.md, \"Tolerance check\")",
-        tic_gap.abs() / 2.0
+        "the choice of {chosen} over {runner_up} (ΔTIC {tic_gap:.2}) lies {:.2} from the margin \
+         of {INDISTINGUISHABLE_TIC} at which the recording stops distinguishing them, less than \
+         the {:.2} the TIC moves as the chosen optimum's cost spreads by {spread_nats:.2} nats \
+         between solver tolerances: the integrator does not resolve it (docs/likelihood.md, \
+         \"Tolerance check\")",
+        (tic_gap.abs() - INDISTINGUISHABLE_TIC).abs(),
+        2.0 * spread_nats
     )
 }
 

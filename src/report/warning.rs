@@ -415,8 +415,8 @@ fn choice_unresolved_headline(
     spread_nats: f64,
 ) -> String {
     format!(
-        "The choice of {chosen} over {runner_up} (ΔTIC {tic_gap:.2}) is within the {} nats \
-         the cost moves between solver tolerances: tighten [solver] rtol and refit.",
+        "The choice of {chosen} over {runner_up} (ΔTIC {tic_gap:.2}) could change within the {} \
+         nats the cost moves between solver tolerances: tighten [solver] rtol and refit.",
         num(spread_nats, 2)
     )
 }
