@@ -85,6 +85,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let mut fits = fit_candidates(job, &meas, &candidates, &pb)?;
     let gaps = select::score_gaps(&fits, &job.job.spectrum.bands);
     confirm_deferred(job, &mut fits, &gaps, &pb)?;
+    search::take_nested_optima(&mut fits, &pb)?;
     let explicit = !fit.models.is_empty();
     let choose = |fits: &mut Vec<CandidateFit>| -> Result<select::Selection> {
         let selection = select::choose(fits, &job.job.spectrum.bands, explicit);

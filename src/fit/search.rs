@@ -689,6 +689,83 @@ pub(super) fn settle_anew(
     Ok(())
 }
 
+/// Every candidate `X` on which a fitted candidate `Y` is nested (`X+shoulder`, or `X@law` with a
+/// larger law) takes `Y`'s optimum read in `X`'s own parameters when that is more than
+/// [`VALLEY_GAIN_NATS`] more likely than `X`'s search end, and is settled anew from it; candidates
+/// nested on a moved `X` then keep at least its likelihood ([`keep_nested_above`]). Why: `Y`
+/// starts from `X`'s optimum and searches further, so it can end at a point of `X`'s own family
+/// (a viscous term at D = 0, a shoulder the neck never reaches) that `X`'s shorter search missed;
+/// `X` would then lose the choice to a larger model that adds nothing, or be reported short of
+/// its own optimum. One simulation per nested pair. Returns whether any candidate moved.
+pub(super) fn take_nested_optima(
+    fits: &mut Vec<CandidateFit>,
+    pb: &Option<indicatif::ProgressBar>,
+) -> Result<bool> {
+    let mut moved = false;
+    for small in 0..fits.len() {
+        if !fits[small].problem.cost_is_nll() || interrupt::stop_requested() {
+            continue;
+        }
+        let projected: Vec<(Vec<f64>, f64, Candidate)> = fits
+            .iter()
+            .filter(|y| y.candidate.extends(&fits[small].candidate))
+            .filter(|y| y.cost < fits[small].cost - VALLEY_GAIN_NATS)
+            .filter_map(|y| Some((projection(&fits[small], y)?, y.candidate)))
+            .map(|(u, c)| (u.clone(), fits[small].problem.cost_at(&u), c))
+            .collect();
+        let best = projected
+            .into_iter()
+            .filter(|(_, cost, _)| cost.is_finite())
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        let Some((u, cost, larger)) = best else {
+            continue;
+        };
+        let f = &mut fits[small];
+        if cost >= f.cost - VALLEY_GAIN_NATS {
+            continue;
+        }
+        let started = std::time::Instant::now();
+        let wall_time_s = f.wall_time_s;
+        add_note(
+            &mut f.search_note,
+            format!(
+                "{larger}'s optimum, read in this model's parameters, is {:.3} nats more likely \
+                 than its own search end ({cost:.3} against {:.3}), so it continues from there",
+                f.cost - cost,
+                f.cost
+            ),
+        );
+        let reporting = Reporting::continuing(f, pb);
+        let found = Optimised {
+            u,
+            swarm_iters: f.swarm_iters,
+            polish_iters: f.polish_iters,
+            cost,
+            unconfirmed_ends: None,
+        };
+        settle_anew(f, found, &reporting, pb)?;
+        f.wall_time_s = wall_time_s + started.elapsed().as_secs_f64();
+        keep_nested_above(fits, small, pb)?;
+        moved = true;
+    }
+    Ok(moved)
+}
+
+/// `larger`'s optimum in `smaller`'s normalised coordinates: each of `smaller`'s freed parameters
+/// at its value in `larger`'s parameters; `None` when one is not among them or lies outside
+/// `smaller`'s bounds.
+fn projection(smaller: &CandidateFit, larger: &CandidateFit) -> Option<Vec<f64>> {
+    let params = larger.problem.params_at(&larger.best_u);
+    smaller
+        .free
+        .iter()
+        .map(|fp| {
+            let v = fp.name.get(&params)?;
+            (fp.lower..=fp.upper).contains(&v).then(|| fp.u_of(v))
+        })
+        .collect()
+}
+
 /// Every candidate nested on `fits[smaller]` (`X+shoulder` on `X`) that is less likely than it
 /// takes its optimum ([`keep_the_smaller_optimum`]).
 fn keep_nested_above(
