@@ -299,10 +299,13 @@ crate::names::named_enum! {
     pub enum NoiseSpectrum: "noise spectrum" {
         /// White noise of the σ second differences give, `1.4826·MAD(Δ²x)/√6`, fixed before the
         /// fit.
-        #[default]
         White => "white",
         /// AR(1) noise whose σ and ρ maximise the recording's likelihood at every simulation (the
         /// profile likelihood; [`crate::fit::evidence::RecordingLikelihood::profile_noise`]).
+        /// The default: white noise is its case ρ = 0, which it finds on a white recording, and
+        /// trackers correlate neighbouring frames (docs/validation.md, "Tracking-noise
+        /// departures").
+        #[default]
         Ar1 => "ar1",
     }
 }
