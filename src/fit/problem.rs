@@ -149,6 +149,22 @@ impl SpectralProblem {
         p
     }
 
+    /// Whether `p` is a shoulder that softens the neck (`k1_contact < k1`) in a fit that frees the
+    /// contact stiffness. A shoulder is a stop the neck leans on: touching it adds stiffness, so the
+    /// neck is stiffer beyond θ_c, never softer (physics.md §2.3: "a bilinear k1(θ) (soft, then
+    /// stiff past the shoulder-contact angle)"; docs/model.md, "Shoulder contact"). Without this
+    /// bound a misspecified recording (coloured tracking noise, a viscous friction term) is fitted
+    /// by a softening neck the blade does not have and reported as a shoulder. `k1_contact = k1`, the
+    /// shoulder that changes nothing, is allowed (to a relative 1e-9, the round trip of a value
+    /// through another parameter's normalised coordinate): the nested candidates start there.
+    pub(super) fn softening_shoulder(&self, p: &BladeParams) -> bool {
+        self.free
+            .iter()
+            .any(|f| f.name == crate::model::ParamId::K1c)
+            && p.shoulder
+                .is_some_and(|s| s.k1_contact_nm_per_rad < p.k1_nm_per_rad * (1.0 - 1e-9))
+    }
+
     /// Simulates the model at `params`, sampled at the recording's times.
     pub fn simulate(&self, params: &BladeParams) -> Result<BladeSimulation> {
         self.simulate_with(params, &self.solver)
@@ -353,6 +369,10 @@ impl SpectralProblem {
             return FAILED_COST;
         }
         let p = self.params_at(u);
+        if self.softening_shoulder(&p) {
+            // Outside the model's physics: no simulation, not an evaluation.
+            return FAILED_COST;
+        }
         let c = self
             .counted(|| self.stage_cost(&self.simulate_with(&p, solver)?, stage))
             .unwrap_or(FAILED_COST)

@@ -164,3 +164,37 @@ fn a_shoulder_never_reached_changes_nothing() {
     assert_eq!(a.theta_rad, b.theta_rad);
     assert_eq!(a.transitions.len(), b.transitions.len());
 }
+
+/// The fit's shoulder only stiffens the neck: on the main job's `blade2dof+shoulder` candidate a
+/// point with `k1c` below `k1` gets the failed cost without a simulation (the evaluation counter
+/// does not move), and the same point with `k1c` above `k1`, or equal (the shoulder that changes
+/// nothing, where the nested search starts), is simulated and scored.
+#[test]
+fn the_fits_shoulder_never_softens_the_neck() {
+    use std::sync::atomic::Ordering;
+    use wiperlab::fit::{FAILED_COST, problem_for};
+    use wiperlab::model::ParamId;
+    let job = wiperlab::job::LoadedJob::load(&common::root().join("fits/reversal.toml"))
+        .expect("the shipped job loads");
+    let p = problem_for(&job, "blade2dof+shoulder".parse().unwrap()).expect("problem");
+    // The sample's true blade (data/reversal/truth.json) with a contact angle of 0.1 rad.
+    let value = |id: ParamId, k1c: f64| match id {
+        ParamId::A => 0.88,
+        ParamId::B => 69.74712740275162,
+        ParamId::C => 0.56,
+        ParamId::K1 => 0.029748408887917077,
+        ParamId::K1c => k1c,
+        ParamId::ThetaC => 0.1,
+        other => panic!("unexpected free parameter {other:?}"),
+    };
+    let at = |k1c: f64| -> Vec<f64> { p.free.iter().map(|f| f.u_of(value(f.name, k1c))).collect() };
+    let runs = || p.evaluations.load(Ordering::Relaxed);
+    let before = runs();
+    assert_eq!(p.cost_at(&at(0.015)), FAILED_COST);
+    assert_eq!(runs(), before, "a softening shoulder is not simulated");
+    for k1c in [0.029748408887917077, 0.06] {
+        let c = p.cost_at(&at(k1c));
+        assert!(c.is_finite() && c < FAILED_COST, "k1c {k1c}: {c}");
+    }
+    assert_eq!(runs(), before + 2);
+}
