@@ -696,26 +696,24 @@ pub(super) fn settle_anew(
 /// starts from `X`'s optimum and searches further, so it can end at a point of `X`'s own family
 /// (a viscous term at D = 0, a shoulder the neck never reaches) that `X`'s shorter search missed;
 /// `X` would then lose the choice to a larger model that adds nothing, or be reported short of
-/// its own optimum. One simulation per nested pair. Returns whether any candidate moved.
+/// its own optimum. One simulation per nested pair.
 pub(super) fn take_nested_optima(
     fits: &mut Vec<CandidateFit>,
     pb: &Option<indicatif::ProgressBar>,
-) -> Result<bool> {
-    let mut moved = false;
+) -> Result<()> {
     for small in 0..fits.len() {
-        if !fits[small].problem.cost_is_nll() || interrupt::stop_requested() {
+        let x = &fits[small];
+        if !x.problem.cost_is_nll() || interrupt::stop_requested() {
             continue;
         }
-        let projected: Vec<(Vec<f64>, f64, Candidate)> = fits
+        let best = fits
             .iter()
-            .filter(|y| y.candidate.extends(&fits[small].candidate))
-            .filter(|y| y.cost < fits[small].cost - VALLEY_GAIN_NATS)
-            .filter_map(|y| Some((projection(&fits[small], y)?, y.candidate)))
-            .map(|(u, c)| (u.clone(), fits[small].problem.cost_at(&u), c))
-            .collect();
-        let best = projected
-            .into_iter()
-            .filter(|(_, cost, _)| cost.is_finite())
+            .filter(|y| y.candidate.extends(&x.candidate) && y.cost < x.cost - VALLEY_GAIN_NATS)
+            .filter_map(|y| {
+                let u = projection(x, y)?;
+                let cost = x.problem.cost_at(&u);
+                cost.is_finite().then_some((u, cost, y.candidate))
+            })
             .min_by(|a, b| a.1.total_cmp(&b.1));
         let Some((u, cost, larger)) = best else {
             continue;
@@ -746,9 +744,8 @@ pub(super) fn take_nested_optima(
         settle_anew(f, found, &reporting, pb)?;
         f.wall_time_s = wall_time_s + started.elapsed().as_secs_f64();
         keep_nested_above(fits, small, pb)?;
-        moved = true;
     }
-    Ok(moved)
+    Ok(())
 }
 
 /// `larger`'s optimum in `smaller`'s normalised coordinates: each of `smaller`'s freed parameters

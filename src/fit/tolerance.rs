@@ -174,8 +174,7 @@ impl ToleranceCheck {
         runner_up: Candidate,
         tic_gap: f64,
     ) -> Option<FitWarning> {
-        let to_margin = (tic_gap.abs() - INDISTINGUISHABLE_TIC).abs();
-        (tic_gap.is_finite() && 2.0 * self.spread_nats > to_margin).then_some(
+        (tic_gap.is_finite() && 2.0 * self.spread_nats > distance_to_margin(tic_gap)).then_some(
             FitWarning::ChoiceUnresolved {
                 chosen,
                 runner_up,
@@ -184,6 +183,12 @@ impl ToleranceCheck {
             },
         )
     }
+}
+
+/// How far a TIC gap lies from [`INDISTINGUISHABLE_TIC`], the margin at which a choice turns
+/// between "distinguishable" and "not distinguishable".
+pub(super) fn distance_to_margin(tic_gap: f64) -> f64 {
+    (tic_gap.abs() - INDISTINGUISHABLE_TIC).abs()
 }
 
 #[cfg(test)]

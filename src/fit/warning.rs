@@ -793,7 +793,7 @@ fn choice_unresolved(
          the {:.2} the TIC moves as the chosen optimum's cost spreads by {spread_nats:.2} nats \
          between solver tolerances: the integrator does not resolve it (docs/likelihood.md, \
          \"Tolerance check\")",
-        (tic_gap.abs() - INDISTINGUISHABLE_TIC).abs(),
+        super::tolerance::distance_to_margin(tic_gap),
         2.0 * spread_nats
     )
 }

@@ -395,17 +395,9 @@ fn short(x: f64) -> f64 {
     format!("{x:.3e}").parse().unwrap_or(x)
 }
 
-/// ` unit` for a parameter with one, nothing for a dimensionless one.
-fn with_unit(id: ParamId) -> String {
-    match id.unit() {
-        "-" => String::new(),
-        u => format!(" {u}"),
-    }
-}
-
 impl std::fmt::Display for ParamConflict {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let (id, unit) = (self.parameter, with_unit(self.parameter));
+        let (id, unit) = (self.parameter, self.parameter.unit_suffix());
         let (prior, from) = match self.prior {
             ParamPrior::Normal { mean, sd } => (
                 format!("normal, mean {mean}{unit}, sd {sd}{unit}"),

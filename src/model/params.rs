@@ -84,6 +84,14 @@ impl ParamId {
         }
     }
 
+    /// The unit as it follows a number: `" s/m"`, or nothing for a pure number.
+    pub fn unit_suffix(self) -> String {
+        match self.unit() {
+            "-" => String::new(),
+            u => format!(" {u}"),
+        }
+    }
+
     /// The parameter's SI unit (`-` for a pure number).
     pub fn unit(self) -> &'static str {
         match self {

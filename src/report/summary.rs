@@ -119,10 +119,7 @@ fn digits(values: &[f64]) -> usize {
 
 /// `x` with its unit, e.g. "70.6 s/m", or the number alone for a dimensionless parameter.
 fn with_unit(x: String, id: ParamId) -> String {
-    match id.unit() {
-        "-" => x,
-        u => format!("{x} {u}"),
-    }
+    x + &id.unit_suffix()
 }
 
 /// A fitted parameter in words: its value, and its interval (or 1σ) with the level.

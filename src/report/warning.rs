@@ -294,19 +294,27 @@ fn fit_headline(w: &FitWarning) -> String {
         NoBladeModes { .. } => {
             "The blade's modes could not be computed at the fitted parameters.".into()
         }
-        PriorConflict(c) => format!(
-            "{} is fitted {:+.1} prior standard deviations from its [fit.priors] prior: the \
-             recording disagrees with the prior; check the prior's value, or the model.",
-            c.parameter, c.z
-        ),
-        RigCurveConflict(c) => format!(
-            "The fitted friction law misses the rig curve as a whole (rms z {:.2} over {} \
-             points): the recording disagrees with the rig's μ(v); check the rig's sd and \
-             conditions, or the friction law.",
-            c.rms_z, c.points
-        ),
+        PriorConflict(c) => prior_conflict_headline(c.parameter, c.z),
+        RigCurveConflict(c) => rig_curve_conflict_headline(c.rms_z, c.points),
         Text { text } => text.clone(),
     }
+}
+
+/// [`FitWarning::PriorConflict`]'s headline: `parameter` fitted `z` prior sds from its prior.
+fn prior_conflict_headline(parameter: ParamId, z: f64) -> String {
+    format!(
+        "{parameter} is fitted {z:+.1} prior standard deviations from its [fit.priors] prior: the \
+         recording disagrees with the prior; check the prior's value, or the model."
+    )
+}
+
+/// [`FitWarning::RigCurveConflict`]'s headline: the rig's `points` at an rms z of `rms_z`.
+fn rig_curve_conflict_headline(rms_z: f64, points: usize) -> String {
+    format!(
+        "The fitted friction law misses the rig curve as a whole (rms z {rms_z:.2} over {points} \
+         points): the recording disagrees with the rig's μ(v); check the rig's sd and \
+         conditions, or the friction law."
+    )
 }
 
 /// [`FitWarning::TruthMoreLikely`]'s headline, the truth `short_nats` more likely than the fit.
