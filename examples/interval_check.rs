@@ -1,0 +1,216 @@
+//! Are a fit's intervals consistent with its likelihood? At the point where a fit of a recording
+//! with a known truth ended (its `<name>.result.toml`), this tool compares three descriptions of
+//! the likelihood around the fit:
+//!
+//! 1. **The likelihood along the segment from the fit to the truth**: the NLL at 11 points of the
+//!    straight line between them in the search's normalised coordinates (one simulation each).
+//! 2. **The rise the Laplace method predicts there**: `½ dᵀ F d` with `F` the Gauss–Newton Fisher
+//!    information the Laplace intervals come from (`wiperlab::fit::evidence::at_fit_smoothed`), and
+//!    the truth's Mahalanobis distance under the reported sandwich covariance.
+//! 3. **A posterior sample** (the affine-invariant ensemble of `[fit.uncertainty] method = "mcmc"`,
+//!    32 walkers, the likelihood tempered by `k/tr(F⁻¹V)`): its 68 % and 95 % intervals and the
+//!    truth's quantile in each marginal.
+//!
+//! The job must be the one the fit ran (same recording, bounds and likelihood): the tool prints
+//! the cost it finds at the fitted point beside the result's, and stops when they differ by more
+//! than 0.5 nats. `--noise white` re-reads a result made with the white tracking-noise floor by a
+//! job that does not say so. How the development set's fits look under this tool is in
+//! docs/validation.md, "Intervals against the likelihood".
+//!
+//! ```sh
+//! cargo run --release --example interval_check -- JOB.toml JOB.result.toml --noise white --steps 400
+//! ```
+
+use clap::Parser;
+use nalgebra::{DMatrix, DVector};
+use std::path::PathBuf;
+use wiperlab::fit::evidence::at_fit_smoothed;
+use wiperlab::fit::{FAILED_COST, SpectralProblem, posterior_tempering, problem_for};
+use wiperlab::job::{Candidate, LoadedJob, NoiseSpectrum};
+use wiperlab::likelihood::covariance::cholesky_of_covariance;
+use wiperlab::posterior::{EnsembleSettings, ensemble::gaussian_ball_with, sample};
+
+#[derive(Parser)]
+struct Args {
+    /// The fit job (with `[truth]` for every freed parameter).
+    job: PathBuf,
+    /// The result the job's fit wrote.
+    result: PathBuf,
+    /// Read the likelihood with this tracking-noise spectrum instead of the job's.
+    #[arg(long)]
+    noise: Option<String>,
+    /// Steps of every walker of the posterior sample (0: no sample).
+    #[arg(long, default_value_t = 400)]
+    steps: usize,
+}
+
+const WALKERS: usize = 32;
+
+type Fallible<T> = Result<T, Box<dyn std::error::Error>>;
+
+/// What the posterior sample needs from the fit's local description.
+struct Spread {
+    /// `k/tr(F⁻¹V)`, the likelihood's tempering.
+    tempering: f64,
+    /// Cholesky factor of the sandwich covariance: the walkers' starting ball.
+    ball: Option<DMatrix<f64>>,
+}
+
+/// The largest gap between the result's cost and the cost recomputed at its parameters taken as
+/// the same likelihood, nats.
+const MAX_COST_GAP_NATS: f64 = 0.5;
+
+fn main() -> Fallible<()> {
+    let args = Args::parse();
+    let mut job = LoadedJob::load(&args.job)?;
+    if let Some(n) = &args.noise {
+        job.job.fit.likelihood.noise = match n.as_str() {
+            "white" => NoiseSpectrum::White,
+            "ar1" => NoiseSpectrum::Ar1,
+            other => return Err(format!("--noise: expected white or ar1, got {other}").into()),
+        };
+    }
+    let result: toml::Value = toml::from_str(&std::fs::read_to_string(&args.result)?)?;
+    let model: Candidate = result["model"]
+        .as_str()
+        .ok_or("result without model")?
+        .parse()?;
+    let p = problem_for(&job, model)?;
+    let fitted = |name: &str, key: &str| -> Option<f64> {
+        result["parameters"]
+            .as_array()?
+            .iter()
+            .find(|q| q["name"].as_str() == Some(name))?
+            .get(key)?
+            .as_float()
+    };
+    let mut u_fit = Vec::new();
+    let mut u_true = Vec::new();
+    for fp in &p.free {
+        let name = fp.name.to_string();
+        u_fit.push(fp.u_of(fitted(&name, "value").ok_or(format!("no fitted {name}"))?));
+        let t = job.truth.get(&fp.name).ok_or(format!("no true {name}"))?;
+        u_true.push(fp.u_of(*t));
+    }
+    let cost_fit = p.cost_at(&u_fit);
+    let reported = result["cost"].as_float().ok_or("result without cost")?;
+    println!("model {model}: cost at the fit {cost_fit:.4} nats (result {reported:.4})");
+    // The cost is reproducible only to the simulation's own jitter: the parameters' round trip
+    // through the result's decimal values can flip a step of the adaptive integrator (0.08 nats
+    // on the main job, as its tolerance check's spread shows). A larger gap is another likelihood.
+    if (cost_fit - reported).abs() > MAX_COST_GAP_NATS {
+        return Err("the job's likelihood is not the one the fit ran (see --noise)".into());
+    }
+    segment(&p, &u_fit, &u_true, cost_fit);
+    let spread = predicted_rise(&p, &u_fit, &u_true)?;
+    if args.steps > 0 {
+        posterior(&p, &job, &u_fit, spread, args.steps)?;
+    }
+    Ok(())
+}
+
+/// The NLL along the straight line from the fit (s = 0) to the truth (s = 1).
+fn segment(p: &SpectralProblem, u_fit: &[f64], u_true: &[f64], cost_fit: f64) {
+    println!("segment from the fit (s = 0) to the truth (s = 1): rise of the NLL, nats");
+    for i in 0..=10 {
+        let s = f64::from(i) / 10.0;
+        let u: Vec<f64> = u_fit
+            .iter()
+            .zip(u_true)
+            .map(|(a, b)| a + s * (b - a))
+            .collect();
+        println!("  s = {s:.1}: {:+.4}", p.cost_at(&u) - cost_fit);
+    }
+}
+
+/// `½ dᵀ C⁻¹ d` for the Fisher and the sandwich covariances at the fit, `d` = truth − fit;
+/// returns the posterior's tempering `k/tr(F⁻¹V)` and the Cholesky factor of the sandwich (the
+/// posterior's starting ball).
+fn predicted_rise(p: &SpectralProblem, u_fit: &[f64], u_true: &[f64]) -> Fallible<Spread> {
+    let lf = at_fit_smoothed(p, u_fit)?;
+    let k = u_fit.len();
+    let d = DVector::from_iterator(k, u_true.iter().zip(u_fit).map(|(t, f)| t - f));
+    for (name, sigma, corr) in [
+        ("Fisher F⁻¹", &lf.curvature_sigma_u, &lf.curvature_corr),
+        ("sandwich F⁻¹VF⁻¹", &lf.sigma_u, &lf.corr),
+    ] {
+        let c = DMatrix::from_fn(k, k, |i, j| sigma[i] * sigma[j] * corr[i][j]);
+        match c.try_inverse() {
+            Some(ci) => println!(
+                "{name}: ½ dᵀC⁻¹d = {:.2} (the rise a quadratic likelihood with this covariance puts at the truth)",
+                0.5 * (d.transpose() * ci * &d)[(0, 0)]
+            ),
+            None => println!("{name}: singular"),
+        }
+    }
+    let w = posterior_tempering(k, lf.nll.effective_parameters);
+    println!(
+        "tr(F⁻¹V) = {:.3}, tempering w = {w:.3}",
+        lf.nll.effective_parameters.unwrap_or(f64::NAN)
+    );
+    Ok(Spread {
+        tempering: w,
+        ball: cholesky_of_covariance(&lf.sigma_u, &lf.corr),
+    })
+}
+
+/// The tempered posterior sample's 68 % and 95 % intervals and the truth's quantiles.
+fn posterior(
+    p: &SpectralProblem,
+    job: &LoadedJob,
+    u_fit: &[f64],
+    spread: Spread,
+    steps: usize,
+) -> Fallible<()> {
+    let w = spread.tempering;
+    let k = u_fit.len();
+    let inside = |u: &[f64]| u.iter().all(|x| (0.0..=1.0).contains(x));
+    let log_density = |u: &[f64]| {
+        if !inside(u) {
+            return f64::NEG_INFINITY;
+        }
+        let c = p.cost_at(u);
+        if c < FAILED_COST {
+            -w * c
+        } else {
+            f64::NEG_INFINITY
+        }
+    };
+    let ball = spread
+        .ball
+        .unwrap_or_else(|| DMatrix::identity(k, k) * 0.01);
+    let start = gaussian_ball_with(u_fit, &ball, WALKERS, 1, inside);
+    let settings = EnsembleSettings {
+        walkers: WALKERS,
+        steps,
+        stretch: 2.0,
+        seed: 1,
+    };
+    let started = std::time::Instant::now();
+    let chains = sample(log_density, start, &settings, |_| true)?;
+    let burn_in = steps * 3 / 10;
+    println!(
+        "posterior sample: {WALKERS} walkers × {steps} steps ({burn_in} burn-in), acceptance {:.2}, {:.0} s",
+        chains.accepted as f64 / (WALKERS * steps) as f64,
+        started.elapsed().as_secs_f64()
+    );
+    for (i, fp) in p.free.iter().enumerate() {
+        let mut xs: Vec<f64> = chains.positions[burn_in..]
+            .iter()
+            .flat_map(|step| step.iter().map(move |walker| fp.value(walker[i])))
+            .collect();
+        xs.sort_by(f64::total_cmp);
+        let q = |f: f64| xs[((xs.len() - 1) as f64 * f).round() as usize];
+        let truth = job.truth[&fp.name];
+        let below = xs.iter().filter(|x| **x < truth).count() as f64 / xs.len() as f64;
+        println!(
+            "  {}: 68 % [{:.4e}, {:.4e}], 95 % [{:.4e}, {:.4e}], truth {truth:.4e} at quantile {below:.3}",
+            fp.name,
+            q(0.1587),
+            q(0.8413),
+            q(0.025),
+            q(0.975)
+        );
+    }
+    Ok(())
+}
