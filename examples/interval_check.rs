@@ -24,7 +24,8 @@
 use clap::Parser;
 use nalgebra::{DMatrix, DVector};
 use std::path::PathBuf;
-use wiperlab::fit::evidence::at_fit_smoothed;
+use wiperlab::fit::evidence::{LocalFit, at_fit_smoothed};
+use wiperlab::fit::secant::{SECANT_PROBE_SIGMA, flat_axes};
 use wiperlab::fit::{FAILED_COST, SpectralProblem, posterior_tempering, problem_for};
 use wiperlab::job::{Candidate, LoadedJob, NoiseSpectrum};
 use wiperlab::likelihood::covariance::cholesky_of_covariance;
@@ -135,12 +136,16 @@ fn predicted_rise(p: &SpectralProblem, u_fit: &[f64], u_true: &[f64]) -> Fallibl
         ("sandwich F⁻¹VF⁻¹", &lf.sigma_u, &lf.corr),
     ] {
         let c = DMatrix::from_fn(k, k, |i, j| sigma[i] * sigma[j] * corr[i][j]);
-        match c.try_inverse() {
+        match c.clone().try_inverse() {
             Some(ci) => println!(
                 "{name}: ½ dᵀC⁻¹d = {:.2} (the rise a quadratic likelihood with this covariance puts at the truth)",
                 0.5 * (d.transpose() * ci * &d)[(0, 0)]
             ),
             None => println!("{name}: singular"),
+        }
+        along_axes(&c, &d);
+        if name.starts_with("Fisher") {
+            probe_axes(p, u_fit, &c);
         }
     }
     let w = posterior_tempering(k, lf.nll.effective_parameters);
@@ -148,10 +153,75 @@ fn predicted_rise(p: &SpectralProblem, u_fit: &[f64], u_true: &[f64]) -> Fallibl
         "tr(F⁻¹V) = {:.3}, tempering w = {w:.3}",
         lf.nll.effective_parameters.unwrap_or(f64::NAN)
     );
+    laplace_and_secant(p, u_fit, u_true, &lf);
     Ok(Spread {
         tempering: w,
         ball: cholesky_of_covariance(&lf.sigma_u, &lf.corr),
     })
+}
+
+/// The Laplace intervals' 1σ (the sandwich's) with the truth's distance from the fit in them,
+/// and the axes the fit's secant check (`wiperlab::fit::secant`) finds flatter than the quadratic.
+fn laplace_and_secant(p: &SpectralProblem, u_fit: &[f64], u_true: &[f64], lf: &LocalFit) {
+    let cost = p.cost_at(u_fit);
+    for (i, fp) in p.free.iter().enumerate() {
+        println!(
+            "  {}: Laplace 1σ {:.2e} (normalised), the truth at {:+.1}σ",
+            fp.name,
+            lf.sigma_u[i],
+            (u_true[i] - u_fit[i]) / lf.sigma_u[i]
+        );
+    }
+    let fisher = (&lf.curvature_sigma_u[..], &lf.curvature_corr[..]);
+    for a in flat_axes(|u| p.cost_at(u), u_fit, cost, fisher) {
+        println!(
+            "secant check: the axis of 1σ {:.2e} rises {:.3} nats at ±{SECANT_PROBE_SIGMA}σ: {:.1} times flatter in σ",
+            a.fisher_sigma_u, a.rise_nats, a.stretch
+        );
+    }
+}
+
+/// `d` in the principal axes of the covariance `c`, widest first: each axis's 1σ (normalised
+/// units) and `d`'s component along it in those σ.
+fn along_axes(c: &DMatrix<f64>, d: &DVector<f64>) {
+    let eig = c.clone().symmetric_eigen();
+    let mut order: Vec<usize> = (0..d.len()).collect();
+    order.sort_by(|a, b| eig.eigenvalues[*b].total_cmp(&eig.eigenvalues[*a]));
+    let parts: Vec<String> = order
+        .iter()
+        .map(|&i| {
+            let sd = eig.eigenvalues[i].max(0.0).sqrt();
+            let along = eig.eigenvectors.column(i).dot(d);
+            format!("1σ {sd:.2e}: {:+.1}σ", along / sd)
+        })
+        .collect();
+    println!(
+        "  the truth along its principal axes, widest first: {}",
+        parts.join(", ")
+    );
+}
+
+/// The NLL's rise along each principal axis of `c` at ±r of its 1σ against the quadratic's r²/2.
+fn probe_axes(p: &SpectralProblem, u_fit: &[f64], c: &DMatrix<f64>) {
+    let c0 = p.cost_at(u_fit);
+    let eig = c.clone().symmetric_eigen();
+    for r in [3.0f64, 5.0, 10.0] {
+        let mut parts = Vec::new();
+        for i in 0..u_fit.len() {
+            let sd = eig.eigenvalues[i].max(0.0).sqrt();
+            for sign in [1.0, -1.0] {
+                let u: Vec<f64> = (0..u_fit.len())
+                    .map(|a| u_fit[a] + sign * r * sd * eig.eigenvectors[(a, i)])
+                    .collect();
+                parts.push(format!("{:.2}", p.cost_at(&u) - c0));
+            }
+        }
+        println!(
+            "  rise at ±{r}σ along each axis (quadratic {:.1}): {}",
+            r * r / 2.0,
+            parts.join(" ")
+        );
+    }
 }
 
 /// The tempered posterior sample's 68 % and 95 % intervals and the truth's quantiles.

@@ -20,6 +20,7 @@ mod problem;
 pub mod result;
 pub mod scan;
 mod search;
+pub mod secant;
 pub mod select;
 pub mod tolerance;
 mod uncertainty;

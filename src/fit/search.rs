@@ -217,6 +217,8 @@ pub(super) struct CandidateFit {
     pub(super) corr: Vec<Vec<f64>>,
     /// 1σ of the normalised coordinates from the Fisher information alone, with a likelihood.
     pub(super) fisher_sigma_u: Option<Vec<f64>>,
+    /// The correlations of `F⁻¹`, with `fisher_sigma_u`.
+    pub(super) fisher_corr: Option<Vec<Vec<f64>>>,
     /// The recording's NLL at the optimum (`sigma_u` and `corr` then come from its sandwich
     /// covariance, [`super::evidence::at_fit`]), or why there is none (then from the cost's
     /// curvature).
@@ -248,6 +250,7 @@ impl CandidateFit {
             self.sigma_u = l.sigma_u;
             self.corr = l.corr;
             self.fisher_sigma_u = Some(l.curvature_sigma_u);
+            self.fisher_corr = Some(l.curvature_corr);
             self.evidence = Ok(l.nll);
         }
         self
@@ -874,7 +877,7 @@ fn finish(
     // likelihood (a target job).
     reporting.stage(format_args!("curvature"));
     let n = best_u.len();
-    let (sigma_u, corr, fisher_sigma_u, evidence) = if interrupt::stop_requested() {
+    let (sigma_u, corr, fisher, evidence) = if interrupt::stop_requested() {
         (
             vec![f64::NAN; n],
             vec![vec![f64::NAN; n]; n],
@@ -893,7 +896,12 @@ fn finish(
             super::evidence::at_fit(&problem, &best_u)
         };
         match local {
-            Ok(l) => (l.sigma_u, l.corr, Some(l.curvature_sigma_u), Ok(l.nll)),
+            Ok(l) => (
+                l.sigma_u,
+                l.corr,
+                Some((l.curvature_sigma_u, l.curvature_corr)),
+                Ok(l.nll),
+            ),
             Err(e) => {
                 let (s, c) = curvature(&problem, &best_u);
                 (s, c, None, Err(super::NoEvidence::Failed(Arc::new(e))))
@@ -910,7 +918,8 @@ fn finish(
         best_u,
         sigma_u,
         corr,
-        fisher_sigma_u,
+        fisher_sigma_u: fisher.as_ref().map(|f| f.0.clone()),
+        fisher_corr: fisher.map(|f| f.1),
         evidence,
         swarm_iters,
         polish_iters,

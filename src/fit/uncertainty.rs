@@ -77,7 +77,8 @@ fn other_intervals(
         UncertaintyMethod::Laplace => match &cf.evidence {
             Ok(_) => {
                 let mut intervals = laplace_intervals(&cf.free, &cf.best_u, &cf.sigma_u);
-                let mut warnings = along_contact_ridge(cf, &mut intervals);
+                let mut warnings = secant_check(cf);
+                warnings.extend(along_contact_ridge(cf, &mut intervals));
                 warnings.extend(near_best_of(cf, &mut intervals));
                 Ok((Some(intervals), warnings))
             }
@@ -599,6 +600,28 @@ pub fn widen_to_near_best(
         warnings.push(FitWarning::ShortOfBestEvaluation { gain_nats: gain });
     }
     warnings
+}
+
+/// The Laplace intervals of `cf` checked against its likelihood along the principal axes of
+/// `F⁻¹` ([`super::secant`]): a warning per axis along which the likelihood is flatter than the
+/// quadratic the intervals assume. `2k` simulations.
+fn secant_check(cf: &CandidateFit) -> Vec<FitWarning> {
+    use super::secant::{SECANT_PROBE_SIGMA, flat_axes, main_parameter};
+    let (Some(fs), Some(fc)) = (&cf.fisher_sigma_u, &cf.fisher_corr) else {
+        return Vec::new();
+    };
+    if super::interrupt::stop_requested() {
+        return Vec::new();
+    }
+    flat_axes(|u| cf.problem.cost_at(u), &cf.best_u, cf.cost, (fs, fc))
+        .iter()
+        .map(|a| FitWarning::FlatterThanCurvature {
+            parameter: main_parameter(&cf.free, a).name,
+            rise_nats: a.rise_nats,
+            quadratic_nats: 0.5 * SECANT_PROBE_SIGMA * SECANT_PROBE_SIGMA,
+            stretch: a.stretch,
+        })
+        .collect()
 }
 
 /// Widens `interval` to contain `[lo, hi]`, keeping its ends before the first widening in

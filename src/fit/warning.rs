@@ -157,6 +157,18 @@ pub enum FitWarning {
         /// The interval reported.
         widened: [f64; 2],
     },
+    /// The likelihood is flatter along a principal axis of `F⁻¹` than the Laplace quadratic
+    /// ([`crate::fit::secant`]): the Laplace intervals understate the spread along it.
+    FlatterThanCurvature {
+        /// The parameter the axis moves most.
+        parameter: ParamId,
+        /// The NLL's mean rise at the probes, nats.
+        rise_nats: f64,
+        /// The quadratic's rise there, nats.
+        quadratic_nats: f64,
+        /// The axis's secant 1σ over `F⁻¹`'s.
+        stretch: f64,
+    },
     /// The search evaluated a point more likely than the fit.
     ShortOfBestEvaluation { gain_nats: f64 },
     /// k1 and theta_c trade along the shoulder's contact-moment ridge; both intervals span it.
@@ -283,6 +295,7 @@ impl FitWarning {
             | ProfileAtBound { .. }
             | ProfileOpen { .. }
             | ProfileMoreLikely { .. }
+            | FlatterThanCurvature { .. }
             | ShortOfBestEvaluation { .. }
             | PosteriorUnconverged { .. }
             | PosteriorSpansBounds { .. }
@@ -314,6 +327,7 @@ impl FitWarning {
             ProfileOpen { .. } => "profile_open",
             ProfileMoreLikely { .. } => "profile_more_likely",
             WidenedInterval { .. } => "widened_interval",
+            FlatterThanCurvature { .. } => "flatter_than_curvature",
             ShortOfBestEvaluation { .. } => "short_of_best_evaluation",
             PosteriorUnconverged { .. } => "posterior_unconverged",
             PosteriorSpansBounds { .. } => "posterior_spans_bounds",
@@ -344,6 +358,7 @@ impl FitWarning {
             | ProfileOpen { parameter, .. }
             | ProfileMoreLikely { parameter, .. }
             | WidenedInterval { parameter, .. }
+            | FlatterThanCurvature { parameter, .. }
             | PosteriorUnconverged { parameter, .. }
             | PosteriorSpansBounds { parameter, .. } => Some(*parameter),
             PriorConflict(c) => Some(c.parameter),
@@ -444,6 +459,12 @@ impl fmt::Display for FitWarning {
                 method,
                 widened,
             } => widened_interval(f, *parameter, *rise_limit_nats, [points, method, widened]),
+            FlatterThanCurvature {
+                parameter,
+                rise_nats,
+                quadratic_nats,
+                stretch,
+            } => flatter_than_curvature(f, *parameter, [*rise_nats, *quadratic_nats], *stretch),
             ShortOfBestEvaluation { gain_nats } => short_of_best_evaluation(f, *gain_nats),
             PosteriorUnconverged {
                 parameter,
@@ -657,6 +678,24 @@ fn widened_interval(
          span {p_lo:.4e} to {p_hi:.4e}, beyond the method's own interval [{lo0:.4e}, \
          {hi0:.4e}]: the likelihood is flatter there than that interval says, so it is widened \
          to [{lo:.4e}, {hi:.4e}]"
+    )
+}
+
+/// [`FitWarning::FlatterThanCurvature`]'s sentence.
+fn flatter_than_curvature(
+    f: &mut fmt::Formatter<'_>,
+    parameter: ParamId,
+    [rise, quadratic]: [f64; 2],
+    stretch: f64,
+) -> fmt::Result {
+    write!(
+        f,
+        "along a principal axis of the Fisher information (mostly {parameter}) the likelihood \
+         rises {rise:.2} nats at ±{r}σ where the Laplace quadratic rises {quadratic:.1}: it is \
+         {stretch:.1} times wider there than the curvature at the fit says, so the Laplace \
+         intervals understate the spread of the parameters that direction moves; \
+         method = \"mcmc\" samples the likelihood itself",
+        r = super::secant::SECANT_PROBE_SIGMA
     )
 }
 

@@ -249,6 +249,14 @@ fn fit_headline(w: &FitWarning) -> String {
             widened,
             ..
         } => widened_headline(*parameter, method, widened),
+        FlatterThanCurvature {
+            parameter, stretch, ..
+        } => format!(
+            "The likelihood is {stretch:.1} times wider than its curvature at the fit says along \
+             a direction that moves mostly {parameter}: the Laplace intervals understate the \
+             spread there; refit with `method = \"mcmc\"`, which samples the likelihood itself \
+             (docs/uncertainty.md)."
+        ),
         ShortOfBestEvaluation { gain_nats } => format!(
             "The search evaluated a point {gain_nats:.2} nats more likely than the fit: it ended \
              short of its own best point; refit with more restarts or polish iterations."

@@ -310,6 +310,18 @@ fn main_job_end_to_end() {
         );
         println!("{name}: Laplace 68 % interval [{lo:.6e}, {hi:.6e}]");
     }
+    // The Laplace intervals describe this likelihood: along the segment from the fit to the truth
+    // the NLL rises about as the sandwich's quadratic says (0.19 nats against 0.27 predicted,
+    // `cargo run --release --example interval_check -- fits/reversal.toml
+    // fits/reversal.result.toml --steps 0`, docs/validation.md, "Intervals against the
+    // likelihood"), so the secant check at ±5σ finds no axis four times flatter than `F` says.
+    let kinds: Vec<&str> = r["warning_details"]
+        .as_array()
+        .expect("warning_details")
+        .iter()
+        .filter_map(|w| w["warning"]["kind"].as_str())
+        .collect();
+    assert!(!kinds.contains(&"flatter_than_curvature"), "{kinds:?}");
     // Correlations from the sandwich are finite (positive semi-definite by construction).
     assert_eq!(r["spread_source"], "sandwich");
     for row in r["correlation"].as_array().expect("correlation") {
