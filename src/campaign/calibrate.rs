@@ -32,6 +32,7 @@ use super::Campaign;
 use super::run::{EntryPaths, State, read_status};
 use crate::fit::SHORTFALL_TOLERANCE_NATS;
 use crate::fit::result::{FitResult, FittedParam};
+use crate::fit::truth::RIDGE_NATS;
 use crate::io::write_atomic;
 use crate::job::{Candidate, FreeParam};
 use crate::model::ParamId;
@@ -145,6 +146,8 @@ pub struct RecordingScore {
     pub chosen: Option<Candidate>,
     /// Fit cost − the truth's own cost, nats, when the result has the truth's cost.
     pub shortfall_nats: Option<f64>,
+    /// The ridge on the segment from the fit to the truth, nats ([`crate::fit::truth`]).
+    pub ridge_nats: Option<f64>,
     pub wall_time_s: f64,
     /// The scored parameters (empty when the chosen model does not contain the truth's).
     pub params: Vec<Scored>,
@@ -261,6 +264,19 @@ impl Calibration {
         self.recordings.iter().filter(|r| r.state == "done")
     }
 
+    /// Of the fits above [`SHORTFALL_TOLERANCE_NATS`]: (those with a measured segment to the
+    /// truth, of them those with a ridge above [`RIDGE_NATS`]: the truth in another basin).
+    pub fn shortfall_ridges(&self) -> (usize, usize) {
+        let short = self.done().filter(|r| {
+            r.model_contains_truth()
+                && r.shortfall_nats
+                    .is_some_and(|s| s > SHORTFALL_TOLERANCE_NATS)
+        });
+        let ridges: Vec<f64> = short.filter_map(|r| r.ridge_nats).collect();
+        let beyond = ridges.iter().filter(|h| **h > RIDGE_NATS).count();
+        (ridges.len(), beyond)
+    }
+
     /// (fits whose shortfall is known, of them above [`SHORTFALL_TOLERANCE_NATS`], the largest).
     pub fn shortfalls(&self) -> (usize, usize, f64) {
         let s: Vec<f64> = self
@@ -307,6 +323,7 @@ pub fn calibrate(campaign: &Campaign) -> Result<Option<Calibration>> {
             true_model,
             chosen: None,
             shortfall_nats: None,
+            ridge_nats: None,
             wall_time_s: f64::NAN,
             params: Vec::new(),
             departure,
@@ -372,6 +389,7 @@ fn truth_labels(path: &Path) -> Result<(Option<Candidate>, Option<String>)> {
 fn score(r: &mut RecordingScore, result: &FitResult) {
     r.chosen = Some(result.model);
     r.shortfall_nats = result.shortfall_nats();
+    r.ridge_nats = result.truth_segment.as_ref().map(|s| s.ridge_nats);
     r.law = super::law::LawScore::of(result);
     r.gof_p = result.goodness_of_fit.as_ref().map(|g| g.p_value);
     if !r.model_contains_truth() {
@@ -538,6 +556,17 @@ pub fn to_markdown(c: &Calibration, notes: Option<&str>, command: &str) -> Strin
         },
         num(max, 3)
     );
+    let (measured, beyond) = c.shortfall_ridges();
+    if measured > 0 {
+        let _ = writeln!(
+            md,
+            "\nOf the {measured} short fits whose result has the segment from the fit to the truth, \
+             {beyond} have a ridge higher than {RIDGE_NATS} nats on it: the truth lies in another \
+             basin, which the global search did not enter; in the other {} the search stopped on \
+             the slope of the truth's own basin (`ridge_nats` in calibration_recordings.csv).",
+            measured - beyond
+        );
+    }
     confusion_section(&mut md, c);
     super::law::law_section(&mut md, c);
     let times: Vec<f64> = c.done().map(|r| r.wall_time_s).collect();
@@ -660,6 +689,7 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
         "true_model",
         "chosen_model",
         "shortfall_nats",
+        "ridge_nats",
         "wall_time_s",
         "departure",
         "law_rms_rel_diff",
@@ -680,6 +710,7 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
             name(r.true_model),
             name(r.chosen),
             r.shortfall_nats.map(csv_num).unwrap_or_default(),
+            r.ridge_nats.map(csv_num).unwrap_or_default(),
             csv_num(r.wall_time_s),
             r.departure.clone().unwrap_or_default(),
             r.law.map(|l| csv_num(l.rms_rel_diff)).unwrap_or_default(),
@@ -849,6 +880,7 @@ mod tests {
             true_model: None,
             chosen: "blade2dof".parse().ok(),
             shortfall_nats: Some(0.0),
+            ridge_nats: None,
             wall_time_s: 1.0,
             params: z
                 .iter()
@@ -891,6 +923,7 @@ mod tests {
         free.true_model = c("blade2dof");
         free.chosen = c("blade2dof+shoulder");
         free.shortfall_nats = Some(0.3);
+        free.ridge_nats = Some(2.2);
         let mut shoulder = recording(&[]);
         shoulder.id = "shoulder".into();
         shoulder.true_model = c("blade2dof+shoulder");
@@ -924,6 +957,13 @@ mod tests {
             "{md}"
         );
         assert!(md.contains("1 of 1 fits"), "{md}");
+        // Its segment to the truth crosses a 2.2-nat ridge: another basin.
+        assert_eq!(cal.shortfall_ridges(), (1, 1));
+        assert!(
+            md.contains("Of the 1 short fits whose result has the segment")
+                && md.contains("1 have a ridge"),
+            "{md}"
+        );
         assert!(md.contains("| blade2dof | 0 | 1 |"), "{md}");
         assert!(md.contains("| blade2dof+shoulder | 1 | 0 |"), "{md}");
         assert!(md.contains("- broken failed: simulation failed"), "{md}");

@@ -23,6 +23,7 @@ mod search;
 pub mod secant;
 pub mod select;
 pub mod tolerance;
+pub mod truth;
 mod uncertainty;
 pub mod warning;
 
@@ -34,6 +35,7 @@ pub use result::{
 };
 pub use search::{NESTED_GLOBAL_GAIN_NATS, problem_for};
 pub use select::aic;
+pub use truth::SHORTFALL_TOLERANCE_NATS;
 pub use uncertainty::{
     MIN_ESS, ProfileStart, RHAT_LIMIT, bootstrap_intervals, identifiability_warnings,
     laplace_intervals, posterior_tempering, profile_intervals_at, widen_to_near_best,
@@ -137,7 +139,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     warnings.extend(absorbing);
     warnings.extend(line_warnings(&peaks));
     warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
-    let (tolerance_check, truth_cost) = optimum_checks(
+    let (tolerance_check, truth) = optimum_checks(
         job,
         &cf,
         &best,
@@ -146,7 +148,11 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         &mut warnings,
     );
     warnings.extend(failure_warning(&cf.problem));
-    warnings.extend(truth_cost.and_then(|t| shortfall_warning(best.cost, t)));
+    warnings.extend(
+        truth
+            .as_ref()
+            .and_then(|t| truth::shortfall_warning(best.cost, t)),
+    );
     // The chosen model's counts include its bootstrap replicates and the tolerance check's
     // simulations (they share its counters).
     let chosen = &mut selection.trials[selection.chosen];
@@ -175,7 +181,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
             goodness_of_fit,
             tolerance_check,
             tracking_noise: tracking_noise(&cf, &best.sim),
-            truth_cost,
+            truth,
         },
     );
     let result = FitResult {
@@ -227,7 +233,7 @@ fn optimum_checks(
     trials: &[result::ModelTrial],
     interrupted: bool,
     warnings: &mut Vec<FitWarning>,
-) -> (Option<tolerance::ToleranceCheck>, Option<f64>) {
+) -> (Option<tolerance::ToleranceCheck>, Option<truth::TruthCheck>) {
     let tolerance_check = (!interrupted && !interrupt::stop_requested())
         .then(|| {
             let at_job = (best.cost, best.sim.transitions.len());
@@ -241,8 +247,10 @@ fn optimum_checks(
             .zip(runner_up(trials))
             .and_then(|(t, (chosen, runner, gap))| t.choice_warning(chosen, runner, gap)),
     );
-    let truth_cost = (!interrupted).then(|| truth_cost(job, cf)).flatten();
-    (tolerance_check, truth_cost)
+    let truth = (!interrupted)
+        .then(|| truth::check(job, cf, best.cost))
+        .flatten();
+    (tolerance_check, truth)
 }
 
 /// The chosen trial's name, the name of the trial with the TIC nearest to it among the others, and
@@ -276,32 +284,6 @@ fn goodness_of_fit(cf: &CandidateFit, sim: &BladeSimulation) -> GoodnessOutcome 
     }
     lik.goodness_of_fit(p, sim).map(Some)
 }
-
-/// The chosen model's cost with every freed parameter at the job's truth (the others as the blade
-/// file), at the fit's solver; `None` without a truth for every freed parameter or when the truth
-/// cannot be simulated.
-fn truth_cost(job: &LoadedJob, cf: &CandidateFit) -> Option<f64> {
-    let p = &cf.problem;
-    let mut params = p.base;
-    for fp in &p.free {
-        fp.name.set(&mut params, *job.truth.get(&fp.name)?);
-    }
-    Some(p.total_cost(&p.simulate(&params).ok()?).ok()? + p.prior.nats(&params))
-}
-
-/// The warning of a fit whose cost `cost` lies above the truth's own `truth_cost` by more than
-/// [`SHORTFALL_TOLERANCE_NATS`]: the search stopped short of the likelihood's maximum.
-fn shortfall_warning(cost: f64, truth_cost: f64) -> Option<FitWarning> {
-    (cost - truth_cost > SHORTFALL_TOLERANCE_NATS).then_some(FitWarning::TruthMoreLikely {
-        fit_cost_nats: cost,
-        truth_cost_nats: truth_cost,
-    })
-}
-
-/// How far above the truth's cost a fit may end before it counts as a search that fell short,
-/// nats: the integrator's own resolution of the cost (the tolerance check's spread on the main job
-/// is a few hundredths of a nat).
-pub const SHORTFALL_TOLERANCE_NATS: f64 = 0.1;
 
 /// The tracking noise the chosen fit's likelihood reads at its optimum `sim`; `None` without a
 /// likelihood or when the simulation's spectra cannot be computed.
@@ -632,7 +614,7 @@ struct Assembled {
     goodness_of_fit: Option<likelihood::GoodnessOfFit>,
     tolerance_check: Option<tolerance::ToleranceCheck>,
     tracking_noise: Option<result::NoiseEstimate>,
-    truth_cost: Option<f64>,
+    truth: Option<truth::TruthCheck>,
 }
 
 /// The result of the chosen fit, with the job's provenance (the recording's hash and the effective
@@ -696,7 +678,8 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         goodness_of_fit: a.goodness_of_fit,
         tolerance_check: a.tolerance_check,
         tracking_noise: a.tracking_noise,
-        truth_cost: a.truth_cost,
+        truth_cost: a.truth.as_ref().map(|t| t.cost_nats),
+        truth_segment: a.truth.and_then(|t| t.segment),
         friction_curve: None,
         posterior: None,
         priors,

@@ -438,6 +438,11 @@ pub struct FitResult {
     /// short of the likelihood's maximum. `None` without a truth for every freed parameter.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub truth_cost: Option<f64>,
+    /// The chosen model's cost along the segment from the fit to the truth
+    /// ([`crate::fit::truth`]): a ridge on it puts the truth in another basin. `None` without a
+    /// truth inside the search box for every freed parameter.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truth_segment: Option<crate::fit::truth::TruthSegment>,
     /// The fitted μ_d(v) over the slip speeds the fitted motion covers, with its ±1σ band and the
     /// true law when known ([`crate::model::friction_curve`]); `None` when the fitted model never
     /// slips, and in results written before this field.
@@ -630,6 +635,7 @@ mod tests {
             )),
             tracking_noise: None,
             truth_cost: None,
+            truth_segment: None,
             friction_curve: None,
             posterior: None,
             priors: Some(crate::likelihood::prior::PriorsReport {

@@ -80,6 +80,10 @@ pub enum FitWarning {
         fit_cost_nats: f64,
         /// The chosen model's cost at the truth, nats.
         truth_cost_nats: f64,
+        /// The ridge on the segment from the fit to the truth ([`crate::fit::truth`]), nats;
+        /// `None` where it was not measured.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        ridge_nats: Option<f64>,
     },
     /// The chosen model does not explain the recording's spectra to their noise.
     Misfit {
@@ -396,7 +400,8 @@ impl fmt::Display for FitWarning {
             TruthMoreLikely {
                 fit_cost_nats,
                 truth_cost_nats,
-            } => truth_more_likely(f, *fit_cost_nats, *truth_cost_nats),
+                ridge_nats,
+            } => truth_more_likely(f, *fit_cost_nats, *truth_cost_nats, *ridge_nats),
             Misfit {
                 test,
                 shoulder_listed,
@@ -513,7 +518,12 @@ impl fmt::Display for FitWarning {
 }
 
 /// [`FitWarning::TruthMoreLikely`]'s sentence.
-fn truth_more_likely(f: &mut fmt::Formatter<'_>, fit: f64, truth: f64) -> fmt::Result {
+fn truth_more_likely(
+    f: &mut fmt::Formatter<'_>,
+    fit: f64,
+    truth: f64,
+    ridge: Option<f64>,
+) -> fmt::Result {
     write!(
         f,
         "the truth is more likely than the fit: cost {truth:.2} nats at the true parameters \
@@ -521,7 +531,19 @@ fn truth_more_likely(f: &mut fmt::Formatter<'_>, fit: f64, truth: f64) -> fmt::R
          likelihood's maximum, so the fitted values and their intervals describe a point that is \
          not the estimate",
         fit - truth
-    )
+    )?;
+    match ridge {
+        Some(r) if r > super::truth::RIDGE_NATS => write!(
+            f,
+            "; a ridge {r:.2} nats high lies between them on the straight line, so the truth's \
+             basin is another one, which the global search did not enter (more restarts)"
+        ),
+        Some(_) => f.write_str(
+            "; no ridge lies between them on the straight line, so the search stopped on the \
+             slope of the truth's own basin (a longer polish)",
+        ),
+        None => Ok(()),
+    }
 }
 
 /// [`FitWarning::Misfit`]'s sentence, with the shoulder's advice when the job lists a shoulder

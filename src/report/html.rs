@@ -1220,6 +1220,7 @@ pub(super) mod tests {
             tolerance_check: None,
             tracking_noise: None,
             truth_cost: None,
+            truth_segment: None,
             friction_curve: None,
             posterior: None,
             priors: None,

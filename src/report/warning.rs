@@ -197,7 +197,8 @@ fn fit_headline(w: &FitWarning) -> String {
         TruthMoreLikely {
             fit_cost_nats,
             truth_cost_nats,
-        } => truth_more_likely_headline(fit_cost_nats - truth_cost_nats),
+            ridge_nats,
+        } => truth_more_likely_headline(fit_cost_nats - truth_cost_nats, *ridge_nats),
         Misfit { test, shape, .. } => misfit_headline(test.p_value, shape),
         AbsorbsModelStructure {
             parameter,
@@ -326,11 +327,17 @@ fn rig_curve_conflict_headline(rms_z: f64, points: usize) -> String {
 }
 
 /// [`FitWarning::TruthMoreLikely`]'s headline, the truth `short_nats` more likely than the fit.
-fn truth_more_likely_headline(short_nats: f64) -> String {
+fn truth_more_likely_headline(short_nats: f64, ridge_nats: Option<f64>) -> String {
+    let basin = match ridge_nats {
+        Some(r) if r > crate::fit::truth::RIDGE_NATS => {
+            " The truth lies in another basin, beyond a ridge: refit with more restarts."
+        }
+        Some(_) => " No ridge lies between them: the search stopped on the truth's slope.",
+        None => "",
+    };
     format!(
-        "The truth is {:.2} nats more likely than the fit: the search stopped short of the \
-         likelihood's maximum, so the values and intervals describe the wrong point.",
-        short_nats
+        "The truth is {short_nats:.2} nats more likely than the fit: the search stopped short of \
+         the likelihood's maximum, so the values and intervals describe the wrong point.{basin}"
     )
 }
 

@@ -322,6 +322,16 @@ fn main_job_end_to_end() {
         .filter_map(|w| w["warning"]["kind"].as_str())
         .collect();
     assert!(!kinds.contains(&"flatter_than_curvature"), "{kinds:?}");
+    // The same segment in the result: nine interior points, none more than the ridge height
+    // (0.5 nats, `wiperlab::fit::truth::RIDGE_NATS`) above the higher end, since the fit lies in
+    // the truth's basin (the segment rose at most 0.21 nats above the fit in the measurement
+    // above, with the truth 0.19 above it).
+    let seg = &r["truth_segment"];
+    assert_eq!(seg["rise_nats"].as_array().map(Vec::len), Some(9), "{seg}");
+    assert!(
+        num(seg, "/ridge_nats") < wiperlab::fit::truth::RIDGE_NATS,
+        "{seg}"
+    );
     // Correlations from the sandwich are finite (positive semi-definite by construction).
     assert_eq!(r["spread_source"], "sandwich");
     for row in r["correlation"].as_array().expect("correlation") {

@@ -1,0 +1,146 @@
+//! The fit against the truth of a model-made recording (a job's `[truth]`): the chosen model's cost
+//! at the true parameters, and the likelihood along the straight segment from the fit to them.
+//!
+//! A fit less likely than the truth has failed its search; the segment says how. A ridge on it
+//! (an interior point less likely than both ends by more than [`RIDGE_NATS`]) puts the truth in
+//! another basin, which the global search did not enter; without one the search stopped on the
+//! slope of the truth's own basin. A fit more likely than the truth whose intervals miss it is the
+//! intervals' failure, and the segment's rise against the one the intervals' quadratic predicts
+//! measures it (`examples/interval_check.rs`, docs/validation.md, "Intervals against the
+//! likelihood").
+
+use super::search::CandidateFit;
+use super::warning::FitWarning;
+use crate::job::LoadedJob;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// How far above the truth's cost a fit may end before it counts as a search that fell short,
+/// nats: the integrator's own resolution of the cost (the tolerance check's spread on the main job
+/// is a few hundredths of a nat).
+pub const SHORTFALL_TOLERANCE_NATS: f64 = 0.1;
+
+/// Interior points of the segment, evenly spaced (s = 0.1 … 0.9).
+pub const SEGMENT_POINTS: usize = 9;
+
+/// The height above both ends (nats) beyond which an interior point of the segment counts as a
+/// ridge between two basins: five times the cost's jitter between nearby points (about 0.1 nats,
+/// docs/validation.md, "Settling"). On the development set's six fits the segments either rose
+/// 2–31 nats above both ends or never above the higher end (docs/validation.md, "Intervals
+/// against the likelihood").
+pub const RIDGE_NATS: f64 = 0.5;
+
+/// The chosen model's NLL along the segment from the fit (s = 0) to the truth (s = 1) in the
+/// search's normalised coordinates.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TruthSegment {
+    /// The cost at s = 0.1, 0.2, … 0.9 minus the fit's, nats (NaN where the simulation failed).
+    pub rise_nats: Vec<f64>,
+    /// The highest interior point's height above the higher of the two ends, nats (negative: the
+    /// segment stays below the higher end).
+    pub ridge_nats: f64,
+}
+
+impl TruthSegment {
+    /// Whether a ridge higher than [`RIDGE_NATS`] separates the fit from the truth.
+    pub fn has_ridge(&self) -> bool {
+        self.ridge_nats > RIDGE_NATS
+    }
+}
+
+/// What the truth says of a fit: the chosen model's cost there and the segment to it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TruthCheck {
+    pub cost_nats: f64,
+    pub segment: Option<TruthSegment>,
+}
+
+/// The truth's cost and segment for the chosen fit `cf` of cost `fit_cost`, at the fit's solver;
+/// `None` without a truth for every freed parameter or when the truth cannot be simulated. The
+/// segment is left out where a true value lies outside the search box. `1 + 9` simulations, counted
+/// as the chosen model's evaluations; none of them enters the intervals (already computed) or the
+/// search's record of near-best points.
+pub(super) fn check(job: &LoadedJob, cf: &CandidateFit, fit_cost: f64) -> Option<TruthCheck> {
+    let p = &cf.problem;
+    let mut params = p.base;
+    let mut u_true = Vec::with_capacity(p.free.len());
+    let mut inside = true;
+    for fp in &p.free {
+        let t = *job.truth.get(&fp.name)?;
+        fp.name.set(&mut params, t);
+        inside &= (fp.lower..=fp.upper).contains(&t);
+        u_true.push(fp.u_of(t));
+    }
+    let cost_nats = p.total_cost(&p.simulate(&params).ok()?).ok()? + p.prior.nats(&params);
+    let segment = inside.then(|| segment(cf, &u_true, fit_cost, cost_nats));
+    Some(TruthCheck { cost_nats, segment })
+}
+
+/// [`TruthSegment`] from the fit `cf.best_u` (cost `fit_cost`) to `u_true` (cost `truth_cost`).
+fn segment(cf: &CandidateFit, u_true: &[f64], fit_cost: f64, truth_cost: f64) -> TruthSegment {
+    let p = &cf.problem;
+    let rise_nats: Vec<f64> = (1..=SEGMENT_POINTS)
+        .into_par_iter()
+        .map(|i| {
+            let s = i as f64 / (SEGMENT_POINTS + 1) as f64;
+            let u: Vec<f64> = cf
+                .best_u
+                .iter()
+                .zip(u_true)
+                .map(|(a, b)| a + s * (b - a))
+                .collect();
+            p.cost_with_solver(&u, &p.solver)
+                .map_or(f64::NAN, |(c, _)| c - fit_cost)
+        })
+        .collect();
+    TruthSegment {
+        ridge_nats: ridge_height(&rise_nats, truth_cost - fit_cost),
+        rise_nats,
+    }
+}
+
+/// The highest of `interior` (rises above the fit) above `max(0, truth_rise)`; a failed point
+/// (NaN) counts as a ridge of infinite height (the model cannot be simulated between them).
+pub fn ridge_height(interior: &[f64], truth_rise: f64) -> f64 {
+    let top = interior
+        .iter()
+        .map(|r| if r.is_nan() { f64::INFINITY } else { *r })
+        .fold(f64::NEG_INFINITY, f64::max);
+    top - truth_rise.max(0.0)
+}
+
+/// The warning of a fit whose cost `cost` lies above the truth's own by more than
+/// [`SHORTFALL_TOLERANCE_NATS`]: the search stopped short of the likelihood's maximum, with the
+/// segment's ridge when it was measured.
+pub fn shortfall_warning(cost: f64, truth: &TruthCheck) -> Option<FitWarning> {
+    (cost - truth.cost_nats > SHORTFALL_TOLERANCE_NATS).then(|| FitWarning::TruthMoreLikely {
+        fit_cost_nats: cost,
+        truth_cost_nats: truth.cost_nats,
+        ridge_nats: truth.segment.as_ref().map(|s| s.ridge_nats),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A segment that climbs between its ends has a ridge measured above the higher end; one that
+    /// rises steadily from the fit to a less likely truth has none; a failed interior point is a
+    /// ridge.
+    #[test]
+    fn the_ridge_is_measured_above_the_higher_end() {
+        // Fit at 0, truth 2.5 nats more likely, a hump of 31 nats between (dev_018's shape).
+        let hump = [5.0, 20.0, 31.0, 18.0, 4.0, 1.0, -1.0, -2.0, -2.4];
+        assert_eq!(ridge_height(&hump, -2.5), 31.0);
+        // A fit more likely than the truth (+0.71), rising steadily to it (dev_001's shape).
+        let slope = [0.003, 0.011, 0.026, 0.048, 0.085, 0.14, 0.22, 0.33, 0.49];
+        let r = ridge_height(&slope, 0.71);
+        assert!((r - (0.49 - 0.71)).abs() < 1e-12, "{r}");
+        let segment = TruthSegment {
+            rise_nats: slope.to_vec(),
+            ridge_nats: r,
+        };
+        assert!(!segment.has_ridge());
+        assert_eq!(ridge_height(&[0.1, f64::NAN, 0.2], 0.3), f64::INFINITY);
+    }
+}
