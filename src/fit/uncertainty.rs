@@ -41,7 +41,12 @@ pub(super) fn intervals(
     if fit.uncertainty.method() == UncertaintyMethod::Mcmc {
         return Ok(match &cf.evidence {
             Ok(nll) => {
-                let (iv, w, post) = mcmc_intervals(cf, nll.effective_parameters, fit, pb)?;
+                let (iv, mut w, post) = mcmc_intervals(cf, nll.effective_parameters, fit, pb)?;
+                let near = cf.problem.near_best.lock();
+                w.extend(short_of_best(
+                    cf.cost,
+                    &near.unwrap_or_else(|e| e.into_inner()),
+                ));
                 (Some(iv), w, Some(post))
             }
             Err(why) => (None, vec![no_intervals(UncertaintyMethod::Mcmc, why)], None),
@@ -57,6 +62,18 @@ pub(super) type Intervals = (
     Vec<FitWarning>,
     Option<PosteriorSummary>,
 );
+
+/// [`FitWarning::ShortOfBestEvaluation`] when a point evaluated at the polish's tolerance (`near`:
+/// by the search, or by the posterior sample's walkers, which can cross into a basin the search
+/// missed) is more likely than the fit's `cost` by more than [`super::search::CONFIRM_NATS`]. On a development
+/// recording whose search ended 1.1 nats short of the truth, the walkers moved into the truth's
+/// basin (docs/validation.md, "Intervals against the likelihood"): the sample's intervals then
+/// describe another point than the fit's.
+fn short_of_best(cost: f64, near: &super::problem::EvaluatedNearBest) -> Option<FitWarning> {
+    let gain = cost - near.lowest();
+    (gain > super::search::CONFIRM_NATS)
+        .then_some(FitWarning::ShortOfBestEvaluation { gain_nats: gain })
+}
 
 /// [`FitWarning::NoIntervals`] of `method`, for `why`.
 fn no_intervals(method: UncertaintyMethod, why: &impl std::fmt::Display) -> FitWarning {
@@ -595,10 +612,7 @@ pub fn widen_to_near_best(
             });
         }
     }
-    let gain = at.cost_nats - near.lowest();
-    if gain > super::search::CONFIRM_NATS {
-        warnings.push(FitWarning::ShortOfBestEvaluation { gain_nats: gain });
-    }
+    warnings.extend(short_of_best(at.cost_nats, near));
     warnings
 }
 
@@ -1169,6 +1183,19 @@ mod tests {
             }
         }
         near
+    }
+
+    /// A point evaluated more than `CONFIRM_NATS` (0.5) below the fit's cost is reported with its
+    /// gain; one 0.3 nats below is the likelihood's ripple and is not.
+    #[test]
+    fn a_point_more_likely_than_the_fit_is_reported() {
+        let mut near = super::super::problem::EvaluatedNearBest::default();
+        near.record(&[0.5], 8.0);
+        match short_of_best(9.0, &near) {
+            Some(FitWarning::ShortOfBestEvaluation { gain_nats }) => assert_eq!(gain_nats, 1.0),
+            other => panic!("{other:?}"),
+        }
+        assert!(short_of_best(8.3, &near).is_none());
     }
 
     #[test]
