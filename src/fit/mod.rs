@@ -148,11 +148,6 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         &mut warnings,
     );
     warnings.extend(failure_warning(&cf.problem));
-    warnings.extend(
-        truth
-            .as_ref()
-            .and_then(|t| truth::shortfall_warning(best.cost, t)),
-    );
     // The chosen model's counts include its bootstrap replicates and the tolerance check's
     // simulations (they share its counters).
     let chosen = &mut selection.trials[selection.chosen];
@@ -225,7 +220,8 @@ fn friction_curve(
 
 /// The checks at the chosen optimum `best` that simulate again: the tolerance check, with its
 /// warnings pushed to `warnings` (and whether it leaves the model choice open among `trials`), and
-/// the truth's own cost. Neither runs after an interrupt.
+/// the truth's cost and segment ([`truth::check`]), with the shortfall warning. Neither runs after
+/// an interrupt.
 fn optimum_checks(
     job: &LoadedJob,
     cf: &CandidateFit,
@@ -250,6 +246,7 @@ fn optimum_checks(
     let truth = (!interrupted)
         .then(|| truth::check(job, cf, best.cost))
         .flatten();
+    warnings.extend((truth.as_ref()).and_then(|t| truth::shortfall_warning(best.cost, t)));
     (tolerance_check, truth)
 }
 

@@ -604,6 +604,17 @@ mod tests {
                     parameter: ParamId::K1,
                 },
                 crate::fit::FitWarning::Text { text: "w".into() },
+                crate::fit::FitWarning::FlatterThanCurvature(crate::fit::secant::FlatAxisReport {
+                    parameter: ParamId::C,
+                    rise_nats: 0.11,
+                    quadratic_nats: 12.5,
+                    stretch: 10.0,
+                }),
+                crate::fit::FitWarning::TruthMoreLikely {
+                    fit_cost_nats: 38.3,
+                    truth_cost_nats: 35.9,
+                    ridge_nats: Some(31.1),
+                },
             ]
             .into(),
             input_sha256: "ab".into(),
@@ -634,8 +645,11 @@ mod tests {
                 vec!["rtol 1e-10: too many steps".into()],
             )),
             tracking_noise: None,
-            truth_cost: None,
-            truth_segment: None,
+            truth_cost: Some(35.9),
+            truth_segment: Some(crate::fit::truth::TruthSegment {
+                rise_nats: vec![5.0, 31.1, -2.0],
+                ridge_nats: 31.1,
+            }),
             friction_curve: None,
             posterior: None,
             priors: Some(crate::likelihood::prior::PriorsReport {

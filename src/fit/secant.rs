@@ -39,6 +39,19 @@ pub const SECANT_FLAT_RATIO: f64 = 4.0;
 /// is not measured (the ripples dominate), and the axis is called at least this much wider.
 pub const SECANT_MAX_STRETCH: f64 = 10.0;
 
+/// What the fit's `flatter_than_curvature` warning says of a [`FlatAxis`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FlatAxisReport {
+    /// The parameter the axis moves most ([`main_parameter`]).
+    pub parameter: crate::model::ParamId,
+    /// The NLL's mean rise at the probes, nats.
+    pub rise_nats: f64,
+    /// The quadratic's rise there, `r²/2` nats.
+    pub quadratic_nats: f64,
+    /// The axis's secant 1σ over `F⁻¹`'s.
+    pub stretch: f64,
+}
+
 /// One principal axis along which the likelihood is flatter than the quadratic.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlatAxis {

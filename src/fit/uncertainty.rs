@@ -620,7 +620,7 @@ pub fn widen_to_near_best(
 /// `F⁻¹` ([`super::secant`]): a warning per axis along which the likelihood is flatter than the
 /// quadratic the intervals assume. `2k` simulations.
 fn secant_check(cf: &CandidateFit) -> Vec<FitWarning> {
-    use super::secant::{SECANT_PROBE_SIGMA, flat_axes, main_parameter};
+    use super::secant::{FlatAxisReport, SECANT_PROBE_SIGMA, flat_axes, main_parameter};
     let (Some(fs), Some(fc)) = (&cf.fisher_sigma_u, &cf.fisher_corr) else {
         return Vec::new();
     };
@@ -629,11 +629,13 @@ fn secant_check(cf: &CandidateFit) -> Vec<FitWarning> {
     }
     flat_axes(|u| cf.problem.cost_at(u), &cf.best_u, cf.cost, (fs, fc))
         .iter()
-        .map(|a| FitWarning::FlatterThanCurvature {
-            parameter: main_parameter(&cf.free, a).name,
-            rise_nats: a.rise_nats,
-            quadratic_nats: 0.5 * SECANT_PROBE_SIGMA * SECANT_PROBE_SIGMA,
-            stretch: a.stretch,
+        .map(|a| {
+            FitWarning::FlatterThanCurvature(FlatAxisReport {
+                parameter: main_parameter(&cf.free, a).name,
+                rise_nats: a.rise_nats,
+                quadratic_nats: 0.5 * SECANT_PROBE_SIGMA * SECANT_PROBE_SIGMA,
+                stretch: a.stretch,
+            })
         })
         .collect()
 }

@@ -14,6 +14,7 @@
 //! recording and in the model, model evaluations that failed where the lip tip would leave the
 //! glass).
 
+use super::secant::FlatAxisReport;
 use super::select::INDISTINGUISHABLE_TIC;
 use super::tolerance::{SPREAD_WARN_NATS, TolerancePoint};
 use super::uncertainty::{PROFILE_68_NATS, PROFILE_MAX_STEPS};
@@ -163,16 +164,7 @@ pub enum FitWarning {
     },
     /// The likelihood is flatter along a principal axis of `F⁻¹` than the Laplace quadratic
     /// ([`crate::fit::secant`]): the Laplace intervals understate the spread along it.
-    FlatterThanCurvature {
-        /// The parameter the axis moves most.
-        parameter: ParamId,
-        /// The NLL's mean rise at the probes, nats.
-        rise_nats: f64,
-        /// The quadratic's rise there, nats.
-        quadratic_nats: f64,
-        /// The axis's secant 1σ over `F⁻¹`'s.
-        stretch: f64,
-    },
+    FlatterThanCurvature(FlatAxisReport),
     /// The search evaluated a point more likely than the fit.
     ShortOfBestEvaluation { gain_nats: f64 },
     /// k1 and theta_c trade along the shoulder's contact-moment ridge; both intervals span it.
@@ -299,7 +291,7 @@ impl FitWarning {
             | ProfileAtBound { .. }
             | ProfileOpen { .. }
             | ProfileMoreLikely { .. }
-            | FlatterThanCurvature { .. }
+            | FlatterThanCurvature(_)
             | ShortOfBestEvaluation { .. }
             | PosteriorUnconverged { .. }
             | PosteriorSpansBounds { .. }
@@ -331,7 +323,7 @@ impl FitWarning {
             ProfileOpen { .. } => "profile_open",
             ProfileMoreLikely { .. } => "profile_more_likely",
             WidenedInterval { .. } => "widened_interval",
-            FlatterThanCurvature { .. } => "flatter_than_curvature",
+            FlatterThanCurvature(_) => "flatter_than_curvature",
             ShortOfBestEvaluation { .. } => "short_of_best_evaluation",
             PosteriorUnconverged { .. } => "posterior_unconverged",
             PosteriorSpansBounds { .. } => "posterior_spans_bounds",
@@ -362,10 +354,10 @@ impl FitWarning {
             | ProfileOpen { parameter, .. }
             | ProfileMoreLikely { parameter, .. }
             | WidenedInterval { parameter, .. }
-            | FlatterThanCurvature { parameter, .. }
             | PosteriorUnconverged { parameter, .. }
             | PosteriorSpansBounds { parameter, .. } => Some(*parameter),
             PriorConflict(c) => Some(c.parameter),
+            FlatterThanCurvature(a) => Some(a.parameter),
             _ => None,
         }
     }
@@ -464,12 +456,7 @@ impl fmt::Display for FitWarning {
                 method,
                 widened,
             } => widened_interval(f, *parameter, *rise_limit_nats, [points, method, widened]),
-            FlatterThanCurvature {
-                parameter,
-                rise_nats,
-                quadratic_nats,
-                stretch,
-            } => flatter_than_curvature(f, *parameter, [*rise_nats, *quadratic_nats], *stretch),
+            FlatterThanCurvature(a) => flatter_than_curvature(f, a),
             ShortOfBestEvaluation { gain_nats } => short_of_best_evaluation(f, *gain_nats),
             PosteriorUnconverged {
                 parameter,
@@ -704,20 +691,18 @@ fn widened_interval(
 }
 
 /// [`FitWarning::FlatterThanCurvature`]'s sentence.
-fn flatter_than_curvature(
-    f: &mut fmt::Formatter<'_>,
-    parameter: ParamId,
-    [rise, quadratic]: [f64; 2],
-    stretch: f64,
-) -> fmt::Result {
+fn flatter_than_curvature(f: &mut fmt::Formatter<'_>, a: &FlatAxisReport) -> fmt::Result {
     write!(
         f,
-        "along a principal axis of the Fisher information (mostly {parameter}) the likelihood \
-         rises {rise:.2} nats at ±{r}σ where the Laplace quadratic rises {quadratic:.1}: it is \
-         {stretch:.1} times wider there than the curvature at the fit says, so the Laplace \
-         intervals understate the spread of the parameters that direction moves; \
-         method = \"mcmc\" samples the likelihood itself",
-        r = super::secant::SECANT_PROBE_SIGMA
+        "along a principal axis of the Fisher information (mostly {}) the likelihood rises {:.2} \
+         nats at ±{}σ where the Laplace quadratic rises {:.1}: it is {:.1} times wider there than \
+         the curvature at the fit says, so the Laplace intervals understate the spread of the \
+         parameters that direction moves; method = \"mcmc\" samples the likelihood itself",
+        a.parameter,
+        a.rise_nats,
+        super::secant::SECANT_PROBE_SIGMA,
+        a.quadratic_nats,
+        a.stretch
     )
 }
 

@@ -250,14 +250,7 @@ fn fit_headline(w: &FitWarning) -> String {
             widened,
             ..
         } => widened_headline(*parameter, method, widened),
-        FlatterThanCurvature {
-            parameter, stretch, ..
-        } => format!(
-            "The likelihood is {stretch:.1} times wider than its curvature at the fit says along \
-             a direction that moves mostly {parameter}: the Laplace intervals understate the \
-             spread there; refit with `method = \"mcmc\"`, which samples the likelihood itself \
-             (docs/uncertainty.md)."
-        ),
+        FlatterThanCurvature(a) => flatter_headline(a.parameter, a.stretch),
         ShortOfBestEvaluation { gain_nats } => format!(
             "The search evaluated a point {gain_nats:.2} nats more likely than the fit: it ended \
              short of its own best point; refit with more restarts or polish iterations."
@@ -368,6 +361,17 @@ fn profile_at_bound_headline(parameter: ParamId, bounds: &[End]) -> String {
             .collect::<Vec<_>>()
             .join(" and "),
         if bounds.len() > 1 { "s" } else { "" }
+    )
+}
+
+/// [`FitWarning::FlatterThanCurvature`]'s headline: how many times wider the likelihood is along
+/// a direction that moves mostly `parameter`.
+fn flatter_headline(parameter: ParamId, stretch: f64) -> String {
+    format!(
+        "The likelihood is {stretch:.1} times wider than its curvature at the fit says along a \
+         direction that moves mostly {parameter}: the Laplace intervals understate the spread \
+         there; refit with `method = \"mcmc\"`, which samples the likelihood itself \
+         (docs/uncertainty.md)."
     )
 }
 
