@@ -25,10 +25,10 @@ use clap::Parser;
 use nalgebra::{DMatrix, DVector};
 use std::path::PathBuf;
 use wiperlab::fit::evidence::{LocalFit, at_fit_smoothed};
-use wiperlab::fit::secant::{SECANT_PROBE_SIGMA, flat_axes};
 use wiperlab::fit::{FAILED_COST, SpectralProblem, posterior_tempering, problem_for};
 use wiperlab::job::{Candidate, LoadedJob, NoiseSpectrum};
-use wiperlab::likelihood::covariance::cholesky_of_covariance;
+use wiperlab::likelihood::covariance::{cholesky_of_covariance, covariance_of};
+use wiperlab::likelihood::secant::{SECANT_PROBE_SIGMA, flat_axes};
 use wiperlab::posterior::{EnsembleSettings, ensemble::gaussian_ball_with, sample};
 
 #[derive(Parser)]
@@ -135,7 +135,7 @@ fn predicted_rise(p: &SpectralProblem, u_fit: &[f64], u_true: &[f64]) -> Fallibl
         ("Fisher F⁻¹", &lf.curvature_sigma_u, &lf.curvature_corr),
         ("sandwich F⁻¹VF⁻¹", &lf.sigma_u, &lf.corr),
     ] {
-        let c = DMatrix::from_fn(k, k, |i, j| sigma[i] * sigma[j] * corr[i][j]);
+        let c = covariance_of(sigma, corr);
         match c.clone().try_inverse() {
             Some(ci) => println!(
                 "{name}: ½ dᵀC⁻¹d = {:.2} (the rise a quadratic likelihood with this covariance puts at the truth)",
@@ -161,7 +161,7 @@ fn predicted_rise(p: &SpectralProblem, u_fit: &[f64], u_true: &[f64]) -> Fallibl
 }
 
 /// The Laplace intervals' 1σ (the sandwich's) with the truth's distance from the fit in them,
-/// and the axes the fit's secant check (`wiperlab::fit::secant`) finds flatter than the quadratic.
+/// and the axes the fit's secant check (`wiperlab::likelihood::secant`) finds flatter than the quadratic.
 fn laplace_and_secant(p: &SpectralProblem, u_fit: &[f64], u_true: &[f64], lf: &LocalFit) {
     let cost = p.cost_at(u_fit);
     for (i, fp) in p.free.iter().enumerate() {
@@ -173,7 +173,8 @@ fn laplace_and_secant(p: &SpectralProblem, u_fit: &[f64], u_true: &[f64], lf: &L
         );
     }
     let fisher = (&lf.curvature_sigma_u[..], &lf.curvature_corr[..]);
-    for a in flat_axes(|u| p.cost_at(u), u_fit, cost, fisher) {
+    let cost_at = |u: &[f64]| Some(p.cost_at(u)).filter(|c| *c < FAILED_COST);
+    for a in flat_axes(cost_at, u_fit, cost, fisher) {
         println!(
             "secant check: the axis of 1σ {:.2e} rises {:.3} nats at ±{SECANT_PROBE_SIGMA}σ: {:.1} times flatter in σ",
             a.fisher_sigma_u, a.rise_nats, a.stretch

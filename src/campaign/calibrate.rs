@@ -32,7 +32,7 @@ use super::Campaign;
 use super::run::{EntryPaths, State, read_status};
 use crate::fit::SHORTFALL_TOLERANCE_NATS;
 use crate::fit::result::{FitResult, FittedParam};
-use crate::fit::truth::RIDGE_NATS;
+use crate::fit::truth::{RIDGE_NATS, is_ridge};
 use crate::io::write_atomic;
 use crate::job::{Candidate, FreeParam};
 use crate::model::ParamId;
@@ -273,7 +273,7 @@ impl Calibration {
                     .is_some_and(|s| s > SHORTFALL_TOLERANCE_NATS)
         });
         let ridges: Vec<f64> = short.filter_map(|r| r.ridge_nats).collect();
-        let beyond = ridges.iter().filter(|h| **h > RIDGE_NATS).count();
+        let beyond = ridges.iter().filter(|h| is_ridge(**h)).count();
         (ridges.len(), beyond)
     }
 

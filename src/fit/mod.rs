@@ -20,7 +20,6 @@ mod problem;
 pub mod result;
 pub mod scan;
 mod search;
-pub mod secant;
 pub mod select;
 pub mod tolerance;
 pub mod truth;

@@ -604,12 +604,14 @@ mod tests {
                     parameter: ParamId::K1,
                 },
                 crate::fit::FitWarning::Text { text: "w".into() },
-                crate::fit::FitWarning::FlatterThanCurvature(crate::fit::secant::FlatAxisReport {
-                    parameter: ParamId::C,
-                    rise_nats: 0.11,
-                    quadratic_nats: 12.5,
-                    stretch: 10.0,
-                }),
+                crate::fit::FitWarning::FlatterThanCurvature(
+                    crate::likelihood::secant::FlatAxisReport {
+                        parameter: ParamId::C,
+                        rise_nats: 0.11,
+                        quadratic_nats: 12.5,
+                        stretch: 10.0,
+                    },
+                ),
                 crate::fit::FitWarning::TruthMoreLikely {
                     fit_cost_nats: 38.3,
                     truth_cost_nats: 35.9,

@@ -911,6 +911,7 @@ fn finish(
     if let Some(pb) = pb {
         pb.set_position(reporting.base + problem.evaluations.load(Ordering::Relaxed) as u64);
     }
+    let (fisher_sigma_u, fisher_corr) = fisher.unzip();
     Ok(CandidateFit {
         candidate,
         free,
@@ -918,8 +919,8 @@ fn finish(
         best_u,
         sigma_u,
         corr,
-        fisher_sigma_u: fisher.as_ref().map(|f| f.0.clone()),
-        fisher_corr: fisher.map(|f| f.1),
+        fisher_sigma_u,
+        fisher_corr,
         evidence,
         swarm_iters,
         polish_iters,

@@ -41,11 +41,10 @@ pub struct TruthSegment {
     pub ridge_nats: f64,
 }
 
-impl TruthSegment {
-    /// Whether a ridge higher than [`RIDGE_NATS`] separates the fit from the truth.
-    pub fn has_ridge(&self) -> bool {
-        self.ridge_nats > RIDGE_NATS
-    }
+/// Whether a segment's `ridge_nats` ([`TruthSegment::ridge_nats`]) is a ridge: higher than
+/// [`RIDGE_NATS`], so that the truth lies in another basin than the fit.
+pub fn is_ridge(ridge_nats: f64) -> bool {
+    ridge_nats > RIDGE_NATS
 }
 
 /// What the truth says of a fit: the chosen model's cost there and the segment to it.
@@ -136,11 +135,7 @@ mod tests {
         let slope = [0.003, 0.011, 0.026, 0.048, 0.085, 0.14, 0.22, 0.33, 0.49];
         let r = ridge_height(&slope, 0.71);
         assert!((r - (0.49 - 0.71)).abs() < 1e-12, "{r}");
-        let segment = TruthSegment {
-            rise_nats: slope.to_vec(),
-            ridge_nats: r,
-        };
-        assert!(!segment.has_ridge());
+        assert!(!is_ridge(r));
         assert_eq!(ridge_height(&[0.1, f64::NAN, 0.2], 0.3), f64::INFINITY);
     }
 }

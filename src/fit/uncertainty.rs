@@ -617,17 +617,20 @@ pub fn widen_to_near_best(
 }
 
 /// The Laplace intervals of `cf` checked against its likelihood along the principal axes of
-/// `F⁻¹` ([`super::secant`]): a warning per axis along which the likelihood is flatter than the
+/// `F⁻¹` ([`crate::likelihood::secant`]): a warning per axis along which the likelihood is flatter than the
 /// quadratic the intervals assume. `2k` simulations.
 fn secant_check(cf: &CandidateFit) -> Vec<FitWarning> {
-    use super::secant::{FlatAxisReport, SECANT_PROBE_SIGMA, flat_axes, main_parameter};
+    use crate::likelihood::secant::{
+        FlatAxisReport, SECANT_PROBE_SIGMA, flat_axes, main_parameter,
+    };
     let (Some(fs), Some(fc)) = (&cf.fisher_sigma_u, &cf.fisher_corr) else {
         return Vec::new();
     };
     if super::interrupt::stop_requested() {
         return Vec::new();
     }
-    flat_axes(|u| cf.problem.cost_at(u), &cf.best_u, cf.cost, (fs, fc))
+    let cost_at = |u: &[f64]| Some(cf.problem.cost_at(u)).filter(|c| *c < super::FAILED_COST);
+    flat_axes(cost_at, &cf.best_u, cf.cost, (fs, fc))
         .iter()
         .map(|a| {
             FitWarning::FlatterThanCurvature(FlatAxisReport {

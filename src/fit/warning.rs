@@ -14,7 +14,6 @@
 //! recording and in the model, model evaluations that failed where the lip tip would leave the
 //! glass).
 
-use super::secant::FlatAxisReport;
 use super::select::INDISTINGUISHABLE_TIC;
 use super::tolerance::{SPREAD_WARN_NATS, TolerancePoint};
 use super::uncertainty::{PROFILE_68_NATS, PROFILE_MAX_STEPS};
@@ -22,6 +21,7 @@ use crate::job::Candidate;
 use crate::job::UncertaintyMethod;
 use crate::likelihood::GoodnessOfFit;
 use crate::likelihood::prior::{ParamConflict, PriorsReport, RigConflict};
+use crate::likelihood::secant::FlatAxisReport;
 use crate::model::ParamId;
 use crate::names::named_enum;
 use crate::simulate::failure::FailureCause;
@@ -163,7 +163,7 @@ pub enum FitWarning {
         widened: [f64; 2],
     },
     /// The likelihood is flatter along a principal axis of `F⁻¹` than the Laplace quadratic
-    /// ([`crate::fit::secant`]): the Laplace intervals understate the spread along it.
+    /// ([`crate::likelihood::secant`]): the Laplace intervals understate the spread along it.
     FlatterThanCurvature(FlatAxisReport),
     /// The search evaluated a point more likely than the fit.
     ShortOfBestEvaluation { gain_nats: f64 },
@@ -380,6 +380,12 @@ fn line_name(source: LineSource, band: &str) -> String {
     }
 }
 
+/// [`FitWarning::Line`]'s sentence: the `origin`'s concern about the line called `name`.
+fn line(f: &mut fmt::Formatter<'_>, name: String, origin: &LineOrigin) -> fmt::Result {
+    let concern = origin.concern(&name);
+    f.write_str(&concern.unwrap_or_else(|| format!("{name} needs no warning")))
+}
+
 impl fmt::Display for FitWarning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         use FitWarning::*;
@@ -417,11 +423,7 @@ impl fmt::Display for FitWarning {
                 source,
                 origin,
                 ..
-            } => f.write_str(
-                &origin
-                    .concern(&line_name(*source, band))
-                    .unwrap_or_else(|| format!("{} needs no warning", line_name(*source, band))),
-            ),
+            } => line(f, line_name(*source, band), origin),
             Undetermined { parameter } => undetermined(f, *parameter),
             TradeOff {
                 first,
@@ -520,7 +522,7 @@ fn truth_more_likely(
         fit - truth
     )?;
     match ridge {
-        Some(r) if r > super::truth::RIDGE_NATS => write!(
+        Some(r) if super::truth::is_ridge(r) => write!(
             f,
             "; a ridge {r:.2} nats high lies between them on the straight line, so the truth's \
              basin is another one, which the global search did not enter (more restarts)"
@@ -700,7 +702,7 @@ fn flatter_than_curvature(f: &mut fmt::Formatter<'_>, a: &FlatAxisReport) -> fmt
          parameters that direction moves; method = \"mcmc\" samples the likelihood itself",
         a.parameter,
         a.rise_nats,
-        super::secant::SECANT_PROBE_SIGMA,
+        crate::likelihood::secant::SECANT_PROBE_SIGMA,
         a.quadratic_nats,
         a.stretch
     )

@@ -20,6 +20,13 @@ pub fn sample_covariance(x: &[Vec<f64>]) -> DMatrix<f64> {
     })
 }
 
+/// The covariance matrix with 1σ `sigma` and correlations `corr` (the inverse of [`covariance`]'s
+/// split).
+pub fn covariance_of(sigma: &[f64], corr: &[Vec<f64>]) -> DMatrix<f64> {
+    let k = sigma.len();
+    DMatrix::from_fn(k, k, |i, j| corr[i][j] * sigma[i] * sigma[j])
+}
+
 /// The lower Cholesky factor `L` of the covariance with 1σ `sigma` and correlations `corr`
 /// (`LLᵀ = Σ`; `u + L z` maps whitened coordinates `z` to normalised ones). `None` where a 1σ is
 /// not finite (a coordinate without information) or the covariance is not positive definite.
@@ -27,9 +34,7 @@ pub fn cholesky_of_covariance(sigma: &[f64], corr: &[Vec<f64>]) -> Option<DMatri
     if sigma.iter().any(|s| !s.is_finite()) {
         return None;
     }
-    let k = sigma.len();
-    let cov = DMatrix::from_fn(k, k, |i, j| corr[i][j] * sigma[i] * sigma[j]);
-    Some(cov.cholesky()?.l())
+    Some(covariance_of(sigma, corr).cholesky()?.l())
 }
 
 /// Covariance of the normalised coordinates from a Fisher information `f` (its pseudo-inverse over

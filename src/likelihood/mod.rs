@@ -77,7 +77,7 @@
 //! What the likelihood and the cost read of a recording is measured here too: [`measure`] reads the
 //! recording (or a target job's targets) into features per band and noise floors, [`instfreq`]
 //! adds frequency against tip speed. [`covariance`] turns the likelihood's information into the
-//! spread of an estimate.
+//! spread of an estimate, and [`secant`] checks that spread's quadratic against the likelihood.
 
 pub mod covariance;
 mod error;
@@ -85,6 +85,7 @@ pub mod instfreq;
 pub mod measure;
 pub mod misfit;
 pub mod prior;
+pub mod secant;
 
 pub use error::{MeasureError, NoHeadTrack};
 

@@ -322,7 +322,7 @@ fn rig_curve_conflict_headline(rms_z: f64, points: usize) -> String {
 /// [`FitWarning::TruthMoreLikely`]'s headline, the truth `short_nats` more likely than the fit.
 fn truth_more_likely_headline(short_nats: f64, ridge_nats: Option<f64>) -> String {
     let basin = match ridge_nats {
-        Some(r) if r > crate::fit::truth::RIDGE_NATS => {
+        Some(r) if crate::fit::truth::is_ridge(r) => {
             " The truth lies in another basin, beyond a ridge: refit with more restarts."
         }
         Some(_) => " No ridge lies between them: the search stopped on the truth's slope.",

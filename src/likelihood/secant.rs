@@ -20,9 +20,9 @@
 //! likelihood is not a quadratic at any one scale), so the fit warns and names the method that
 //! samples the likelihood itself.
 
-use super::problem::FAILED_COST;
+use super::covariance::covariance_of;
 use crate::job::FreeParam;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
 /// Radius of the probes, in standard deviations of `F⁻¹` along each principal axis: far enough
 /// that the likelihood's ripples (a few hundredths of a nat, docs/validation.md, "Settling") are
@@ -66,17 +66,11 @@ pub struct FlatAxis {
     pub stretch: f64,
 }
 
-/// The covariance with 1σ `sigma` and correlations `corr`.
-fn covariance(sigma: &[f64], corr: &[Vec<f64>]) -> DMatrix<f64> {
-    let k = sigma.len();
-    DMatrix::from_fn(k, k, |i, j| sigma[i] * sigma[j] * corr[i][j])
-}
-
 /// The NLL's mean rise above `cost` at `u ± r·v` (one side where the other leaves the box or its
 /// simulation fails); `None` where neither side can be read.
 fn mean_rise<F>(cost_at: &F, u: &[f64], step: &DVector<f64>, cost: f64) -> Option<f64>
 where
-    F: Fn(&[f64]) -> f64 + Sync,
+    F: Fn(&[f64]) -> Option<f64> + Sync,
 {
     use rayon::prelude::*;
     let rises: Vec<f64> = [1.0, -1.0]
@@ -90,8 +84,7 @@ where
             if p.iter().any(|x| !(0.0..=1.0).contains(x)) {
                 return None;
             }
-            let c = cost_at(&p);
-            (c < FAILED_COST).then_some(c - cost)
+            cost_at(&p).map(|c| c - cost)
         })
         .collect();
     (!rises.is_empty()).then(|| rises.iter().sum::<f64>() / rises.len() as f64)
@@ -108,7 +101,7 @@ pub fn stretch_of(rise: f64, r: f64) -> f64 {
 }
 
 /// The principal axes of `F⁻¹` (1σ `fisher.0`, correlations `fisher.1`) along which the NLL
-/// `cost_at` (nats; [`FAILED_COST`] or more: a failed simulation) at the fit `u` (cost `cost`) is
+/// `cost_at` (nats; `None`: a failed simulation) at the fit `u` (cost `cost`) is
 /// [`SECANT_FLAT_RATIO`] times flatter than the Laplace quadratic ([`stretch_of`]); empty where
 /// every axis rises as the quadratic or faster, or where `F⁻¹` has no finite positive 1σ (a
 /// parameter the likelihood does not inform is reported as such elsewhere). `2k` evaluations of
@@ -120,12 +113,12 @@ pub fn flat_axes<F>(
     fisher: (&[f64], &[Vec<f64>]),
 ) -> Vec<FlatAxis>
 where
-    F: Fn(&[f64]) -> f64 + Sync,
+    F: Fn(&[f64]) -> Option<f64> + Sync,
 {
     if !fisher.0.iter().all(|x| x.is_finite() && *x > 0.0) {
         return Vec::new();
     }
-    let eig = covariance(fisher.0, fisher.1).symmetric_eigen();
+    let eig = covariance_of(fisher.0, fisher.1).symmetric_eigen();
     (0..u.len())
         .filter_map(|i| {
             let sd = eig.eigenvalues[i].max(0.0).sqrt();
@@ -182,13 +175,13 @@ mod tests {
     #[test]
     fn the_quadratic_of_f_itself_has_no_flat_axis() {
         let (s, c) = fisher_of([0.02, 0.05], 0.8);
-        let cov = covariance(&s, &c);
+        let cov = covariance_of(&s, &c);
         let inv = cov.try_inverse().expect("positive definite");
         let u0 = [0.4, 0.6];
         let slope = [30.0, -10.0];
         let nll = |u: &[f64]| {
             let d = DVector::from_iterator(2, u.iter().zip(&u0).map(|(a, b)| a - b));
-            0.5 * (d.transpose() * &inv * &d)[(0, 0)] + slope[0] * d[0] + slope[1] * d[1]
+            Some(0.5 * (d.transpose() * &inv * &d)[(0, 0)] + slope[0] * d[0] + slope[1] * d[1])
         };
         assert!(flat_axes(nll, &u0, 0.0, (&s, &c)).is_empty());
     }
@@ -201,7 +194,7 @@ mod tests {
         let (s, c) = fisher_of([0.01, 0.03], 0.0);
         let nll = |u: &[f64]| {
             let (x, y) = (u[0] - 0.5, u[1] - 0.5);
-            0.5 * (x / 0.01).powi(2) + 0.5 * (y / 0.09).powi(2)
+            Some(0.5 * (x / 0.01).powi(2) + 0.5 * (y / 0.09).powi(2))
         };
         let axes = flat_axes(nll, &[0.5, 0.5], 0.0, (&s, &c));
         assert_eq!(axes.len(), 1, "{axes:?}");
@@ -221,12 +214,12 @@ mod tests {
     fn probes_outside_the_box_or_failed_are_skipped() {
         let (s, c) = fisher_of([0.2, 0.01], 0.0);
         // Flat everywhere: every readable axis would be reported.
-        let flat = |_: &[f64]| 0.0;
+        let flat = |_: &[f64]| Some(0.0);
         // At u = (0.05, 0.5) the first axis's probes (±1.0) both leave the box.
         let axes = flat_axes(flat, &[0.05, 0.5], 0.0, (&s, &c));
         assert_eq!(axes.len(), 1, "{axes:?}");
         assert!((axes[0].fisher_sigma_u - 0.01).abs() < 1e-12);
-        let failed = |_: &[f64]| FAILED_COST;
+        let failed = |_: &[f64]| None;
         assert!(flat_axes(failed, &[0.5, 0.5], 0.0, (&s, &c)).is_empty());
     }
 }
