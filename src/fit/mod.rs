@@ -42,7 +42,7 @@ pub use uncertainty::{
 pub use warning::{FitWarning, Severity, Warnings};
 
 use crate::Result;
-use crate::job::{self, Candidate, LoadedJob};
+use crate::job::{self, LoadedJob};
 use crate::likelihood;
 use crate::likelihood::measure::measure;
 use crate::model::BladeParams;
@@ -90,9 +90,9 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     search::take_nested_optima(&mut fits, &pb)?;
     let explicit = !fit.models.is_empty();
     let choose = |fits: &mut Vec<CandidateFit>| -> Result<select::Selection> {
-        let selection = select::choose(fits, &job.job.spectrum.bands, explicit);
+        let selection = select::choose(fits, &job.job.spectrum.bands, explicit, &[]);
         Ok(if descend_chosen(job, fits, selection.chosen, &pb)? {
-            select::choose(fits, &job.job.spectrum.bands, explicit)
+            select::choose(fits, &job.job.spectrum.bands, explicit, &[])
         } else {
             selection
         })
@@ -110,9 +110,11 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
             selection = choose(&mut fits)?;
             (best, gof) = chosen_goodness(&fits[selection.chosen])?;
         } else {
-            selection = select::choose(&fits, &job.job.spectrum.bands, explicit);
+            selection = select::choose(&fits, &job.job.spectrum.bands, explicit, &[]);
         }
     }
+    let (tolerance_check, choice_warning) =
+        choose_at_resolution(job, &fits, &mut selection, (&mut best, &mut gof), explicit)?;
     let absorbing = select::absorbing_warnings(&fits, selection.chosen, &job.job.spectrum.bands);
     // Laplace and profile intervals read the sandwich over the bowl's centre; a bootstrap's come
     // from its replicates, so its 1σ and correlations keep the sandwich at the fit.
@@ -138,11 +140,12 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     warnings.extend(absorbing);
     warnings.extend(line_warnings(&peaks));
     warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
-    let (tolerance_check, truth) = optimum_checks(
+    warnings.extend(choice_warning);
+    let truth = optimum_checks(
         job,
         &cf,
         &best,
-        &selection.trials,
+        tolerance_check.as_ref(),
         interrupted,
         &mut warnings,
     );
@@ -217,51 +220,60 @@ fn friction_curve(
     )
 }
 
-/// The checks at the chosen optimum `best` that simulate again: the tolerance check, with its
-/// warnings pushed to `warnings` (and whether it leaves the model choice open among `trials`), and
-/// the truth's cost and segment ([`truth::check`]), with the shortfall warning. Neither runs after
-/// an interrupt.
+/// The chosen optimum's tolerance check ([`tolerance::ToleranceCheck`]) and, where an optimum the
+/// choice reads is not resolved by the integrator, the choice again with its margins widened by
+/// the unresolved spreads ([`select::margin`]): `selection`, `best` and `gof` move to the
+/// candidate reported then (simulated again), and the warning says why. No check runs after an
+/// interrupt.
+///
+/// # Errors
+/// A newly chosen model that cannot be simulated again.
+fn choose_at_resolution(
+    job: &LoadedJob,
+    fits: &[CandidateFit],
+    selection: &mut select::Selection,
+    (best, gof): (&mut BestModel, &mut GoodnessOutcome),
+    explicit: bool,
+) -> Result<(Option<tolerance::ToleranceCheck>, Option<FitWarning>)> {
+    if interrupt::stop_requested() {
+        return Ok((None, None));
+    }
+    let cf = &fits[selection.chosen];
+    let at_job = (best.cost, best.sim.transitions.len());
+    let check = tolerance::ToleranceCheck::run(&cf.problem, &cf.best_u, at_job);
+    let mut checks = tolerance::checks_for_choice(fits, selection.chosen, check);
+    let spreads: Vec<f64> = checks
+        .iter()
+        .map(|c| tolerance::unresolved_spread(c.as_ref()))
+        .collect();
+    // Chosen again in any case: the trials' evaluation counts then include the checks'.
+    let widened = select::choose(fits, &job.job.spectrum.bands, explicit, &spreads);
+    let mut warning = None;
+    if widened.chosen != selection.chosen {
+        warning = select::moved_choice(&widened, selection.chosen, &spreads);
+        (*best, *gof) = chosen_goodness(&fits[widened.chosen])?;
+    }
+    *selection = widened;
+    Ok((checks.swap_remove(selection.chosen), warning))
+}
+
+/// The checks at the chosen optimum `best` that simulate again or read its tolerance check: the
+/// check's warnings pushed to `warnings`, and the truth's cost and segment ([`truth::check`]),
+/// with the shortfall warning. The truth is not checked after an interrupt.
 fn optimum_checks(
     job: &LoadedJob,
     cf: &CandidateFit,
     best: &BestModel,
-    trials: &[result::ModelTrial],
+    tolerance_check: Option<&tolerance::ToleranceCheck>,
     interrupted: bool,
     warnings: &mut Vec<FitWarning>,
-) -> (Option<tolerance::ToleranceCheck>, Option<truth::TruthCheck>) {
-    let tolerance_check = (!interrupted && !interrupt::stop_requested())
-        .then(|| {
-            let at_job = (best.cost, best.sim.transitions.len());
-            tolerance::ToleranceCheck::run(&cf.problem, &cf.best_u, at_job)
-        })
-        .flatten();
-    warnings.extend(tolerance_check.as_ref().and_then(|t| t.warning()));
-    warnings.extend(
-        tolerance_check
-            .as_ref()
-            .zip(runner_up(trials))
-            .and_then(|(t, (chosen, runner, gap))| t.choice_warning(chosen, runner, gap)),
-    );
+) -> Option<truth::TruthCheck> {
+    warnings.extend(tolerance_check.and_then(|t| t.warning()));
     let truth = (!interrupted)
         .then(|| truth::check(job, cf, best.cost))
         .flatten();
     warnings.extend((truth.as_ref()).and_then(|t| truth::shortfall_warning(best.cost, t)));
-    (tolerance_check, truth)
-}
-
-/// The chosen trial's name, the name of the trial with the TIC nearest to it among the others, and
-/// that TIC's distance above the chosen one's (`None` without two trials in likelihood units).
-fn runner_up(trials: &[result::ModelTrial]) -> Option<(Candidate, Candidate, f64)> {
-    let tic = |t: &result::ModelTrial| t.evidence.as_ref().and_then(|e| e.tic);
-    let chosen = trials.iter().find(|t| t.chosen)?;
-    let chosen_tic = tic(chosen)?;
-    trials
-        .iter()
-        .filter(|t| !t.chosen)
-        .filter_map(|t| Some((t, tic(t)? - chosen_tic)))
-        .filter(|(_, gap)| gap.is_finite())
-        .min_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
-        .map(|(t, gap)| (chosen.model, t.model, gap))
+    truth
 }
 
 /// The chosen fit's goodness of fit to the recording's spectra

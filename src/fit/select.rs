@@ -64,17 +64,25 @@ fn evidences(fits: &[CandidateFit]) -> Option<Vec<Option<Evidence>>> {
 /// needs is judged by how well it explains that band (on a head-only recording the high band holds
 /// no neck–lip line, and the head model is the right answer); without a likelihood, the candidates
 /// that can produce every band. If none qualifies, among all. `listed`: the job named its candidates (else the smallest capable model
-/// was the only one).
-pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) -> Selection {
+/// was the only one). `spreads`: each candidate's cost spread between solver tolerances where the
+/// integrator does not resolve its optimum, nats (0 where it does or was not probed; empty: all
+/// 0), which widens the margin of "not distinguishable" ([`margin`]).
+pub(super) fn choose(
+    fits: &[CandidateFit],
+    bands: &[BandSpec],
+    listed: bool,
+    spreads: &[f64],
+) -> Selection {
     let evidence = evidences(fits);
     let (crit, scores) = criteria(fits, bands, evidence.as_deref());
     let ks: Vec<usize> = fits.iter().map(|f| f.free.len()).collect();
-    let chosen = simplest_near_best(&scores, &ks, evidence.is_some());
+    let chosen = simplest_near_best(&scores, &ks, evidence.is_some(), spreads);
     let scored = Scored {
         crit: &crit,
         scores: &scores,
         chosen,
         evidence: evidence.as_deref(),
+        spreads,
     };
     let trials = fits
         .iter()
@@ -98,16 +106,26 @@ pub(super) fn choose(fits: &[CandidateFit], bands: &[BandSpec], listed: bool) ->
     Selection { chosen, trials }
 }
 
+/// The TIC gap within which candidates `i` and `j` are not distinguishable:
+/// [`INDISTINGUISHABLE_TIC`], widened by twice the cost spreads between solver tolerances of
+/// either optimum where the integrator does not resolve it (`spreads`, nats; a cost known only to
+/// within its spread moves the TIC by twice that, and a gap the integrator does not resolve says
+/// nothing about the recording).
+pub(super) fn margin(spreads: &[f64], i: usize, j: usize) -> f64 {
+    let s = |k: usize| spreads.get(k).copied().unwrap_or(0.0);
+    INDISTINGUISHABLE_TIC + 2.0 * (s(i) + s(j))
+}
+
 /// The candidate [`choose`] reports from `scores` (TIC, +∞ where it cannot be chosen) and `ks`
-/// (freed parameters): the one with the fewest parameters among those within
-/// [`INDISTINGUISHABLE_TIC`] of the lowest score (the lower score between equals), or the lowest
-/// when the scores are not in likelihood units (`likelihood` false).
-fn simplest_near_best(scores: &[f64], ks: &[usize], likelihood: bool) -> usize {
+/// (freed parameters): the one with the fewest parameters among those within the [`margin`] of
+/// the lowest score (the lower score between equals), or the lowest when the scores are not in
+/// likelihood units (`likelihood` false).
+fn simplest_near_best(scores: &[f64], ks: &[usize], likelihood: bool, spreads: &[f64]) -> usize {
     let best = (0..scores.len())
         .min_by(|&a, &b| scores[a].total_cmp(&scores[b]))
         .unwrap_or(0);
     let near = |i: usize| {
-        likelihood && scores[i].is_finite() && scores[i] - scores[best] <= INDISTINGUISHABLE_TIC
+        likelihood && scores[i].is_finite() && scores[i] - scores[best] <= margin(spreads, i, best)
     };
     (0..scores.len())
         .filter(|&i| near(i))
@@ -173,6 +191,8 @@ struct Scored<'a> {
     chosen: usize,
     /// Every candidate's evidence, when the comparison is in likelihood units.
     evidence: Option<&'a [Option<Evidence>]>,
+    /// Unresolved cost spreads, nats ([`choose`]).
+    spreads: &'a [f64],
 }
 
 impl Scored<'_> {
@@ -260,14 +280,24 @@ impl Scored<'_> {
                     )
                 })
                 .unwrap_or_default();
-            if next < self.scores[i] {
+            if let Some(lowest) = (0..fits.len())
+                .filter(|&j| self.scores[j] < self.scores[i])
+                .min_by(|&a, &b| self.scores[a].total_cmp(&self.scores[b]))
+            {
+                let m = margin(self.spreads, i, lowest);
+                let widened = if m > INDISTINGUISHABLE_TIC {
+                    " (2 widened by twice the optima's cost spreads between solver tolerances, \
+                     which the integrator does not resolve)"
+                } else {
+                    ""
+                };
                 return format!(
-                    "{} = {:.2} ({lnl}k = {k}), {:.2} above the lowest, within \
-                     {INDISTINGUISHABLE_TIC}: the candidates there are not distinguishable by this \
-                     recording, and this one has the fewest parameters{lrt}",
+                    "{} = {:.2} ({lnl}k = {k}), {:.2} above the lowest, within {m:.2}{widened}: \
+                     the candidates there are not distinguishable by this recording, and this one \
+                     has the fewest parameters{lrt}",
                     self.criterion(),
                     self.scores[i],
-                    self.scores[i] - next
+                    self.scores[i] - self.scores[lowest]
                 );
             }
             return if next.is_finite() {
@@ -295,13 +325,14 @@ impl Scored<'_> {
             self.crit[i],
             self.crit[i] - self.crit[self.chosen]
         );
+        let m = margin(self.spreads, i, self.chosen);
         if self.evidence.is_some()
-            && (self.crit[i] - self.crit[self.chosen]).abs() <= INDISTINGUISHABLE_TIC
+            && (self.crit[i] - self.crit[self.chosen]).abs() <= m
             && self.scores[i].is_finite()
         {
             r.push_str(&format!(
-                "; not distinguishable by this recording (within {INDISTINGUISHABLE_TIC} of the \
-                 chosen model's TIC, which has fewer parameters)"
+                "; not distinguishable by this recording (within {m:.2} of the chosen model's \
+                 TIC, which has fewer parameters)"
             ));
         }
         if let (Some(e), Some(best)) = (self.of(i), self.of(self.chosen)) {
@@ -326,6 +357,28 @@ impl Scored<'_> {
         }
         r
     }
+}
+
+/// The warning of a choice that a margin widened by unresolved cost spreads ([`margin`]) moved
+/// from candidate `was` to `selection.chosen`, which has fewer parameters: `was`'s TIC is lower,
+/// by less than the integrator resolves. `None` without both TICs.
+pub(super) fn moved_choice(
+    selection: &Selection,
+    was: usize,
+    spreads: &[f64],
+) -> Option<FitWarning> {
+    let tic = |i: usize| {
+        let t: &ModelTrial = selection.trials.get(i)?;
+        t.evidence.as_ref().and_then(|e| e.tic)
+    };
+    let now = selection.chosen;
+    let s = |k: usize| spreads.get(k).copied().unwrap_or(0.0);
+    Some(FitWarning::ChoiceUnresolved {
+        chosen: selection.trials[now].model,
+        runner_up: selection.trials.get(was)?.model,
+        tic_gap: tic(was)? - tic(now)?,
+        spread_nats: s(now) + s(was),
+    })
 }
 
 /// Warnings when a parameter moves between the chosen candidate and another candidate that can
@@ -424,22 +477,40 @@ mod tests {
     #[test]
     fn a_law_within_the_margin_of_the_best_gives_way_to_the_simpler() {
         let ks = [4, 5];
-        assert_eq!(simplest_near_best(&[100.0, 98.5], &ks, true), 0);
-        assert_eq!(simplest_near_best(&[100.0, 98.0], &ks, true), 0);
-        assert_eq!(simplest_near_best(&[100.0, 97.5], &ks, true), 1);
-        assert_eq!(simplest_near_best(&[97.0, 100.0], &ks, true), 0);
-        assert_eq!(simplest_near_best(&[100.0, 98.5], &ks, false), 1);
+        assert_eq!(simplest_near_best(&[100.0, 98.5], &ks, true, &[]), 0);
+        assert_eq!(simplest_near_best(&[100.0, 98.0], &ks, true, &[]), 0);
+        assert_eq!(simplest_near_best(&[100.0, 97.5], &ks, true, &[]), 1);
+        assert_eq!(simplest_near_best(&[97.0, 100.0], &ks, true, &[]), 0);
+        assert_eq!(simplest_near_best(&[100.0, 98.5], &ks, false, &[]), 1);
         // Stribeck (k = 6) beside them: the two within 2 of the best, the fewest parameters.
         assert_eq!(
-            simplest_near_best(&[103.0, 101.5, 100.0], &[4, 5, 6], true),
+            simplest_near_best(&[103.0, 101.5, 100.0], &[4, 5, 6], true, &[]),
             1
         );
         assert_eq!(
-            simplest_near_best(&[f64::INFINITY, 101.0, 100.0], &[4, 5, 6], true),
+            simplest_near_best(&[f64::INFINITY, 101.0, 100.0], &[4, 5, 6], true, &[]),
             1
         );
         // Equal parameter counts: the lower TIC.
-        assert_eq!(simplest_near_best(&[100.0, 99.0], &[5, 5], true), 1);
+        assert_eq!(simplest_near_best(&[100.0, 99.0], &[5, 5], true, &[]), 1);
+    }
+
+    /// A TIC lead the integrator does not resolve: blade2dof (k = 4) against a shoulder (k = 6)
+    /// 3.84 lower. The margin is 2 + 2·(sum of the unresolved cost spreads): resolved optima
+    /// (no spread) or a 0.6-nat spread (margin 3.2) leave the shoulder chosen; 1.0 nat (margin
+    /// 4.0), on either optimum or split between them, reports blade2dof.
+    #[test]
+    fn a_lead_within_the_unresolved_spread_gives_way_to_the_simpler() {
+        let (scores, ks) = ([100.0, 96.16], [4, 6]);
+        assert_eq!(simplest_near_best(&scores, &ks, true, &[]), 1);
+        assert_eq!(simplest_near_best(&scores, &ks, true, &[0.0, 0.6]), 1);
+        assert_eq!(simplest_near_best(&scores, &ks, true, &[0.0, 1.0]), 0);
+        assert_eq!(simplest_near_best(&scores, &ks, true, &[1.0, 0.0]), 0);
+        assert_eq!(simplest_near_best(&scores, &ks, true, &[0.5, 0.5]), 0);
+        assert!((margin(&[0.0, 1.0], 0, 1) - 4.0).abs() < 1e-12);
+        assert_eq!(margin(&[], 0, 1), INDISTINGUISHABLE_TIC);
+        // Without a likelihood the lowest score wins whatever the spreads.
+        assert_eq!(simplest_near_best(&scores, &ks, false, &[0.0, 5.0]), 1);
     }
 
     /// A shoulder chosen over its shoulder-free model is said (the caller asks only on a failed

@@ -12,9 +12,9 @@
 //! smaller than the spread do not tell parameter sets apart, and intervals read from the local
 //! curvature at the 0.5-nat scale understate the uncertainty. The check costs two simulations.
 
-use super::select::INDISTINGUISHABLE_TIC;
-use super::{FitWarning, SpectralProblem};
-use crate::job::Candidate;
+use super::problem::FAILED_COST;
+use super::search::CandidateFit;
+use super::{FitWarning, SpectralProblem, interrupt};
 use serde::{Deserialize, Serialize};
 
 /// Factors by which the probes divide the job's `rtol` and `atol`.
@@ -160,35 +160,40 @@ impl ToleranceCheck {
             }),
         }
     }
-
-    /// The warning of a model choice the integrator does not resolve: `chosen` over `runner_up`,
-    /// whose TIC is `tic_gap` above the chosen one's, when moving that gap by the TIC the
-    /// optimum's cost spreads over (`2·spread_nats`) could carry it across
-    /// [`INDISTINGUISHABLE_TIC`], the margin at which the choice turns from "distinguishable" to
-    /// "not distinguishable, the simpler reported" or back; `None` otherwise. Two candidates with
-    /// the same optimum (a shoulder the motion never reaches: gap 0) are not distinguishable at
-    /// any tolerance, so a spread smaller than the margin leaves that verdict as it is.
-    pub fn choice_warning(
-        &self,
-        chosen: Candidate,
-        runner_up: Candidate,
-        tic_gap: f64,
-    ) -> Option<FitWarning> {
-        (tic_gap.is_finite() && 2.0 * self.spread_nats > distance_to_margin(tic_gap)).then_some(
-            FitWarning::ChoiceUnresolved {
-                chosen,
-                runner_up,
-                tic_gap,
-                spread_nats: self.spread_nats,
-            },
-        )
-    }
 }
 
-/// How far a TIC gap lies from [`INDISTINGUISHABLE_TIC`], the margin at which a choice turns
-/// between "distinguishable" and "not distinguishable".
-pub(super) fn distance_to_margin(tic_gap: f64) -> f64 {
-    (tic_gap.abs() - INDISTINGUISHABLE_TIC).abs()
+/// The cost spread by which `check` leaves its optimum unresolved, nats: its spread when the
+/// verdict is [`Verdict::Unresolved`], else 0 (a spread within [`SPREAD_WARN_NATS`] is the
+/// integrator resolving the optimum; an unprobed one has no spread to widen a margin by).
+pub fn unresolved_spread(check: Option<&ToleranceCheck>) -> f64 {
+    check
+        .filter(|c| c.verdict() == Verdict::Unresolved)
+        .map_or(0.0, |c| c.spread_nats)
+}
+
+/// The tolerance checks a model choice reads ([`super::select::margin`]): the chosen candidate's
+/// (`chosen_check`, at index `chosen`), and those of the candidates with fewer freed parameters
+/// that have a model, which a margin widened by an unresolved spread could report instead, each
+/// from a simulation at the job's tolerance and the probes (three simulations, counted as that
+/// candidate's evaluations). `None` for the others: a candidate with as many parameters or more
+/// is reported only for a lower TIC, which no margin changes.
+pub(super) fn checks_for_choice(
+    fits: &[CandidateFit],
+    chosen: usize,
+    chosen_check: Option<ToleranceCheck>,
+) -> Vec<Option<ToleranceCheck>> {
+    let k = fits[chosen].free.len();
+    let mut checks: Vec<Option<ToleranceCheck>> = vec![None; fits.len()];
+    for (i, f) in fits.iter().enumerate() {
+        if f.free.len() >= k || f.cost >= FAILED_COST || interrupt::stop_requested() {
+            continue;
+        }
+        if let Ok(at_job) = f.problem.cost_with_solver(&f.best_u, &f.problem.solver) {
+            checks[i] = ToleranceCheck::run(&f.problem, &f.best_u, at_job);
+        }
+    }
+    checks[chosen] = chosen_check;
+    checks
 }
 
 #[cfg(test)]
@@ -233,34 +238,14 @@ mod tests {
     }
 
     #[test]
-    fn a_choice_closer_than_the_spread_warns() {
-        let apart =
-            ToleranceCheck::of(vec![point(1e-8, 66.8, 168), point(1e-9, 68.0, 170)], vec![]);
-        // 1.2 nats of spread moves the TIC by up to 2.4: ΔTIC 2.0 (at the margin of 2) and 4.0
-        // (2.0 above it) can cross it, unresolved; ΔTIC 5.0 (3.0 above) and 0.0 (two equal
-        // optima, 2.0 inside) with a 0.9-nat spread cannot, resolved.
-        let (a, b): (Candidate, Candidate) = (
-            "blade2dof".parse().unwrap(),
-            "blade2dof+shoulder".parse().unwrap(),
-        );
-        let w = apart.choice_warning(a, b, 2.0).expect("2.4 > 0");
-        assert!(
-            matches!(w, FitWarning::ChoiceUnresolved { chosen, runner_up, .. }
-                if chosen == a && runner_up == b),
-            "{w:?}"
-        );
-        assert!(
-            w.to_string()
-                .contains("blade2dof over blade2dof+shoulder (ΔTIC 2.00) lies 0.00 from"),
-            "{w}"
-        );
-        assert!(apart.choice_warning(a, b, 4.0).is_some());
-        assert!(apart.choice_warning(a, b, 5.0).is_none());
-        let close =
-            ToleranceCheck::of(vec![point(1e-8, 66.8, 168), point(1e-9, 67.7, 170)], vec![]);
-        assert!(close.choice_warning(a, b, 0.0).is_none());
-        assert!(close.choice_warning(a, b, 1.5).is_some());
-        assert!(apart.choice_warning(a, b, f64::INFINITY).is_none());
+    fn only_an_unresolved_check_has_a_spread_to_widen_a_margin_by() {
+        let apart = three([(66.83, 168), (67.03, 170), (69.03, 170)]);
+        assert!((unresolved_spread(Some(&apart)) - 2.2).abs() < 1e-9);
+        let close = three([(78.317, 160), (78.318, 160), (78.320, 160)]);
+        assert_eq!(unresolved_spread(Some(&close)), 0.0);
+        let alone = ToleranceCheck::of(vec![point(1e-8, 5.0, 3)], vec!["rtol 1e-9: x".into()]);
+        assert_eq!(unresolved_spread(Some(&alone)), 0.0);
+        assert_eq!(unresolved_spread(None), 0.0);
     }
 
     #[test]

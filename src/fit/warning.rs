@@ -211,11 +211,15 @@ pub enum FitWarning {
         /// The nested candidate's TIC above the chosen one's.
         delta_tic: f64,
     },
-    /// The model choice's TIC gap is smaller than the tolerance spread.
+    /// The candidate with the lowest TIC (`runner_up`) is not reported because its lead over
+    /// `chosen`, which has fewer parameters, lies within the margin widened by the optima's cost
+    /// spreads between solver tolerances: the integrator does not resolve it.
     ChoiceUnresolved {
         chosen: Candidate,
         runner_up: Candidate,
+        /// `runner_up`'s TIC minus `chosen`'s (negative).
         tic_gap: f64,
+        /// The two optima's unresolved cost spreads, summed, nats.
         spread_nats: f64,
     },
     /// More than [`FAILED_WARN_FRACTION`] of the chosen model's evaluations failed.
@@ -827,7 +831,7 @@ fn chosen_on_misfit(
     )
 }
 
-/// [`FitWarning::ChoiceUnresolved`]'s sentence: `chosen` over `runner_up`.
+/// [`FitWarning::ChoiceUnresolved`]'s sentence: `chosen` reported over `runner_up`.
 fn choice_unresolved(
     f: &mut fmt::Formatter<'_>,
     [chosen, runner_up]: [&Candidate; 2],
@@ -836,12 +840,13 @@ fn choice_unresolved(
 ) -> fmt::Result {
     write!(
         f,
-        "the choice of {chosen} over {runner_up} (ΔTIC {tic_gap:.2}) lies {:.2} from the margin \
-         of {INDISTINGUISHABLE_TIC} at which the recording stops distinguishing them, less than \
-         the {:.2} the TIC moves as the chosen optimum's cost spreads by {spread_nats:.2} nats \
-         between solver tolerances: the integrator does not resolve it (docs/likelihood.md, \
+        "{chosen} is reported, not {runner_up}, whose TIC is {:.2} lower: the optima's costs \
+         spread by {spread_nats:.2} nats between solver tolerances, so the TIC is known only to \
+         within {:.2} and a lead below {INDISTINGUISHABLE_TIC} + {:.2} is not resolved by the \
+         integrator; the candidate with fewer parameters is reported (docs/likelihood.md, \
          \"Tolerance check\")",
-        super::tolerance::distance_to_margin(tic_gap),
+        -tic_gap,
+        2.0 * spread_nats,
         2.0 * spread_nats
     )
 }

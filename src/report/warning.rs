@@ -442,8 +442,9 @@ fn choice_unresolved_headline(
     spread_nats: f64,
 ) -> String {
     format!(
-        "The choice of {chosen} over {runner_up} (ΔTIC {tic_gap:.2}) could change within the {} \
-         nats the cost moves between solver tolerances: tighten [solver] rtol and refit.",
+        "{chosen} is reported, not {runner_up} (TIC {} lower): the cost moves {} nats between \
+         solver tolerances, more than the lead can be told from; tighten [solver] rtol and refit.",
+        num(-tic_gap, 2),
         num(spread_nats, 2)
     )
 }
