@@ -1,5 +1,6 @@
 //! One line per step of the event-driven integrator on the true blade's default window
-//! (`data/reversal/blade_true.toml`; arguments rtol, method, atol, default atol = rtol/100): end time, step size, accepted steps,
+//! (`data/reversal/blade_true.toml`; arguments rtol, method, atol, default atol = rtol/100, and
+//! the solver's `lift_off_margin`, default 0.5): end time, step size, accepted steps,
 //! rejected attempts and right-hand-side evaluations since the last line, why the step ended and
 //! the phase it ran in; the totals on stderr. Where the evaluations go by part of the window
 //! (docs/validation.md, "DOP853 against DOPRI5"):
@@ -35,6 +36,9 @@ fn main() {
             .get(3)
             .map_or(rtol / 100.0, |a| a.parse().expect("atol")),
         method,
+        lift_off_margin: args
+            .get(4)
+            .map_or(0.5, |a| a.parse().expect("lift_off_margin")),
         ..SolverOptions::default()
     };
     let mut s = HybridSolver::new(&blade, t0, y0, Mode::new(s0, 0.0), t1, &opts).unwrap();

@@ -298,6 +298,7 @@ pub fn simulate<'py>(
     stats.set_item("rejected", sim.stats.rejected)?;
     stats.set_item("rhs_evals", sim.stats.rhs_evals)?;
     stats.set_item("event_evals", sim.stats.event_evals)?;
+    stats.set_item("kinematic_evals", sim.stats.kinematic_evals)?;
     stats.set_item("transitions", n_transitions)?;
     d.set_item("stats", stats)?;
     d.set_item("reach_m", sim.reach_m)?;

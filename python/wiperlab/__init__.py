@@ -452,8 +452,9 @@ class Simulation:
     friction_force : friction force of the glass on the lip tip along +x, N.
     phase : int8 contact phase, 1 slip+, 0 stick, -1 slip-.
     transitions : list of Transition (time, from, to) in time order.
-    stats : solver counters (``steps``, ``rejected``, ``rhs_evals``, ``event_evals``,
-        ``transitions``).
+    stats : solver counters (``steps``, ``rejected``, ``rhs_evals``, ``event_evals``: event
+        functions with the contact forces solved, ``kinematic_evals``: event functions of slip read
+        from the state alone, ``transitions``).
     reach_m : lip-tip depth below the upright head, l1 + l2, m.
     """
 

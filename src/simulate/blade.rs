@@ -319,6 +319,7 @@ pub fn simulate_necklip(
         sim.stats.rejected += run.stats.rejected;
         sim.stats.rhs_evals += run.stats.rhs_evals;
         sim.stats.event_evals += run.stats.event_evals;
+        sim.stats.kinematic_evals += run.stats.kinematic_evals;
     }
     Ok(sim)
 }

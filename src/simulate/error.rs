@@ -91,6 +91,9 @@ pub enum SettingError {
     /// A maximum step that is not positive.
     #[error("solver: h_max must be > 0 (got {h_max_s})")]
     HMax { h_max_s: f64 },
+    /// A lift-off margin outside [0, 1].
+    #[error("solver: lift_off_margin must be between 0 and 1 (got {margin})")]
+    LiftOffMargin { margin: f64 },
     /// An empty or reversed window.
     #[error("simulation window must have t_end > t0 (got {t0_s} .. {t_end_s})")]
     Window { t0_s: f64, t_end_s: f64 },

@@ -21,12 +21,27 @@
 //! phase's event function may start at exactly 0 (a tangential stick→slip departure, physics.md §1.8);
 //! it is armed by the first strictly positive value, and if its first sample is already negative the
 //! sub-interval is searched for a positive maximum (a departure and a return within one sub-step).
+//!
+//! In slip, the slip velocity and the switching functions are functions of the state alone: the
+//! interior samples and the searches read them from the interpolated state without solving for
+//! the contact forces ([`Stats::kinematic_evals`]), bitwise the values the solve gives. The normal
+//! force needs the solve, and only its sign matters (lift-off ends the run), so it is sampled inside
+//! a step only when the step is not clear of zero: when some right-hand-side evaluation of the step
+//! (every stage, the end and the start) or of the step before gave `N ≤ lift_off_margin · N_max`,
+//! `N_max` the largest of them ([`SolverOptions::lift_off_margin`], 0.5 by default). Such a step
+//! and the one after it sample and search `N` exactly as every step does with
+//! `lift_off_margin = 1` (the step before it gives its last interior sample, solved, to the
+//! boundary's minimum test). In a clear step, the samples could only have caught a dip of `N`
+//! through zero that none of the step's 7 (DOPRI5) or 16 (DOP853) evaluations, at most half
+//! (DOPRI5) or 0.27 (DOP853) of the step apart, comes within half its size of: a swing of the
+//! force on a time scale the step does not resolve. A dip that the stages see is found as before.
 
 use super::error::{SettingError, SimulationError, StopCause};
 use super::method::{Dense, Method, Outcome, Step};
 use crate::{Error, Result};
 
 use serde::Serialize;
+use std::cell::Cell;
 
 pub use crate::model::stick_slip::{
     Contact, MAX_SWITCHING_SURFACES, Mode, ModelFault, Phase, StickSlipModel, region_of,
@@ -44,6 +59,11 @@ pub struct SolverOptions {
     pub h_max: f64,
     /// Interior points per step at which event functions are sampled (0 = ends only).
     pub event_samples: usize,
+    /// In slip, the normal force (the lift-off event) is sampled at the interior points only in a
+    /// step where it came within this fraction of its size: some right-hand-side evaluation of the
+    /// step or of the step before gave `N ≤ lift_off_margin · N_max`, `N_max` the largest `N` of
+    /// those evaluations (0 to 1; 1 samples it in every step).
+    pub lift_off_margin: f64,
     /// Largest number of accepted steps before giving up.
     pub max_steps: usize,
     /// Largest number of transitions before giving up (accumulation guard).
@@ -59,6 +79,7 @@ impl Default for SolverOptions {
             atol: 1e-12,
             h_max: f64::INFINITY,
             event_samples: 3,
+            lift_off_margin: 0.5,
             max_steps: 20_000_000,
             max_transitions: 1_000_000,
             method: Method::Dopri5,
@@ -84,6 +105,10 @@ impl SolverOptions {
             let h_max_s = self.h_max;
             return Err(SettingError::HMax { h_max_s }.into());
         }
+        if !(0.0..=1.0).contains(&self.lift_off_margin) {
+            let margin = self.lift_off_margin;
+            return Err(SettingError::LiftOffMargin { margin }.into());
+        }
         Ok(())
     }
 }
@@ -102,8 +127,14 @@ pub struct Stats {
     pub steps: usize,
     pub rejected: usize,
     pub rhs_evals: usize,
-    /// Event-function evaluations (each one solves for the contact forces).
+    /// Event-function evaluations that solve for the contact forces, outside the steps' stages:
+    /// phase starts, a step's end when its last stage was elsewhere, interior samples in stick and
+    /// where the normal force is sampled in slip, the dip search and refinement of a force event,
+    /// and the choice of phase after a transition.
     pub event_evals: usize,
+    /// Event-function evaluations in slip from the state alone (the slip velocity and the
+    /// switching functions, no contact solve): interior samples, dip searches and refinements.
+    pub kinematic_evals: usize,
 }
 
 /// One crossing of a switching surface (no change of phase).
@@ -184,6 +215,46 @@ fn event_values_of<M: StickSlipModel<N>, const N: usize>(
         g[3 + i] = if mode.region & (1 << i) != 0 { si } else { -si };
     }
     g
+}
+
+/// The event functions of a slip `mode` that the state alone gives, at `(t, y)` (made consistent
+/// with `mode` first): `g0 = s·v_rel` and the switching functions, bitwise as [`event_values`] gives
+/// them; `g2` (the normal force, which needs the contact solve) is NaN: not sampled.
+fn kinematic_event_values<M: StickSlipModel<N>, const N: usize>(
+    model: &M,
+    mode: &Mode,
+    s: f64,
+    t: f64,
+    y: &[f64; N],
+) -> std::result::Result<[f64; N_EVENTS], ModelFault> {
+    let mut yc = *y;
+    model.complete(mode, t, &mut yc)?;
+    let mut g = [NO_EVENT; N_EVENTS];
+    g[0] = s * model.slip_velocity(t, &yc);
+    g[2] = f64::NAN;
+    for i in 0..model.switching_surfaces().min(MAX_SWITCHING_SURFACES) {
+        let si = model.switching_function(i, t, &yc);
+        g[3 + i] = if mode.region & (1 << i) != 0 { si } else { -si };
+    }
+    Ok(g)
+}
+
+/// Whether a step of a slip phase leaves its normal force clear of zero: the smallest `N` of its
+/// right-hand-side evaluations and of its two ends, `n_min`, is positive and above `margin` times the
+/// largest, `n_max` (NaN is never clear). The interior samples then skip `N`: to be caught by
+/// them, `N` would have to fall from above `margin · n_max` to zero and come back between two of
+/// those evaluations, a swing larger than everything the step's own stages show.
+fn normal_clear(n_min: f64, n_max: f64, margin: f64) -> bool {
+    n_min > 0.0 && n_min > margin * n_max
+}
+
+/// The smaller of `a` and `b`, NaN when either is (`f64::min` would drop the NaN).
+fn min_or_nan(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.min(b)
+    }
 }
 
 /// Minimum of `g` on `[a, b]` by golden-section search (Kiefer 1953), stopping as soon as a value
@@ -357,6 +428,12 @@ pub struct HybridSolver<'m, M: StickSlipModel<N>, const N: usize> {
     /// was at the accepted step's end (the FSAL stage), the event functions there read its contact
     /// instead of solving the model again (bitwise the same values).
     last_rhs: Option<(f64, [f64; N], Contact)>,
+    /// The smallest and largest normal force of the last attempt's right-hand-side calls (NaN
+    /// when one was not a number).
+    stage_normal: (f64, f64),
+    /// The previous accepted step of this phase left its normal force clear of zero
+    /// ([`normal_clear`]), and sampled only the kinematic event functions inside.
+    prev_normal_clear: bool,
     settled: f64,
     segments: Vec<Segment<N>>,
     quick_transitions: usize,
@@ -416,6 +493,8 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
             g_prev: [NO_EVENT; N_EVENTS],
             prev: None,
             last_rhs: None,
+            stage_normal: (f64::NAN, f64::NAN),
+            prev_normal_clear: false,
             settled: t0,
             segments: Vec::new(),
             quick_transitions: 0,
@@ -535,6 +614,7 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
         }
         self.g_prev = g;
         self.prev = None;
+        self.prev_normal_clear = true;
         self.phase_start = false;
         Ok(())
     }
@@ -560,6 +640,7 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
         let (model, mode) = (self.model, self.mode);
         let mut evals = 0;
         let mut last_rhs = None;
+        let (mut n_min, mut n_max) = (f64::INFINITY, f64::NEG_INFINITY);
         // Only calls at the step's end can serve the end's event functions (`end_event_values`):
         // keep those, not a copy of every stage.
         let t_step_end = self.t + self.h;
@@ -567,6 +648,8 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
             evals += 1;
             let c = model.rhs(&mode, tt, yy, dy)?;
             last_rhs = (tt == t_step_end).then_some((tt, *yy, c)).or(last_rhs);
+            n_min = min_or_nan(n_min, c.normal);
+            n_max = n_max.max(c.normal);
             Ok::<(), ModelFault>(())
         };
         let method = self.opts.method;
@@ -581,6 +664,7 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
         );
         self.stats.rhs_evals += evals;
         self.last_rhs = last_rhs;
+        self.stage_normal = (n_min, n_max);
         match outcome {
             // The right-hand side failed inside the step, or the error estimate or state is not
             // finite (e.g. near a singular constraint): shrink, so the collapse check ends the run.
@@ -601,11 +685,16 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
     }
 
     /// The earliest event in the accepted step `a` ending at `t_new`: its function and its time.
-    /// The event function is sampled at `event_samples` interior points and the end; a crossing
+    /// The event functions are sampled at `event_samples` interior points and the end; a crossing
     /// is refined by the Illinois method, a dip between samples found by golden-section search.
+    /// In slip the slip velocity and the switching functions are read from the state alone, and
+    /// the normal force is sampled inside only in a step that is not clear of zero
+    /// ([`normal_clear`]) or that follows one; there, its samples and searches are those of sampling
+    /// it in every step.
     fn locate(&mut self, a: &Step<N>, t_new: f64) -> Result<Option<(usize, f64)>> {
         let (model, mode, t, h) = (self.model, self.mode, self.t, self.h);
         let m = self.opts.event_samples;
+        let slip = mode.phase.slip_dir();
         let mut found: Option<(usize, f64)> = None;
         let mut ta = t;
         let mut ga = self.g_prev;
@@ -615,32 +704,91 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
             .map_or((f64::NAN, [f64::NAN; N_EVENTS]), |(_, tp, gp)| (tp, gp));
         let prev = self.prev;
         let dense = a.dense;
+        let (solves, kinematic) = (Cell::new(0), Cell::new(0));
+        // In slip the end's values come first: their normal force decides the interior sampling.
+        // A fault there is left to the loop below, which meets it where it always did.
+        let g_end = match slip {
+            Some(_) => match self.end_event_values(true, t_new, &a.y_new) {
+                Some(g) => Some(g),
+                None => {
+                    solves.set(solves.get() + 1);
+                    event_values(model, &mode, t_new, &a.y_new)
+                        .ok()
+                        .map(|(g, _)| g)
+                }
+            },
+            None => None,
+        };
+        let clear = slip.is_some()
+            && self.prev_normal_clear
+            && g_end.is_some_and(|ge| {
+                let (lo, hi) = self.stage_normal;
+                normal_clear(
+                    min_or_nan(min_or_nan(lo, ga[2]), ge[2]),
+                    hi.max(ga[2]).max(ge[2]),
+                    self.opts.lift_off_margin,
+                )
+            });
+        if slip.is_some()
+            && !clear
+            && gb[2].is_nan()
+            && let Some((pd, tp, _)) = prev
+        {
+            // The previous step sampled only the kinematic functions inside: its last interior
+            // sample with the contact solved, for the minimum test at this step's start.
+            let yb = pd.eval(tp);
+            self.stats.event_evals += 1;
+            gb = event_values(model, &mode, tp, &yb)
+                .map_err(|e| self.fail(tp, &yb, e.into()))?
+                .0;
+        }
         // State on [previous step, this step] from the continuous extensions.
         let y_at = |tt: f64| match prev {
             Some((pd, _, _)) if tt < t => pd.eval(tt),
             _ => dense.eval(tt),
         };
+        // Event function `k` at `tt` for the searches; in slip all but the normal force from the
+        // state alone.
         let g_at = |k: usize, tt: f64| {
             let yy = y_at(tt);
-            event_values(model, &mode, tt, &yy).map(|(g, _)| g[k])
+            match slip {
+                Some(s) if k != 2 => {
+                    kinematic.set(kinematic.get() + 1);
+                    kinematic_event_values(model, &mode, s, tt, &yy).map(|g| g[k])
+                }
+                _ => {
+                    solves.set(solves.get() + 1);
+                    event_values(model, &mode, tt, &yy).map(|(g, _)| g[k])
+                }
+            }
         };
         for j in 1..=m + 1 {
-            let tj = if j == m + 1 {
+            let at_end = j == m + 1;
+            let tj = if at_end {
                 t_new
             } else {
                 t + h * j as f64 / (m + 1) as f64
             };
-            let yj = if j == m + 1 { a.y_new } else { dense.eval(tj) };
-            let gj = match self.end_event_values(j == m + 1, tj, &yj) {
-                Some(g) => g,
-                None => {
-                    self.stats.event_evals += 1;
-                    event_values(model, &mode, tj, &yj)
+            let yj = if at_end { a.y_new } else { dense.eval(tj) };
+            let gj = match (at_end, g_end, slip) {
+                (true, Some(g), _) => g,
+                (false, _, Some(s)) if clear => {
+                    kinematic.set(kinematic.get() + 1);
+                    kinematic_event_values(model, &mode, s, tj, &yj)
                         .map_err(|e| self.fail(tj, &yj, e.into()))?
-                        .0
                 }
+                _ => match self.end_event_values(at_end, tj, &yj) {
+                    Some(g) => g,
+                    None => {
+                        solves.set(solves.get() + 1);
+                        event_values(model, &mode, tj, &yj)
+                            .map_err(|e| self.fail(tj, &yj, e.into()))?
+                            .0
+                    }
+                },
             };
-            for k in 0..N_EVENTS {
+            // In a clear step the normal force has no interior samples: nothing to test.
+            for k in (0..N_EVENTS).filter(|&k| !(clear && k == 2)) {
                 let bracket = if k >= 3 {
                     // A switching surface: fires on leaving the current region, also when the
                     // function leaves exactly 0 on the wrong side (a graze right after a switch).
@@ -651,9 +799,8 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
                     // Just after a transition the function starts at 0; if it is already negative
                     // at the first sample it may have risen and fallen back in between (a slip that
                     // reverses again within the first sub-step): look for a positive maximum.
-                    let (tm, gm, n) = golden_extremum(|tt| g_at(k, tt).map(|g| -g), ta, tj)
+                    let (tm, gm, _) = golden_extremum(|tt| g_at(k, tt).map(|g| -g), ta, tj)
                         .map_err(|e| self.fail(tj, &yj, e.into()))?;
-                    self.stats.event_evals += n;
                     (-gm > 0.0).then_some((tm, tj, -gm, gj[k]))
                 } else if gb[k] > 0.0
                     && ga[k] > 0.0
@@ -664,9 +811,8 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
                 {
                     // The samples have an interior minimum above zero: the function may dip
                     // across zero and back between samples. Find the minimum.
-                    let (tm, gm, n) = golden_extremum(|tt| g_at(k, tt), tb, tj)
+                    let (tm, gm, _) = golden_extremum(|tt| g_at(k, tt), tb, tj)
                         .map_err(|e| self.fail(tj, &yj, e.into()))?;
-                    self.stats.event_evals += n;
                     (gm <= 0.0).then_some((tb, tm, gb[k], gm))
                 } else {
                     None
@@ -687,9 +833,12 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
             ta = tj;
             ga = gj;
         }
+        self.stats.event_evals += solves.get();
+        self.stats.kinematic_evals += kinematic.get();
         if found.is_none() {
             self.g_prev = ga;
             self.prev = Some((dense, tb, gb));
+            self.prev_normal_clear = clear;
         }
         Ok(found)
     }
@@ -705,7 +854,10 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
         t_end: f64,
         y_end: &[f64; N],
     ) -> Option<[f64; N_EVENTS]> {
-        let (tt, yy, c) = self.last_rhs.take().filter(|_| at_end)?;
+        if !at_end {
+            return None;
+        }
+        let (tt, yy, c) = self.last_rhs.take()?;
         if tt != t_end || yy != *y_end {
             return None;
         }
@@ -957,7 +1109,164 @@ fn decide_after_event<M: StickSlipModel<N>, const N: usize>(
 
 #[cfg(test)]
 mod tests {
-    use super::golden_extremum;
+    use super::*;
+
+    /// A contact that slips forward for ever (slip velocity `1 + t`, state `[v]`) under a normal
+    /// force `N(t) = 1 − depth·exp(−((t − t_dip)/width)²)` that does not act back on it.
+    struct Probe {
+        t_dip: f64,
+        width: f64,
+        depth: f64,
+    }
+
+    impl Probe {
+        fn normal(&self, t: f64) -> f64 {
+            1.0 - self.depth * (-((t - self.t_dip) / self.width).powi(2)).exp()
+        }
+    }
+
+    impl StickSlipModel<1> for Probe {
+        fn rhs(
+            &self,
+            _mode: &Mode,
+            t: f64,
+            _y: &[f64; 1],
+            dy: &mut [f64; 1],
+        ) -> std::result::Result<Contact, ModelFault> {
+            dy[0] = 1.0;
+            Ok(Contact {
+                normal: self.normal(t),
+                friction: 0.0,
+                limit: 1.0,
+                slip_velocity: None,
+            })
+        }
+        fn slip_velocity(&self, _t: f64, y: &[f64; 1]) -> f64 {
+            y[0]
+        }
+        fn contact_position(&self, _t: f64, _y: &[f64; 1]) -> f64 {
+            0.0
+        }
+        fn enter_stick(&self, _t: f64, y: &mut [f64; 1], _anchor: f64) {
+            y[0] = 0.0;
+        }
+        fn describe(&self, _t: f64, y: &[f64; 1]) -> String {
+            format!("v = {}", y[0])
+        }
+    }
+
+    /// Steps of at most `h` s that are all accepted (the slip velocity is linear in t, which either
+    /// method integrates exactly).
+    fn fixed_step(h: f64, method: Method, lift_off_margin: f64) -> SolverOptions {
+        SolverOptions {
+            rtol: 1e6,
+            atol: 1e6,
+            h_max: h,
+            method,
+            lift_off_margin,
+            ..SolverOptions::default()
+        }
+    }
+
+    const SLIP: Mode = Mode {
+        phase: Phase::SlipPos,
+        anchor: 0.0,
+        region: 0,
+    };
+
+    /// With the normal force constant, no step comes near lift-off: the interior samples read the
+    /// slip velocity from the state, and the contact is solved only at the phase's start (and at
+    /// the last step's end if its last stage fell elsewhere). With `lift_off_margin = 1` every
+    /// interior sample solves it.
+    #[test]
+    fn slip_far_from_lift_off_samples_without_contact_solves() {
+        let probe = Probe {
+            t_dip: 0.0,
+            width: 1.0,
+            depth: 0.0,
+        };
+        for method in Method::ALL.iter().copied() {
+            let run = integrate(
+                &probe,
+                0.0,
+                [1.0],
+                SLIP,
+                4.0,
+                &[],
+                &fixed_step(0.25, method, 0.5),
+            )
+            .unwrap();
+            let st = run.stats;
+            assert!(st.steps >= 16, "{method}: {st:?}");
+            assert!(st.event_evals <= 2, "{method}: {st:?}");
+            assert!(st.kinematic_evals >= 3 * st.steps, "{method}: {st:?}");
+            let all = integrate(
+                &probe,
+                0.0,
+                [1.0],
+                SLIP,
+                4.0,
+                &[],
+                &fixed_step(0.25, method, 1.0),
+            )
+            .unwrap();
+            assert_eq!(all.stats.steps, st.steps);
+            assert!(
+                all.stats.event_evals >= 3 * st.steps,
+                "{method}: {:?}",
+                all.stats
+            );
+        }
+    }
+
+    /// A dip of the normal force below zero around 0.3 of one step, 0.05 step wide: N is positive
+    /// at both ends of the step and at its three interior samples, so only the dip search finds
+    /// it; the stages near 0.3 of the step see N < 0, so the step samples N inside. The run stops
+    /// with the contact lost where N first reaches 0, t_dip − width·√(ln 1.5) in closed form.
+    #[test]
+    fn normal_force_dip_between_samples_seen_by_the_stages_is_found() {
+        let h = 0.25;
+        for method in Method::ALL.iter().copied() {
+            let flat = Probe {
+                t_dip: 0.0,
+                width: 1.0,
+                depth: 0.0,
+            };
+            let opts = fixed_step(h, method, 0.5);
+            // The step boundaries of the run (the probe's normal force does not change them).
+            let mut solver = HybridSolver::new(&flat, 0.0, [1.0], SLIP, 4.0, &opts).unwrap();
+            let mut ends = Vec::new();
+            while let StopReason::InternalStep { t_s } = solver.step().unwrap() {
+                ends.push(t_s);
+            }
+            let (ta, tb) = ends
+                .windows(2)
+                .map(|w| (w[0], w[1]))
+                .find(|&(a, b)| a > 1.0 && b - a == h)
+                .expect("a full step after 1 s");
+            let probe = Probe {
+                t_dip: ta + 0.3 * h,
+                width: 0.05 * h,
+                depth: 1.5,
+            };
+            for i in 0..=4 {
+                let n = probe.normal(ta + 0.25 * h * i as f64);
+                assert!(n > 0.4, "{method}: sample {i} sees N = {n}");
+            }
+            let e = integrate(&probe, 0.0, [1.0], SLIP, 4.0, &[], &opts).unwrap_err();
+            let e = SimulationError::of(&e).expect("a simulation error");
+            assert!(
+                matches!(e.cause, StopCause::ContactLost { .. }),
+                "{method}: {e}"
+            );
+            let t_lift = probe.t_dip - probe.width * 1.5f64.ln().sqrt();
+            assert!(
+                (e.t_s - t_lift).abs() < 1e-12 && tb > e.t_s,
+                "{method}: stopped at {} s, N first 0 at {t_lift} s",
+                e.t_s
+            );
+        }
+    }
 
     /// The bracket the dip search met in a neck/lip run near the flip (t ≈ 1.9906 s, 7.6e-14 s wide):
     /// without the ulp floor the search would cycle forever between two adjacent doubles.

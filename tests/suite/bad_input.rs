@@ -892,6 +892,12 @@ fn fit_cases() -> Vec<Case> {
             &["$D/job.toml:", "rk4", "dop853"],
         ),
         case(
+            "fit: lift-off margin out of range",
+            j(&[("atol = 1e-10", "atol = 1e-10\nlift_off_margin = 1.5")]),
+            fit,
+            &["$D/job.toml:", "lift_off_margin", "between 0 and 1"],
+        ),
+        case(
             "simulate: unknown --method",
             vec![],
             &["simulate", BLADE, "--method", "rk4"],

@@ -319,3 +319,54 @@ fn step_reports_why_it_stopped() {
     let stepped: Vec<f64> = events.iter().map(|e| e.0).collect();
     assert_eq!(times, stepped);
 }
+
+/// In slip the normal force is sampled inside a step only near lift-off (`lift_off_margin`, 0.5 by
+/// default): on the true blade and on the seed experiment's blade with its shoulder (switching
+/// surface), over the reversal window with either method, the transitions, the shoulder crossings
+/// and the end state are bitwise those of sampling it in every step (`lift_off_margin = 1`), with
+/// under a third of the contact solves for events.
+#[test]
+fn sampling_the_normal_force_near_lift_off_only_keeps_every_event() {
+    let shoulder: BladeParams = toml::from_str(
+        &std::fs::read_to_string(common::root().join("data/paper/seed_experiment_blade.toml"))
+            .expect("read seed_experiment_blade.toml"),
+    )
+    .expect("parse");
+    for (name, params) in [("true blade", common::true_blade()), ("shoulder", shoulder)] {
+        let (t0, t1) = default_window(&params);
+        let blade = Blade::new(params, StickForm::Reduced);
+        let y0 = blade.slip_equilibrium(t0).unwrap();
+        let mode = Mode {
+            phase: Phase::SlipPos,
+            anchor: 0.0,
+            region: 0,
+        };
+        for method in Method::ALL.iter().copied() {
+            let opts = |lift_off_margin| SolverOptions {
+                rtol: 1e-6,
+                atol: 1e-8,
+                method,
+                lift_off_margin,
+                ..SolverOptions::default()
+            };
+            let near = integrate(&blade, t0, y0, mode, t1, &[], &opts(0.5)).unwrap();
+            let every = integrate(&blade, t0, y0, mode, t1, &[], &opts(1.0)).unwrap();
+            eprintln!(
+                "{name} ({method}): {} transitions, {} switches; {:?} against {:?}",
+                near.transitions.len(),
+                near.switches.len(),
+                near.stats,
+                every.stats
+            );
+            assert!(near.transitions.len() > 50, "{name} {method}");
+            assert_eq!(near.transitions, every.transitions, "{name} {method}");
+            assert_eq!(near.switches, every.switches, "{name} {method}");
+            assert_eq!(near.y_end, every.y_end, "{name} {method}");
+            assert_eq!(near.stats.steps, every.stats.steps, "{name} {method}");
+            assert!(
+                3 * near.stats.event_evals < every.stats.event_evals,
+                "{name} {method}"
+            );
+        }
+    }
+}
