@@ -38,22 +38,113 @@ pub(super) fn intervals(
     if cf.problem.targets.is_some() {
         return Ok((None, vec![FitWarning::TargetJobIntervals], None));
     }
-    if fit.uncertainty.method() == UncertaintyMethod::Mcmc {
-        return Ok(match &cf.evidence {
-            Ok(nll) => {
-                let (iv, mut w, post) = mcmc_intervals(cf, nll.effective_parameters, fit, pb)?;
-                let near = cf.problem.near_best.lock();
-                w.extend(short_of_best(
-                    cf.cost,
-                    &near.unwrap_or_else(|e| e.into_inner()),
-                ));
-                (Some(iv), w, Some(post))
-            }
-            Err(why) => (None, vec![no_intervals(UncertaintyMethod::Mcmc, why)], None),
-        });
+    match fit.uncertainty.method() {
+        UncertaintyMethod::Mcmc => sampled_intervals(cf, fit, pb, None),
+        UncertaintyMethod::Auto => auto_intervals(cf, fit, pb),
+        _ => {
+            let (iv, w) = other_intervals(cf, best_sim, fit, pb)?;
+            Ok((iv, w, None))
+        }
     }
-    let (iv, w) = other_intervals(cf, best_sim, fit, pb)?;
-    Ok((iv, w, None))
+}
+
+/// [`mcmc_intervals`] with their warnings, the search's shortfall against the walkers' best
+/// point, and `why` a posterior was sampled (`method = "auto"`); a warning instead without a
+/// likelihood.
+fn sampled_intervals(
+    cf: &CandidateFit,
+    fit: &job::FitSection,
+    pb: &Option<indicatif::ProgressBar>,
+    why: Option<FitWarning>,
+) -> Result<Intervals> {
+    let method = fit.uncertainty.method();
+    let nll = match &cf.evidence {
+        Ok(nll) => nll,
+        Err(e) => return Ok((None, vec![no_intervals(method, e)], None)),
+    };
+    let (iv, mut w, post) = mcmc_intervals(cf, nll.effective_parameters, fit, pb)?;
+    w.extend(why);
+    let near = cf.problem.near_best.lock();
+    w.extend(short_of_best(
+        cf.cost,
+        &near.unwrap_or_else(|e| e.into_inner()),
+    ));
+    Ok((Some(iv), w, Some(post)))
+}
+
+/// How many times wider than a Laplace interval the likelihood must reach before `method =
+/// "auto"` samples the posterior instead. Chosen on the development set (docs/validation.md,
+/// "Intervals against the likelihood"): on the main job the search's evaluations inside the
+/// profile region reach 1.47 times its widest Laplace interval, which covers the truth unwidened;
+/// on the development fits whose Laplace intervals miss, 4.4–6.2 times.
+pub const AUTO_WIDTH_FACTOR: f64 = 2.0;
+
+/// `method = "auto"`: the Laplace intervals where the likelihood is the quadratic the curvature
+/// at the fit says, else a posterior sample ([`sampled_intervals`]). The evidence, per parameter,
+/// as a factor on its Laplace interval's width: the widening the search's evaluations inside the
+/// profile region ([`widen_to_near_best`]) and the shoulder's contact ridge
+/// ([`along_contact_ridge`]) would make, and the stretch of an axis the secant check finds flatter
+/// than the curvature (mostly that parameter). Above [`AUTO_WIDTH_FACTOR`] anywhere the posterior is
+/// sampled; otherwise the Laplace intervals stand as they are, not widened.
+fn auto_intervals(
+    cf: &CandidateFit,
+    fit: &job::FitSection,
+    pb: &Option<indicatif::ProgressBar>,
+) -> Result<Intervals> {
+    if let Err(why) = &cf.evidence {
+        return Ok((None, vec![no_intervals(UncertaintyMethod::Auto, why)], None));
+    }
+    let laplace = laplace_intervals(&cf.free, &cf.best_u, &cf.sigma_u);
+    let mut reached = laplace.clone();
+    along_contact_ridge(cf, &mut reached);
+    near_best_of(cf, &mut reached);
+    let mut factor: Vec<f64> = laplace.iter().zip(&reached).map(width_ratio).collect();
+    for w in secant_check(cf) {
+        if let FitWarning::FlatterThanCurvature(a) = w
+            && let Some(i) = cf.free.iter().position(|f| f.name == a.parameter)
+        {
+            factor[i] = factor[i].max(a.stretch);
+        }
+    }
+    match widest_beyond(&factor) {
+        Some(i) => {
+            let why = FitWarning::IntervalsSampled {
+                parameter: cf.free[i].name,
+                width_factor: factor[i],
+            };
+            sampled_intervals(cf, fit, pb, Some(why))
+        }
+        _ => {
+            let near = cf.problem.near_best.lock();
+            let near = near.unwrap_or_else(|e| e.into_inner());
+            Ok((
+                Some(laplace),
+                short_of_best(cf.cost, &near).into_iter().collect(),
+                None,
+            ))
+        }
+    }
+}
+
+/// The parameter whose factor on its Laplace width is the largest, when that exceeds
+/// [`AUTO_WIDTH_FACTOR`] (`method = "auto"` then samples).
+fn widest_beyond(factor: &[f64]) -> Option<usize> {
+    (0..factor.len())
+        .max_by(|&a, &b| factor[a].total_cmp(&factor[b]))
+        .filter(|&i| factor[i] > AUTO_WIDTH_FACTOR)
+}
+
+/// How many times wider `reached` is than `laplace` (∞ where a zero-width interval grew, 1 where
+/// neither has width).
+fn width_ratio((laplace, reached): (&Interval, &Interval)) -> f64 {
+    let (w0, w) = (laplace.hi - laplace.lo, reached.hi - reached.lo);
+    if w0 > 0.0 {
+        w / w0
+    } else if w > 0.0 {
+        f64::INFINITY
+    } else {
+        1.0
+    }
 }
 
 /// [`intervals`]' intervals, warnings and posterior sample.
@@ -113,7 +204,7 @@ fn other_intervals(
             Ok((None, vec![FitWarning::NoBootstrapReplicates]))
         }
         // [`intervals`] samples the posterior itself.
-        UncertaintyMethod::Mcmc => Ok((None, Vec::new())),
+        UncertaintyMethod::Mcmc | UncertaintyMethod::Auto => Ok((None, Vec::new())),
         UncertaintyMethod::Bootstrap => {
             let intervals = bootstrap_intervals(&cf.problem, &cf.best_u, best_sim, fit)?;
             Ok((Some(intervals), Vec::new()))
@@ -983,6 +1074,32 @@ pub fn identifiability_warnings(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `auto` samples where the likelihood reaches more than twice a Laplace width: the main
+    /// job's largest factor (1.47, C's near-best points) keeps Laplace; a development fit's 4.4
+    /// (dev_001's A) samples, naming that parameter; a zero-width interval that grew is infinitely
+    /// wider.
+    #[test]
+    fn auto_samples_beyond_twice_a_laplace_width() {
+        let iv = |lo: f64, hi: f64| Interval {
+            lo,
+            hi,
+            level: 0.6827,
+            method: IntervalMethod::Laplace {
+                fisher_step_u: 0.003,
+                noise_replicates: 256,
+                span_sigma: 0.5,
+            },
+            widened_from: None,
+        };
+        assert!((width_ratio((&iv(1.0, 2.0), &iv(0.8, 2.2))) - 1.4).abs() < 1e-12);
+        assert_eq!(width_ratio((&iv(1.0, 1.0), &iv(0.9, 1.0))), f64::INFINITY);
+        assert_eq!(width_ratio((&iv(1.0, 1.0), &iv(1.0, 1.0))), 1.0);
+        assert_eq!(widest_beyond(&[1.09, 1.07, 1.47, 1.0]), None);
+        assert_eq!(widest_beyond(&[4.4, 1.3, 4.7, 1.7]), Some(2));
+        assert_eq!(widest_beyond(&[2.0]), None);
+        assert_eq!(widest_beyond(&[]), None);
+    }
     use crate::model::ParamId;
 
     /// The NLL rise of a quadratic profile with 1σ `sigma` in a composite likelihood whose rise is

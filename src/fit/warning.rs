@@ -167,6 +167,12 @@ pub enum FitWarning {
     FlatterThanCurvature(FlatAxisReport),
     /// The search evaluated a point more likely than the fit.
     ShortOfBestEvaluation { gain_nats: f64 },
+    /// `method = "auto"` sampled the posterior: the likelihood reaches `width_factor` times the
+    /// Laplace interval of `parameter` (the widest such), so the curvature does not describe it.
+    IntervalsSampled {
+        parameter: ParamId,
+        width_factor: f64,
+    },
     /// k1 and theta_c trade along the shoulder's contact-moment ridge; both intervals span it.
     ContactRidge { k1_lo: f64, k1_hi: f64 },
     /// The job's interval method gave no intervals.
@@ -248,6 +254,7 @@ impl FitWarning {
         use FitWarning::*;
         match self {
             WidenedInterval { .. }
+            | IntervalsSampled { .. }
             | ContactRidge { .. }
             | TradeOff { .. }
             | TargetJobIntervals
@@ -329,6 +336,7 @@ impl FitWarning {
             WidenedInterval { .. } => "widened_interval",
             FlatterThanCurvature(_) => "flatter_than_curvature",
             ShortOfBestEvaluation { .. } => "short_of_best_evaluation",
+            IntervalsSampled { .. } => "intervals_sampled",
             PosteriorUnconverged { .. } => "posterior_unconverged",
             PosteriorSpansBounds { .. } => "posterior_spans_bounds",
             ContactRidge { .. } => "contact_ridge",
@@ -358,6 +366,7 @@ impl FitWarning {
             | ProfileOpen { parameter, .. }
             | ProfileMoreLikely { parameter, .. }
             | WidenedInterval { parameter, .. }
+            | IntervalsSampled { parameter, .. }
             | PosteriorUnconverged { parameter, .. }
             | PosteriorSpansBounds { parameter, .. } => Some(*parameter),
             PriorConflict(c) => Some(c.parameter),
@@ -464,6 +473,17 @@ impl fmt::Display for FitWarning {
             } => widened_interval(f, *parameter, *rise_limit_nats, [points, method, widened]),
             FlatterThanCurvature(a) => flatter_than_curvature(f, a),
             ShortOfBestEvaluation { gain_nats } => short_of_best_evaluation(f, *gain_nats),
+            IntervalsSampled {
+                parameter,
+                width_factor,
+            } => write!(
+                f,
+                "the likelihood reaches {width_factor:.1} times the Laplace interval of \
+                 {parameter} (the search's evaluations inside its profile region, or the check \
+                 along the Fisher information's axes), more than the curvature at the fit \
+                 describes, so every interval comes from a posterior sample ([fit.uncertainty] \
+                 method = \"auto\"; docs/uncertainty.md, \"Automatic\")"
+            ),
             PosteriorUnconverged {
                 parameter,
                 r_hat,
@@ -734,6 +754,7 @@ fn no_intervals(
         UncertaintyMethod::Profile => write!(f, "no profile-likelihood intervals: {reason}"),
         UncertaintyMethod::Bootstrap => write!(f, "no bootstrap intervals: {reason}"),
         UncertaintyMethod::Mcmc => write!(f, "no posterior (MCMC) intervals: {reason}"),
+        UncertaintyMethod::Auto => write!(f, "no intervals: {reason}"),
     }
 }
 

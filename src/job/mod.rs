@@ -452,6 +452,12 @@ crate::names::named_enum! {
         /// affine-invariant ensemble sampler (`walkers` × `steps` simulations): quantile intervals
         /// with convergence diagnostics.
         Mcmc => "mcmc",
+        /// Laplace where the likelihood is the quadratic its curvature says, else the posterior
+        /// sample of `mcmc`: the sample replaces the Laplace intervals when the secant check finds
+        /// an axis flatter than the curvature, or the search's own evaluations (or the shoulder's
+        /// contact ridge) reach more than twice a Laplace interval's width inside the profile
+        /// region.
+        Auto => "auto",
     }
 }
 
@@ -470,11 +476,12 @@ pub struct UncertaintySection {
     pub polish_iterations: u64,
     /// Seed of the replicates' noise, and of the ensemble sampler's moves.
     pub seed: u64,
-    /// `method = "mcmc"`: walkers of the ensemble (even, at least twice the freed parameters).
+    /// `method = "mcmc"` (and `"auto"` when it samples): walkers of the ensemble (even, at least
+    /// twice the freed parameters).
     pub walkers: usize,
-    /// `method = "mcmc"`: steps of every walker, burn-in included.
+    /// `method = "mcmc"` / `"auto"`: steps of every walker, burn-in included.
     pub steps: usize,
-    /// `method = "mcmc"`: steps discarded at the start of every walker's chain.
+    /// `method = "mcmc"` / `"auto"`: steps discarded at the start of every walker's chain.
     pub burn_in: usize,
 }
 
@@ -1063,7 +1070,10 @@ impl Check<'_> {
             ));
         }
         let u = &fit.uncertainty;
-        if u.method() == UncertaintyMethod::Mcmc {
+        if matches!(
+            u.method(),
+            UncertaintyMethod::Mcmc | UncertaintyMethod::Auto
+        ) {
             let at = |key| [Key::Name("fit"), Key::Name("uncertainty"), Key::Name(key)];
             if u.walkers < 4 || u.walkers % 2 == 1 {
                 return Err(self.error(

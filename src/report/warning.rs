@@ -255,6 +255,13 @@ fn fit_headline(w: &FitWarning) -> String {
             "The search evaluated a point {gain_nats:.2} nats more likely than the fit: it ended \
              short of its own best point; refit with more restarts or polish iterations."
         ),
+        IntervalsSampled {
+            parameter,
+            width_factor,
+        } => format!(
+            "The likelihood reaches {width_factor:.1} times {parameter}'s curvature interval: \
+             the intervals come from a posterior sample."
+        ),
         ContactRidge { k1_lo, k1_hi } => contact_ridge_headline(*k1_lo, *k1_hi),
         PosteriorUnconverged { parameter, .. } => format!(
             "The posterior sample of {parameter} has not converged: its interval is not yet \
@@ -468,6 +475,7 @@ fn no_intervals_headline(method: UncertaintyMethod) -> String {
             UncertaintyMethod::Profile => "profile-likelihood",
             UncertaintyMethod::Bootstrap => "bootstrap",
             UncertaintyMethod::Mcmc => "posterior (MCMC)",
+            UncertaintyMethod::Auto => "automatic",
         }
     )
 }

@@ -17,6 +17,7 @@ mod dop853_work;
 mod event_location;
 mod explore;
 mod fit_recovery;
+mod fit_result;
 mod geometry_fit;
 mod goodness_of_fit;
 mod hard_cases;
