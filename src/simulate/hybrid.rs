@@ -1186,36 +1186,19 @@ mod tests {
             depth: 0.0,
         };
         for method in Method::ALL.iter().copied() {
-            let run = integrate(
-                &probe,
-                0.0,
-                [1.0],
-                SLIP,
-                4.0,
-                &[],
-                &fixed_step(0.25, method, 0.5),
-            )
-            .unwrap();
-            let st = run.stats;
+            let stats = |margin: f64| {
+                let opts = fixed_step(0.25, method, margin);
+                integrate(&probe, 0.0, [1.0], SLIP, 4.0, &[], &opts)
+                    .unwrap()
+                    .stats
+            };
+            let st = stats(0.5);
             assert!(st.steps >= 16, "{method}: {st:?}");
             assert!(st.event_evals <= 2, "{method}: {st:?}");
             assert!(st.kinematic_evals >= 3 * st.steps, "{method}: {st:?}");
-            let all = integrate(
-                &probe,
-                0.0,
-                [1.0],
-                SLIP,
-                4.0,
-                &[],
-                &fixed_step(0.25, method, 1.0),
-            )
-            .unwrap();
-            assert_eq!(all.stats.steps, st.steps);
-            assert!(
-                all.stats.event_evals >= 3 * st.steps,
-                "{method}: {:?}",
-                all.stats
-            );
+            let all = stats(1.0);
+            assert_eq!(all.steps, st.steps);
+            assert!(all.event_evals >= 3 * st.steps, "{method}: {all:?}");
         }
     }
 
