@@ -141,14 +141,8 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     warnings.extend(line_warnings(&peaks));
     warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
     warnings.extend(choice_warning);
-    let truth = optimum_checks(
-        job,
-        &cf,
-        &best,
-        tolerance_check.as_ref(),
-        interrupted,
-        &mut warnings,
-    );
+    let tol = tolerance_check.as_ref();
+    let truth = optimum_checks(job, &cf, &best, tol, interrupted, &mut warnings);
     warnings.extend(failure_warning(&cf.problem));
     // The chosen model's counts include its bootstrap replicates and the tolerance check's
     // simulations (they share its counters).

@@ -473,17 +473,7 @@ impl fmt::Display for FitWarning {
             } => widened_interval(f, *parameter, *rise_limit_nats, [points, method, widened]),
             FlatterThanCurvature(a) => flatter_than_curvature(f, a),
             ShortOfBestEvaluation { gain_nats } => short_of_best_evaluation(f, *gain_nats),
-            IntervalsSampled {
-                parameter,
-                width_factor,
-            } => write!(
-                f,
-                "the likelihood reaches {width_factor:.1} times the Laplace interval of \
-                 {parameter} (the search's evaluations inside its profile region, or the check \
-                 along the Fisher information's axes), more than the curvature at the fit \
-                 describes, so every interval comes from a posterior sample ([fit.uncertainty] \
-                 method = \"auto\"; docs/uncertainty.md, \"Automatic\")"
-            ),
+            IntervalsSampled { .. } => intervals_sampled(f, self),
             PosteriorUnconverged {
                 parameter,
                 r_hat,
@@ -849,6 +839,25 @@ fn chosen_on_misfit(
         "{chosen} is chosen over {nested} (TIC {delta_tic:.1} lower) by a fit that fails the \
          goodness-of-fit test: what it adds to {nested} may absorb the misfit rather than \
          describe the blade, so it is not confirmed by this recording"
+    )
+}
+
+/// [`FitWarning::IntervalsSampled`]'s sentence (nothing for another warning).
+fn intervals_sampled(f: &mut fmt::Formatter<'_>, w: &FitWarning) -> fmt::Result {
+    let FitWarning::IntervalsSampled {
+        parameter,
+        width_factor: factor,
+    } = w
+    else {
+        return Ok(());
+    };
+    write!(
+        f,
+        "the likelihood reaches {factor:.1} times the Laplace interval of {parameter} (the \
+         search's evaluations inside its profile region, or the check along the Fisher \
+         information's axes), more than the curvature at the fit describes, so every interval \
+         comes from a posterior sample ([fit.uncertainty] method = \"auto\"; docs/uncertainty.md, \
+         \"Automatic\")"
     )
 }
 

@@ -255,13 +255,7 @@ fn fit_headline(w: &FitWarning) -> String {
             "The search evaluated a point {gain_nats:.2} nats more likely than the fit: it ended \
              short of its own best point; refit with more restarts or polish iterations."
         ),
-        IntervalsSampled {
-            parameter,
-            width_factor,
-        } => format!(
-            "The likelihood reaches {width_factor:.1} times {parameter}'s curvature interval: \
-             the intervals come from a posterior sample."
-        ),
+        IntervalsSampled { .. } => sampled_headline(w),
         ContactRidge { k1_lo, k1_hi } => contact_ridge_headline(*k1_lo, *k1_hi),
         PosteriorUnconverged { parameter, .. } => format!(
             "The posterior sample of {parameter} has not converged: its interval is not yet \
@@ -439,6 +433,21 @@ fn tolerance_unresolved_headline(spread_nats: f64) -> String {
         "The optimum's cost moves by {} nats between solver tolerances: the intervals \
          understate the uncertainty; tighten [solver] rtol and refit.",
         num(spread_nats, 2)
+    )
+}
+
+/// [`FitWarning::IntervalsSampled`]'s headline (empty for another warning).
+fn sampled_headline(w: &FitWarning) -> String {
+    let FitWarning::IntervalsSampled {
+        parameter,
+        width_factor,
+    } = w
+    else {
+        return String::new();
+    };
+    format!(
+        "The intervals come from a posterior sample: the likelihood reaches {width_factor:.1} times \
+         {parameter}'s curvature interval."
     )
 }
 

@@ -705,42 +705,9 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
         let prev = self.prev;
         let dense = a.dense;
         let (solves, kinematic) = (Cell::new(0), Cell::new(0));
-        // In slip the end's values come first: their normal force decides the interior sampling.
-        // A fault there is left to the loop below, which meets it where it always did.
-        let g_end = match slip {
-            Some(_) => match self.end_event_values(true, t_new, &a.y_new) {
-                Some(g) => Some(g),
-                None => {
-                    solves.set(solves.get() + 1);
-                    event_values(model, &mode, t_new, &a.y_new)
-                        .ok()
-                        .map(|(g, _)| g)
-                }
-            },
-            None => None,
-        };
-        let clear = slip.is_some()
-            && self.prev_normal_clear
-            && g_end.is_some_and(|ge| {
-                let (lo, hi) = self.stage_normal;
-                normal_clear(
-                    min_or_nan(min_or_nan(lo, ga[2]), ge[2]),
-                    hi.max(ga[2]).max(ge[2]),
-                    self.opts.lift_off_margin,
-                )
-            });
-        if slip.is_some()
-            && !clear
-            && gb[2].is_nan()
-            && let Some((pd, tp, _)) = prev
-        {
-            // The previous step sampled only the kinematic functions inside: its last interior
-            // sample with the contact solved, for the minimum test at this step's start.
-            let yb = pd.eval(tp);
-            self.stats.event_evals += 1;
-            gb = event_values(model, &mode, tp, &yb)
-                .map_err(|e| self.fail(tp, &yb, e.into()))?
-                .0;
+        let (g_end, clear) = self.slip_end(a, t_new, &ga, &solves);
+        if slip.is_some() && !clear && gb[2].is_nan() {
+            gb = self.solved_prev_sample(gb)?;
         }
         // State on [previous step, this step] from the continuous extensions.
         let y_at = |tt: f64| match prev {
@@ -841,6 +808,53 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
             self.prev_normal_clear = clear;
         }
         Ok(found)
+    }
+
+    /// In slip, the event functions at the accepted step `a`'s end `t_new` (the last stage's, or
+    /// a contact solve counted in `solves`; `None` on a fault, which the sampling loop meets where
+    /// it always did) and whether the step's normal force, with `g_start` at its start, stays
+    /// clear of zero ([`normal_clear`]) after a step that was clear too. They come first because
+    /// the end's normal force decides the interior sampling. Outside slip `(None, false)`.
+    fn slip_end(
+        &mut self,
+        a: &Step<N>,
+        t_new: f64,
+        g_start: &[f64; N_EVENTS],
+        solves: &Cell<usize>,
+    ) -> (Option<[f64; N_EVENTS]>, bool) {
+        if self.mode.phase.slip_dir().is_none() {
+            return (None, false);
+        }
+        let g_end = self.end_event_values(true, t_new, &a.y_new).or_else(|| {
+            solves.set(solves.get() + 1);
+            event_values(self.model, &self.mode, t_new, &a.y_new)
+                .ok()
+                .map(|(g, _)| g)
+        });
+        let clear = self.prev_normal_clear
+            && g_end.is_some_and(|ge| {
+                let (lo, hi) = self.stage_normal;
+                normal_clear(
+                    min_or_nan(min_or_nan(lo, g_start[2]), ge[2]),
+                    hi.max(g_start[2]).max(ge[2]),
+                    self.opts.lift_off_margin,
+                )
+            });
+        (g_end, clear)
+    }
+
+    /// The previous step's last interior sample with the contact solved, when that step sampled
+    /// only the kinematic functions inside (`gb`'s normal force NaN): for the minimum test at this
+    /// step's start. `gb` itself without a previous step.
+    fn solved_prev_sample(&mut self, gb: [f64; N_EVENTS]) -> Result<[f64; N_EVENTS]> {
+        let Some((pd, tp, _)) = self.prev else {
+            return Ok(gb);
+        };
+        let yb = pd.eval(tp);
+        self.stats.event_evals += 1;
+        Ok(event_values(self.model, &self.mode, tp, &yb)
+            .map_err(|e| self.fail(tp, &yb, e.into()))?
+            .0)
     }
 
     /// The event functions at the accepted step's end `(t_end, y_end)` from the attempt's last
