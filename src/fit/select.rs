@@ -112,8 +112,12 @@ pub(super) fn choose(
 /// within its spread moves the TIC by twice that, and a gap the integrator does not resolve says
 /// nothing about the recording).
 pub(super) fn margin(spreads: &[f64], i: usize, j: usize) -> f64 {
-    let s = |k: usize| spreads.get(k).copied().unwrap_or(0.0);
-    INDISTINGUISHABLE_TIC + 2.0 * (s(i) + s(j))
+    INDISTINGUISHABLE_TIC + 2.0 * (spread(spreads, i) + spread(spreads, j))
+}
+
+/// Candidate `k`'s unresolved cost spread in `spreads` (0 beyond its end), nats.
+fn spread(spreads: &[f64], k: usize) -> f64 {
+    spreads.get(k).copied().unwrap_or(0.0)
 }
 
 /// The candidate [`choose`] reports from `scores` (TIC, +∞ where it cannot be chosen) and `ks`
@@ -267,10 +271,10 @@ impl Scored<'_> {
             .map(|e| format!("ln L = {:.2} nats, ", e.log_likelihood()))
             .unwrap_or_default();
         if i == self.chosen {
-            let next = (0..fits.len())
+            let runner = (0..fits.len())
                 .filter(|&j| j != self.chosen)
-                .map(|j| self.scores[j])
-                .fold(f64::INFINITY, f64::min);
+                .min_by(|&a, &b| self.scores[a].total_cmp(&self.scores[b]));
+            let next = runner.map_or(f64::INFINITY, |j| self.scores[j]);
             let lrt = self
                 .ratio_test(fits, i)
                 .map(|t| {
@@ -280,10 +284,7 @@ impl Scored<'_> {
                     )
                 })
                 .unwrap_or_default();
-            if let Some(lowest) = (0..fits.len())
-                .filter(|&j| self.scores[j] < self.scores[i])
-                .min_by(|&a, &b| self.scores[a].total_cmp(&self.scores[b]))
-            {
+            if let Some(lowest) = runner.filter(|&j| self.scores[j] < self.scores[i]) {
                 let m = margin(self.spreads, i, lowest);
                 let widened = if m > INDISTINGUISHABLE_TIC {
                     " (2 widened by twice the optima's cost spreads between solver tolerances, \
@@ -372,12 +373,11 @@ pub(super) fn moved_choice(
         t.evidence.as_ref().and_then(|e| e.tic)
     };
     let now = selection.chosen;
-    let s = |k: usize| spreads.get(k).copied().unwrap_or(0.0);
     Some(FitWarning::ChoiceUnresolved {
         chosen: selection.trials[now].model,
         runner_up: selection.trials.get(was)?.model,
         tic_gap: tic(was)? - tic(now)?,
-        spread_nats: s(now) + s(was),
+        spread_nats: spread(spreads, now) + spread(spreads, was),
     })
 }
 

@@ -64,11 +64,7 @@ fn sampled_intervals(
     };
     let (iv, mut w, post) = mcmc_intervals(cf, nll.effective_parameters, fit, pb)?;
     w.extend(why);
-    let near = cf.problem.near_best.lock();
-    w.extend(short_of_best(
-        cf.cost,
-        &near.unwrap_or_else(|e| e.into_inner()),
-    ));
+    w.extend(search_short_of_best(cf));
     Ok((Some(iv), w, Some(post)))
 }
 
@@ -108,21 +104,17 @@ fn auto_intervals(
     }
     match widest_beyond(&factor) {
         Some(i) => {
-            let why = FitWarning::IntervalsSampled {
+            let why = FitWarning::IntervalsSampled(super::warning::SampledReason {
                 parameter: cf.free[i].name,
                 width_factor: factor[i],
-            };
+            });
             sampled_intervals(cf, fit, pb, Some(why))
         }
-        _ => {
-            let near = cf.problem.near_best.lock();
-            let near = near.unwrap_or_else(|e| e.into_inner());
-            Ok((
-                Some(laplace),
-                short_of_best(cf.cost, &near).into_iter().collect(),
-                None,
-            ))
-        }
+        _ => Ok((
+            Some(laplace),
+            search_short_of_best(cf).into_iter().collect(),
+            None,
+        )),
     }
 }
 
@@ -164,6 +156,12 @@ fn short_of_best(cost: f64, near: &super::problem::EvaluatedNearBest) -> Option<
     let gain = cost - near.lowest();
     (gain > super::search::CONFIRM_NATS)
         .then_some(FitWarning::ShortOfBestEvaluation { gain_nats: gain })
+}
+
+/// [`short_of_best`] of the chosen fit against the points its problem kept.
+fn search_short_of_best(cf: &CandidateFit) -> Option<FitWarning> {
+    let near = cf.problem.near_best.lock();
+    short_of_best(cf.cost, &near.unwrap_or_else(|e| e.into_inner()))
 }
 
 /// [`FitWarning::NoIntervals`] of `method`, for `why`.
@@ -1074,6 +1072,7 @@ pub fn identifiability_warnings(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::ParamId;
 
     /// `auto` samples where the likelihood reaches more than twice a Laplace width: the main
     /// job's largest factor (1.47, C's near-best points) keeps Laplace; a development fit's 4.4
@@ -1100,7 +1099,6 @@ mod tests {
         assert_eq!(widest_beyond(&[2.0]), None);
         assert_eq!(widest_beyond(&[]), None);
     }
-    use crate::model::ParamId;
 
     /// The NLL rise of a quadratic profile with 1σ `sigma` in a composite likelihood whose rise is
     /// `μ` times the exact one: `μ·(x − u0)²/(2σ²)`.

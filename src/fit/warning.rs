@@ -65,6 +65,14 @@ pub const FAILED_WARN_FRACTION: f64 = 0.1;
 /// the search then spends most of its budget where the model cannot go.
 pub const FAILED_ATTENTION_FRACTION: f64 = 0.5;
 
+/// Why `method = "auto"` sampled the posterior: the likelihood reaches `width_factor` times the
+/// Laplace interval of `parameter`, the widest such.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SampledReason {
+    pub parameter: ParamId,
+    pub width_factor: f64,
+}
+
 /// One warning of a fit, with its numbers. Serialised (in `warning_details`) as a table tagged by
 /// `kind`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -167,12 +175,8 @@ pub enum FitWarning {
     FlatterThanCurvature(FlatAxisReport),
     /// The search evaluated a point more likely than the fit.
     ShortOfBestEvaluation { gain_nats: f64 },
-    /// `method = "auto"` sampled the posterior: the likelihood reaches `width_factor` times the
-    /// Laplace interval of `parameter` (the widest such), so the curvature does not describe it.
-    IntervalsSampled {
-        parameter: ParamId,
-        width_factor: f64,
-    },
+    /// `method = "auto"` sampled the posterior: the curvature does not describe the likelihood.
+    IntervalsSampled(SampledReason),
     /// k1 and theta_c trade along the shoulder's contact-moment ridge; both intervals span it.
     ContactRidge { k1_lo: f64, k1_hi: f64 },
     /// The job's interval method gave no intervals.
@@ -254,7 +258,7 @@ impl FitWarning {
         use FitWarning::*;
         match self {
             WidenedInterval { .. }
-            | IntervalsSampled { .. }
+            | IntervalsSampled(_)
             | ContactRidge { .. }
             | TradeOff { .. }
             | TargetJobIntervals
@@ -336,7 +340,7 @@ impl FitWarning {
             WidenedInterval { .. } => "widened_interval",
             FlatterThanCurvature(_) => "flatter_than_curvature",
             ShortOfBestEvaluation { .. } => "short_of_best_evaluation",
-            IntervalsSampled { .. } => "intervals_sampled",
+            IntervalsSampled(_) => "intervals_sampled",
             PosteriorUnconverged { .. } => "posterior_unconverged",
             PosteriorSpansBounds { .. } => "posterior_spans_bounds",
             ContactRidge { .. } => "contact_ridge",
@@ -366,11 +370,11 @@ impl FitWarning {
             | ProfileOpen { parameter, .. }
             | ProfileMoreLikely { parameter, .. }
             | WidenedInterval { parameter, .. }
-            | IntervalsSampled { parameter, .. }
             | PosteriorUnconverged { parameter, .. }
             | PosteriorSpansBounds { parameter, .. } => Some(*parameter),
             PriorConflict(c) => Some(c.parameter),
             FlatterThanCurvature(a) => Some(a.parameter),
+            IntervalsSampled(r) => Some(r.parameter),
             _ => None,
         }
     }
@@ -473,7 +477,7 @@ impl fmt::Display for FitWarning {
             } => widened_interval(f, *parameter, *rise_limit_nats, [points, method, widened]),
             FlatterThanCurvature(a) => flatter_than_curvature(f, a),
             ShortOfBestEvaluation { gain_nats } => short_of_best_evaluation(f, *gain_nats),
-            IntervalsSampled { .. } => intervals_sampled(f, self),
+            IntervalsSampled(r) => intervals_sampled(f, r),
             PosteriorUnconverged {
                 parameter,
                 r_hat,
@@ -842,15 +846,9 @@ fn chosen_on_misfit(
     )
 }
 
-/// [`FitWarning::IntervalsSampled`]'s sentence (nothing for another warning).
-fn intervals_sampled(f: &mut fmt::Formatter<'_>, w: &FitWarning) -> fmt::Result {
-    let FitWarning::IntervalsSampled {
-        parameter,
-        width_factor: factor,
-    } = w
-    else {
-        return Ok(());
-    };
+/// [`FitWarning::IntervalsSampled`]'s sentence.
+fn intervals_sampled(f: &mut fmt::Formatter<'_>, r: &SampledReason) -> fmt::Result {
+    let (parameter, factor) = (r.parameter, r.width_factor);
     write!(
         f,
         "the likelihood reaches {factor:.1} times the Laplace interval of {parameter} (the \

@@ -255,7 +255,7 @@ fn fit_headline(w: &FitWarning) -> String {
             "The search evaluated a point {gain_nats:.2} nats more likely than the fit: it ended \
              short of its own best point; refit with more restarts or polish iterations."
         ),
-        IntervalsSampled { .. } => sampled_headline(w),
+        IntervalsSampled(r) => sampled_headline(r.parameter, r.width_factor),
         ContactRidge { k1_lo, k1_hi } => contact_ridge_headline(*k1_lo, *k1_hi),
         PosteriorUnconverged { parameter, .. } => format!(
             "The posterior sample of {parameter} has not converged: its interval is not yet \
@@ -436,15 +436,8 @@ fn tolerance_unresolved_headline(spread_nats: f64) -> String {
     )
 }
 
-/// [`FitWarning::IntervalsSampled`]'s headline (empty for another warning).
-fn sampled_headline(w: &FitWarning) -> String {
-    let FitWarning::IntervalsSampled {
-        parameter,
-        width_factor,
-    } = w
-    else {
-        return String::new();
-    };
+/// [`FitWarning::IntervalsSampled`]'s headline.
+fn sampled_headline(parameter: ParamId, width_factor: f64) -> String {
     format!(
         "The intervals come from a posterior sample: the likelihood reaches {width_factor:.1} times \
          {parameter}'s curvature interval."

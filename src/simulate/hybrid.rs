@@ -210,11 +210,23 @@ fn event_values_of<M: StickSlipModel<N>, const N: usize>(
             g[2] = c.normal;
         }
     }
+    switching_values(model, mode, t, yc, &mut g);
+    g
+}
+
+/// The switching functions at `(t, yc)` into `g[3..]`, each signed so that leaving `mode`'s region
+/// makes it negative.
+fn switching_values<M: StickSlipModel<N>, const N: usize>(
+    model: &M,
+    mode: &Mode,
+    t: f64,
+    yc: &[f64; N],
+    g: &mut [f64; N_EVENTS],
+) {
     for i in 0..model.switching_surfaces().min(MAX_SWITCHING_SURFACES) {
         let si = model.switching_function(i, t, yc);
         g[3 + i] = if mode.region & (1 << i) != 0 { si } else { -si };
     }
-    g
 }
 
 /// The event functions of a slip `mode` that the state alone gives, at `(t, y)` (made consistent
@@ -232,10 +244,7 @@ fn kinematic_event_values<M: StickSlipModel<N>, const N: usize>(
     let mut g = [NO_EVENT; N_EVENTS];
     g[0] = s * model.slip_velocity(t, &yc);
     g[2] = f64::NAN;
-    for i in 0..model.switching_surfaces().min(MAX_SWITCHING_SURFACES) {
-        let si = model.switching_function(i, t, &yc);
-        g[3 + i] = if mode.region & (1 << i) != 0 { si } else { -si };
-    }
+    switching_values(model, mode, t, &yc, &mut g);
     Ok(g)
 }
 

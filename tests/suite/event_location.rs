@@ -11,6 +11,13 @@ use wiperlab::simulate::hybrid::{
     Contact, Mode, ModelFault, Phase, SolverOptions, StickSlipModel, integrate,
 };
 
+/// Forward slip from the start of a run.
+const SLIP_POS: Mode = Mode {
+    phase: Phase::SlipPos,
+    anchor: 0.0,
+    region: 0,
+};
+
 /// Fixed steps of size `h` with `method`: tolerances so loose that every step is accepted,
 /// `h_max = h`.
 fn fixed_step(h: f64, method: Method) -> SolverOptions {
@@ -169,11 +176,7 @@ fn dip_across_zero_within_one_step_is_not_missed() {
     {
         let dip = Dip { t1, t2 };
         let opts = fixed_step(0.25, method);
-        let mode = Mode {
-            phase: Phase::SlipPos,
-            anchor: 0.0,
-            region: 0,
-        };
+        let mode = SLIP_POS;
         let run = integrate(&dip, 0.0, [t1 * t2], mode, 2.0, &[], &opts).unwrap();
         let times: Vec<(f64, Phase)> = run.transitions.iter().map(|tr| (tr.t_s, tr.to)).collect();
         eprintln!(
@@ -236,11 +239,7 @@ fn tangential_departures_take_the_consistent_direction() {
     let times: Vec<f64> = (0..n).map(|i| t0 + i as f64 * 1e-5).collect();
     let blade = Blade::new(params, StickForm::Reduced);
     let y0 = blade.slip_equilibrium(t0).unwrap();
-    let mode = Mode {
-        phase: Phase::SlipPos,
-        anchor: 0.0,
-        region: 0,
-    };
+    let mode = SLIP_POS;
     for method in Method::ALL.iter().copied() {
         let opts = SolverOptions {
             method,
@@ -336,11 +335,7 @@ fn sampling_the_normal_force_near_lift_off_only_keeps_every_event() {
         let (t0, t1) = default_window(&params);
         let blade = Blade::new(params, StickForm::Reduced);
         let y0 = blade.slip_equilibrium(t0).unwrap();
-        let mode = Mode {
-            phase: Phase::SlipPos,
-            anchor: 0.0,
-            region: 0,
-        };
+        let mode = SLIP_POS;
         for method in Method::ALL.iter().copied() {
             let opts = |lift_off_margin| SolverOptions {
                 rtol: 1e-6,
