@@ -287,6 +287,29 @@ pub struct Dynamics {
     pub friction_n: f64,
 }
 
+/// `(sin, cos)` of the link angles θ and φ at one state.
+#[derive(Debug, Clone, Copy)]
+struct Angles {
+    theta: (f64, f64),
+    phi: (f64, f64),
+}
+
+/// The head and tip positions at one instant ([`Blade::kinematics`]) and what the tip's velocity
+/// needs besides the angular rates ([`Blade::tip_velocity_from`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Kinematics {
+    /// Head horizontal position v (the drive), m.
+    pub head_position_m: f64,
+    /// Head horizontal speed v̇, m/s.
+    pub head_speed_m_per_s: f64,
+    /// Head drop u = l1(1 − cos θ) + l2(1 − cos φ), m.
+    pub head_drop_m: f64,
+    /// Tip horizontal position v3, m.
+    pub tip_position_m: f64,
+    /// `[cos θ, cos φ]`.
+    pub cos: [f64; 2],
+}
+
 /// Rows (1)–(3) of the equations of motion at one instant ([`Blade::rows`]) and the tip kinematics
 /// computed from the same sines and cosines.
 #[derive(Debug, Clone, Copy)]
@@ -345,7 +368,13 @@ impl Blade {
 
     /// Head drop u = l1(1 − cos θ) + l2(1 − cos φ), m.
     pub fn head_drop(&self, y: &[f64; 4]) -> f64 {
-        self.params.l1_m * (1.0 - y[0].cos()) + self.params.l2_m * (1.0 - y[1].cos())
+        self.head_drop_from([y[0].cos(), y[1].cos()])
+    }
+
+    /// [`Blade::head_drop`] from `cos = [cos θ, cos φ]`.
+    #[inline]
+    fn head_drop_from(&self, cos: [f64; 2]) -> f64 {
+        self.params.l1_m * (1.0 - cos[0]) + self.params.l2_m * (1.0 - cos[1])
     }
 
     /// Tip horizontal position v3 = v + l1 sin θ + l2 sin φ, m.
@@ -356,9 +385,30 @@ impl Blade {
     /// Tip horizontal velocity v̇3, m/s.
     #[inline]
     pub fn tip_velocity(&self, t: f64, y: &[f64; 4]) -> f64 {
-        self.drive(t).1
-            + self.params.l1_m * y[0].cos() * y[2]
-            + self.params.l2_m * y[1].cos() * y[3]
+        self.tip_velocity_from(self.drive(t).1, [y[0].cos(), y[1].cos()], y)
+    }
+
+    /// [`Blade::tip_velocity`] from the head's speed `v̇` and `cos = [cos θ, cos φ]` at the state `y`.
+    #[inline]
+    pub fn tip_velocity_from(&self, head_speed: f64, cos: [f64; 2], y: &[f64; 4]) -> f64 {
+        head_speed + self.params.l1_m * cos[0] * y[2] + self.params.l2_m * cos[1] * y[3]
+    }
+
+    /// The head and tip kinematics at `(t, y)` from one evaluation of the drive and one `sin_cos`
+    /// of each angle: bitwise the values [`Blade::drive`], [`Blade::head_drop`] and
+    /// [`Blade::tip_position`] give (`sin_cos` and `sin`, `cos` agree).
+    pub fn kinematics(&self, t: f64, y: &[f64; 4]) -> Kinematics {
+        let (v, vd, _) = self.drive(t);
+        let (sth, cth) = y[0].sin_cos();
+        let (sph, cph) = y[1].sin_cos();
+        let cos = [cth, cph];
+        Kinematics {
+            head_position_m: v,
+            head_speed_m_per_s: vd,
+            head_drop_m: self.head_drop_from(cos),
+            tip_position_m: v + self.params.l1_m * sth + self.params.l2_m * sph,
+            cos,
+        }
     }
 
     /// Rows (1)–(3) of the equations of motion as `A·[θ̈, φ̈, N]ᵀ + a_f·f = b`; returns
@@ -379,15 +429,30 @@ impl Blade {
     /// `cos` give; `sin_cos` and `cos` agree).
     #[inline]
     pub(crate) fn rows_with_kinematics(&self, t: f64, y: &[f64; 4], touching: bool) -> Rows {
+        let angles = Angles {
+            theta: y[0].sin_cos(),
+            phi: y[1].sin_cos(),
+        };
+        self.rows_from(self.drive(t), angles, y, touching)
+    }
+
+    /// [`Blade::rows_with_kinematics`] from the drive `(v, v̇, v̈)` at `t` and the sines and
+    /// cosines of the state's angles.
+    #[inline]
+    fn rows_from(
+        &self,
+        (v, vd, vdd): (f64, f64, f64),
+        angles: Angles,
+        y: &[f64; 4],
+        touching: bool,
+    ) -> Rows {
         let p = &self.params;
         let m = &self.mc;
         let (l1, l2) = (p.l1_m, p.l2_m);
         let (th, ph, thd, phd) = (y[0], y[1], y[2], y[3]);
-        let (sth, cth) = th.sin_cos();
-        let (sph, cph) = ph.sin_cos();
+        let ((sth, cth), (sph, cph)) = (angles.theta, angles.phi);
         // sin(θ − φ), cos(θ − φ) by the difference identities: one libm call fewer per evaluation.
         let (sd, cd) = (sth * cph - cth * sph, cth * cph + sth * sph);
-        let (v, vd, vdd) = self.drive(t);
         // As in `tip_position`, `tip_velocity` and `tip_constraint_rhs`, term by term.
         let tip_position = v + l1 * sth + l2 * sph;
         let tip_velocity = vd + l1 * cth * thd + l2 * cph * phd;
@@ -572,7 +637,16 @@ impl Blade {
         omega_b: f64,
         touching: bool,
     ) -> Result<Dynamics, ModelFault> {
-        let r = self.rows_with_kinematics(t, y, touching);
+        self.stick_dynamics_of(&self.rows_with_kinematics(t, y, touching), anchor, omega_b)
+    }
+
+    /// [`Blade::stick_dynamics_on`] from the rows at the state.
+    fn stick_dynamics_of(
+        &self,
+        r: &Rows,
+        anchor: f64,
+        omega_b: f64,
+    ) -> Result<Dynamics, ModelFault> {
         let rhs4 = r.tip_constraint_rhs(anchor, omega_b);
         let z = self
             .solve_with_tip_constraint(r.cos, &r.a, &r.af, &r.b, rhs4)
@@ -595,9 +669,21 @@ impl Blade {
         theta_d: f64,
         anchor: f64,
     ) -> Result<(f64, f64), ModelFault> {
+        let (phi, phi_d, _) =
+            self.constrained_lip_from(self.drive(t), theta.sin_cos(), theta_d, anchor)?;
+        Ok((phi, phi_d))
+    }
+
+    /// [`Blade::constrained_lip`] from the drive `(v, v̇, v̈)` at `t` and `(sin θ, cos θ)`; also
+    /// the angles' sines and cosines at the constrained state.
+    fn constrained_lip_from(
+        &self,
+        (v, vd, _): (f64, f64, f64),
+        (sth, cth): (f64, f64),
+        theta_d: f64,
+        anchor: f64,
+    ) -> Result<(f64, f64, Angles), ModelFault> {
         let (l1, l2) = (self.params.l1_m, self.params.l2_m);
-        let (v, vd, _) = self.drive(t);
-        let (sth, cth) = theta.sin_cos();
         let arg = (anchor - v - l1 * sth) / l2;
         let reachable = arg.abs() < 1.0;
         if !reachable {
@@ -607,8 +693,13 @@ impl Blade {
             });
         }
         let phi = arg.asin();
-        let phi_d = -(vd + l1 * cth * theta_d) / (l2 * phi.cos());
-        Ok((phi, phi_d))
+        let (sph, cph) = phi.sin_cos();
+        let phi_d = -(vd + l1 * cth * theta_d) / (l2 * cph);
+        let angles = Angles {
+            theta: (sth, cth),
+            phi: (sph, cph),
+        };
+        Ok((phi, phi_d, angles))
     }
 
     /// Quasi-static slip equilibrium at `t` (θ̇ = φ̇ = 0 and θ̈ = φ̈ = 0, slip direction from the
@@ -676,9 +767,13 @@ impl StickSlipModel<4> for Blade {
                 None,
             ),
             (Phase::Stick, StickForm::Reduced) => {
-                let (phi, phi_d) = self.constrained_lip(t, y[0], y[2], mode.anchor)?;
+                // The drive and sin θ, cos θ serve both the constraint and the rows.
+                let drive = self.drive(t);
+                let (phi, phi_d, angles) =
+                    self.constrained_lip_from(drive, y[0].sin_cos(), y[2], mode.anchor)?;
                 let yc = [y[0], phi, y[2], phi_d];
-                let d = self.stick_dynamics_on(t, &yc, mode.anchor, 0.0, touching)?;
+                let rows = self.rows_from(drive, angles, &yc, touching);
+                let d = self.stick_dynamics_of(&rows, mode.anchor, 0.0)?;
                 dy[0] = y[2];
                 dy[1] = 0.0;
                 dy[2] = d.theta_dd;
@@ -855,7 +950,13 @@ impl LockedBlade {
     }
 
     fn slip_velocity_of(&self, t: f64, th: f64, thd: f64) -> f64 {
-        self.blade.drive(t).1 + self.reach() * th.cos() * thd
+        self.tip_velocity_from(self.blade.drive(t).1, th.cos(), thd)
+    }
+
+    /// The link tip's velocity `v̇ + (l1 + l2) cos θ θ̇` from the head's speed `v̇` and `cos θ`.
+    #[inline]
+    pub fn tip_velocity_from(&self, head_speed: f64, cos_theta: f64, theta_d: f64) -> f64 {
+        head_speed + self.reach() * cos_theta * theta_d
     }
 
     /// Link angle and rate that hold the tip at `anchor` at time `t`.
@@ -1011,6 +1112,69 @@ mod drive_tests {
                     assert!(dev.abs() < 1e-15, "{dev}");
                 }
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod shared_trig_tests {
+    use super::*;
+
+    fn blade(stick_form: StickForm) -> Blade {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/data/reversal/blade_true.toml");
+        let params: BladeParams = toml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+        Blade::new(params, stick_form)
+    }
+
+    /// States across the reversal window: both signs of the angles and rates.
+    const STATES: [(f64, [f64; 4]); 4] = [
+        (1.0, [0.05, -0.12, 3.0, -40.0]),
+        (1.6, [-0.004, -0.046, 6.8, 92.7]),
+        (2.1, [-0.09, 0.2, -1.5, 10.0]),
+        (2.7, [0.0, 0.0, 0.0, 0.0]),
+    ];
+
+    /// [`Blade::kinematics`] (one `sin_cos` per angle) gives bitwise the values of the separate
+    /// functions: the drive, head drop, tip position, and with [`Blade::tip_velocity_from`] the tip
+    /// velocity.
+    #[test]
+    fn kinematics_match_the_separate_functions_bitwise() {
+        let b = blade(StickForm::Reduced);
+        for (t, y) in STATES {
+            let k = b.kinematics(t, &y);
+            assert_eq!(k.head_position_m, b.drive(t).0);
+            assert_eq!(k.head_speed_m_per_s, b.drive(t).1);
+            assert_eq!(k.head_drop_m, b.head_drop(&y));
+            assert_eq!(k.tip_position_m, b.tip_position(t, &y));
+            assert_eq!(
+                b.tip_velocity_from(k.head_speed_m_per_s, k.cos, &y),
+                b.tip_velocity(t, &y)
+            );
+        }
+    }
+
+    /// The reduced stick right-hand side, which shares the drive and sin θ, cos θ between the
+    /// constraint and the rows, gives bitwise what the constrained lip angle put into
+    /// [`Blade::stick_dynamics_on`] gives.
+    #[test]
+    fn reduced_stick_rhs_matches_the_constraint_then_the_rows() {
+        let b = blade(StickForm::Reduced);
+        for (t, y) in STATES {
+            // An anchor the lip can reach: the tip where the state puts it, moved by 0.1 mm.
+            let anchor = b.tip_position(t, &y) + 1e-4;
+            let mode = Mode {
+                phase: Phase::Stick,
+                anchor,
+                region: 0,
+            };
+            let mut dy = [0.0; 4];
+            let c = b.rhs(&mode, t, &y, &mut dy).unwrap();
+            let (phi, phi_d) = b.constrained_lip(t, y[0], y[2], anchor).unwrap();
+            let d = b
+                .stick_dynamics_on(t, &[y[0], phi, y[2], phi_d], anchor, 0.0, false)
+                .unwrap();
+            assert_eq!(dy, [y[2], 0.0, d.theta_dd, 0.0]);
+            assert_eq!((c.normal, c.friction), (d.normal_n, d.friction_n));
         }
     }
 }

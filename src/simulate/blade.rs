@@ -3,7 +3,7 @@
 use super::hybrid::{
     Mode, ModelFault, Phase, SolverOptions, Stats, StickSlipModel, Switch, Transition, integrate,
 };
-use crate::model::blade::{Blade, BladeParams, LockedBlade, StickForm};
+use crate::model::blade::{Blade, BladeParams, Kinematics, LockedBlade, StickForm};
 use crate::trace::{PointTrack, Role, Trace};
 use crate::{Error, Result};
 
@@ -46,8 +46,9 @@ pub struct BladeSimulation {
 
 impl BladeSimulation {
     /// Fills sample `j` from the state `y` (layout `[θ, φ, θ̇, φ̇]`) in `mode`: positions from
-    /// `blade`'s kinematics, the slip velocity from `model`.
-    fn observe<M: StickSlipModel<4>>(
+    /// `blade`'s kinematics, the slip velocity from `model`, all from one evaluation of the drive
+    /// and of each angle's sine and cosine.
+    fn observe<M: Observed>(
         &mut self,
         j: usize,
         model: &M,
@@ -55,14 +56,15 @@ impl BladeSimulation {
         y: &[f64; 4],
         mode: &Mode,
     ) {
-        let t = self.t_s[j];
-        self.u_m[j] = blade.head_drop(y);
-        self.v3_m[j] = blade.tip_position(t, y);
+        let k = blade.kinematics(self.t_s[j], y);
+        self.v_m[j] = k.head_position_m;
+        self.u_m[j] = k.head_drop_m;
+        self.v3_m[j] = k.tip_position_m;
         self.theta_rad[j] = y[0];
         self.phi_rad[j] = y[1];
         self.theta_dot_rad_per_s[j] = y[2];
         self.phi_dot_rad_per_s[j] = y[3];
-        self.v3_dot_m_per_s[j] = model.slip_velocity(t, y);
+        self.v3_dot_m_per_s[j] = model.slip_velocity_from(&k, y);
         self.modes[j] = *mode;
     }
 
@@ -324,13 +326,46 @@ pub fn simulate_necklip(
     Ok(sim)
 }
 
+/// A model whose state has the blade's layout `[θ, φ, θ̇, φ̇]`, observed through the blade's
+/// kinematics.
+trait Observed: StickSlipModel<4> {
+    /// [`StickSlipModel::slip_velocity`] at the state `y` whose kinematics are `k` (bitwise).
+    fn slip_velocity_from(&self, k: &Kinematics, y: &[f64; 4]) -> f64;
+}
+
+impl Observed for Blade {
+    fn slip_velocity_from(&self, k: &Kinematics, y: &[f64; 4]) -> f64 {
+        self.tip_velocity_from(k.head_speed_m_per_s, k.cos, y)
+    }
+}
+
+impl Observed for LockedBlade {
+    fn slip_velocity_from(&self, k: &Kinematics, y: &[f64; 4]) -> f64 {
+        self.tip_velocity_from(k.head_speed_m_per_s, k.cos[0], y[2])
+    }
+}
+
+impl Observed for crate::model::necklip::NeckLip {
+    fn slip_velocity_from(&self, k: &Kinematics, y: &[f64; 4]) -> f64 {
+        self.blade.tip_velocity_from(k.head_speed_m_per_s, k.cos, y)
+    }
+}
+
 /// A simulation before any sample was observed: the drive `v` at every sample, NaN positions,
 /// angles, rates and forces, every sample in `phase`.
 fn unsimulated(blade: &Blade, sample_times: &[f64], phase: Phase, reach_m: f64) -> BladeSimulation {
+    let mut sim = unobserved(sample_times, phase, reach_m);
+    sim.v_m = sample_times.iter().map(|&t| blade.drive(t).0).collect();
+    sim
+}
+
+/// A simulation before any sample was observed: NaN drive, positions, angles, rates and forces,
+/// every sample in `phase` (for a run that observes every sample).
+fn unobserved(sample_times: &[f64], phase: Phase, reach_m: f64) -> BladeSimulation {
     let n = sample_times.len();
     BladeSimulation {
         t_s: sample_times.to_vec(),
-        v_m: sample_times.iter().map(|&t| blade.drive(t).0).collect(),
+        v_m: vec![f64::NAN; n],
         u_m: vec![f64::NAN; n],
         v3_m: vec![f64::NAN; n],
         theta_rad: vec![f64::NAN; n],
@@ -438,7 +473,7 @@ pub fn simulate_blade(
 
 /// Integrates `model` (whose state has the blade's layout `[θ, φ, θ̇, φ̇]`) from `y0` and turns the run
 /// into observables with `blade`'s kinematics.
-fn run_to_simulation<M: crate::simulate::hybrid::StickSlipModel<4>>(
+fn run_to_simulation<M: Observed>(
     model: &M,
     blade: &Blade,
     y0: [f64; 4],
@@ -454,7 +489,7 @@ fn run_to_simulation<M: crate::simulate::hybrid::StickSlipModel<4>>(
         Phase::SlipNeg
     };
     let run = integrate(model, t0, y0, Mode::new(s0, 0.0), t1, sample_times, opts)?;
-    let mut sim = unsimulated(blade, &run.t_s, s0, params.l1_m + params.l2_m);
+    let mut sim = unobserved(&run.t_s, s0, params.l1_m + params.l2_m);
     for (j, (y, mode)) in run.y.iter().zip(&run.modes).enumerate() {
         sim.observe(j, model, blade, y, mode);
     }
