@@ -10,6 +10,7 @@
 //! rayon), then a Nelder–Mead polish from the best particle. Parameters are searched in normalised
 //! coordinates `u ∈ [0, 1]` (logarithmic for bounds spanning a factor ≥ 10).
 
+mod climb;
 mod error;
 pub mod evidence;
 pub mod ipop;
@@ -112,6 +113,12 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         } else {
             selection = select::choose(&fits, &job.job.spectrum.bands, explicit, &[]);
         }
+    }
+    if fit.uncertainty.method() == job::UncertaintyMethod::Profile
+        && climb::climb_chosen(job, &mut fits, selection.chosen, &pb)?
+    {
+        selection = choose(&mut fits)?;
+        (best, gof) = chosen_goodness(&fits[selection.chosen])?;
     }
     let (tolerance_check, choice_warning) =
         choose_at_resolution(job, &fits, &mut selection, (&mut best, &mut gof), explicit)?;

@@ -235,6 +235,8 @@ pub(super) struct CandidateFit {
     pub(super) search_note: Option<String>,
     /// The deferred confirmation of an unconfirmed best end, until [`confirm_deferred`].
     pub(super) unconfirmed: Option<Unconfirmed>,
+    /// The profile walk at the optimum ([`super::climb::climb_chosen`]), kept for its intervals.
+    pub(super) profile_walk: Option<super::climb::ProfileWalk>,
 }
 
 impl CandidateFit {
@@ -768,7 +770,7 @@ fn projection(smaller: &CandidateFit, larger: &CandidateFit) -> Option<Vec<f64>>
 
 /// Every candidate nested on `fits[smaller]` (`X+shoulder` on `X`) that is less likely than it
 /// takes its optimum ([`keep_the_smaller_optimum`]).
-fn keep_nested_above(
+pub(super) fn keep_nested_above(
     fits: &mut Vec<CandidateFit>,
     smaller: usize,
     pb: &Option<indicatif::ProgressBar>,
@@ -930,6 +932,7 @@ fn finish(
         search_cost,
         search_note: None,
         unconfirmed: None,
+        profile_walk: None,
     })
 }
 

@@ -477,7 +477,20 @@ fn profile_intervals(
     fit: &job::FitSection,
     pb: &Option<indicatif::ProgressBar>,
 ) -> Result<(Vec<Interval>, Vec<FitWarning>)> {
-    let at = ProfileStart::of(cf);
+    // The climb's last walk started at this optimum with this spread: its intervals stand.
+    if let Some(w) = cf.profile_walk.as_ref().filter(|w| w.at_u == cf.best_u) {
+        return Ok((w.intervals.clone(), w.warnings.clone()));
+    }
+    profile_walk(cf, ProfileStart::of(cf), fit.polish_iterations, pb)
+}
+
+/// [`profile_intervals_at`] of the candidate fit `cf` from `at`, its walks moving the progress bar.
+pub(super) fn profile_walk(
+    cf: &CandidateFit,
+    at: ProfileStart,
+    polish_iterations: u64,
+    pb: &Option<indicatif::ProgressBar>,
+) -> Result<(Vec<Interval>, Vec<FitWarning>)> {
     let progress = pb.as_ref().map(|bar| {
         // The bar's estimate: two steps a side, each polish its simplex and ten iterations (on
         // the main job's fit they stop at the ripples' depth after 6–12).
@@ -490,7 +503,7 @@ fn profile_intervals(
             evals: Arc::new(AtomicUsize::new(0)),
         }
     });
-    profile_with(&cf.problem, at, fit.polish_iterations, progress)
+    profile_with(&cf.problem, at, polish_iterations, progress)
 }
 
 /// Where [`profile_intervals_at`] starts: a fit and its spread, normalised coordinates.

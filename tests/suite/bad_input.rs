@@ -875,7 +875,7 @@ fn fit_cases() -> Vec<Case> {
         ),
         case(
             "fit: unknown uncertainty method",
-            j(&[("method = \"auto\"", "method = \"jackknife\"")]),
+            j(&[("method = \"profile\"", "method = \"jackknife\"")]),
             fit,
             &["$D/job.toml:", "jackknife"],
         ),
@@ -912,8 +912,8 @@ fn fit_cases() -> Vec<Case> {
         case(
             "fit: block means without the time-domain term",
             j(&[(
-                "method = \"auto\"",
-                "method = \"auto\"\n[fit.likelihood]\nblock_s = 0.02",
+                "method = \"profile\"",
+                "method = \"profile\"\n[fit.likelihood]\nblock_s = 0.02",
             )]),
             fit,
             &["$D/job.toml:", "block_s", "time_domain = true"],
@@ -921,8 +921,8 @@ fn fit_cases() -> Vec<Case> {
         case(
             "fit: block length zero",
             j(&[(
-                "method = \"auto\"",
-                "method = \"auto\"\n[fit.likelihood]\ntime_domain = true\nblock_s = 0.0",
+                "method = \"profile\"",
+                "method = \"profile\"\n[fit.likelihood]\ntime_domain = true\nblock_s = 0.0",
             )]),
             fit,
             &["$D/job.toml:", "block_s", "> 0 s"],
