@@ -132,10 +132,8 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let mut parameters = fitted_parameters(job, &cf);
     let peaks = peak_comparisons(&cf, &best.features)?;
     let (intervals, mut warnings, interrupted, posterior) = chosen_intervals(&cf, &best, fit, &pb)?;
-    if let Some(intervals) = intervals {
-        for (p, iv) in parameters.iter_mut().zip(intervals) {
-            p.interval = Some(iv);
-        }
+    for (p, iv) in parameters.iter_mut().zip(intervals.into_iter().flatten()) {
+        p.interval = Some(iv);
     }
     if let Some(pb) = &pb {
         pb.finish_and_clear();
