@@ -13,7 +13,7 @@
 //! [`PROFILE_CLIMBS`] times. The last walk, at the optimum the fit reports, is kept for the
 //! profile intervals ([`ProfileWalk`]), so a fit that does not move pays for one walk.
 
-use super::problem::EvaluatedNearBest;
+use super::evidence::LocalFit;
 use super::search::{
     CONFIRM_NATS, CandidateFit, Optimised, POLISH_STEP_U, Reporting, VALLEY_GAIN_NATS, add_note,
     keep_nested_above, polish, settle_anew,
@@ -25,10 +25,12 @@ use crate::job;
 /// The most times the climb moves the fit: each move costs a polish, a settling and a walk.
 pub const PROFILE_CLIMBS: usize = 3;
 
-/// A profile walk of a fit's optimum: its intervals and warnings, and the point it was walked at.
+/// A profile walk of a fit's optimum: its intervals and warnings, the point it was walked at, and
+/// the spread there it was walked with (what [`CandidateFit::with_smoothed_spread`] reports).
 pub(super) struct ProfileWalk {
     /// The normalised coordinates the walk started from (the intervals apply only there).
     pub(super) at_u: Vec<f64>,
+    pub(super) spread: LocalFit,
     pub(super) intervals: Vec<Interval>,
     pub(super) warnings: Vec<FitWarning>,
 }
@@ -59,14 +61,18 @@ pub(super) fn climb_chosen(
     let moved = loop {
         let walk = walk(&fits[chosen], job.job.fit.polish_iterations, pb)?;
         let f = &mut fits[chosen];
-        let better = best_point_beyond(f, CONFIRM_NATS);
-        let (Some(start), true) = (better, moves < PROFILE_CLIMBS) else {
-            f.profile_walk = walk;
+        // Kept unless the fit moves (settling anew makes a fit without a walk).
+        f.profile_walk = walk;
+        let start = {
+            let near = f.problem.near_best.lock();
+            let near = near.unwrap_or_else(|e| e.into_inner());
+            near.lowest_point_below(f.cost - CONFIRM_NATS)
+                .map(<[f64]>::to_vec)
+        };
+        let Some(start) = start.filter(|_| moves < PROFILE_CLIMBS && !interrupt::stop_requested())
+        else {
             break moves > 0;
         };
-        if interrupt::stop_requested() {
-            break moves > 0;
-        }
         let reporting = Reporting::continuing(f, pb);
         reporting.stage(format_args!("profile climb {}", moves + 1));
         let (u, polish_iters, cost) = polish(
@@ -77,7 +83,6 @@ pub(super) fn climb_chosen(
             None,
         )?;
         if f.cost - cost <= VALLEY_GAIN_NATS {
-            f.profile_walk = walk;
             break moves > 0;
         }
         let before = f.cost;
@@ -133,33 +138,16 @@ fn walk(
     let (intervals, warnings) = profile_walk(f, at, polish_iterations, pb)?;
     Ok(Some(ProfileWalk {
         at_u: f.best_u.clone(),
+        spread,
         intervals,
         warnings,
     }))
 }
 
-/// The lowest point the fit's problem kept (the search's and the walks' polish-stage
-/// evaluations) when it is more than `margin` nats more likely than the fit.
-fn best_point_beyond(f: &CandidateFit, margin: f64) -> Option<Vec<f64>> {
-    let near = f
-        .problem
-        .near_best
-        .lock()
-        .unwrap_or_else(|e| e.into_inner());
-    lowest_below(&near, f.cost - margin)
-}
-
-/// The lowest point of `near` when its cost is below `cost`.
-fn lowest_below(near: &EvaluatedNearBest, cost: f64) -> Option<Vec<f64>> {
-    let lowest = near.lowest();
-    (lowest < cost)
-        .then(|| near.at_most(lowest).next().map(|(_, u)| u.to_vec()))
-        .flatten()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fit::problem::EvaluatedNearBest;
 
     /// The climb starts from the lowest point kept, and only when it lies more than the margin
     /// below the fit: a fit at 10 nats with points kept at 9.7, 9.2 and 9.4 nats climbs from the
@@ -171,10 +159,10 @@ mod tests {
         near.record(&[0.2, 0.3], 9.2);
         near.record(&[0.4, 0.5], 9.4);
         assert_eq!(
-            lowest_below(&near, 10.0 - CONFIRM_NATS),
-            Some(vec![0.2, 0.3])
+            near.lowest_point_below(10.0 - CONFIRM_NATS),
+            Some([0.2, 0.3].as_slice())
         );
-        assert_eq!(lowest_below(&near, 10.0 - 1.0), None);
-        assert_eq!(lowest_below(&EvaluatedNearBest::default(), 10.0), None);
+        assert_eq!(near.lowest_point_below(10.0 - 1.0), None);
+        assert_eq!(EvaluatedNearBest::default().lowest_point_below(10.0), None);
     }
 }

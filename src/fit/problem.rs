@@ -130,6 +130,14 @@ impl EvaluatedNearBest {
         self.lowest
     }
 
+    /// The lowest recorded point when its cost is below `cost` (where a search that ended at
+    /// `cost` plus a margin could go on from).
+    pub fn lowest_point_below(&self, cost: f64) -> Option<&[f64]> {
+        (self.lowest < cost)
+            .then(|| self.at_most(self.lowest).next().map(|(_, u)| u))
+            .flatten()
+    }
+
     /// The recorded points whose cost is at most `cost`, as `(cost, u)`.
     pub fn at_most(&self, cost: f64) -> impl Iterator<Item = (f64, &[f64])> {
         self.points

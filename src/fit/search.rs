@@ -248,7 +248,15 @@ impl CandidateFit {
         if self.evidence.is_err() || interrupt::stop_requested() {
             return self;
         }
-        if let Ok(l) = super::evidence::at_fit_smoothed(&self.problem, &self.best_u) {
+        // The profile climb's last walk computed this spread at this optimum.
+        let walked = self
+            .profile_walk
+            .as_ref()
+            .filter(|w| w.at_u == self.best_u)
+            .map(|w| Ok(w.spread.clone()));
+        let smoothed =
+            walked.unwrap_or_else(|| super::evidence::at_fit_smoothed(&self.problem, &self.best_u));
+        if let Ok(l) = smoothed {
             self.sigma_u = l.sigma_u;
             self.corr = l.corr;
             self.fisher_sigma_u = Some(l.curvature_sigma_u);
