@@ -131,6 +131,7 @@ fn main() {
             blade: truth,
             truth: truths.iter().copied().collect(),
             truth_friction_law: None,
+            truth_model: None,
             ..main.clone()
         };
         job.job.fit.models.retain(|m| m.name() == "blade2dof");

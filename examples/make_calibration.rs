@@ -849,6 +849,9 @@ fn write_campaign(
          notes = \"\"\"\n{notes}\"\"\"\n\
          # The cameras run at 5–20 kHz: the main job's bands keep their bin widths at each frame rate.\n\
          bands_follow_frame_rate = true\n\n\
+         # Each recording's true model (its truth file's /model): the truth's cost is read in that\n\
+         # model's fit, so the search shortfall is measured whichever model the fit chooses.\n\
+         truth_model = \"/model\"\n\n\
          {law}\
          [truth_keys]               # the main job's [truth] names A, B, C and k1; a shoulder's are added\n\
          theta_c = \"/params/theta_c\"\n\

@@ -17,9 +17,11 @@
 //! * **Σz²** against χ²(n) ([`chi2_two_sided_p`]): too large, intervals too narrow; too small,
 //!   too wide;
 //! * median and 90th-percentile |relative error| ([`quantile`]);
-//! * **search shortfall**: the fit's cost above the truth's own cost at the same model, counted
-//!   where the chosen model contains the truth's (the same model, or a shoulder added to a
-//!   shoulder-free truth, whose truth file then prices it with a contact that is never reached);
+//! * **search shortfall**: the fit's cost above the truth's own cost at the same model: in the true
+//!   model's own candidate when the fits name it (`[truth] model`, the campaign's `truth_model`),
+//!   whichever model was chosen; else where the chosen model contains the truth's (the same model,
+//!   or a shoulder added to a shoulder-free truth, whose truth file then prices it with a contact
+//!   that is never reached);
 //! * the **model-choice confusion** matrix, true model × chosen model;
 //! * fit wall time, and the recordings that failed or have no result.
 //!
@@ -144,7 +146,8 @@ pub struct RecordingScore {
     /// The model that made the recording (`/model` of its truth file).
     pub true_model: Option<Candidate>,
     pub chosen: Option<Candidate>,
-    /// Fit cost − the truth's own cost, nats, when the result has the truth's cost.
+    /// Fit cost − the truth's own cost in the same model, nats, when the result has it
+    /// ([`FitResult::shortfall_nats`]) and that model can state the truth.
     pub shortfall_nats: Option<f64>,
     /// The ridge on the segment from the fit to the truth, nats ([`crate::fit::truth`]).
     pub ridge_nats: Option<f64>,
@@ -268,9 +271,8 @@ impl Calibration {
     /// truth, of them those with a ridge above [`RIDGE_NATS`]: the truth in another basin).
     pub fn shortfall_ridges(&self) -> (usize, usize) {
         let short = self.done().filter(|r| {
-            r.model_contains_truth()
-                && r.shortfall_nats
-                    .is_some_and(|s| s > SHORTFALL_TOLERANCE_NATS)
+            r.shortfall_nats
+                .is_some_and(|s| s > SHORTFALL_TOLERANCE_NATS)
         });
         let ridges: Vec<f64> = short.filter_map(|r| r.ridge_nats).collect();
         let beyond = ridges.iter().filter(|h| is_ridge(**h)).count();
@@ -279,11 +281,7 @@ impl Calibration {
 
     /// (fits whose shortfall is known, of them above [`SHORTFALL_TOLERANCE_NATS`], the largest).
     pub fn shortfalls(&self) -> (usize, usize, f64) {
-        let s: Vec<f64> = self
-            .done()
-            .filter(|r| r.model_contains_truth())
-            .filter_map(|r| r.shortfall_nats)
-            .collect();
+        let s: Vec<f64> = self.done().filter_map(|r| r.shortfall_nats).collect();
         let over = s.iter().filter(|x| **x > SHORTFALL_TOLERANCE_NATS).count();
         (s.len(), over, s.iter().copied().fold(f64::NAN, f64::max))
     }
@@ -388,7 +386,7 @@ fn truth_labels(path: &Path) -> Result<(Option<Candidate>, Option<String>)> {
 /// Fills `r` from its fit `result`: the chosen model, the shortfall and the scored parameters.
 fn score(r: &mut RecordingScore, result: &FitResult) {
     r.chosen = Some(result.model);
-    r.shortfall_nats = result.shortfall_nats();
+    r.shortfall_nats = priced_shortfall(r, result.shortfall_nats(), result.truth_model.is_some());
     r.ridge_nats = result.truth_segment.as_ref().map(|s| s.ridge_nats);
     r.law = super::law::LawScore::of(result);
     r.gof_p = result.goodness_of_fit.as_ref().map(|g| g.p_value);
@@ -408,6 +406,13 @@ fn score(r: &mut RecordingScore, result: &FitResult) {
             level: p.interval.as_ref().map_or(f64::NAN, |i| i.level),
         });
     }
+}
+
+/// A fit's `shortfall` where it measures the search: the truth priced in its own model's candidate
+/// (`in_true_model`, the fit's `[truth] model`) or in a chosen model that can state it; `None`
+/// where the truth was priced in a model that cannot (its cost there says nothing of the search).
+fn priced_shortfall(r: &RecordingScore, shortfall: Option<f64>, in_true_model: bool) -> Option<f64> {
+    shortfall.filter(|_| in_true_model || r.model_contains_truth())
 }
 
 pub(super) fn pct(x: f64) -> String {
@@ -546,8 +551,8 @@ pub fn to_markdown(c: &Calibration, notes: Option<&str>, command: &str) -> Strin
     let _ = writeln!(
         md,
         "\n## Search shortfall\n\n\
-         {over} of {known} fits (those whose chosen model contains the true one and whose result has \
-         the truth's own cost) end more than {SHORTFALL_TOLERANCE_NATS} nats above the truth's cost; \
+         {over} of {known} fits (those whose result has the truth's own cost in the true model's \
+         candidate, or in a chosen model that contains it) end more than {SHORTFALL_TOLERANCE_NATS} nats above the truth's cost; \
          rate {}; largest shortfall {} nats (negative: the fit is more likely than the truth).",
         if known > 0 {
             pct(over as f64 / known as f64)
@@ -912,9 +917,10 @@ mod tests {
         assert!((s.median_abs_rel_error - 0.05).abs() < 1e-12);
     }
 
-    /// The page of four recordings: a shoulder-free truth fitted with a shoulder (scored, its
+    /// The page of five recordings: a shoulder-free truth fitted with a shoulder (scored, its
     /// shortfall 0.3 nats counted), a shoulder truth fitted without (not scored, in the confusion
-    /// matrix), a failure with its reason and a recording not yet fitted.
+    /// matrix; its shortfall counted only where the fit priced the truth in the true model), a
+    /// failure with its reason and a recording not yet fitted.
     #[test]
     fn markdown_counts_shortfalls_confusion_and_missing_fits() {
         let c = |s: &str| s.parse::<Candidate>().ok();
@@ -927,7 +933,12 @@ mod tests {
         let mut shoulder = recording(&[]);
         shoulder.id = "shoulder".into();
         shoulder.true_model = c("blade2dof+shoulder");
-        shoulder.shortfall_nats = Some(5.0);
+        shoulder.shortfall_nats = priced_shortfall(&shoulder, Some(5.0), false);
+        assert_eq!(shoulder.shortfall_nats, None, "priced in the chosen blade2dof");
+        let mut priced = shoulder.clone();
+        priced.id = "priced".into();
+        priced.shortfall_nats = priced_shortfall(&priced, Some(-0.4), true);
+        assert_eq!(priced.shortfall_nats, Some(-0.4), "priced in its own model");
         let mut failed = recording(&[]);
         failed.id = "broken".into();
         failed.state = "failed".into();
@@ -936,7 +947,7 @@ mod tests {
         let mut missing = failed.clone();
         missing.id = "later".into();
         missing.state = "missing".into();
-        let recordings = vec![free, shoulder, failed, missing];
+        let recordings = vec![free, shoulder, priced, failed, missing];
         let cal = Calibration {
             name: "t".into(),
             campaign: PathBuf::from("t.toml"),
@@ -946,17 +957,17 @@ mod tests {
         };
         assert_eq!(
             cal.shortfalls().0,
-            1,
-            "the shoulder truth fitted without one is not priced"
+            2,
+            "the shoulder truth fitted without one is priced only in its own model"
         );
         assert_eq!(cal.shortfalls().1, 1);
         let md = to_markdown(&cal, Some("notes here"), "wiperlab campaign collect t.toml");
         assert!(md.contains("notes here") && md.contains("`wiperlab campaign collect t.toml`"));
         assert!(
-            md.contains("2 fitted, 1 failed, 1 without a result"),
+            md.contains("3 fitted, 1 failed, 1 without a result"),
             "{md}"
         );
-        assert!(md.contains("1 of 1 fits"), "{md}");
+        assert!(md.contains("1 of 2 fits"), "{md}");
         // Its segment to the truth crosses a 2.2-nat ridge: another basin.
         assert_eq!(cal.shortfall_ridges(), (1, 1));
         assert!(
@@ -965,7 +976,7 @@ mod tests {
             "{md}"
         );
         assert!(md.contains("| blade2dof | 0 | 1 |"), "{md}");
-        assert!(md.contains("| blade2dof+shoulder | 1 | 0 |"), "{md}");
+        assert!(md.contains("| blade2dof+shoulder | 2 | 0 |"), "{md}");
         assert!(md.contains("- broken failed: simulation failed"), "{md}");
         assert!(
             md.contains("- 1 not fitted (or still running): later"),

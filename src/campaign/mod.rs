@@ -64,6 +64,11 @@ pub struct CampaignFile {
     /// friction_law`): the fitted law is then scored as a curve over the measured slip speeds.
     #[serde(default)]
     pub truth_friction_law: Option<String>,
+    /// JSON pointer to the name of each recording's true model (the template's `[truth] model`):
+    /// the fit then reads the truth's cost in that model's candidate, so the search shortfall is
+    /// measured on every recording, whichever model the fit chooses.
+    #[serde(default)]
+    pub truth_model: Option<String>,
     /// Scale the template's Welch bands to each recording's frame rate (`fps_hz` column): keep
     /// each band's bin width (nperseg, and noverlap and nfft when given, times the frame-rate
     /// ratio, rounded to a power of two as `wiperlab init` does) and clip its upper edge at the
@@ -237,13 +242,15 @@ impl Campaign {
                 "a campaign template must be a fit job with a [recording] section (its file is replaced per recording)",
             ));
         }
-        if (!file.truth_keys.is_empty() || file.truth_friction_law.is_some())
+        if (!file.truth_keys.is_empty()
+            || file.truth_friction_law.is_some()
+            || file.truth_model.is_some())
             && template.truth.is_none()
         {
             return Err(Error::input(
                 &path,
                 format!(
-                    "truth_keys and truth_friction_law add to the template's [truth], but the template {} has no [truth] section",
+                    "truth_keys, truth_friction_law and truth_model add to the template's [truth], but the template {} has no [truth] section",
                     template_path.display()
                 ),
             ));
@@ -332,6 +339,9 @@ impl Campaign {
         let mut truth = merged_truth(template.truth, &self.file.truth_keys)?;
         if let Some(ptr) = &self.file.truth_friction_law {
             truth.friction_law = Some(ptr.clone());
+        }
+        if let Some(ptr) = &self.file.truth_model {
+            truth.model = Some(ptr.clone());
         }
         truth.json = match entry.files.get(&FileOverride::TruthJson) {
             Some(p) => p.clone(),

@@ -103,6 +103,9 @@ pub fn generate(campaign: &Campaign, entry: &Entry, paths: &EntryPaths) -> Resul
     if let Some(ptr) = &campaign.file.truth_friction_law {
         table_at(&mut job, tpl, "truth")?.insert("friction_law".into(), ptr.clone().into());
     }
+    if let Some(ptr) = &campaign.file.truth_model {
+        table_at(&mut job, tpl, "truth")?.insert("model".into(), ptr.clone().into());
+    }
     if campaign.file.bands_follow_frame_rate {
         follow_frame_rate(campaign, entry, &mut job)?;
     }

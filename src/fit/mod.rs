@@ -147,7 +147,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     warnings.extend(identifiability_warnings(&parameters, &cf.corr, &cf.best_u));
     warnings.extend(choice_warning);
     let tol = tolerance_check.as_ref();
-    let truth = optimum_checks(job, &cf, &best, tol, interrupted, &mut warnings);
+    let truth = optimum_checks(job, (&cf, &fits), &best, tol, interrupted, &mut warnings);
     warnings.extend(failure_warning(&cf.problem));
     // The chosen model's counts include its bootstrap replicates and the tolerance check's
     // simulations (they share its counters).
@@ -257,21 +257,28 @@ fn choose_at_resolution(
 }
 
 /// The checks at the chosen optimum `best` that simulate again or read its tolerance check: the
-/// check's warnings pushed to `warnings`, and the truth's cost and segment ([`truth::check`]),
-/// with the shortfall warning. The truth is not checked after an interrupt.
+/// check's warnings pushed to `warnings`, and the truth's cost and segment ([`truth::check`]) in
+/// the chosen fit `cf` or, where `[truth] model` names another, in that model's fit among
+/// `others`, with the shortfall warning. The truth is not checked after an interrupt.
 fn optimum_checks(
     job: &LoadedJob,
-    cf: &CandidateFit,
+    (cf, others): (&CandidateFit, &[CandidateFit]),
     best: &BestModel,
     tolerance_check: Option<&tolerance::ToleranceCheck>,
     interrupted: bool,
     warnings: &mut Vec<FitWarning>,
 ) -> Option<truth::TruthCheck> {
     warnings.extend(tolerance_check.and_then(|t| t.warning()));
-    let truth = (!interrupted)
-        .then(|| truth::check(job, cf, best.cost))
-        .flatten();
-    warnings.extend((truth.as_ref()).and_then(|t| truth::shortfall_warning(best.cost, t)));
+    if interrupted {
+        return None;
+    }
+    let tf = truth::truth_fit(job, cf, others)?;
+    let truth = if std::ptr::eq(tf, cf) {
+        truth::check(job, cf, best.cost, None)
+    } else {
+        truth::check(job, tf, tf.cost, Some(tf.candidate))
+    };
+    warnings.extend(truth.as_ref().and_then(truth::shortfall_warning));
     truth
 }
 
@@ -686,6 +693,9 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         tolerance_check: a.tolerance_check,
         tracking_noise: a.tracking_noise,
         truth_cost: a.truth.as_ref().map(|t| t.cost_nats),
+        truth_model: a.truth.as_ref().and_then(|t| t.model),
+        truth_model_cost: (a.truth.as_ref())
+            .and_then(|t| t.model.is_some().then_some(t.fit_cost_nats)),
         truth_segment: a.truth.and_then(|t| t.segment),
         friction_curve: None,
         posterior: None,

@@ -443,6 +443,14 @@ pub struct FitResult {
     /// truth inside the search box for every freed parameter.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub truth_segment: Option<crate::fit::truth::TruthSegment>,
+    /// The model the truth's cost and segment are read in when it is not the chosen one (the
+    /// job's `[truth] model`, [`crate::fit::truth`]); `None`: the chosen model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truth_model: Option<Candidate>,
+    /// The cost of [`FitResult::truth_model`]'s own fit, nats (its optimum, which the choice did
+    /// not take).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truth_model_cost: Option<f64>,
     /// The fitted μ_d(v) over the slip speeds the fitted motion covers, with its ±1σ band and the
     /// true law when known ([`crate::model::friction_curve`]); `None` when the fitted model never
     /// slips, and in results written before this field.
@@ -460,10 +468,12 @@ pub struct FitResult {
 }
 
 impl FitResult {
-    /// How far the fit's cost lies above the truth's own ([`FitResult::truth_cost`]), nats:
-    /// positive when the search stopped short of a point it could have reached.
+    /// How far the fit's cost lies above the truth's own ([`FitResult::truth_cost`]), nats, in the
+    /// model the truth is read in (the chosen one, or [`FitResult::truth_model`]): positive when
+    /// the search stopped short of a point it could have reached.
     pub fn shortfall_nats(&self) -> Option<f64> {
-        self.truth_cost.map(|t| self.cost - t)
+        let fit = self.truth_model_cost.unwrap_or(self.cost);
+        self.truth_cost.map(|t| fit - t)
     }
 }
 

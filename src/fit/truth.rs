@@ -1,5 +1,7 @@
-//! The fit against the truth of a model-made recording (a job's `[truth]`): the chosen model's cost
-//! at the true parameters, and the likelihood along the straight segment from the fit to them.
+//! The fit against the truth of a model-made recording (a job's `[truth]`): the cost at the true
+//! parameters, and the likelihood along the straight segment from the fit to them. Both are read in
+//! the true model's candidate when `[truth] model` names one the job fitted (so the search is
+//! judged where the truth can be stated, whichever model was chosen), else in the chosen one.
 //!
 //! A fit less likely than the truth has failed its search; the segment says how. A ridge on it
 //! (an interior point less likely than both ends by more than [`RIDGE_NATS`]) puts the truth in
@@ -11,7 +13,7 @@
 
 use super::search::CandidateFit;
 use super::warning::FitWarning;
-use crate::job::LoadedJob;
+use crate::job::{Candidate, LoadedJob};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -47,19 +49,53 @@ pub fn is_ridge(ridge_nats: f64) -> bool {
     ridge_nats > RIDGE_NATS
 }
 
-/// What the truth says of a fit: the chosen model's cost there and the segment to it.
+/// What the truth says of a fit: the cost there and the segment to it, in the candidate the truth
+/// is read in ([`truth_fit`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct TruthCheck {
+    /// The cost at the true parameters, nats.
     pub cost_nats: f64,
     pub segment: Option<TruthSegment>,
+    /// The cost of the fit the truth is compared with (that candidate's own optimum), nats.
+    pub fit_cost_nats: f64,
+    /// The true model, when the truth is read in a candidate other than the chosen one.
+    pub model: Option<Candidate>,
 }
 
-/// The truth's cost and segment for the chosen fit `cf` of cost `fit_cost`, at the fit's solver;
-/// `None` without a truth for every freed parameter or when the truth cannot be simulated. The
-/// segment is left out where a true value lies outside the search box. `1 + 9` simulations, counted
-/// as the chosen model's evaluations; none of them enters the intervals (already computed) or the
-/// search's record of near-best points.
-pub(super) fn check(job: &LoadedJob, cf: &CandidateFit, fit_cost: f64) -> Option<TruthCheck> {
+/// The candidate fit the truth is read in: the chosen fit when its model is the truth's or the job
+/// names no true model; else the lowest-cost fit among `others` of the true model (its kind and
+/// shoulder, and its law where the truth names one); `None` when the job did not fit the true model.
+pub(super) fn truth_fit<'a>(
+    job: &LoadedJob,
+    chosen: &'a CandidateFit,
+    others: &'a [CandidateFit],
+) -> Option<&'a CandidateFit> {
+    let Some(m) = job.truth_model else {
+        return Some(chosen);
+    };
+    let is_true = |c: &Candidate| {
+        c.kind == m.kind && c.shoulder == m.shoulder && (m.law.is_none() || c.law == m.law)
+    };
+    if is_true(&chosen.candidate) {
+        return Some(chosen);
+    }
+    others
+        .iter()
+        .filter(|f| is_true(&f.candidate))
+        .min_by(|a, b| a.cost.total_cmp(&b.cost))
+}
+
+/// The truth's cost and segment for the fit `cf` of cost `fit_cost`, at the fit's solver; `None`
+/// without a truth for every freed parameter or when the truth cannot be simulated. The segment is
+/// left out where a true value lies outside the search box. `1 + 9` simulations, counted as `cf`'s
+/// evaluations; none of them enters the intervals (already computed) or the search's record of
+/// near-best points. `model` is the true model when `cf` is not the chosen fit.
+pub(super) fn check(
+    job: &LoadedJob,
+    cf: &CandidateFit,
+    fit_cost: f64,
+    model: Option<Candidate>,
+) -> Option<TruthCheck> {
     let p = &cf.problem;
     let mut params = p.base;
     let mut u_true = Vec::with_capacity(p.free.len());
@@ -72,7 +108,12 @@ pub(super) fn check(job: &LoadedJob, cf: &CandidateFit, fit_cost: f64) -> Option
     }
     let cost_nats = p.total_cost(&p.simulate(&params).ok()?).ok()? + p.prior.nats(&params);
     let segment = inside.then(|| segment(cf, &u_true, fit_cost, cost_nats));
-    Some(TruthCheck { cost_nats, segment })
+    Some(TruthCheck {
+        cost_nats,
+        segment,
+        fit_cost_nats: fit_cost,
+        model,
+    })
 }
 
 /// [`TruthSegment`] from the fit `cf.best_u` (cost `fit_cost`) to `u_true` (cost `truth_cost`).
@@ -108,14 +149,17 @@ pub fn ridge_height(interior: &[f64], truth_rise: f64) -> f64 {
     top - truth_rise.max(0.0)
 }
 
-/// The warning of a fit whose cost `cost` lies above the truth's own by more than
-/// [`SHORTFALL_TOLERANCE_NATS`]: the search stopped short of the likelihood's maximum, with the
-/// segment's ridge when it was measured.
-pub fn shortfall_warning(cost: f64, truth: &TruthCheck) -> Option<FitWarning> {
-    (cost - truth.cost_nats > SHORTFALL_TOLERANCE_NATS).then(|| FitWarning::TruthMoreLikely {
-        fit_cost_nats: cost,
-        truth_cost_nats: truth.cost_nats,
-        ridge_nats: truth.segment.as_ref().map(|s| s.ridge_nats),
+/// The warning of a fit whose cost lies above the truth's own by more than
+/// [`SHORTFALL_TOLERANCE_NATS`] (in the candidate the truth is read in): the search stopped short
+/// of the likelihood's maximum, with the segment's ridge when it was measured.
+pub fn shortfall_warning(truth: &TruthCheck) -> Option<FitWarning> {
+    (truth.fit_cost_nats - truth.cost_nats > SHORTFALL_TOLERANCE_NATS).then(|| {
+        FitWarning::TruthMoreLikely {
+            fit_cost_nats: truth.fit_cost_nats,
+            truth_cost_nats: truth.cost_nats,
+            ridge_nats: truth.segment.as_ref().map(|s| s.ridge_nats),
+            model: truth.model,
+        }
     })
 }
 

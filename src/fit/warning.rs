@@ -93,6 +93,9 @@ pub enum FitWarning {
         /// `None` where it was not measured.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         ridge_nats: Option<f64>,
+        /// The true model, when it is not the chosen one: the costs are that candidate's.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        model: Option<crate::job::Candidate>,
     },
     /// The chosen model does not explain the recording's spectra to their noise.
     Misfit {
@@ -416,7 +419,8 @@ impl fmt::Display for FitWarning {
                 fit_cost_nats,
                 truth_cost_nats,
                 ridge_nats,
-            } => truth_more_likely(f, *fit_cost_nats, *truth_cost_nats, *ridge_nats),
+                model,
+            } => truth_more_likely(f, [*fit_cost_nats, *truth_cost_nats], *ridge_nats, *model),
             Misfit {
                 test,
                 shoulder_listed,
@@ -527,16 +531,17 @@ impl fmt::Display for FitWarning {
 /// [`FitWarning::TruthMoreLikely`]'s sentence.
 fn truth_more_likely(
     f: &mut fmt::Formatter<'_>,
-    fit: f64,
-    truth: f64,
+    [fit, truth]: [f64; 2],
     ridge: Option<f64>,
+    model: Option<crate::job::Candidate>,
 ) -> fmt::Result {
+    let whose = model.map_or(String::new(), |m| format!(" of the true model {m}"));
     write!(
         f,
-        "the truth is more likely than the fit: cost {truth:.2} nats at the true parameters \
-         against {fit:.2} at the fit ({:.2} nats short): the search stopped before the \
-         likelihood's maximum, so the fitted values and their intervals describe a point that is \
-         not the estimate",
+        "the truth is more likely than the fit{whose}: cost {truth:.2} nats at the true \
+         parameters against {fit:.2} at the fit ({:.2} nats short): the search stopped before \
+         the likelihood's maximum, so the fitted values and their intervals describe a point that \
+         is not the estimate",
         fit - truth
     )?;
     match ridge {

@@ -573,6 +573,11 @@ pub struct TruthSection {
     /// blade file's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction_law: Option<String>,
+    /// JSON pointer to the name of the model that made the recording (as in `[fit] models`, e.g.
+    /// `"blade2dof+shoulder"`): the truth's cost is then read in that candidate's fit, whichever
+    /// model the fit chooses ([`crate::fit::truth`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<String>,
 }
 
 /// One step of a path into a TOML document: a key of a table or an index into an array.
@@ -701,6 +706,8 @@ pub struct LoadedJob {
     pub truth: BTreeMap<ParamId, f64>,
     /// The true friction law at `[truth] friction_law`, when the job names one.
     pub truth_friction_law: Option<FrictionLaw>,
+    /// The model that made the recording, at `[truth] model`, when the job names one.
+    pub truth_model: Option<Candidate>,
     /// The rig curve of `[fit.priors.friction_curve]`, as read.
     pub rig_curve: Option<RigCurve>,
 }
@@ -742,7 +749,11 @@ impl LoadedJob {
         check.solver()?;
         check.bands()?;
         let rig_curve = check.priors(&free, dir)?;
-        let (truth, truth_friction_law) = read_truth(dir, job.truth.as_ref())?;
+        let TruthRead {
+            values: truth,
+            law: truth_friction_law,
+            model: truth_model,
+        } = read_truth(dir, job.truth.as_ref())?;
         Ok(LoadedJob {
             recording_path: match &job.recording {
                 Some(r) => dir.join(&r.file),
@@ -756,6 +767,7 @@ impl LoadedJob {
             free,
             truth,
             truth_friction_law,
+            truth_model,
             rig_curve,
         })
     }
@@ -1262,19 +1274,26 @@ impl Check<'_> {
     }
 }
 
-/// True values of the freed parameters from the job's `[truth]` JSON file (empty without one), and
-/// the true friction law when `[truth] friction_law` points to one.
-fn read_truth(
-    dir: &Path,
-    truth: Option<&TruthSection>,
-) -> Result<(BTreeMap<ParamId, f64>, Option<FrictionLaw>)> {
-    let mut values = BTreeMap::new();
+/// What a job's `[truth]` says ([`read_truth`]).
+#[derive(Debug, Default)]
+struct TruthRead {
+    /// True values of the freed parameters.
+    values: BTreeMap<ParamId, f64>,
+    /// The true friction law, at `[truth] friction_law`.
+    law: Option<FrictionLaw>,
+    /// The model that made the recording, at `[truth] model`.
+    model: Option<Candidate>,
+}
+
+/// The job's `[truth]` JSON file read at its keys and pointers (empty without one).
+fn read_truth(dir: &Path, truth: Option<&TruthSection>) -> Result<TruthRead> {
     let Some(t) = truth else {
-        return Ok((values, None));
+        return Ok(TruthRead::default());
     };
     let tp = dir.join(&t.json);
     let v: serde_json::Value = serde_json::from_str(&read_text(&tp)?)
         .map_err(|e| Error::parse(&tp, e.line(), e.column(), format!("not valid JSON: {e}")))?;
+    let mut values = BTreeMap::new();
     for (k, ptr) in &t.keys {
         // `null`: the recording's true model has no such parameter (a friction law of another
         // family), so the fit's value has no truth to be scored against.
@@ -1289,25 +1308,39 @@ fn read_truth(
         })?;
         values.insert(*k, x);
     }
-    let law = match &t.friction_law {
-        None => None,
-        Some(ptr) => {
-            let at = v.pointer(ptr).ok_or_else(|| {
-                Error::input(
-                    &tp,
-                    format!("nothing at JSON pointer {ptr} (for friction_law)"),
-                )
+    let law = t
+        .friction_law
+        .as_deref()
+        .map(|ptr| true_law(&tp, &v, ptr))
+        .transpose()?;
+    let model = t
+        .model
+        .as_deref()
+        .map(|ptr| {
+            let name = v.pointer(ptr).and_then(|x| x.as_str()).ok_or_else(|| {
+                Error::input(&tp, format!("no model name at JSON pointer {ptr} (for model)"))
             })?;
-            let law = FrictionLaw::deserialize(at).map_err(|e| {
-                Error::input(&tp, format!("the friction law at JSON pointer {ptr}: {e}"))
-            })?;
-            law.validate().map_err(|e| {
-                Error::input(&tp, format!("the friction law at JSON pointer {ptr}: {e}"))
-            })?;
-            Some(law)
-        }
-    };
-    Ok((values, law))
+            name.parse::<Candidate>().map_err(|e| {
+                Error::input(&tp, format!("the model at JSON pointer {ptr}: {e}"))
+            })
+        })
+        .transpose()?;
+    Ok(TruthRead { values, law, model })
+}
+
+/// The friction law at JSON pointer `ptr` of the truth file `tp` (parsed as `v`).
+fn true_law(tp: &Path, v: &serde_json::Value, ptr: &str) -> Result<FrictionLaw> {
+    let at = v.pointer(ptr).ok_or_else(|| {
+        Error::input(
+            tp,
+            format!("nothing at JSON pointer {ptr} (for friction_law)"),
+        )
+    })?;
+    let law = FrictionLaw::deserialize(at)
+        .map_err(|e| Error::input(tp, format!("the friction law at JSON pointer {ptr}: {e}")))?;
+    law.validate()
+        .map_err(|e| Error::input(tp, format!("the friction law at JSON pointer {ptr}: {e}")))?;
+    Ok(law)
 }
 
 #[cfg(test)]
@@ -1342,9 +1375,11 @@ mod tests {
             json: "truth.json".into(),
             keys: BTreeMap::new(),
             friction_law: Some(ptr.into()),
+            model: None,
         };
-        let (_, law) = read_truth(dir.path(), Some(&section("/law"))).unwrap();
-        job.truth_friction_law = law;
+        job.truth_friction_law = read_truth(dir.path(), Some(&section("/law")))
+            .unwrap()
+            .law;
         assert_eq!(
             job.true_friction_law(),
             Some(FrictionLaw::ExponentialViscous {
@@ -1381,15 +1416,17 @@ mod tests {
             json: "truth.json".into(),
             keys: keys.iter().map(|(k, p)| (*k, p.to_string())).collect(),
             friction_law: None,
+            model: None,
         };
-        let (values, _) = read_truth(
+        let values = read_truth(
             dir.path(),
             Some(&section(&[
                 (ParamId::A, "/params/A"),
                 (ParamId::K1, "/params/k1"),
             ])),
         )
-        .unwrap();
+        .unwrap()
+        .values;
         assert_eq!(values, BTreeMap::from([(ParamId::K1, 0.03)]));
         let e = read_truth(dir.path(), Some(&section(&[(ParamId::C, "/params/C")])))
             .unwrap_err()
@@ -1398,6 +1435,38 @@ mod tests {
             e.contains("no number (or null) at JSON pointer /params/C"),
             "{e}"
         );
+    }
+
+    /// `[truth] model` reads the true model's name (a shoulder model here); a pointer to nothing
+    /// or to a name that is no model is refused naming the pointer.
+    #[test]
+    fn the_true_model_comes_from_the_truth() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("truth.json"),
+            r#"{"model": "blade2dof+shoulder", "bad": "blade3dof"}"#,
+        )
+        .unwrap();
+        let section = |ptr: &str| TruthSection {
+            json: "truth.json".into(),
+            keys: BTreeMap::new(),
+            friction_law: None,
+            model: Some(ptr.into()),
+        };
+        let model = read_truth(dir.path(), Some(&section("/model")))
+            .unwrap()
+            .model
+            .unwrap();
+        assert_eq!(model.to_string(), "blade2dof+shoulder");
+        for (ptr, says) in [
+            ("/bad", "the model at JSON pointer /bad"),
+            ("/none", "no model name at JSON pointer /none"),
+        ] {
+            let e = read_truth(dir.path(), Some(&section(ptr)))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(says), "{e}");
+        }
     }
 
     #[test]

@@ -1221,6 +1221,8 @@ pub(super) mod tests {
             tracking_noise: None,
             truth_cost: None,
             truth_segment: None,
+            truth_model: None,
+            truth_model_cost: None,
             friction_curve: None,
             posterior: None,
             priors: None,

@@ -198,7 +198,8 @@ fn fit_headline(w: &FitWarning) -> String {
             fit_cost_nats,
             truth_cost_nats,
             ridge_nats,
-        } => truth_more_likely_headline(fit_cost_nats - truth_cost_nats, *ridge_nats),
+            model,
+        } => truth_more_likely_headline(fit_cost_nats - truth_cost_nats, *ridge_nats, *model),
         Misfit { test, shape, .. } => misfit_headline(test.p_value, shape),
         AbsorbsModelStructure {
             parameter,
@@ -320,8 +321,13 @@ fn rig_curve_conflict_headline(rms_z: f64, points: usize) -> String {
     )
 }
 
-/// [`FitWarning::TruthMoreLikely`]'s headline, the truth `short_nats` more likely than the fit.
-fn truth_more_likely_headline(short_nats: f64, ridge_nats: Option<f64>) -> String {
+/// [`FitWarning::TruthMoreLikely`]'s headline, the truth `short_nats` more likely than the fit (of
+/// the true `model` when the choice took another).
+fn truth_more_likely_headline(
+    short_nats: f64,
+    ridge_nats: Option<f64>,
+    model: Option<Candidate>,
+) -> String {
     let basin = match ridge_nats {
         Some(r) if crate::fit::truth::is_ridge(r) => {
             " The truth lies in another basin, beyond a ridge: refit with more restarts."
@@ -329,10 +335,18 @@ fn truth_more_likely_headline(short_nats: f64, ridge_nats: Option<f64>) -> Strin
         Some(_) => " No ridge lies between them: the search stopped on the truth's slope.",
         None => "",
     };
-    format!(
-        "The truth is {short_nats:.2} nats more likely than the fit: the search stopped short of \
-         the likelihood's maximum, so the values and intervals describe the wrong point.{basin}"
-    )
+    match model {
+        None => format!(
+            "The truth is {short_nats:.2} nats more likely than the fit: the search stopped short \
+             of the likelihood's maximum, so the values and intervals describe the wrong \
+             point.{basin}"
+        ),
+        Some(m) => format!(
+            "The truth is {short_nats:.2} nats more likely than the fit of its own model, {m}, \
+             which the choice did not take: that model's search stopped short of its maximum, so \
+             the models were compared at a point that is not its estimate.{basin}"
+        ),
+    }
 }
 
 /// [`FitWarning::AbsorbsModelStructure`]'s headline: the parameter's value with the chosen model,

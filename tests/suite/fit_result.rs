@@ -121,6 +121,7 @@ fn sample() -> FitResult {
                 fit_cost_nats: 38.3,
                 truth_cost_nats: 35.9,
                 ridge_nats: Some(31.1),
+                model: Some("blade2dof+shoulder".parse().expect("a model name")),
             },
         ]
         .into(),
@@ -157,6 +158,8 @@ fn sample() -> FitResult {
             rise_nats: vec![5.0, 31.1, -2.0],
             ridge_nats: 31.1,
         }),
+        truth_model: Some("blade2dof+shoulder".parse().expect("a model name")),
+        truth_model_cost: Some(38.3),
         friction_curve: None,
         posterior: None,
         priors: Some(wiperlab::likelihood::prior::PriorsReport {
