@@ -1,0 +1,129 @@
+//! Does the fit's integrator reproduce a model-made recording at its true parameters? The cost of
+//! the truth (a job's `[truth]`, in the model `[truth] model` names, else `--model`) at the job's
+//! own solver, at tenfold and hundredfold tighter tolerances, and with DOP853 at rtol 1e-10 and
+//! 1e-12 (the calibration recordings are made with DOP853 at 1e-10); with a result, the fitted
+//! point's cost at the same solvers beside it.
+//!
+//! A truth whose cost falls by more than the likelihood's resolution (a few tenths of a nat) as the
+//! tolerance tightens is one the fit's tolerance prices wrongly: its excess over the fit is then
+//! the integrator's, not the noise's, and intervals calibrated on the noise cannot cover it
+//! (docs/validation.md, "Calibration by simulation").
+//!
+//! ```sh
+//! cargo run --release --example truth_tolerance -- JOB.toml [RESULT.toml] [--model NAME]
+//! ```
+
+use clap::Parser;
+use std::path::PathBuf;
+use wiperlab::fit::problem_for;
+use wiperlab::job::{Candidate, LoadedJob};
+use wiperlab::simulate::{Method, SolverOptions};
+
+#[derive(Parser)]
+struct Args {
+    /// The fit job (with `[truth]` for every freed parameter of the model).
+    job: PathBuf,
+    /// The result the job's fit wrote: its fitted point is priced beside the truth.
+    result: Option<PathBuf>,
+    /// The model to price the truth in (default: `[truth] model`, else the result's, else the
+    /// job's first candidate).
+    #[arg(long)]
+    model: Option<Candidate>,
+}
+
+type Fallible<T> = Result<T, Box<dyn std::error::Error>>;
+
+/// The solvers the truth is priced at: the job's, its tenfold and hundredfold tighter
+/// tolerances, and DOP853 at 1e-10 and 1e-12 (atol a hundredth of rtol).
+fn solvers(job: &SolverOptions) -> Vec<(String, SolverOptions)> {
+    let mut out = vec![(format!("job ({} {:.0e})", job.method, job.rtol), *job)];
+    for d in [10.0, 100.0] {
+        let s = SolverOptions {
+            rtol: job.rtol / d,
+            atol: job.atol / d,
+            max_steps: job.max_steps * 4,
+            ..*job
+        };
+        out.push((format!("{} {:.0e}", s.method, s.rtol), s));
+    }
+    for rtol in [1e-10, 1e-12] {
+        let s = SolverOptions {
+            rtol,
+            atol: rtol / 100.0,
+            method: Method::Dop853,
+            max_steps: job.max_steps * 8,
+            ..*job
+        };
+        out.push((format!("dop853 {rtol:.0e}"), s));
+    }
+    out
+}
+
+/// The fitted point of `result` in the problem's freed parameters, when the result names them all.
+fn fitted_u(result: &toml::Value, free: &[wiperlab::job::FreeParam]) -> Option<Vec<f64>> {
+    let params = result.get("parameters")?.as_array()?;
+    free.iter()
+        .map(|fp| {
+            let p = params
+                .iter()
+                .find(|p| p.get("name").and_then(|n| n.as_str()) == Some(fp.name.name()))?;
+            Some(fp.u_of(p.get("value")?.as_float()?))
+        })
+        .collect()
+}
+
+fn main() -> Fallible<()> {
+    let args = Args::parse();
+    let job = LoadedJob::load(&args.job)?;
+    let result: Option<toml::Value> = match &args.result {
+        Some(p) => Some(toml::from_str(&std::fs::read_to_string(p)?)?),
+        None => None,
+    };
+    let result_model = result
+        .as_ref()
+        .and_then(|r| r.get("model")?.as_str()?.parse::<Candidate>().ok());
+    let candidate = (args.model)
+        .or(job.truth_model)
+        .or(result_model)
+        .unwrap_or(job.candidates()[0]);
+    let problem = problem_for(&job, candidate)?;
+    let mut u_true = Vec::new();
+    for fp in &problem.free {
+        let t = job
+            .truth
+            .get(&fp.name)
+            .ok_or_else(|| format!("the truth has no value for {}", fp.name.name()))?;
+        u_true.push(fp.u_of(*t));
+    }
+    let u_fit = result
+        .as_ref()
+        .filter(|_| result_model == Some(candidate))
+        .and_then(|r| fitted_u(r, &problem.free));
+    println!(
+        "{}: truth priced in {candidate}{}",
+        args.job.display(),
+        if u_fit.is_some() {
+            ", beside the fit"
+        } else {
+            ""
+        }
+    );
+    println!("solver             truth (nats)  transitions   fit (nats)   truth − fit");
+    for (name, s) in solvers(&problem.solver) {
+        let price = |u: &[f64]| problem.cost_with_solver(u, &s).ok();
+        let t = price(&u_true);
+        let f = u_fit.as_deref().and_then(price);
+        let show = |c: Option<(f64, usize)>| c.map_or("failed".into(), |c| format!("{:.3}", c.0));
+        println!(
+            "{name:<18} {:>12} {:>12} {:>12} {:>12}",
+            show(t),
+            t.map_or("-".into(), |c| c.1.to_string()),
+            show(f),
+            match (t, f) {
+                (Some(t), Some(f)) => format!("{:+.3}", t.0 - f.0),
+                _ => "-".into(),
+            }
+        );
+    }
+    Ok(())
+}
