@@ -112,14 +112,14 @@ fn main() -> Fallible<()> {
     for (name, s) in solvers(&problem.solver) {
         let price = |u: &[f64]| problem.cost_with_solver(u, &s).ok();
         let t = price(&u_true);
-        let f = u_fit.as_deref().and_then(price);
+        let f = u_fit.as_deref().map(price);
         let show = |c: Option<(f64, usize)>| c.map_or("failed".into(), |c| format!("{:.3}", c.0));
         println!(
             "{name:<18} {:>12} {:>12} {:>12} {:>12}",
             show(t),
             t.map_or("-".into(), |c| c.1.to_string()),
-            show(f),
-            match (t, f) {
+            f.map_or("-".into(), show),
+            match (t, f.flatten()) {
                 (Some(t), Some(f)) => format!("{:+.3}", t.0 - f.0),
                 _ => "-".into(),
             }

@@ -33,6 +33,7 @@
 use super::Campaign;
 use super::run::{EntryPaths, State, read_status};
 use crate::fit::SHORTFALL_TOLERANCE_NATS;
+use crate::fit::select::INDISTINGUISHABLE_TIC;
 use crate::fit::result::{FitResult, FittedParam};
 use crate::fit::truth::{RIDGE_NATS, is_ridge};
 use crate::io::write_atomic;
@@ -160,6 +161,9 @@ pub struct RecordingScore {
     pub law: Option<super::law::LawScore>,
     /// The goodness-of-fit test's p-value.
     pub gof_p: Option<f64>,
+    /// The true model's TIC above the chosen model's (0 when it is the chosen one), when the fit
+    /// tried it and the result has its TIC.
+    pub true_model_delta_tic: Option<f64>,
 }
 
 impl RecordingScore {
@@ -286,6 +290,23 @@ impl Calibration {
         (s.len(), over, s.iter().copied().fold(f64::NAN, f64::max))
     }
 
+    /// Of the done recordings whose chosen model is not the true one: (how many, of them how many
+    /// have the true model within [`INDISTINGUISHABLE_TIC`] of the chosen one, the largest TIC lead
+    /// against the true model among the rest).
+    pub fn wrong_choices(&self) -> (usize, usize, f64) {
+        let wrong: Vec<Option<f64>> = self
+            .done()
+            .filter(|r| r.true_model.is_some() && r.chosen != r.true_model)
+            .map(|r| r.true_model_delta_tic)
+            .collect();
+        let near = |d: &Option<f64>| d.is_some_and(|d| d <= INDISTINGUISHABLE_TIC);
+        let unresolved = wrong.iter().filter(|d| near(d)).count();
+        let lead = (wrong.iter().flatten())
+            .filter(|d| **d > INDISTINGUISHABLE_TIC)
+            .fold(f64::NAN, |a, d| a.max(*d));
+        (wrong.len(), unresolved, lead)
+    }
+
     /// Counts of (true model, chosen model) over done recordings whose truth names a model.
     pub fn confusion(&self) -> BTreeMap<(String, String), usize> {
         let mut m = BTreeMap::new();
@@ -327,6 +348,7 @@ pub fn calibrate(campaign: &Campaign) -> Result<Option<Calibration>> {
             departure,
             law: None,
             gof_p: None,
+            true_model_delta_tic: None,
         };
         if let Some(s) = status {
             r.wall_time_s = s.wall_time_s;
@@ -387,6 +409,10 @@ fn truth_labels(path: &Path) -> Result<(Option<Candidate>, Option<String>)> {
 fn score(r: &mut RecordingScore, result: &FitResult) {
     r.chosen = Some(result.model);
     r.shortfall_nats = priced_shortfall(r, result.shortfall_nats(), result.truth_model.is_some());
+    r.true_model_delta_tic = r.true_model.and_then(|t| {
+        let trial = result.model_trials.iter().find(|m| m.model == t)?;
+        trial.evidence.as_ref()?.delta_tic
+    });
     r.ridge_nats = result.truth_segment.as_ref().map(|s| s.ridge_nats);
     r.law = super::law::LawScore::of(result);
     r.gof_p = result.goodness_of_fit.as_ref().map(|g| g.p_value);
@@ -504,6 +530,17 @@ fn confusion_section(md: &mut String, c: &Calibration) {
                 .collect();
             let _ = writeln!(md, "| {t} | {} |", cells.join(" | "));
         }
+    }
+    let (wrong, unresolved, lead) = c.wrong_choices();
+    if wrong > 0 {
+        let _ = writeln!(
+            md,
+            "\n{wrong} fits chose another model than the true one; {unresolved} of them report the \
+             true model as not distinguishable by the recording (its TIC within \
+             {INDISTINGUISHABLE_TIC} of the chosen model's); the others chose against it by a TIC \
+             of up to {} (`true_model_delta_tic` in calibration_recordings.csv).",
+            num(lead, 2)
+        );
     }
 }
 
@@ -700,6 +737,7 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
         "law_rms_rel_diff",
         "law_share_in_band",
         "gof_p",
+        "true_model_delta_tic",
     ]
     .map(String::from)
     .to_vec();
@@ -724,6 +762,7 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
                 .map(csv_num)
                 .unwrap_or_default(),
             r.gof_p.map(csv_num).unwrap_or_default(),
+            r.true_model_delta_tic.map(csv_num).unwrap_or_default(),
         ];
         for p in &params {
             match r.params.iter().find(|s| s.param == *p) {
@@ -900,6 +939,7 @@ mod tests {
             departure: None,
             law: None,
             gof_p: None,
+            true_model_delta_tic: None,
         }
     }
 
@@ -935,9 +975,11 @@ mod tests {
         shoulder.true_model = c("blade2dof+shoulder");
         shoulder.shortfall_nats = priced_shortfall(&shoulder, Some(5.0), false);
         assert_eq!(shoulder.shortfall_nats, None, "priced in the chosen blade2dof");
+        shoulder.true_model_delta_tic = Some(1.2);
         let mut priced = shoulder.clone();
         priced.id = "priced".into();
         priced.shortfall_nats = priced_shortfall(&priced, Some(-0.4), true);
+        priced.true_model_delta_tic = Some(7.5);
         assert_eq!(priced.shortfall_nats, Some(-0.4), "priced in its own model");
         let mut failed = recording(&[]);
         failed.id = "broken".into();
@@ -977,6 +1019,15 @@ mod tests {
         );
         assert!(md.contains("| blade2dof | 0 | 1 |"), "{md}");
         assert!(md.contains("| blade2dof+shoulder | 2 | 0 |"), "{md}");
+        // Three wrong choices: the shoulder-free truth's shoulder (no TIC known), one shoulder
+        // truth not distinguishable (1.2), one chosen against by 7.5.
+        assert_eq!(cal.wrong_choices().0, 3);
+        assert_eq!(cal.wrong_choices().1, 1);
+        assert!(
+            md.contains("3 fits chose another model than the true one; 1 of them")
+                && md.contains("by a TIC of up to 7.50"),
+            "{md}"
+        );
         assert!(md.contains("- broken failed: simulation failed"), "{md}");
         assert!(
             md.contains("- 1 not fitted (or still running): later"),
