@@ -164,6 +164,9 @@ pub struct RecordingScore {
     /// The true model's TIC above the chosen model's (0 when it is the chosen one), when the fit
     /// tried it and the result has its TIC.
     pub true_model_delta_tic: Option<f64>,
+    /// The true model's freed parameters `k` and Takeuchi's `tr(F⁻¹V)` at its fit, when the
+    /// result has them ([`crate::fit::result::TrialEvidence::effective_parameters`]).
+    pub true_model_k_tr: Option<(usize, f64)>,
 }
 
 impl RecordingScore {
@@ -290,6 +293,37 @@ impl Calibration {
         (s.len(), over, s.iter().copied().fold(f64::NAN, f64::max))
     }
 
+    /// The likelihood ratio at the truth over the fits whose shortfall and true model's
+    /// `(k, tr(F⁻¹V))` are known: (fits, mean of D = truth's cost − fit's, mean `tr/2`, mean `k/2`,
+    /// fits whose D exceeds the 95 % point of `(tr/k)·χ²(k)/2`).
+    pub fn truth_ratios(&self) -> (usize, f64, f64, f64, usize) {
+        let rows: Vec<(f64, usize, f64)> = self
+            .done()
+            .filter_map(|r| Some((-r.shortfall_nats?, r.true_model_k_tr?)))
+            .filter(|(_, (k, tr))| *k > 0 && *tr > 0.0)
+            .map(|(d, (k, tr))| (d, k, tr))
+            .collect();
+        let n = rows.len();
+        let mean = |f: &dyn Fn(&(f64, usize, f64)) -> f64| {
+            rows.iter().map(f).sum::<f64>() / n as f64
+        };
+        let beyond = rows
+            .iter()
+            .filter(|(d, k, tr)| {
+                ChiSquared::new(*k as f64)
+                    .map(|c| *d > tr / *k as f64 * c.inverse_cdf(0.95) / 2.0)
+                    .unwrap_or(false)
+            })
+            .count();
+        (
+            n,
+            mean(&|r| r.0),
+            mean(&|r| r.2 / 2.0),
+            mean(&|r| r.1 as f64 / 2.0),
+            beyond,
+        )
+    }
+
     /// Of the done recordings whose chosen model is not the true one: (how many, of them how many
     /// have the true model within [`INDISTINGUISHABLE_TIC`] of the chosen one, the largest TIC lead
     /// against the true model among the rest).
@@ -349,6 +383,7 @@ pub fn calibrate(campaign: &Campaign) -> Result<Option<Calibration>> {
             law: None,
             gof_p: None,
             true_model_delta_tic: None,
+            true_model_k_tr: None,
         };
         if let Some(s) = status {
             r.wall_time_s = s.wall_time_s;
@@ -409,10 +444,11 @@ fn truth_labels(path: &Path) -> Result<(Option<Candidate>, Option<String>)> {
 fn score(r: &mut RecordingScore, result: &FitResult) {
     r.chosen = Some(result.model);
     r.shortfall_nats = priced_shortfall(r, result.shortfall_nats(), result.truth_model.is_some());
-    r.true_model_delta_tic = r.true_model.and_then(|t| {
-        let trial = result.model_trials.iter().find(|m| m.model == t)?;
-        trial.evidence.as_ref()?.delta_tic
-    });
+    let true_trial = (r.true_model)
+        .and_then(|t| result.model_trials.iter().find(|m| m.model == t))
+        .and_then(|m| Some((m.parameters.len(), m.evidence.as_ref()?)));
+    r.true_model_delta_tic = true_trial.and_then(|(_, e)| e.delta_tic);
+    r.true_model_k_tr = true_trial.and_then(|(k, e)| Some((k, e.effective_parameters?)));
     r.ridge_nats = result.truth_segment.as_ref().map(|s| s.ridge_nats);
     r.law = super::law::LawScore::of(result);
     r.gof_p = result.goodness_of_fit.as_ref().map(|g| g.p_value);
@@ -491,6 +527,28 @@ fn stats_table(md: &mut String, stats: &[ParamStats]) {
 
 /// The model-choice section: the confusion matrix, true model × chosen model (nothing when no
 /// recording names its true model).
+/// How far above the fit the truth's cost lies, against what the calibrated likelihood predicts.
+fn ratio_section(md: &mut String, c: &Calibration) {
+    let (n, d, tr, k, beyond) = c.truth_ratios();
+    if n == 0 {
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "\n## Likelihood ratio at the truth\n\n\
+         Over the {n} fits priced in the true model with its `tr(F⁻¹V)`: the truth's cost lies on \
+         average {} nats above the fit's (D; negative: the fit is less likely). Under the \
+         likelihood as its intervals calibrate it, 2D is distributed as Σλᵢχ²(1) with \
+         Σλᵢ = tr(F⁻¹V) (Takeuchi; Varin, Reid & Firth 2011), mean tr/2 = {} on average; Wilks' \
+         uncalibrated χ²(k) has mean k/2 = {}. {beyond} of the {n} exceed the 95 % point of \
+         (tr/k)·χ²(k)/2 (5 % expected): a share far above it says the truth lies further from \
+         the fit, in likelihood, than the noise replicates at the fit say.",
+        num(d, 2),
+        num(tr, 2),
+        num(k, 2)
+    );
+}
+
 fn confusion_section(md: &mut String, c: &Calibration) {
     let confusion = c.confusion();
     if confusion.is_empty() {
@@ -609,6 +667,7 @@ pub fn to_markdown(c: &Calibration, notes: Option<&str>, command: &str) -> Strin
             measured - beyond
         );
     }
+    ratio_section(&mut md, c);
     confusion_section(&mut md, c);
     super::law::law_section(&mut md, c);
     let times: Vec<f64> = c.done().map(|r| r.wall_time_s).collect();
@@ -940,6 +999,7 @@ mod tests {
             law: None,
             gof_p: None,
             true_model_delta_tic: None,
+            true_model_k_tr: None,
         }
     }
 
@@ -980,6 +1040,7 @@ mod tests {
         priced.id = "priced".into();
         priced.shortfall_nats = priced_shortfall(&priced, Some(-0.4), true);
         priced.true_model_delta_tic = Some(7.5);
+        priced.true_model_k_tr = Some((6, 1.5));
         assert_eq!(priced.shortfall_nats, Some(-0.4), "priced in its own model");
         let mut failed = recording(&[]);
         failed.id = "broken".into();
@@ -1019,6 +1080,9 @@ mod tests {
         );
         assert!(md.contains("| blade2dof | 0 | 1 |"), "{md}");
         assert!(md.contains("| blade2dof+shoulder | 2 | 0 |"), "{md}");
+        // The one ratio: D = 0.4 against tr/2 = 0.75, below (1.5/6)·χ²(6)'s 95 % point/2 = 1.57.
+        assert_eq!(cal.truth_ratios(), (1, 0.4, 0.75, 3.0, 0));
+        assert!(md.contains("## Likelihood ratio at the truth"), "{md}");
         // Three wrong choices: the shoulder-free truth's shoulder (no TIC known), one shoulder
         // truth not distinguishable (1.2), one chosen against by 7.5.
         assert_eq!(cal.wrong_choices().0, 3);
