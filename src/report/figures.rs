@@ -1061,9 +1061,17 @@ pub fn fit_summary(r: &FitResult) -> String {
         );
     }
     if let (Some(t), Some(short)) = (r.truth_cost, r.shortfall_nats()) {
+        let whose = r
+            .truth_model
+            .map_or(String::new(), |m| format!(" (in the true model, {m})"));
         let _ = writeln!(
             s,
-            "  truth's own cost {t:.2} nats: the fit is {:.2} nats {} likely than the truth",
+            "  truth's own cost{whose} {t:.2} nats: the fit{} is {:.2} nats {} likely than the truth",
+            if r.truth_model.is_some() {
+                " of that model"
+            } else {
+                ""
+            },
             short.abs(),
             if short > 0.0 { "less" } else { "more" }
         );
