@@ -33,8 +33,8 @@
 use super::Campaign;
 use super::run::{EntryPaths, State, read_status};
 use crate::fit::SHORTFALL_TOLERANCE_NATS;
-use crate::fit::select::INDISTINGUISHABLE_TIC;
 use crate::fit::result::{FitResult, FittedParam};
+use crate::fit::select::INDISTINGUISHABLE_TIC;
 use crate::fit::truth::{RIDGE_NATS, is_ridge};
 use crate::io::write_atomic;
 use crate::job::{Candidate, FreeParam};
@@ -304,9 +304,8 @@ impl Calibration {
             .map(|(d, (k, tr))| (d, k, tr))
             .collect();
         let n = rows.len();
-        let mean = |f: &dyn Fn(&(f64, usize, f64)) -> f64| {
-            rows.iter().map(f).sum::<f64>() / n as f64
-        };
+        let mean =
+            |f: &dyn Fn(&(f64, usize, f64)) -> f64| rows.iter().map(f).sum::<f64>() / n as f64;
         let beyond = rows
             .iter()
             .filter(|(d, k, tr)| {
@@ -473,7 +472,11 @@ fn score(r: &mut RecordingScore, result: &FitResult) {
 /// A fit's `shortfall` where it measures the search: the truth priced in its own model's candidate
 /// (`in_true_model`, the fit's `[truth] model`) or in a chosen model that can state it; `None`
 /// where the truth was priced in a model that cannot (its cost there says nothing of the search).
-fn priced_shortfall(r: &RecordingScore, shortfall: Option<f64>, in_true_model: bool) -> Option<f64> {
+fn priced_shortfall(
+    r: &RecordingScore,
+    shortfall: Option<f64>,
+    in_true_model: bool,
+) -> Option<f64> {
     shortfall.filter(|_| in_true_model || r.model_contains_truth())
 }
 
@@ -542,7 +545,8 @@ fn ratio_section(md: &mut String, c: &Calibration) {
          Σλᵢ = tr(F⁻¹V) (Takeuchi; Varin, Reid & Firth 2011), mean tr/2 = {} on average; Wilks' \
          uncalibrated χ²(k) has mean k/2 = {}. {beyond} of the {n} exceed the 95 % point of \
          (tr/k)·χ²(k)/2 (5 % expected): a share far above it says the truth lies further from \
-         the fit, in likelihood, than the noise replicates at the fit say.",
+         the fit, in likelihood, than the noise replicates at the fit say (`true_model_k`, \
+         `true_model_tr_fv` and `shortfall_nats` in calibration_recordings.csv).",
         num(d, 2),
         num(tr, 2),
         num(k, 2)
@@ -797,6 +801,8 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
         "law_share_in_band",
         "gof_p",
         "true_model_delta_tic",
+        "true_model_k",
+        "true_model_tr_fv",
     ]
     .map(String::from)
     .to_vec();
@@ -822,6 +828,12 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
                 .unwrap_or_default(),
             r.gof_p.map(csv_num).unwrap_or_default(),
             r.true_model_delta_tic.map(csv_num).unwrap_or_default(),
+            r.true_model_k_tr
+                .map(|(k, _)| k.to_string())
+                .unwrap_or_default(),
+            r.true_model_k_tr
+                .map(|(_, tr)| csv_num(tr))
+                .unwrap_or_default(),
         ];
         for p in &params {
             match r.params.iter().find(|s| s.param == *p) {
@@ -1034,7 +1046,10 @@ mod tests {
         shoulder.id = "shoulder".into();
         shoulder.true_model = c("blade2dof+shoulder");
         shoulder.shortfall_nats = priced_shortfall(&shoulder, Some(5.0), false);
-        assert_eq!(shoulder.shortfall_nats, None, "priced in the chosen blade2dof");
+        assert_eq!(
+            shoulder.shortfall_nats, None,
+            "priced in the chosen blade2dof"
+        );
         shoulder.true_model_delta_tic = Some(1.2);
         let mut priced = shoulder.clone();
         priced.id = "priced".into();

@@ -1318,11 +1318,13 @@ fn read_truth(dir: &Path, truth: Option<&TruthSection>) -> Result<TruthRead> {
         .as_deref()
         .map(|ptr| {
             let name = v.pointer(ptr).and_then(|x| x.as_str()).ok_or_else(|| {
-                Error::input(&tp, format!("no model name at JSON pointer {ptr} (for model)"))
+                Error::input(
+                    &tp,
+                    format!("no model name at JSON pointer {ptr} (for model)"),
+                )
             })?;
-            name.parse::<Candidate>().map_err(|e| {
-                Error::input(&tp, format!("the model at JSON pointer {ptr}: {e}"))
-            })
+            name.parse::<Candidate>()
+                .map_err(|e| Error::input(&tp, format!("the model at JSON pointer {ptr}: {e}")))
         })
         .transpose()?;
     Ok(TruthRead { values, law, model })
@@ -1377,9 +1379,7 @@ mod tests {
             friction_law: Some(ptr.into()),
             model: None,
         };
-        job.truth_friction_law = read_truth(dir.path(), Some(&section("/law")))
-            .unwrap()
-            .law;
+        job.truth_friction_law = read_truth(dir.path(), Some(&section("/law"))).unwrap().law;
         assert_eq!(
             job.true_friction_law(),
             Some(FrictionLaw::ExponentialViscous {
