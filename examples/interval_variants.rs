@@ -73,7 +73,12 @@ fn main() -> Fallible<()> {
         u_fit.push(fp.u_of(fitted(&name).ok_or(format!("no fitted {name}"))?));
         truth.push(*job.truth.get(&fp.name).ok_or(format!("no true {name}"))?);
     }
-    let u_true: Vec<f64> = p.free.iter().zip(&truth).map(|(fp, t)| fp.u_of(*t)).collect();
+    let u_true: Vec<f64> = p
+        .free
+        .iter()
+        .zip(&truth)
+        .map(|(fp, t)| fp.u_of(*t))
+        .collect();
     let cost = p.cost_at(&u_fit);
     println!(
         "{}: {model}, cost at the fit {cost:.3} nats, at the truth {:+.3} above it",
