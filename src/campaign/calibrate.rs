@@ -293,14 +293,15 @@ impl Calibration {
         (s.len(), over, s.iter().copied().fold(f64::NAN, f64::max))
     }
 
-    /// The likelihood ratio at the truth over the fits whose shortfall and true model's
-    /// `(k, tr(F⁻¹V))` are known: (fits, mean of D = truth's cost − fit's, mean `tr/2`, mean `k/2`,
-    /// fits whose D exceeds the 95 % point of `(tr/k)·χ²(k)/2`).
+    /// The likelihood ratio at the truth over the fits that did not fall short (shortfall at most
+    /// [`SHORTFALL_TOLERANCE_NATS`]; a short fit measures its search, not the likelihood) and whose
+    /// true model's `(k, tr(F⁻¹V))` are known: (fits, mean of D = truth's cost − fit's, mean
+    /// `tr/2`, mean `k/2`, fits whose D exceeds the 95 % point of `(tr/k)·χ²(k)/2`).
     pub fn truth_ratios(&self) -> (usize, f64, f64, f64, usize) {
         let rows: Vec<(f64, usize, f64)> = self
             .done()
             .filter_map(|r| Some((-r.shortfall_nats?, r.true_model_k_tr?)))
-            .filter(|(_, (k, tr))| *k > 0 && *tr > 0.0)
+            .filter(|(d, (k, tr))| *d >= -SHORTFALL_TOLERANCE_NATS && *k > 0 && *tr > 0.0)
             .map(|(d, (k, tr))| (d, k, tr))
             .collect();
         let n = rows.len();
@@ -539,8 +540,8 @@ fn ratio_section(md: &mut String, c: &Calibration) {
     let _ = writeln!(
         md,
         "\n## Likelihood ratio at the truth\n\n\
-         Over the {n} fits priced in the true model with its `tr(F⁻¹V)`: the truth's cost lies on \
-         average {} nats above the fit's (D; negative: the fit is less likely). Under the \
+         Over the {n} fits priced in the true model with its `tr(F⁻¹V)` that did not fall short: \
+         the truth's cost lies on average {} nats above the fit's (D). Under the \
          likelihood as its intervals calibrate it, 2D is distributed as Σλᵢχ²(1) with \
          Σλᵢ = tr(F⁻¹V) (Takeuchi; Varin, Reid & Firth 2011), mean tr/2 = {} on average; Wilks' \
          uncalibrated χ²(k) has mean k/2 = {}. {beyond} of the {n} exceed the 95 % point of \
@@ -595,13 +596,21 @@ fn confusion_section(md: &mut String, c: &Calibration) {
     }
     let (wrong, unresolved, lead) = c.wrong_choices();
     if wrong > 0 {
+        let others = if unresolved == wrong {
+            String::new()
+        } else {
+            format!(
+                "; the others chose against it by a TIC of up to {} (a silent wrong choice where \
+                 that lead is the search's shortfall)",
+                num(lead, 2)
+            )
+        };
         let _ = writeln!(
             md,
             "\n{wrong} fits chose another model than the true one; {unresolved} of them report the \
              true model as not distinguishable by the recording (its TIC within \
-             {INDISTINGUISHABLE_TIC} of the chosen model's); the others chose against it by a TIC \
-             of up to {} (`true_model_delta_tic` in calibration_recordings.csv).",
-            num(lead, 2)
+             {INDISTINGUISHABLE_TIC} of the chosen model's){others} \
+             (`true_model_delta_tic` in calibration_recordings.csv)."
         );
     }
 }
@@ -1029,10 +1038,10 @@ mod tests {
         assert!((s.median_abs_rel_error - 0.05).abs() < 1e-12);
     }
 
-    /// The page of five recordings: a shoulder-free truth fitted with a shoulder (scored, its
-    /// shortfall 0.3 nats counted), a shoulder truth fitted without (not scored, in the confusion
-    /// matrix; its shortfall counted only where the fit priced the truth in the true model), a
-    /// failure with its reason and a recording not yet fitted.
+    /// The page of six recordings: a shoulder-free truth fitted with a shoulder (scored, its
+    /// shortfall 0.3 nats counted), shoulder truths fitted without (not scored, in the confusion
+    /// matrix; a shortfall counted only where the fit priced the truth in the true model, one of
+    /// them 18 nats short), a failure with its reason and a recording not yet fitted.
     #[test]
     fn markdown_counts_shortfalls_confusion_and_missing_fits() {
         let c = |s: &str| s.parse::<Candidate>().ok();
@@ -1065,7 +1074,11 @@ mod tests {
         let mut missing = failed.clone();
         missing.id = "later".into();
         missing.state = "missing".into();
-        let recordings = vec![free, shoulder, priced, failed, missing];
+        let mut short = priced.clone();
+        short.id = "short".into();
+        short.shortfall_nats = Some(18.0);
+        short.true_model_delta_tic = Some(1.0);
+        let recordings = vec![free, shoulder, priced, short, failed, missing];
         let cal = Calibration {
             name: "t".into(),
             campaign: PathBuf::from("t.toml"),
@@ -1075,17 +1088,17 @@ mod tests {
         };
         assert_eq!(
             cal.shortfalls().0,
-            2,
+            3,
             "the shoulder truth fitted without one is priced only in its own model"
         );
-        assert_eq!(cal.shortfalls().1, 1);
+        assert_eq!(cal.shortfalls().1, 2);
         let md = to_markdown(&cal, Some("notes here"), "wiperlab campaign collect t.toml");
         assert!(md.contains("notes here") && md.contains("`wiperlab campaign collect t.toml`"));
         assert!(
-            md.contains("3 fitted, 1 failed, 1 without a result"),
+            md.contains("4 fitted, 1 failed, 1 without a result"),
             "{md}"
         );
-        assert!(md.contains("1 of 2 fits"), "{md}");
+        assert!(md.contains("2 of 3 fits"), "{md}");
         // Its segment to the truth crosses a 2.2-nat ridge: another basin.
         assert_eq!(cal.shortfall_ridges(), (1, 1));
         assert!(
@@ -1094,16 +1107,17 @@ mod tests {
             "{md}"
         );
         assert!(md.contains("| blade2dof | 0 | 1 |"), "{md}");
-        assert!(md.contains("| blade2dof+shoulder | 2 | 0 |"), "{md}");
-        // The one ratio: D = 0.4 against tr/2 = 0.75, below (1.5/6)·χ²(6)'s 95 % point/2 = 1.57.
+        assert!(md.contains("| blade2dof+shoulder | 3 | 0 |"), "{md}");
+        // The one ratio (the short fit left out): D = 0.4 against tr/2 = 0.75, below
+        // (1.5/6)·χ²(6)'s 95 % point/2 = 1.57.
         assert_eq!(cal.truth_ratios(), (1, 0.4, 0.75, 3.0, 0));
         assert!(md.contains("## Likelihood ratio at the truth"), "{md}");
-        // Three wrong choices: the shoulder-free truth's shoulder (no TIC known), one shoulder
-        // truth not distinguishable (1.2), one chosen against by 7.5.
-        assert_eq!(cal.wrong_choices().0, 3);
-        assert_eq!(cal.wrong_choices().1, 1);
+        // Four wrong choices: the shoulder-free truth's shoulder (no TIC known), two shoulder
+        // truths not distinguishable (1.2, 1.0), one chosen against by 7.5.
+        assert_eq!(cal.wrong_choices().0, 4);
+        assert_eq!(cal.wrong_choices().1, 2);
         assert!(
-            md.contains("3 fits chose another model than the true one; 1 of them")
+            md.contains("4 fits chose another model than the true one; 2 of them")
                 && md.contains("by a TIC of up to 7.50"),
             "{md}"
         );
