@@ -5,10 +5,9 @@
 //! model), the tool walks each parameter's profile ([`profile_intervals_at`], the fit's own walk)
 //! with three limits on the NLL's rise:
 //!
-//! - `sandwich`: `0.5·σ²_sandwich/σ²_Fisher` nats (the composite likelihood's magnitude
-//!   adjustment at the optimum: Kent 1982; Varin, Reid & Firth 2011);
-//! - `wilks68`: 0.5 nats, the 68.27 % point of χ²₁/2 for a likelihood taken at face value (the
-//!   fit's own limit, `wiperlab::fit::uncertainty::PROFILE_68_NATS`);
+//! - `sandwich`: `0.5·σ²_sandwich/σ²_Fisher` nats, the fit's own (the composite likelihood's
+//!   magnitude adjustment at the optimum: Kent 1982; Varin, Reid & Firth 2011);
+//! - `wilks68`: 0.5 nats, the 68.27 % point of χ²₁/2 for a likelihood taken at face value;
 //! - `wilks95`: 1.92 nats, its 95 % point.
 //!
 //! For each it prints every parameter's interval and whether it contains the truth, and the NLL at
@@ -37,8 +36,8 @@ struct Args {
 
 type Fallible<T> = Result<T, Box<dyn std::error::Error>>;
 
-/// The rise limits compared: each parameter's `0.5·σ²_sandwich/σ²_Fisher`, or a fixed limit in
-/// nats.
+/// The rise limits compared: name and the factor on `σ²_Fisher/σ²_sandwich` that gives it (so
+/// that `0.5·(σ_s/σ_f)²·factor` is the limit), or a fixed limit in nats.
 enum Limit {
     Sandwich,
     Fixed(f64),
@@ -88,25 +87,18 @@ fn main() -> Fallible<()> {
     );
     let lf = at_fit_smoothed(&p, &u_fit)?;
     for (name, limit) in LIMITS {
-        // The fit's own limit differs between parameters (μ is each one's): a walk per parameter.
-        let walk = |rise_limit_nats: f64| {
-            let at = ProfileStart {
-                u: &u_fit,
-                cost_nats: cost,
-                sigma_u: &lf.sigma_u,
-                rise_limit_nats,
-            };
-            profile_intervals_at(&p, at, job.job.fit.polish_iterations).map(|(iv, _)| iv)
+        // `profile_rise_limit` is 0.5·(σ_s/σ_f)²: a Fisher 1σ of σ_s·√(0.5/limit) gives `limit`.
+        let fisher: Vec<f64> = match limit {
+            Limit::Sandwich => lf.curvature_sigma_u.clone(),
+            Limit::Fixed(l) => lf.sigma_u.iter().map(|s| s * (0.5 / l).sqrt()).collect(),
         };
-        let intervals = match limit {
-            Limit::Fixed(l) => walk(l)?,
-            Limit::Sandwich => (0..p.free.len())
-                .map(|i| {
-                    let mu = (lf.sigma_u[i] / lf.curvature_sigma_u[i]).powi(2);
-                    walk(0.5 * mu).map(|iv| iv[i].clone())
-                })
-                .collect::<Result<_, _>>()?,
+        let at = ProfileStart {
+            u: &u_fit,
+            cost_nats: cost,
+            sigma_u: &lf.sigma_u,
+            fisher_sigma_u: &fisher,
         };
+        let (intervals, _) = profile_intervals_at(&p, at, job.job.fit.polish_iterations)?;
         let cells: Vec<String> = p
             .free
             .iter()

@@ -133,7 +133,7 @@ fn walk(
         u: &f.best_u,
         cost_nats: f.cost,
         sigma_u: &spread.sigma_u,
-        rise_limit_nats: super::uncertainty::PROFILE_68_NATS,
+        fisher_sigma_u: &spread.curvature_sigma_u,
     };
     let (intervals, warnings) = profile_walk(f, at, polish_iterations, pb)?;
     Ok(Some(ProfileWalk {

@@ -77,8 +77,8 @@ pub struct SpectralProblem {
 }
 
 /// How far above the lowest cost seen (nats) [`EvaluatedNearBest`] keeps a point: above the
-/// profile rise limit the intervals use ([`super::uncertainty::PROFILE_68_NATS`]) and the climb's
-/// margin.
+/// profile rise limits the intervals use (0.5 nats times σ²_sandwich/σ²_Fisher,
+/// [`super::uncertainty::profile_rise_limit`]) for a sandwich up to twice the Fisher 1σ.
 pub const NEAR_BEST_MARGIN_NATS: f64 = 2.0;
 
 /// The points a problem's search evaluated at the polish's tolerance, inside the search box, with a

@@ -85,7 +85,8 @@ pub enum IntervalMethod {
     /// Profile likelihood ([`crate::fit::profile_intervals_at`]): where the NLL, minimised over
     /// the other parameters, has risen by `rise_limit_nats` from the fit.
     Profile {
-        /// The rise at the interval's ends, nats (0 in results that did not record it).
+        /// The rise at the interval's ends, nats: 0.5·σ²_sandwich/σ²_Fisher of the parameter (0 in
+        /// results that did not record it).
         #[serde(default)]
         rise_limit_nats: f64,
     },
@@ -132,7 +133,7 @@ impl std::fmt::Display for IntervalMethod {
             IntervalMethod::Profile { rise_limit_nats } if *rise_limit_nats > 0.0 => write!(
                 f,
                 "profile likelihood: where the NLL, minimised over the other parameters, has risen \
-                 {rise_limit_nats:.3} nats from the fit (half χ²₁'s 68.27 % point)"
+                 {rise_limit_nats:.3} nats from the fit (0.5·σ²_sandwich/σ²_Fisher)"
             ),
             IntervalMethod::Profile { .. } => f.write_str("profile likelihood"),
             IntervalMethod::Curvature => f.write_str("curvature"),

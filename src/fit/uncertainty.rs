@@ -383,6 +383,21 @@ pub const PROFILE_MIN_STEP_U: f64 = 0.005;
 /// is infinite).
 pub const PROFILE_MAX_STEP_U: f64 = 0.1;
 
+/// The NLL rise at a 68.27 % profile-likelihood bound of a parameter whose sandwich and Fisher
+/// 1σ are `sigma_sandwich` and `sigma_fisher`: the likelihood is a composite (Whittle-type)
+/// likelihood, so twice its rise is distributed as `μ·χ²₁` with `μ = σ²_sandwich/σ²_Fisher`, not as
+/// `χ²₁` (Kent 1982, *Biometrika* 69:1, Theorem 3.1; Varin, Reid & Firth 2011, *Statistica Sinica*
+/// 21:5, §2.3), and the bound is at `μ·`[`PROFILE_68_NATS`]. On a quadratic likelihood the
+/// profile interval is then the Laplace one. `μ = 1` where either 1σ is not finite and positive.
+pub fn profile_rise_limit(sigma_sandwich: f64, sigma_fisher: f64) -> f64 {
+    let mu = (sigma_sandwich / sigma_fisher).powi(2);
+    if mu.is_finite() && mu > 0.0 {
+        PROFILE_68_NATS * mu
+    } else {
+        PROFILE_68_NATS
+    }
+}
+
 /// Nelder–Mead iterations a profile step's polish typically makes before it stops at the
 /// likelihood's ripples: only the progress bar's length estimate.
 const PROFILE_POLISH_ITERATIONS_TYPICAL: u64 = 10;
@@ -498,21 +513,21 @@ pub struct ProfileStart<'a> {
     pub u: &'a [f64],
     /// The problem's cost there (the recording's NLL), nats.
     pub cost_nats: f64,
-    /// 1σ of each coordinate from the sandwich `F⁻¹ V F⁻¹` ([`super::evidence::at_fit_smoothed`]):
-    /// each walk's first step.
+    /// 1σ of each coordinate from the sandwich `F⁻¹ V F⁻¹` ([`super::evidence::at_fit_smoothed`]).
     pub sigma_u: &'a [f64],
-    /// The NLL's rise at the interval's ends, nats ([`PROFILE_68_NATS`] for a 68.27 % interval).
-    pub rise_limit_nats: f64,
+    /// 1σ of each coordinate from the Fisher information `F⁻¹` alone.
+    pub fisher_sigma_u: &'a [f64],
 }
 
 impl<'a> ProfileStart<'a> {
-    /// The chosen fit's optimum, cost and spread, to the 68.27 % limit.
+    /// The chosen fit's optimum, cost and spread (the Fisher 1σ, or the sandwich's where the fit
+    /// has none).
     fn of(cf: &'a CandidateFit) -> Self {
         ProfileStart {
             u: &cf.best_u,
             cost_nats: cf.cost,
             sigma_u: &cf.sigma_u,
-            rise_limit_nats: PROFILE_68_NATS,
+            fisher_sigma_u: cf.fisher_sigma_u.as_deref().unwrap_or(&cf.sigma_u),
         }
     }
 }
@@ -521,7 +536,8 @@ impl<'a> ProfileStart<'a> {
 /// Raue et al. 2009, *Bioinformatics* 25:15, for models of this kind): for each freed parameter
 /// and each side, [`profile_end`] with the other parameters re-polished by Nelder–Mead
 /// (`polish_iterations`, initial simplex [`POLISH_STEP_U`]) at every step, each polish starting where the
-/// previous one ended, and the limit `at.rise_limit_nats`. Where the likelihood is quadratic this gives the Laplace interval; where it is flat
+/// previous one ended, and the limit [`profile_rise_limit`] from the parameter's sandwich and
+/// Fisher 1σ. Where the likelihood is quadratic this gives the Laplace interval; where it is flat
 /// or bent (a ridge, a valley) the interval follows the likelihood instead of its curvature at the
 /// fit. The 2k walks run in parallel; each costs one polish per step, typically two or three. A
 /// failed simulation counts as an infinite rise. Warnings name a parameter whose profile reaches
@@ -550,7 +566,7 @@ fn profile_with(
 ) -> Result<(Vec<Interval>, Vec<FitWarning>)> {
     use rayon::prelude::*;
     let n = at.u.len();
-    let limit = |_: usize| at.rise_limit_nats;
+    let limit = |i: usize| profile_rise_limit(at.sigma_u[i], at.fisher_sigma_u[i]);
     let walk = |(i, side): (usize, f64)| -> Result<ProfileEnd> {
         let first = at.sigma_u[i].clamp(PROFILE_MIN_STEP_U, PROFILE_MAX_STEP_U);
         let first = if first.is_nan() {
@@ -658,7 +674,7 @@ fn near_best_of(cf: &CandidateFit, intervals: &mut [Interval]) -> Vec<FitWarning
 }
 
 /// Widens each interval to contain the points the search evaluated whose cost lies within the
-/// parameter's profile rise limit of the fit ([`PROFILE_68_NATS`]). The profile likelihood at
+/// parameter's profile rise limit of the fit ([`profile_rise_limit`]). The profile likelihood at
 /// a point's value of a parameter is at most the point's cost (the others held there instead of
 /// re-optimised), so such a point lies inside that parameter's 68.27 % profile-likelihood region
 /// (Pawitan 2001, *In All Likelihood*, §2.6), and a profile interval would contain it. The search's
@@ -678,7 +694,7 @@ pub fn widen_to_near_best(
 ) -> Vec<FitWarning> {
     let mut warnings = Vec::new();
     for (i, fp) in free.iter().enumerate() {
-        let limit = at.rise_limit_nats;
+        let limit = profile_rise_limit(at.sigma_u[i], at.fisher_sigma_u[i]);
         let (lo0, hi0) = (intervals[i].lo, intervals[i].hi);
         let (mut p_lo, mut p_hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for (_, u) in near.at_most(at.cost_nats + limit) {
@@ -754,12 +770,7 @@ pub const RIDGE_K1_FACTORS: [f64; 4] = [
 ];
 
 /// The rise of the NLL at a 68.27 % one-parameter profile-likelihood bound: half the 68.27 % point of
-/// χ²₁ (Pawitan 2001, *In All Likelihood*, §2.6), the likelihood taken at face value. The profile
-/// intervals and the near-best widening read it rather than the composite likelihood's
-/// magnitude-adjusted `μ/2` (μ = σ²_sandwich/σ²_Fisher at the fit; Kent 1982, *Biometrika* 69:1):
-/// μ is read at the fit's basin, and the stick–slip likelihood has others of nearly equal depth, so
-/// intervals at `μ/2` covered the truth far below their level on the development set, and at this
-/// limit at it (docs/validation.md, "Threshold or locality").
+/// χ²₁ (Pawitan 2001, *In All Likelihood*, §2.6).
 pub const PROFILE_68_NATS: f64 = 0.5;
 
 /// Widens the intervals of `k1` and `theta_c` along the shoulder's contact-moment ridge, where a
@@ -1140,6 +1151,10 @@ mod tests {
                 );
             }
         }
+        // The calibrated limit: μ = (σ_sandwich/σ_Fisher)².
+        assert!((profile_rise_limit(0.5, 1.0) - 0.125).abs() < 1e-15);
+        assert_eq!(profile_rise_limit(1.0, f64::INFINITY), PROFILE_68_NATS);
+        assert_eq!(profile_rise_limit(f64::NAN, 1.0), PROFILE_68_NATS);
     }
 
     #[test]
@@ -1350,7 +1365,7 @@ mod tests {
             u: &u0,
             cost_nats: 0.0,
             sigma_u: &sigma,
-            rise_limit_nats: PROFILE_68_NATS,
+            fisher_sigma_u: &sigma,
         };
         // Closed form: on the quadratic bowl of 1σ = 0.01 in each coordinate, a point within
         // 0.5 nats has |Δu| ≤ 0.01 in each, so the Laplace intervals already hold every one.
