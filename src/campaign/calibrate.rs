@@ -600,8 +600,7 @@ fn confusion_section(md: &mut String, c: &Calibration) {
             String::new()
         } else {
             format!(
-                "; the others chose against it by a TIC of up to {} (a silent wrong choice where \
-                 that lead is the search's shortfall)",
+                "; the others, silent wrong choices, chose against it by a TIC of up to {}",
                 num(lead, 2)
             )
         };
