@@ -611,6 +611,23 @@ fn speed_axis_top(r: &FitResult, v_max_m_per_s: Option<f64>) -> f64 {
         .max(1.05 * rig_hi)
 }
 
+/// The summary's line on the truth's own cost and the fit's distance from it, in the true model
+/// when the result priced the truth there (empty without a truth's cost).
+fn truth_line(r: &FitResult) -> String {
+    let (Some(t), Some(short)) = (r.truth_cost, r.shortfall_nats()) else {
+        return String::new();
+    };
+    let (whose, fit) = match r.truth_model {
+        Some(m) => (format!(" (in the true model, {m})"), " of that model"),
+        None => (String::new(), ""),
+    };
+    format!(
+        "  truth's own cost{whose} {t:.2} nats: the fit{fit} is {:.2} nats {} likely than the truth\n",
+        short.abs(),
+        if short > 0.0 { "less" } else { "more" }
+    )
+}
+
 /// The summary's line on `[fit.priors]`: the prior's share of the cost and how far the fit lies
 /// from each prior, in the prior's standard deviations (empty without priors).
 fn prior_lines(r: &FitResult) -> String {
@@ -1060,22 +1077,7 @@ pub fn fit_summary(r: &FitResult) -> String {
             n.spectrum, n.sigma_m, n.rho
         );
     }
-    if let (Some(t), Some(short)) = (r.truth_cost, r.shortfall_nats()) {
-        let whose = r
-            .truth_model
-            .map_or(String::new(), |m| format!(" (in the true model, {m})"));
-        let _ = writeln!(
-            s,
-            "  truth's own cost{whose} {t:.2} nats: the fit{} is {:.2} nats {} likely than the truth",
-            if r.truth_model.is_some() {
-                " of that model"
-            } else {
-                ""
-            },
-            short.abs(),
-            if short > 0.0 { "less" } else { "more" }
-        );
-    }
+    s.push_str(&truth_line(r));
     s.push_str(&prior_lines(r));
     if !r.undetermined.is_empty() {
         let _ = writeln!(
