@@ -529,8 +529,6 @@ fn stats_table(md: &mut String, stats: &[ParamStats]) {
     }
 }
 
-/// The model-choice section: the confusion matrix, true model × chosen model (nothing when no
-/// recording names its true model).
 /// How far above the fit the truth's cost lies, against what the calibrated likelihood predicts.
 fn ratio_section(md: &mut String, c: &Calibration) {
     let (n, d, tr, k, beyond) = c.truth_ratios();
@@ -554,6 +552,9 @@ fn ratio_section(md: &mut String, c: &Calibration) {
     );
 }
 
+/// The model-choice section: the confusion matrix, true model × chosen model (nothing when no
+/// recording names its true model), and how many wrong choices were reported as not
+/// distinguishable.
 fn confusion_section(md: &mut String, c: &Calibration) {
     let confusion = c.confusion();
     if confusion.is_empty() {
