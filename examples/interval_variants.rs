@@ -23,8 +23,9 @@ use clap::Parser;
 use std::path::PathBuf;
 use std::sync::Arc;
 use wiperlab::fit::evidence::at_fit_smoothed;
+use wiperlab::fit::result::FitResult;
 use wiperlab::fit::{ProfileStart, problem_for, profile_intervals_at};
-use wiperlab::job::{Candidate, LoadedJob};
+use wiperlab::job::LoadedJob;
 
 #[derive(Parser)]
 struct Args {
@@ -52,26 +53,16 @@ const LIMITS: [(&str, Limit); 3] = [
 fn main() -> Fallible<()> {
     let args = Args::parse();
     let job = LoadedJob::load(&args.job)?;
-    let result: toml::Value = toml::from_str(&std::fs::read_to_string(&args.result)?)?;
-    let model: Candidate = result["model"]
-        .as_str()
-        .ok_or("result without model")?
-        .parse()?;
+    let result = FitResult::read(&args.result)?;
+    let model = result.model;
     let p = Arc::new(problem_for(&job, model)?);
-    let fitted = |name: &str| -> Option<f64> {
-        result["parameters"]
-            .as_array()?
-            .iter()
-            .find(|q| q["name"].as_str() == Some(name))?
-            .get("value")?
-            .as_float()
-    };
     let mut u_fit = Vec::new();
     let mut truth = Vec::new();
     for fp in &p.free {
-        let name = fp.name.to_string();
-        u_fit.push(fp.u_of(fitted(&name).ok_or(format!("no fitted {name}"))?));
-        truth.push(*job.truth.get(&fp.name).ok_or(format!("no true {name}"))?);
+        let name = fp.name;
+        let fitted = result.parameters.iter().find(|q| q.name == name);
+        u_fit.push(fp.u_of(fitted.ok_or(format!("no fitted {name}"))?.value));
+        truth.push(*job.truth.get(&name).ok_or(format!("no true {name}"))?);
     }
     let u_true: Vec<f64> = p
         .free

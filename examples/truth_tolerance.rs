@@ -16,6 +16,7 @@
 use clap::Parser;
 use std::path::PathBuf;
 use wiperlab::fit::problem_for;
+use wiperlab::fit::result::FitResult;
 use wiperlab::job::{Candidate, LoadedJob};
 use wiperlab::simulate::{Method, SolverOptions};
 
@@ -60,14 +61,11 @@ fn solvers(job: &SolverOptions) -> Vec<(String, SolverOptions)> {
 }
 
 /// The fitted point of `result` in the problem's freed parameters, when the result names them all.
-fn fitted_u(result: &toml::Value, free: &[wiperlab::job::FreeParam]) -> Option<Vec<f64>> {
-    let params = result.get("parameters")?.as_array()?;
+fn fitted_u(result: &FitResult, free: &[wiperlab::job::FreeParam]) -> Option<Vec<f64>> {
     free.iter()
         .map(|fp| {
-            let p = params
-                .iter()
-                .find(|p| p.get("name").and_then(|n| n.as_str()) == Some(fp.name.name()))?;
-            Some(fp.u_of(p.get("value")?.as_float()?))
+            let p = result.parameters.iter().find(|p| p.name == fp.name)?;
+            Some(fp.u_of(p.value))
         })
         .collect()
 }
@@ -75,13 +73,8 @@ fn fitted_u(result: &toml::Value, free: &[wiperlab::job::FreeParam]) -> Option<V
 fn main() -> Fallible<()> {
     let args = Args::parse();
     let job = LoadedJob::load(&args.job)?;
-    let result: Option<toml::Value> = match &args.result {
-        Some(p) => Some(toml::from_str(&std::fs::read_to_string(p)?)?),
-        None => None,
-    };
-    let result_model = result
-        .as_ref()
-        .and_then(|r| r.get("model")?.as_str()?.parse::<Candidate>().ok());
+    let result = args.result.as_deref().map(FitResult::read).transpose()?;
+    let result_model = result.as_ref().map(|r| r.model);
     let candidate = (args.model)
         .or(job.truth_model)
         .or(result_model)
