@@ -34,13 +34,20 @@ pub enum PosteriorError {
     /// The stretch scale `a` must exceed 1.
     #[error("stretch scale {stretch}: it must be greater than 1")]
     Stretch { stretch: f64 },
+    /// A tempering ladder's inverse temperatures must start at 1 and decrease, all above 0.
+    #[error(
+        "tempering ladder {betas:?}: the inverse temperatures must start at 1 and decrease, all above 0"
+    )]
+    Ladder { betas: Vec<f64> },
 }
 
 impl From<PosteriorError> for crate::Error {
     fn from(e: PosteriorError) -> Self {
         let input = matches!(
             e,
-            PosteriorError::Walkers { .. } | PosteriorError::Stretch { .. }
+            PosteriorError::Walkers { .. }
+                | PosteriorError::Stretch { .. }
+                | PosteriorError::Ladder { .. }
         );
         crate::Error::stage(e, input)
     }
@@ -147,7 +154,7 @@ pub fn ball(center: &[f64], radius: f64, walkers: usize, seed: u64) -> Vec<Vec<f
 
 /// Draws from `g(z) ∝ 1/√z` on `[1/a, a]` by inverting its distribution function:
 /// `z = ((a − 1)·r + 1)²/a`, `r` uniform on `[0, 1)` (Goodman & Weare 2010, eq. 9).
-fn stretch_factor(a: f64, r: f64) -> f64 {
+pub(super) fn stretch_factor(a: f64, r: f64) -> f64 {
     ((a - 1.0) * r + 1.0).powi(2) / a
 }
 

@@ -9,6 +9,7 @@
 
 pub mod diagnostics;
 pub mod ensemble;
+pub mod tempering;
 
 use crate::model::ParamId;
 use crate::spectrum::stats::quantile_sorted;
