@@ -9,7 +9,9 @@
 //!    the truth's Mahalanobis distance under the reported sandwich covariance.
 //! 3. **A posterior sample** (the affine-invariant ensemble of `[fit.uncertainty] method = "mcmc"`,
 //!    32 walkers, the likelihood tempered by `k/tr(F⁻¹V)`): its 68 % and 95 % intervals and the
-//!    truth's quantile in each marginal.
+//!    truth's quantile in each marginal. With `--temperatures K` the sample is parallel-tempered
+//!    (`wiperlab::posterior::tempering`, a geometric ladder of K rungs): hot ensembles cross the
+//!    ridges between basins and hand their points down to the untempered one.
 //!
 //! The job must be the one the fit ran (same recording, bounds and likelihood): the tool prints
 //! the cost it finds at the fitted point beside the result's, and stops when they differ by more
@@ -29,7 +31,8 @@ use wiperlab::fit::{FAILED_COST, SpectralProblem, posterior_tempering, problem_f
 use wiperlab::job::{Candidate, LoadedJob, NoiseSpectrum};
 use wiperlab::likelihood::covariance::{cholesky_of_covariance, covariance_of};
 use wiperlab::likelihood::secant::{SECANT_PROBE_SIGMA, flat_axes};
-use wiperlab::posterior::{EnsembleSettings, ensemble::gaussian_ball_with, sample};
+use wiperlab::posterior::tempering::{geometric_ladder, sample_tempered};
+use wiperlab::posterior::{EnsembleSettings, ensemble::gaussian_ball_with};
 
 #[derive(Parser)]
 struct Args {
@@ -43,6 +46,9 @@ struct Args {
     /// Steps of every walker of the posterior sample (0: no sample).
     #[arg(long, default_value_t = 400)]
     steps: usize,
+    /// Rungs of the parallel-tempering ladder (1: the plain ensemble).
+    #[arg(long, default_value_t = 1)]
+    temperatures: usize,
 }
 
 const WALKERS: usize = 32;
@@ -105,7 +111,7 @@ fn main() -> Fallible<()> {
     segment(&p, &u_fit, &u_true, cost_fit);
     let spread = predicted_rise(&p, &u_fit, &u_true)?;
     if args.steps > 0 {
-        posterior(&p, &job, &u_fit, spread, args.steps)?;
+        posterior(&p, &job, &u_fit, spread, args.steps, args.temperatures)?;
     }
     Ok(())
 }
@@ -232,19 +238,21 @@ fn posterior(
     u_fit: &[f64],
     spread: Spread,
     steps: usize,
+    temperatures: usize,
 ) -> Fallible<()> {
     let w = spread.tempering;
     let k = u_fit.len();
     let inside = |u: &[f64]| u.iter().all(|x| (0.0..=1.0).contains(x));
-    let log_density = |u: &[f64]| {
+    // The tempered log-likelihood and the flat prior of the box.
+    let log_parts = |u: &[f64]| {
         if !inside(u) {
-            return f64::NEG_INFINITY;
+            return (f64::NEG_INFINITY, 0.0);
         }
         let c = p.cost_at(u);
         if c < FAILED_COST {
-            -w * c
+            (-w * c, 0.0)
         } else {
-            f64::NEG_INFINITY
+            (f64::NEG_INFINITY, 0.0)
         }
     };
     let ball = spread
@@ -258,11 +266,20 @@ fn posterior(
         seed: 1,
     };
     let started = std::time::Instant::now();
-    let chains = sample(log_density, start, &settings, |_| true)?;
+    let betas = geometric_ladder(temperatures, k);
+    let run = sample_tempered(log_parts, start, &settings, &betas, |_| true)?;
+    let chains = &run.cold;
     let burn_in = steps * 3 / 10;
     println!(
-        "posterior sample: {WALKERS} walkers × {steps} steps ({burn_in} burn-in), acceptance {:.2}, {:.0} s",
+        "posterior sample: {WALKERS} walkers × {steps} steps ({burn_in} burn-in) × {temperatures} \
+         temperatures (β down to {:.3}), acceptance {:.2}, swaps {:?}, {} evaluations, {:.0} s",
+        betas.last().copied().unwrap_or(1.0),
         chains.accepted as f64 / (WALKERS * steps) as f64,
+        run.swap_fractions()
+            .iter()
+            .map(|f| (f * 100.0).round() / 100.0)
+            .collect::<Vec<_>>(),
+        chains.evaluations,
         started.elapsed().as_secs_f64()
     );
     for (i, fp) in p.free.iter().enumerate() {

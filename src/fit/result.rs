@@ -109,6 +109,9 @@ pub enum IntervalMethod {
         burn_in: usize,
         /// The factor the log-likelihood was multiplied by.
         tempering: f64,
+        /// Rungs of the parallel-tempering ladder (1: the plain ensemble).
+        #[serde(default = "one_rung")]
+        temperatures: usize,
     },
     /// Laplace's approximation: ±1σ of the estimate's sandwich covariance `F⁻¹ V F⁻¹` at the fit,
     /// with `F` the Fisher information of the recording's likelihood and `V` the variance of its
@@ -142,12 +145,19 @@ impl std::fmt::Display for IntervalMethod {
                 steps,
                 burn_in,
                 tempering,
-            } => write!(
-                f,
-                "posterior quantiles 15.87–84.13 % of an affine-invariant ensemble sample \
-                 ({walkers} walkers × {steps} steps, {burn_in} burn-in) of the likelihood \
-                 raised to the power {tempering:.3} (k/tr(F⁻¹V)), flat on the search's coordinates"
-            ),
+                temperatures,
+            } => {
+                write!(
+                    f,
+                    "posterior quantiles 15.87–84.13 % of an affine-invariant ensemble sample \
+                     ({walkers} walkers × {steps} steps, {burn_in} burn-in) of the likelihood \
+                     raised to the power {tempering:.3} (k/tr(F⁻¹V)), flat on the search's coordinates"
+                )?;
+                if *temperatures > 1 {
+                    write!(f, ", parallel-tempered over {temperatures} temperatures")?;
+                }
+                Ok(())
+            }
             IntervalMethod::Laplace {
                 fisher_step_u,
                 noise_replicates: 0,
@@ -504,4 +514,9 @@ impl FitResult {
     pub fn to_toml(&self) -> Result<String> {
         toml::to_string_pretty(self).map_err(|e| Error::write("the fit result", "TOML", e))
     }
+}
+
+/// A result written before parallel tempering sampled with one rung.
+fn one_rung() -> usize {
+    1
 }

@@ -238,8 +238,11 @@ pub fn posterior_tempering(k: usize, effective_parameters: Option<f64>) -> f64 {
 /// in a Gaussian ball of the sandwich covariance around the fit (a 0.01 ball where it has no
 /// finite 1σ), kept inside the box. Each interval is the 15.87–84.13 % quantiles; warnings name a
 /// parameter whose chains have not mixed ([`RHAT_LIMIT`], [`MIN_ESS`]) or whose posterior spans
-/// most of its search range. Costs `walkers × (steps + 1)` simulations, a walker half's in
-/// parallel.
+/// most of its search range. With `temperatures = K > 1` the sample is parallel-tempered
+/// ([`crate::posterior::tempering`], the geometric ladder of K rungs): the hot ensembles cross
+/// ridges between basins that the untempered one would not leave, and the intervals are the
+/// untempered ensemble's quantiles. Costs `walkers × (K·steps + 1)` simulations, a walker half's
+/// of every rung in parallel.
 ///
 /// # Errors
 /// [`crate::posterior::PosteriorError`] for too few walkers for the freed parameters or a start
@@ -255,11 +258,9 @@ pub(super) fn mcmc_intervals(
     let inside = |u: &[f64]| u.iter().all(|x| (0.0..=1.0).contains(x));
     // The likelihood tempered, the prior not, as a density in θ (or ln θ): docs/priors.md, "Priors".
     let prior = &cf.problem.prior;
-    let log_density = |u: &[f64]| match inside(u).then(|| cf.problem.cost_at(u)) {
-        Some(c) if c < super::FAILED_COST => {
-            prior.log_posterior(c, w, &cf.free, &cf.problem.base, u)
-        }
-        _ => f64::NEG_INFINITY,
+    let log_parts = |u: &[f64]| match inside(u).then(|| cf.problem.cost_at(u)) {
+        Some(c) if c < super::FAILED_COST => prior.log_parts(c, w, &cf.free, &cf.problem.base, u),
+        _ => (f64::NEG_INFINITY, 0.0),
     };
     let spread = crate::likelihood::covariance::cholesky_of_covariance(&cf.sigma_u, &cf.corr);
     let k = cf.free.len();
@@ -272,36 +273,51 @@ pub(super) fn mcmc_intervals(
         stretch: 2.0,
         seed: s.seed,
     };
+    let ladder = crate::posterior::tempering::geometric_ladder(s.temperatures, k);
+    let per_step = s.walkers * ladder.len();
     if let Some(bar) = pb {
-        bar.inc_length((s.walkers * (s.steps + 1)) as u64);
+        bar.inc_length((s.walkers + per_step * s.steps) as u64);
         bar.inc(s.walkers as u64);
         bar.set_message("posterior sample (MCMC)");
     }
     // Without a terminal the bar is hidden: a line every 50 steps instead, as the search prints.
     let piped = !std::io::IsTerminal::is_terminal(&std::io::stderr());
     let started = std::time::Instant::now();
-    let chains = crate::posterior::sample(log_density, start, &settings, |step| {
-        if let Some(bar) = pb {
-            bar.inc(s.walkers as u64);
-            if piped && (step + 1) % 50 == 0 {
-                let t = started.elapsed().as_secs();
-                eprintln!(
-                    "progress: posterior sample: {}/{} steps, {t} s",
-                    step + 1,
-                    s.steps
-                );
+    let run = crate::posterior::tempering::sample_tempered(
+        log_parts,
+        start,
+        &settings,
+        &ladder,
+        |step| {
+            if let Some(bar) = pb {
+                bar.inc(per_step as u64);
+                if piped && (step + 1) % 50 == 0 {
+                    let t = started.elapsed().as_secs();
+                    eprintln!(
+                        "progress: posterior sample: {}/{} steps, {t} s",
+                        step + 1,
+                        s.steps
+                    );
+                }
             }
-        }
-        !super::interrupt::stop_requested()
-    })?;
+            !super::interrupt::stop_requested()
+        },
+    )?;
+    let chains = &run.cold;
     let names: Vec<_> = cf.free.iter().map(|f| f.name).collect();
     let burn_in = s.burn_in.min(chains.steps().saturating_sub(1));
-    let post = PosteriorSummary::new(&names, &chains, burn_in, 1.0, w, |i, u| cf.free[i].value(u));
+    let mut post =
+        PosteriorSummary::new(&names, chains, burn_in, 1.0, w, |i, u| cf.free[i].value(u));
+    if ladder.len() > 1 {
+        post.swap_fractions = run.swap_fractions();
+        post.ladder = run.betas.clone();
+    }
     let method = IntervalMethod::Mcmc {
         walkers: s.walkers,
         steps: chains.steps(),
         burn_in,
         tempering: w,
+        temperatures: ladder.len(),
     };
     let mut warnings = Vec::new();
     let intervals = post

@@ -461,6 +461,11 @@ crate::names::named_enum! {
     }
 }
 
+/// Most rungs of a parallel-tempering ladder (`[fit.uncertainty] temperatures`): at the geometric
+/// ladder's ratio for 4 parameters (`crate::posterior::tempering::geometric_ladder`) the 16th rung
+/// has β ≈ 3·10⁻⁴, which flattens a ridge of thousands of nats.
+pub const MAX_TEMPERATURES: usize = 16;
+
 /// Settings of the parametric bootstrap that gives each fitted parameter an interval.
 #[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
@@ -483,6 +488,10 @@ pub struct UncertaintySection {
     pub steps: usize,
     /// `method = "mcmc"` / `"auto"`: steps discarded at the start of every walker's chain.
     pub burn_in: usize,
+    /// `method = "mcmc"` / `"auto"`: rungs of the parallel-tempering ladder, each an ensemble of
+    /// `walkers` on the likelihood raised to a smaller power (1: the plain ensemble; K costs K
+    /// times its simulations). Hot rungs cross the ridges between the likelihood's basins.
+    pub temperatures: usize,
 }
 
 impl UncertaintySection {
@@ -508,6 +517,7 @@ impl Default for UncertaintySection {
             walkers: 32,
             steps: 1000,
             burn_in: 300,
+            temperatures: 1,
         }
     }
 }
@@ -1093,6 +1103,15 @@ impl Check<'_> {
                     format!(
                         "[fit.uncertainty] walkers must be even and at least twice the freed parameters (got {})",
                         u.walkers
+                    ),
+                ));
+            }
+            if !(1..=MAX_TEMPERATURES).contains(&u.temperatures) {
+                return Err(self.error(
+                    &at("temperatures"),
+                    format!(
+                        "[fit.uncertainty] temperatures must be 1 (the plain ensemble) to {MAX_TEMPERATURES} (got {}): each rung is a whole ensemble",
+                        u.temperatures
                     ),
                 ));
             }

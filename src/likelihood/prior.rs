@@ -164,8 +164,26 @@ impl Prior {
         base: &BladeParams,
         u: &[f64],
     ) -> f64 {
+        let (ell, pi) = self.log_parts(cost_nats, w, free, base, u);
+        ell + pi
+    }
+
+    /// [`Prior::log_posterior`]'s two terms apart: the tempered log-likelihood `−w·NLL` and the
+    /// log-prior with its Jacobian, which parallel tempering (`crate::posterior::tempering`)
+    /// weighs differently.
+    pub fn log_parts(
+        &self,
+        cost_nats: f64,
+        w: f64,
+        free: &[FreeParam],
+        base: &BladeParams,
+        u: &[f64],
+    ) -> (f64, f64) {
         let prior = self.nats(&params_at(free, base, u));
-        -w * (cost_nats - prior) - prior + self.log_jacobian_u(free, u)
+        (
+            -w * (cost_nats - prior),
+            -prior + self.log_jacobian_u(free, u),
+        )
     }
 
     /// The prior with every observed value drawn anew about the prediction at `p` (`y' = g(θ̂) +

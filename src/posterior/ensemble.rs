@@ -12,7 +12,6 @@
 //! than a round one.
 
 use rand::{Rng, SeedableRng};
-use rayon::prelude::*;
 
 /// What the sampler cannot run with.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -174,80 +173,15 @@ pub fn sample<F>(
     log_density: F,
     start: Vec<Vec<f64>>,
     settings: &EnsembleSettings,
-    mut on_step: impl FnMut(usize) -> bool,
+    on_step: impl FnMut(usize) -> bool,
 ) -> Result<Chains, PosteriorError>
 where
     F: Fn(&[f64]) -> f64 + Sync,
 {
-    let n = start.len();
-    let d = start.first().map_or(0, Vec::len);
-    if n % 2 == 1 || n < 2 * d.max(1) || n != settings.walkers {
-        return Err(PosteriorError::Walkers {
-            walkers: n.max(settings.walkers),
-            dim: d,
-        });
-    }
-    let a = settings.stretch;
-    if a.is_nan() || a <= 1.0 {
-        return Err(PosteriorError::Stretch { stretch: a });
-    }
-    let eval = |x: &[f64]| {
-        let v = log_density(x);
-        if v.is_nan() { f64::NEG_INFINITY } else { v }
-    };
-    let mut lp: Vec<f64> = start.par_iter().map(|x| eval(x)).collect();
-    let finite: Vec<usize> = (0..n).filter(|k| lp[*k].is_finite()).collect();
-    if 2 * finite.len() < n {
-        return Err(PosteriorError::Start {
-            finite: finite.len(),
-            walkers: n,
-        });
-    }
-    let mut x = start;
-    let infinite: Vec<usize> = (0..n).filter(|k| !lp[*k].is_finite()).collect();
-    for (m, k) in infinite.into_iter().enumerate() {
-        let from = finite[m % finite.len()];
-        x[k] = x[from].clone();
-        lp[k] = lp[from];
-    }
-    let mut chains = Chains {
-        positions: Vec::with_capacity(settings.steps),
-        log_density: Vec::with_capacity(settings.steps),
-        accepted: 0,
-        evaluations: n,
-    };
-    let mut rng = rand::rngs::StdRng::seed_from_u64(settings.seed);
-    let half = n / 2;
-    for step in 0..settings.steps {
-        for (moving, other) in [(0..half, half..n), (half..n, 0..half)] {
-            // Proposals (serial, from the seed), densities (parallel), acceptances (serial).
-            let proposals: Vec<(usize, f64, Vec<f64>)> = moving
-                .map(|k| {
-                    let j = rng.random_range(other.clone());
-                    let z = stretch_factor(a, rng.random::<f64>());
-                    let y = x[j].iter().zip(&x[k]).map(|(xj, xk)| xj + z * (xk - xj));
-                    (k, z, y.collect())
-                })
-                .collect();
-            let lp_new: Vec<f64> = proposals.par_iter().map(|(_, _, y)| eval(y)).collect();
-            chains.evaluations += proposals.len();
-            for ((k, z, y), lq) in proposals.into_iter().zip(lp_new) {
-                let log_ratio = (d as f64 - 1.0) * z.ln() + lq - lp[k];
-                let u: f64 = rng.random();
-                if lq.is_finite() && u.ln() < log_ratio {
-                    x[k] = y;
-                    lp[k] = lq;
-                    chains.accepted += 1;
-                }
-            }
-        }
-        chains.positions.push(x.clone());
-        chains.log_density.push(lp.clone());
-        if !on_step(step) {
-            break;
-        }
-    }
-    Ok(chains)
+    // One rung of the tempering ladder at β = 1 is this ensemble: β·ℓ + 0 = ℓ exactly, and a
+    // single rung draws no swaps.
+    let parts = |x: &[f64]| (log_density(x), 0.0);
+    super::tempering::sample_tempered(parts, start, settings, &[1.0], on_step).map(|r| r.cold)
 }
 
 #[cfg(test)]

@@ -65,8 +65,15 @@ pub struct PosteriorSummary {
     /// The factor the log-likelihood was multiplied by before sampling
     /// (docs/uncertainty.md, "Posterior sample").
     pub tempering: f64,
-    /// Log-density evaluations (model simulations).
+    /// Log-density evaluations (model simulations), of every rung of a tempering ladder.
     pub evaluations: usize,
+    /// The inverse temperatures of a parallel-tempered sample ([`tempering`]), coldest (1) first;
+    /// empty for the plain ensemble. The quantiles are the β = 1 ensemble's.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub ladder: Vec<f64>,
+    /// Accepted over proposed swaps between neighbouring rungs of the ladder.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub swap_fractions: Vec<f64>,
     pub parameters: Vec<ParamPosterior>,
     /// Up to [`MAX_KEPT_DRAWS`] draws after burn-in, thinned evenly, each in the parameters'
     /// order and units: the corner plot's points.
@@ -129,6 +136,8 @@ impl PosteriorSummary {
             acceptance_fraction: chains.acceptance_fraction(),
             tempering,
             evaluations: chains.evaluations,
+            ladder: Vec::new(),
+            swap_fractions: Vec::new(),
             parameters,
             draws,
         }

@@ -281,8 +281,15 @@ pub fn posterior_figure(
     crate::report::plot::corner_plot(
         &dir.join("posterior_corner.svg"),
         &format!(
-            "posterior sample: {} walkers × {} steps ({} burn-in), likelihood^{:.2}",
-            post.walkers, post.steps, post.burn_in, post.tempering
+            "posterior sample: {} walkers × {} steps ({} burn-in), likelihood^{:.2}{}",
+            post.walkers,
+            post.steps,
+            post.burn_in,
+            post.tempering,
+            match post.ladder.len() {
+                0 | 1 => String::new(),
+                k => format!(", {k} temperatures"),
+            }
         ),
         &axes,
     )

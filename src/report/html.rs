@@ -1467,6 +1467,8 @@ pub(super) mod tests {
             acceptance_fraction: 0.3,
             tempering: 1.0,
             evaluations: 88,
+            ladder: Vec::new(),
+            swap_fractions: Vec::new(),
             parameters: vec![crate::posterior::ParamPosterior {
                 name,
                 quantiles: [0.01, 0.02, 0.03, 0.04, 0.05],

@@ -880,6 +880,19 @@ fn fit_cases() -> Vec<Case> {
             &["$D/job.toml:", "jackknife"],
         ),
         case(
+            "fit: a tempering ladder of no rungs",
+            j(&[(
+                "method = \"profile\"",
+                "method = \"mcmc\"\ntemperatures = 0",
+            )]),
+            fit,
+            &[
+                "$D/job.toml:",
+                "temperatures",
+                "1 (the plain ensemble) to 16",
+            ],
+        ),
+        case(
             "fit: negative solver tolerance",
             j(&[("rtol = 1e-8", "rtol = -1e-8")]),
             fit,
