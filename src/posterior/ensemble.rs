@@ -65,6 +65,18 @@ pub struct EnsembleSettings {
     pub seed: u64,
 }
 
+impl EnsembleSettings {
+    /// `walkers` × `steps` with the stretch scale 2 (Goodman & Weare's and emcee's default).
+    pub fn new(walkers: usize, steps: usize, seed: u64) -> Self {
+        EnsembleSettings {
+            walkers,
+            steps,
+            stretch: 2.0,
+            seed,
+        }
+    }
+}
+
 /// The walkers' positions and log densities after each step.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Chains {
@@ -189,12 +201,7 @@ mod tests {
     use super::*;
 
     fn settings(walkers: usize, steps: usize, seed: u64) -> EnsembleSettings {
-        EnsembleSettings {
-            walkers,
-            steps,
-            stretch: 2.0,
-            seed,
-        }
+        EnsembleSettings::new(walkers, steps, seed)
     }
 
     /// Mean and covariance of all walkers' points after `burn_in`.

@@ -245,12 +245,7 @@ mod tests {
     use crate::posterior::ensemble::ball;
 
     fn settings(walkers: usize, steps: usize, seed: u64) -> EnsembleSettings {
-        EnsembleSettings {
-            walkers,
-            steps,
-            stretch: 2.0,
-            seed,
-        }
+        EnsembleSettings::new(walkers, steps, seed)
     }
 
     /// A mixture of two unit-variance Gaussians at x = ∓8 in the first coordinate, weights
