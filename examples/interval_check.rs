@@ -244,27 +244,15 @@ fn posterior(
     let k = u_fit.len();
     let inside = |u: &[f64]| u.iter().all(|x| (0.0..=1.0).contains(x));
     // The tempered log-likelihood and the flat prior of the box.
-    let log_parts = |u: &[f64]| {
-        if !inside(u) {
-            return (f64::NEG_INFINITY, 0.0);
-        }
-        let c = p.cost_at(u);
-        if c < FAILED_COST {
-            (-w * c, 0.0)
-        } else {
-            (f64::NEG_INFINITY, 0.0)
-        }
+    let log_parts = |u: &[f64]| match inside(u).then(|| p.cost_at(u)) {
+        Some(c) if c < FAILED_COST => (-w * c, 0.0),
+        _ => (f64::NEG_INFINITY, 0.0),
     };
     let ball = spread
         .ball
         .unwrap_or_else(|| DMatrix::identity(k, k) * 0.01);
     let start = gaussian_ball_with(u_fit, &ball, WALKERS, 1, inside);
-    let settings = EnsembleSettings {
-        walkers: WALKERS,
-        steps,
-        stretch: 2.0,
-        seed: 1,
-    };
+    let settings = EnsembleSettings::new(WALKERS, steps, 1);
     let started = std::time::Instant::now();
     let betas = geometric_ladder(temperatures, k);
     let run = sample_tempered(log_parts, start, &settings, &betas, |_| true)?;

@@ -267,12 +267,7 @@ pub(super) fn mcmc_intervals(
     let l = spread.unwrap_or_else(|| nalgebra::DMatrix::identity(k, k) * 0.01);
     let start =
         crate::posterior::ensemble::gaussian_ball_with(&cf.best_u, &l, s.walkers, s.seed, inside);
-    let settings = crate::posterior::EnsembleSettings {
-        walkers: s.walkers,
-        steps: s.steps,
-        stretch: 2.0,
-        seed: s.seed,
-    };
+    let settings = crate::posterior::EnsembleSettings::new(s.walkers, s.steps, s.seed);
     let ladder = crate::posterior::tempering::geometric_ladder(s.temperatures, k);
     let per_step = s.walkers * ladder.len();
     if let Some(bar) = pb {
@@ -310,7 +305,7 @@ pub(super) fn mcmc_intervals(
         PosteriorSummary::new(&names, chains, burn_in, 1.0, w, |i, u| cf.free[i].value(u));
     if ladder.len() > 1 {
         post.swap_fractions = run.swap_fractions();
-        post.ladder = run.betas.clone();
+        post.ladder = run.betas;
     }
     let method = IntervalMethod::Mcmc {
         walkers: s.walkers,

@@ -35,19 +35,18 @@ pub struct TemperedChains {
     pub cold: Chains,
     /// The inverse temperatures, coldest first.
     pub betas: Vec<f64>,
-    /// Swaps accepted between rung `t` and `t + 1`, over all steps.
+    /// Swaps accepted between rung `t` and `t + 1`, over all steps (one is proposed per walker
+    /// and step).
     pub swaps_accepted: Vec<usize>,
-    /// Swaps proposed between rung `t` and `t + 1` (one per walker and step).
-    pub swaps_proposed: Vec<usize>,
 }
 
 impl TemperedChains {
     /// Accepted over proposed swaps between each pair of neighbouring rungs.
     pub fn swap_fractions(&self) -> Vec<f64> {
+        let proposed = (self.cold.walkers() * self.cold.steps()).max(1) as f64;
         self.swaps_accepted
             .iter()
-            .zip(&self.swaps_proposed)
-            .map(|(&a, &p)| a as f64 / p.max(1) as f64)
+            .map(|&a| a as f64 / proposed)
             .collect()
     }
 }
@@ -126,7 +125,6 @@ where
         evaluations: n,
     };
     let mut swaps_accepted = vec![0; k - 1];
-    let mut swaps_proposed = vec![0; k - 1];
     let mut rng = rand::rngs::StdRng::seed_from_u64(settings.seed);
     let half = n / 2;
     for step in 0..settings.steps {
@@ -157,9 +155,6 @@ where
             }
         }
         swap_round(&mut rungs, betas, &mut rng, &mut swaps_accepted);
-        for p in swaps_proposed.iter_mut() {
-            *p += n;
-        }
         cold.positions
             .push(rungs[0].iter().map(|w| w.x.clone()).collect());
         cold.log_density
@@ -172,7 +167,6 @@ where
         cold,
         betas: betas.to_vec(),
         swaps_accepted,
-        swaps_proposed,
     })
 }
 

@@ -286,9 +286,10 @@ pub fn posterior_figure(
             post.steps,
             post.burn_in,
             post.tempering,
-            match post.ladder.len() {
-                0 | 1 => String::new(),
-                k => format!(", {k} temperatures"),
+            if post.ladder.is_empty() {
+                String::new()
+            } else {
+                format!(", {} temperatures", post.ladder.len())
             }
         ),
         &axes,
