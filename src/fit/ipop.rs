@@ -95,81 +95,35 @@ pub fn search(
     let mut best: Option<(Vec<f64>, f64)> = None;
     let mut runs = Vec::new();
     let mut evaluations = 0;
-    let mut stopped = false;
     for run in 0..=settings.restarts {
         let remaining = settings.max_evaluations.saturating_sub(evaluations);
         let population = settings.population.max(2).saturating_mul(1 << run.min(20));
-        if stopped || remaining < population {
+        if remaining < population {
             break;
         }
         let run_seed = settings.seed ^ (run as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
         let mut rng = rand::rngs::StdRng::seed_from_u64(run_seed);
         let mean: Vec<f64> = (0..n).map(|_| rng.random_range(0.0..=1.0)).collect();
-        let objective = |x: &DVector<f64>| {
-            let u: Vec<f64> = x.iter().map(|&v| mirror(v)).collect();
-            let c = cost(&u);
-            if c.is_nan() { f64::INFINITY } else { c }
+        let start = Start {
+            run,
+            mean,
+            sigma: SIGMA0,
+            population,
+            budget: remaining,
+            tol_fun: settings.tol_fun,
+            seed: run_seed,
+            evaluations_before: evaluations,
         };
-        let options = CMAESOptions::new(mean, SIGMA0)
-            .population_size(population)
-            .seed(run_seed)
-            .tol_fun(settings.tol_fun)
-            .tol_fun_hist(settings.tol_fun)
-            .tol_x(TOL_X)
-            .max_function_evals(remaining - remaining % population);
-        let Ok(mut cma) = options.build(objective) else {
-            break;
-        };
-        let mut run_best: Option<(Vec<f64>, f64)> = None;
-        let mut generations = 0;
-        // The run's best cost after each generation, for its stagnation.
-        let mut bests: Vec<f64> = Vec::new();
-        let window = stagnation_window(n, population);
-        let run_evaluations = loop {
-            let end = cma.next_parallel();
-            generations += 1;
-            if let Some(b) = cma.overall_best_individual() {
-                let u: Vec<f64> = b.point.iter().map(|&v| mirror(v)).collect();
-                run_best = Some((u, b.value));
-                bests.push(b.value);
-            }
-            let done = cma.function_evals();
-            if let Some((u, c)) = &run_best {
-                let go_on = observe(Generation {
-                    run,
-                    population,
-                    generation: generations,
-                    best_cost: *c,
-                    best_u: u,
-                    run_evaluations: done,
-                    evaluations: evaluations + done,
-                });
-                if !go_on {
-                    stopped = true;
-                    break done;
-                }
-            }
-            match end {
-                Some(t) if t.reasons.contains(&TerminationReason::InvalidFunctionValue) => {
-                    stopped = true;
-                    break done;
-                }
-                Some(_) => break done,
-                None if stagnated(&bests, window, settings.tol_fun) => break done,
-                None => {}
-            }
-        };
-        evaluations += run_evaluations;
-        if let Some((u, c)) = run_best {
-            runs.push(RunEnd {
-                population,
-                cost: c,
-                evaluations: run_evaluations,
-                generations,
-            });
+        let (end, stopped) = one_run(start, cost, observe);
+        if let Some((u, c, run_end)) = end {
+            evaluations += run_end.evaluations;
+            runs.push(run_end);
             if best.as_ref().is_none_or(|b| c < b.1) {
                 best = Some((u, c));
             }
+        }
+        if stopped {
+            break;
         }
     }
     best.map(|(u, cost)| Found {
@@ -178,6 +132,136 @@ pub fn search(
         runs,
         evaluations,
     })
+}
+
+/// The step size of a local run ([`local`]), in units of the box's width: ±1σ spans a fifth of
+/// the box, wide enough to step over the ripples and low ridges of a stick–slip likelihood that
+/// stop a simplex, narrow enough to stay in the basin a swarm found.
+pub const LOCAL_SIGMA: f64 = 0.1;
+
+/// One CMA-ES run of `cost` from `start` (box coordinates) with step size [`LOCAL_SIGMA`] and
+/// CMA-ES's default population for `start.len()` parameters, over at most `max_evaluations`:
+/// the local stage after a swarm (`[fit.search] local = "cmaes"`). Stops as every run of
+/// [`search`] does (CMA-ES's criteria, stagnation by `tol_fun`, `observe` returning `false`).
+pub fn local(
+    start: &[f64],
+    cost: &(dyn Fn(&[f64]) -> f64 + Sync),
+    max_evaluations: usize,
+    tol_fun: f64,
+    seed: u64,
+    observe: &mut dyn FnMut(Generation) -> bool,
+) -> Option<Found> {
+    let n = start.len();
+    let population = 4 + (3.0 * (n.max(1) as f64).ln()).floor() as usize;
+    let run = Start {
+        run: 0,
+        mean: start.to_vec(),
+        sigma: LOCAL_SIGMA,
+        population,
+        budget: max_evaluations.max(population),
+        tol_fun,
+        seed,
+        evaluations_before: 0,
+    };
+    let (end, _) = one_run(run, cost, observe);
+    end.map(|(u, cost, run_end)| Found {
+        u,
+        cost,
+        evaluations: run_end.evaluations,
+        runs: vec![run_end],
+    })
+}
+
+/// Where and how one CMA-ES run starts.
+struct Start {
+    /// The run's index (for the observer).
+    run: usize,
+    mean: Vec<f64>,
+    sigma: f64,
+    population: usize,
+    /// Evaluations the run may spend (rounded down to whole generations).
+    budget: usize,
+    tol_fun: f64,
+    seed: u64,
+    /// Evaluations of earlier runs (for the observer's total).
+    evaluations_before: usize,
+}
+
+/// One CMA-ES run: its lowest point, cost and end (`None` when no generation finished or the
+/// options are refused), and whether the search must stop (the observer said so, or a cost was
+/// invalid).
+fn one_run(
+    start: Start,
+    cost: &(dyn Fn(&[f64]) -> f64 + Sync),
+    observe: &mut dyn FnMut(Generation) -> bool,
+) -> (Option<(Vec<f64>, f64, RunEnd)>, bool) {
+    let n = start.mean.len();
+    let objective = |x: &DVector<f64>| {
+        let u: Vec<f64> = x.iter().map(|&v| mirror(v)).collect();
+        let c = cost(&u);
+        if c.is_nan() { f64::INFINITY } else { c }
+    };
+    let population = start.population;
+    let options = CMAESOptions::new(start.mean, start.sigma)
+        .population_size(population)
+        .seed(start.seed)
+        .tol_fun(start.tol_fun)
+        .tol_fun_hist(start.tol_fun)
+        .tol_x(TOL_X)
+        .max_function_evals(start.budget - start.budget % population);
+    let Ok(mut cma) = options.build(objective) else {
+        return (None, true);
+    };
+    let mut run_best: Option<(Vec<f64>, f64)> = None;
+    let mut generations = 0;
+    // The run's best cost after each generation, for its stagnation.
+    let mut bests: Vec<f64> = Vec::new();
+    let window = stagnation_window(n, population);
+    let mut stopped = false;
+    let run_evaluations = loop {
+        let end = cma.next_parallel();
+        generations += 1;
+        if let Some(b) = cma.overall_best_individual() {
+            let u: Vec<f64> = b.point.iter().map(|&v| mirror(v)).collect();
+            run_best = Some((u, b.value));
+            bests.push(b.value);
+        }
+        let done = cma.function_evals();
+        if let Some((u, c)) = &run_best {
+            let go_on = observe(Generation {
+                run: start.run,
+                population,
+                generation: generations,
+                best_cost: *c,
+                best_u: u,
+                run_evaluations: done,
+                evaluations: start.evaluations_before + done,
+            });
+            if !go_on {
+                stopped = true;
+                break done;
+            }
+        }
+        match end {
+            Some(t) if t.reasons.contains(&TerminationReason::InvalidFunctionValue) => {
+                stopped = true;
+                break done;
+            }
+            Some(_) => break done,
+            None if stagnated(&bests, window, start.tol_fun) => break done,
+            None => {}
+        }
+    };
+    let end = run_best.map(|(u, c)| {
+        let run_end = RunEnd {
+            population,
+            cost: c,
+            evaluations: run_evaluations,
+            generations,
+        };
+        (u, c, run_end)
+    });
+    (end, stopped)
 }
 
 /// The generations over which a run's best cost must fall by more than `tol_fun` to go on:
@@ -274,6 +358,36 @@ mod tests {
             found.u[0] < 1e-4 && (found.u[1] - 0.3).abs() < 1e-4,
             "{found:?}"
         );
+    }
+
+    /// A local run descends into the basin it starts in: from (0.8, 0.7), 1.4 widths from the
+    /// narrow basin's centre, to its minimum −2 at (0.9, 0.8); from (0.35, 0.3) on the wide
+    /// basin's slope to the wide basin's minimum −1 at (0.25, 0.25) (the narrow one's tail there
+    /// is below 1e-13), though the narrow basin is deeper: the stage refines a swarm's basin and
+    /// leaves the global search to the swarms.
+    #[test]
+    fn a_local_run_descends_into_the_basin_it_starts_in() {
+        let found = local(&[0.8, 0.7], &two_basins, 2000, 1e-9, 1, &mut |_| true).expect("run");
+        assert!(found.cost < -1.999, "{found:?}");
+        assert!(
+            (found.u[0] - 0.9).hypot(found.u[1] - 0.8) < 1e-3,
+            "{found:?}"
+        );
+        let found = local(&[0.35, 0.3], &two_basins, 2000, 1e-9, 1, &mut |_| true).expect("run");
+        assert!((found.cost + 1.0).abs() < 1e-6, "{found:?}");
+        assert!(
+            (found.u[0] - 0.25).hypot(found.u[1] - 0.25) < 1e-3,
+            "{found:?}"
+        );
+        assert_eq!(found.runs.len(), 1);
+    }
+
+    #[test]
+    fn a_local_run_keeps_to_its_budget() {
+        // Population 4 + ⌊3 ln 4⌋ = 8: 100 evaluations are twelve whole generations (96).
+        let found = local(&[0.3; 4], &rastrigin, 100, 1e-12, 3, &mut |_| true).expect("run");
+        assert!(found.evaluations <= 100, "{}", found.evaluations);
+        assert_eq!(found.runs[0].population, 8);
     }
 
     #[test]

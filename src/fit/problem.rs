@@ -366,7 +366,7 @@ impl SpectralProblem {
     fn unrecorded_cost_at_stage(&self, u: &[f64], stage: SearchStage) -> f64 {
         let solver = match stage {
             SearchStage::Swarm => &self.swarm_solver,
-            SearchStage::Polish | SearchStage::Cmaes => &self.solver,
+            SearchStage::Polish | SearchStage::Cmaes | SearchStage::Local => &self.solver,
         };
         let outside: f64 = u
             .iter()

@@ -24,6 +24,9 @@ named_enum! {
         /// A CMA-ES run (`[fit.search] method = "cmaes"`), on the recording's likelihood at the
         /// job's tolerance.
         Cmaes => "cmaes",
+        /// The local CMA-ES run from a swarm's best particle (`[fit.search] local = "cmaes"`),
+        /// before its Nelder–Mead polish.
+        Local => "local",
     }
 }
 

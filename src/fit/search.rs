@@ -1589,6 +1589,16 @@ fn restart(
         .map(|p| p.position.clone())
         .ok_or(FitError::NoParticle)?;
     let swarm_iters = res.state().get_iter();
+    let swarm_best = match fit.search.local {
+        job::LocalSearch::NelderMead => swarm_best,
+        job::LocalSearch::Cmaes => {
+            match local_cmaes(problem, fit, &swarm_best, (run_seed, r, &run_evals), log) {
+                Some(u) => u,
+                None if interrupt::stop_requested() => return Ok(None),
+                None => swarm_best,
+            }
+        }
+    };
     let (u, polish_iters, cost) = match polish(
         problem,
         &swarm_best,
@@ -1606,6 +1616,51 @@ fn restart(
         swarm_iters,
         polish_iters,
     }))
+}
+
+/// The local CMA-ES run of restart `r` from its swarm's best particle `start`
+/// (`[fit.search] local = "cmaes"`, [`super::ipop::local`]) on the polish's cost, its generations
+/// in the history as [`SearchStage::Local`]: the run's lowest point, `None` when no generation
+/// finished (interrupted). The Nelder–Mead polish then goes on from it. `run`: the run's seed,
+/// the restart and its evaluation counter.
+fn local_cmaes(
+    problem: &Arc<SpectralProblem>,
+    fit: &job::FitSection,
+    start: &[f64],
+    (seed, r, run_evals): (u64, usize, &Arc<AtomicUsize>),
+    log: Option<&Reporting>,
+) -> Option<Vec<f64>> {
+    let cost = |u: &[f64]| {
+        run_evals.fetch_add(1, Ordering::Relaxed);
+        problem.cost_at_stage(u, SearchStage::Local)
+    };
+    let mut observe = |g: super::ipop::Generation| {
+        if let Some(reporting) = log {
+            reporting
+                .history
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .push(HistoryPoint {
+                    stage: SearchStage::Local,
+                    restart: r,
+                    iteration: g.generation,
+                    best_cost: g.best_cost,
+                    evaluations: run_evals.load(Ordering::Relaxed),
+                });
+            reporting.advance(problem.evaluations.load(Ordering::Relaxed));
+        }
+        !interrupt::stop_requested()
+    };
+    let sd = polish_sd(problem);
+    super::ipop::local(
+        start,
+        &cost,
+        fit.search.local_evaluations,
+        sd,
+        seed,
+        &mut observe,
+    )
+    .map(|found| found.u)
 }
 
 /// A swarm's first population with one particle at `warm` and the others drawn uniformly over

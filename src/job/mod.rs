@@ -392,6 +392,23 @@ pub struct SearchSection {
     /// `cmaes`: model evaluations one candidate's search may spend over all its runs; a run that
     /// would pass it is cut short.
     pub max_evaluations: usize,
+    /// `swarm`: the local search from each swarm's best particle.
+    pub local: LocalSearch,
+    /// `swarm` with `local = "cmaes"`: model evaluations each local run may spend.
+    pub local_evaluations: usize,
+}
+
+crate::names::named_enum! {
+    /// The local search from each swarm's best particle (docs/fit.md, "Search").
+    #[derive(Default)]
+    pub enum LocalSearch: "local search" {
+        /// A Nelder–Mead simplex of `[fit] polish_iterations` iterations.
+        #[default]
+        NelderMead => "nelder-mead",
+        /// One CMA-ES run from the particle with step size 0.1 box widths
+        /// ([`crate::fit::ipop::local`]), at most `[fit.search] local_evaluations` evaluations.
+        Cmaes => "cmaes",
+    }
 }
 
 impl Default for SearchSection {
@@ -401,6 +418,8 @@ impl Default for SearchSection {
             population: None,
             restarts: 4,
             max_evaluations: 4000,
+            local: LocalSearch::NelderMead,
+            local_evaluations: 1000,
         }
     }
 }
@@ -1057,7 +1076,24 @@ impl Check<'_> {
                 "[fit.search] max_evaluations must be >= 1",
             ));
         }
+        if search.local == LocalSearch::Cmaes && search.local_evaluations < 2 {
+            return Err(self.error(
+                &at("local_evaluations"),
+                "[fit.search] local_evaluations must be >= 2 (one CMA-ES generation)",
+            ));
+        }
         if search.method == SearchMethod::Cmaes {
+            for key in ["local", "local_evaluations"] {
+                if self.spans.contains(&at(key)) {
+                    return Err(self.error(
+                        &at(key),
+                        format!(
+                            "[fit.search] {key} sets the local search after each swarm; with \
+                             method = \"cmaes\" there is no swarm (docs/fit.md, \"Search\")"
+                        ),
+                    ));
+                }
+            }
             for key in SWARM_KEYS {
                 let path = [Key::Name("fit"), Key::Name(key)];
                 if self.spans.contains(&path) {

@@ -739,6 +739,7 @@ fn cost_figure(dir: &Path, history: &[HistoryPoint], objective: Objective) -> Re
     let stages: &[Option<SearchStage>] = if split {
         &[
             Some(SearchStage::Swarm),
+            Some(SearchStage::Local),
             Some(SearchStage::Polish),
             Some(SearchStage::Cmaes),
         ]
@@ -755,6 +756,7 @@ fn cost_figure(dir: &Path, history: &[HistoryPoint], objective: Objective) -> Re
                 .unzip();
             let what = match st {
                 Some(SearchStage::Swarm) => "swarm, feature cost",
+                Some(SearchStage::Local) => "local CMA-ES, nats",
                 Some(SearchStage::Polish) => "Nelder–Mead, nats",
                 Some(SearchStage::Cmaes) => "CMA-ES",
                 None => "search",

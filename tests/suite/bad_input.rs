@@ -893,6 +893,33 @@ fn fit_cases() -> Vec<Case> {
             ],
         ),
         case(
+            "fit: a local CMA-ES run of one evaluation",
+            j(&[(
+                "[fit.uncertainty]",
+                "[fit.search]\nlocal = \"cmaes\"\nlocal_evaluations = 1\n\n[fit.uncertainty]",
+            )]),
+            fit,
+            &["$D/job.toml:", "local_evaluations", ">= 2"],
+        ),
+        case(
+            "fit: an unknown local search",
+            j(&[(
+                "[fit.uncertainty]",
+                "[fit.search]\nlocal = \"bfgs\"\n\n[fit.uncertainty]",
+            )]),
+            fit,
+            &["$D/job.toml:", "local", "nelder-mead", "cmaes"],
+        ),
+        case(
+            "fit: a local search beside the CMA-ES search",
+            j(&[(
+                "[fit.uncertainty]",
+                "[fit.search]\nmethod = \"cmaes\"\nlocal = \"cmaes\"\n\n[fit.uncertainty]",
+            )]),
+            fit,
+            &["$D/job.toml:", "local", "no swarm"],
+        ),
+        case(
             "fit: negative solver tolerance",
             j(&[("rtol = 1e-8", "rtol = -1e-8")]),
             fit,
