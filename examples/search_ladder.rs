@@ -1,8 +1,13 @@
-//! Probe: particle swarms on the likelihood of a coarsened spectrum (every band's Welch segment
-//! divided by `--coarsest`), then Nelder–Mead polishes down a ladder of resolutions to the job's own.
+//! Search variants on one candidate of a job (docs/validation.md, "A local CMA-ES stage"): per
+//! restart, a particle swarm ranked by the likelihood of a coarsened spectrum (every band's Welch
+//! segment divided by `--coarsest`; 1: the job's own) or, with `--features`, by the feature cost
+//! at rtol 1e-6; then optionally a local CMA-ES run on the job's likelihood (`--cmaes N`
+//! evaluations, step `--sigma` box widths); then Nelder–Mead polishes down the ladder of
+//! resolutions to the job's own. Prints each stage's end and, with a `[truth]`, the truth's cost
+//! at every resolution.
 //!
 //! ```sh
-//! cargo run --release --example search_ladder -- JOB.toml --model blade2dof --coarsest 8
+//! cargo run --release --example search_ladder -- JOB.toml --model blade2dof --coarsest 1 --cmaes 1000
 //! ```
 
 use argmin::core::{CostFunction, Executor, State};
