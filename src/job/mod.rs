@@ -1079,7 +1079,7 @@ impl Check<'_> {
         if search.local == LocalSearch::Cmaes && search.local_evaluations < 2 {
             return Err(self.error(
                 &at("local_evaluations"),
-                "[fit.search] local_evaluations must be >= 2 (one CMA-ES generation)",
+                "[fit.search] local_evaluations must be >= 2",
             ));
         }
         if search.method == SearchMethod::Cmaes {
