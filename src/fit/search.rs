@@ -115,6 +115,27 @@ impl Reporting {
         }
     }
 
+    /// Keeps one CMA-ES generation of `stage` in the history, as restart `restart`'s iteration,
+    /// at `evaluations` of that run.
+    fn generation(
+        &self,
+        stage: SearchStage,
+        restart: usize,
+        g: &super::ipop::Generation,
+        evaluations: usize,
+    ) {
+        self.history
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push(HistoryPoint {
+                stage,
+                restart,
+                iteration: g.generation,
+                best_cost: g.best_cost,
+                evaluations,
+            });
+    }
+
     /// Names the stage on the progress bar.
     pub(super) fn stage(&self, what: std::fmt::Arguments) {
         if let Some(pb) = &self.progress {
@@ -1390,17 +1411,7 @@ fn cmaes_search(
     let cost = |u: &[f64]| problem.cost_at_stage(u, SearchStage::Cmaes);
     let mut observe = |g: super::ipop::Generation| {
         if let Some(reporting) = log {
-            reporting
-                .history
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .push(HistoryPoint {
-                    stage: SearchStage::Cmaes,
-                    restart: g.run,
-                    iteration: g.generation,
-                    best_cost: g.best_cost,
-                    evaluations: g.run_evaluations,
-                });
+            reporting.generation(SearchStage::Cmaes, g.run, &g, g.run_evaluations);
             if g.generation == 1 {
                 reporting.stage(format_args!(
                     "CMA-ES run {} (λ = {})",
@@ -1636,17 +1647,7 @@ fn local_cmaes(
     };
     let mut observe = |g: super::ipop::Generation| {
         if let Some(reporting) = log {
-            reporting
-                .history
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .push(HistoryPoint {
-                    stage: SearchStage::Local,
-                    restart: r,
-                    iteration: g.generation,
-                    best_cost: g.best_cost,
-                    evaluations: run_evals.load(Ordering::Relaxed),
-                });
+            reporting.generation(SearchStage::Local, r, &g, run_evals.load(Ordering::Relaxed));
             reporting.advance(problem.evaluations.load(Ordering::Relaxed));
         }
         !interrupt::stop_requested()
