@@ -152,7 +152,7 @@ pub fn local(
     observe: &mut dyn FnMut(Generation) -> bool,
 ) -> Option<Found> {
     let n = start.len();
-    let population = 4 + (3.0 * (n.max(1) as f64).ln()).floor() as usize;
+    let population = crate::job::default_population(n);
     let run = Start {
         run: 0,
         mean: start.to_vec(),

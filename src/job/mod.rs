@@ -427,9 +427,14 @@ impl Default for SearchSection {
 impl SearchSection {
     /// The first CMA-ES run's population for `n` free parameters.
     pub fn first_population(&self, n: usize) -> usize {
-        self.population
-            .unwrap_or(4 + (3.0 * (n.max(1) as f64).ln()).floor() as usize)
+        self.population.unwrap_or(default_population(n))
     }
+}
+
+/// CMA-ES's default population for `n` free parameters, 4 + ⌊3 ln n⌋ (Hansen 2016, "The CMA
+/// Evolution Strategy: A Tutorial", table 1).
+pub fn default_population(n: usize) -> usize {
+    4 + (3.0 * (n.max(1) as f64).ln()).floor() as usize
 }
 
 crate::names::named_enum! {
