@@ -35,6 +35,7 @@ use super::run::{EntryPaths, State, read_status};
 use crate::fit::SHORTFALL_TOLERANCE_NATS;
 use crate::fit::result::{FitResult, FittedParam};
 use crate::fit::select::INDISTINGUISHABLE_TIC;
+use crate::fit::tolerance::SPREAD_WARN_NATS;
 use crate::fit::truth::{RIDGE_NATS, is_ridge};
 use crate::io::write_atomic;
 use crate::job::{Candidate, FreeParam};
@@ -152,6 +153,10 @@ pub struct RecordingScore {
     pub shortfall_nats: Option<f64>,
     /// The ridge on the segment from the fit to the truth, nats ([`crate::fit::truth`]).
     pub ridge_nats: Option<f64>,
+    /// How far the truth's own cost moves between the job's tolerance and tenfold and hundredfold
+    /// tighter ones, nats ([`FitResult::truth_tolerance`]), when the shortfall is priced and the
+    /// result has the check.
+    pub truth_spread_nats: Option<f64>,
     pub wall_time_s: f64,
     /// The scored parameters (empty when the chosen model does not contain the truth's).
     pub params: Vec<Scored>,
@@ -286,6 +291,26 @@ impl Calibration {
         (ridges.len(), beyond)
     }
 
+    /// Of the fits above [`SHORTFALL_TOLERANCE_NATS`]: (those whose truth was priced at tighter
+    /// tolerances too, of them those whose truth's cost spreads by more than the shortfall: the
+    /// integrator, not the search, may have put the truth below the fit).
+    pub fn shortfall_unresolved(&self) -> (usize, usize) {
+        let spreads: Vec<(f64, f64)> = (self.done())
+            .filter_map(|r| Some((r.shortfall_nats?, r.truth_spread_nats?)))
+            .filter(|(s, _)| *s > SHORTFALL_TOLERANCE_NATS)
+            .collect();
+        let wider = spreads.iter().filter(|(s, w)| w > s).count();
+        (spreads.len(), wider)
+    }
+
+    /// Fits whose truth was priced at tighter tolerances, and of them those whose truth's cost
+    /// spreads by more than [`SPREAD_WARN_NATS`]: a truth the integrator does not resolve.
+    pub fn unresolved_truths(&self) -> (usize, usize) {
+        let spreads: Vec<f64> = self.done().filter_map(|r| r.truth_spread_nats).collect();
+        let wide = spreads.iter().filter(|w| **w > SPREAD_WARN_NATS).count();
+        (spreads.len(), wide)
+    }
+
     /// (fits whose shortfall is known, of them above [`SHORTFALL_TOLERANCE_NATS`], the largest).
     pub fn shortfalls(&self) -> (usize, usize, f64) {
         let s: Vec<f64> = self.done().filter_map(|r| r.shortfall_nats).collect();
@@ -294,12 +319,15 @@ impl Calibration {
     }
 
     /// The likelihood ratio at the truth over the fits that did not fall short (shortfall at most
-    /// [`SHORTFALL_TOLERANCE_NATS`]; a short fit measures its search, not the likelihood) and whose
-    /// true model's `(k, tr(F⁻¹V))` are known: (fits, mean of D = truth's cost − fit's, mean
-    /// `tr/2`, mean `k/2`, fits whose D exceeds the 95 % point of `(tr/k)·χ²(k)/2`).
+    /// [`SHORTFALL_TOLERANCE_NATS`]; a short fit measures its search, not the likelihood), whose
+    /// truth the integrator resolves (its cost spreads by at most [`SPREAD_WARN_NATS`] over the
+    /// tolerances, where the result has that check) and whose true model's `(k, tr(F⁻¹V))` are
+    /// known: (fits, mean of D = truth's cost − fit's, mean `tr/2`, mean `k/2`, fits whose D
+    /// exceeds the 95 % point of `(tr/k)·χ²(k)/2`).
     pub fn truth_ratios(&self) -> (usize, f64, f64, f64, usize) {
         let rows: Vec<(f64, usize, f64)> = self
             .done()
+            .filter(|r| r.truth_spread_nats.is_none_or(|w| w <= SPREAD_WARN_NATS))
             .filter_map(|r| Some((-r.shortfall_nats?, r.true_model_k_tr?)))
             .filter(|(d, (k, tr))| *d >= -SHORTFALL_TOLERANCE_NATS && *k > 0 && *tr > 0.0)
             .map(|(d, (k, tr))| (d, k, tr))
@@ -377,6 +405,7 @@ pub fn calibrate(campaign: &Campaign) -> Result<Option<Calibration>> {
             chosen: None,
             shortfall_nats: None,
             ridge_nats: None,
+            truth_spread_nats: None,
             wall_time_s: f64::NAN,
             params: Vec::new(),
             departure,
@@ -450,6 +479,9 @@ fn score(r: &mut RecordingScore, result: &FitResult) {
     r.true_model_delta_tic = true_trial.and_then(|(_, e)| e.delta_tic);
     r.true_model_k_tr = true_trial.and_then(|(k, e)| Some((k, e.effective_parameters?)));
     r.ridge_nats = result.truth_segment.as_ref().map(|s| s.ridge_nats);
+    r.truth_spread_nats = (result.truth_tolerance.as_ref())
+        .filter(|t| r.shortfall_nats.is_some() && t.points.len() > 1)
+        .map(|t| t.spread_nats);
     r.law = super::law::LawScore::of(result);
     r.gof_p = result.goodness_of_fit.as_ref().map(|g| g.p_value);
     if !r.model_contains_truth() {
@@ -550,6 +582,17 @@ fn ratio_section(md: &mut String, c: &Calibration) {
         num(tr, 2),
         num(k, 2)
     );
+    let (checked, wide) = c.unresolved_truths();
+    if checked > 0 {
+        let _ = writeln!(
+            md,
+            "\nOf the {checked} fits whose result prices the truth at tenfold and hundredfold \
+             tighter tolerances too, {wide} have a truth whose cost spreads by more than \
+             {SPREAD_WARN_NATS} nats over them: the integrator does not resolve that truth, so \
+             its cost says nothing of the noise, and those fits are left out above \
+             (`truth_spread_nats` in calibration_recordings.csv)."
+        );
+    }
 }
 
 /// The model-choice section: the confusion matrix, true model × chosen model (nothing when no
@@ -680,6 +723,15 @@ pub fn to_markdown(c: &Calibration, notes: Option<&str>, command: &str) -> Strin
             measured - beyond
         );
     }
+    let (checked, wider) = c.shortfall_unresolved();
+    if checked > 0 {
+        let _ = writeln!(
+            md,
+            "\nOf the {checked} short fits whose truth was priced at tighter tolerances too, \
+             {wider} have a truth whose cost moves by more than the shortfall between them: \
+             there the integrator, not the search, may have put the fit above the truth."
+        );
+    }
     ratio_section(&mut md, c);
     confusion_section(&mut md, c);
     super::law::law_section(&mut md, c);
@@ -804,6 +856,7 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
         "chosen_model",
         "shortfall_nats",
         "ridge_nats",
+        "truth_spread_nats",
         "wall_time_s",
         "departure",
         "law_rms_rel_diff",
@@ -828,6 +881,7 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
             name(r.chosen),
             r.shortfall_nats.map(csv_num).unwrap_or_default(),
             r.ridge_nats.map(csv_num).unwrap_or_default(),
+            r.truth_spread_nats.map(csv_num).unwrap_or_default(),
             csv_num(r.wall_time_s),
             r.departure.clone().unwrap_or_default(),
             r.law.map(|l| csv_num(l.rms_rel_diff)).unwrap_or_default(),
@@ -1005,6 +1059,7 @@ mod tests {
             chosen: "blade2dof".parse().ok(),
             shortfall_nats: Some(0.0),
             ridge_nats: None,
+            truth_spread_nats: None,
             wall_time_s: 1.0,
             params: z
                 .iter()
@@ -1022,6 +1077,45 @@ mod tests {
             true_model_delta_tic: None,
             true_model_k_tr: None,
         }
+    }
+
+    /// Four fits: two short (by 2 and by 0.3 nats) whose truths' costs spread by 5 and by 0.2 nats
+    /// over the tolerances, one 40 nats more likely than a truth that spreads by 90, one 1 nat
+    /// more likely than a resolved truth. Only the 2-nat shortfall lies within its truth's spread;
+    /// the likelihood ratio reads the 1-nat fit alone (the 0.3-nat one fell short, the 40-nat
+    /// one's truth is unresolved): D = 1 nat against tr/2 = 0.5.
+    #[test]
+    fn unresolved_truths_are_counted_and_left_out_of_the_ratio() {
+        let fit = |short: f64, spread: f64| {
+            let mut r = recording(&[]);
+            r.shortfall_nats = Some(short);
+            r.truth_spread_nats = Some(spread);
+            r.true_model_k_tr = Some((4, 1.0));
+            r
+        };
+        let c = Calibration {
+            name: "t".into(),
+            campaign: PathBuf::from("t.toml"),
+            recordings: vec![
+                fit(2.0, 5.0),
+                fit(0.3, 0.2),
+                fit(-40.0, 90.0),
+                fit(-1.0, 0.1),
+            ],
+            overall: Vec::new(),
+            by_model: Vec::new(),
+        };
+        assert_eq!(c.shortfall_unresolved(), (2, 1));
+        assert_eq!(c.unresolved_truths(), (4, 2));
+        let (n, d, tr, k, _) = c.truth_ratios();
+        assert_eq!(n, 1);
+        assert_eq!((d, tr, k), (1.0, 0.5, 2.0));
+        let md = to_markdown(&c, None, "wiperlab campaign collect t.toml");
+        assert!(
+            md.contains("2 short fits whose truth was priced at tighter tolerances too, 1 have"),
+            "{md}"
+        );
+        assert!(md.contains("4 fits whose result prices the truth"), "{md}");
     }
 
     /// Ten recordings with z = ±0.5 (×6), ±1.5 (×3), 2.5: 6 covered at 68 %, 9 at 95 %, Σz² =

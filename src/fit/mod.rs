@@ -696,6 +696,7 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         truth_model: a.truth.as_ref().and_then(|t| t.model),
         truth_model_cost: (a.truth.as_ref())
             .and_then(|t| t.model.is_some().then_some(t.fit_cost_nats)),
+        truth_tolerance: a.truth.as_ref().and_then(|t| t.tolerance.clone()),
         truth_segment: a.truth.and_then(|t| t.segment),
         friction_curve: None,
         posterior: None,

@@ -456,6 +456,10 @@ pub struct FitResult {
     /// truth inside the search box for every freed parameter.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub truth_segment: Option<crate::fit::truth::TruthSegment>,
+    /// The truth's cost at the job's tolerance and at tenfold and hundredfold tighter ones: a
+    /// spread wider than [`FitResult::shortfall_nats`] leaves the shortfall to the integrator.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truth_tolerance: Option<crate::fit::tolerance::ToleranceCheck>,
     /// The model the truth's cost and segment are read in when it is not the chosen one (the
     /// job's `[truth] model`, [`crate::fit::truth`]); `None`: the chosen model.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -12,6 +12,7 @@
 //! likelihood").
 
 use super::search::CandidateFit;
+use super::tolerance::ToleranceCheck;
 use super::warning::FitWarning;
 use crate::job::{Candidate, LoadedJob};
 use rayon::prelude::*;
@@ -60,6 +61,9 @@ pub struct TruthCheck {
     pub fit_cost_nats: f64,
     /// The true model, when the truth is read in a candidate other than the chosen one.
     pub model: Option<Candidate>,
+    /// The truth's cost again at tenfold and hundredfold tighter tolerances: a truth whose cost
+    /// moves with the integrator by more than a shortfall does not show the search short.
+    pub tolerance: Option<ToleranceCheck>,
 }
 
 /// The candidate fit the truth is read in: the chosen fit when its model is the truth's or the job
@@ -87,7 +91,8 @@ pub(super) fn truth_fit<'a>(
 
 /// The truth's cost and segment for the fit `cf` of cost `fit_cost`, at the fit's solver; `None`
 /// without a truth for every freed parameter or when the truth cannot be simulated. The segment is
-/// left out where a true value lies outside the search box. `1 + 9` simulations, counted as `cf`'s
+/// left out where a true value lies outside the search box; the truth's [`ToleranceCheck`] beside
+/// them. `1 + 9 + 2` simulations, counted as `cf`'s
 /// evaluations; none of them enters the intervals (already computed) or the search's record of
 /// near-best points. `model` is the true model when `cf` is not the chosen fit.
 pub(super) fn check(
@@ -106,13 +111,16 @@ pub(super) fn check(
         inside &= (fp.lower..=fp.upper).contains(&t);
         u_true.push(fp.u_of(t));
     }
-    let cost_nats = p.total_cost(&p.simulate(&params).ok()?).ok()? + p.prior.nats(&params);
+    let sim = p.simulate(&params).ok()?;
+    let cost_nats = p.total_cost(&sim).ok()? + p.prior.nats(&params);
     let segment = inside.then(|| segment(cf, &u_true, fit_cost, cost_nats));
+    let tolerance = ToleranceCheck::run(p, &u_true, (cost_nats, sim.transitions.len()));
     Some(TruthCheck {
         cost_nats,
         segment,
         fit_cost_nats: fit_cost,
         model,
+        tolerance,
     })
 }
 

@@ -630,9 +630,40 @@ fn truth_line(r: &FitResult) -> String {
         None => (String::new(), ""),
     };
     format!(
-        "  truth's own cost{whose} {t:.2} nats: the fit{fit} is {:.2} nats {} likely than the truth\n",
+        "  truth's own cost{whose} {t:.2} nats: the fit{fit} is {:.2} nats {} likely than the truth{}\n",
         short.abs(),
-        if short > 0.0 { "less" } else { "more" }
+        if short > 0.0 { "less" } else { "more" },
+        truth_tolerance_words(r, short)
+    )
+}
+
+/// What the truth's own tolerance check says of the comparison: the truth's costs at the probed
+/// tolerances and, when they spread by more than the fit's distance from the truth, that the
+/// integrator does not tell the two apart (empty without the check).
+fn truth_tolerance_words(r: &FitResult, short: f64) -> String {
+    let Some(tc) = r.truth_tolerance.as_ref().filter(|t| t.points.len() > 1) else {
+        return String::new();
+    };
+    let costs: Vec<String> = tc
+        .points
+        .iter()
+        .map(|p| format!("{:.2}", p.cost_nats))
+        .collect();
+    let rtols: Vec<String> = tc
+        .points
+        .iter()
+        .map(|p| format!("{:.0e}", p.rtol))
+        .collect();
+    let verdict = if tc.spread_nats > short.abs() {
+        ": wider than the gap, so the integrator does not tell the fit from the truth"
+    } else {
+        ""
+    };
+    format!(
+        " (the truth costs {} nats at rtol {}, {:.2} apart{verdict})",
+        costs.join(", "),
+        rtols.join(", "),
+        tc.spread_nats
     )
 }
 

@@ -1221,6 +1221,7 @@ pub(super) mod tests {
             tracking_noise: None,
             truth_cost: None,
             truth_segment: None,
+            truth_tolerance: None,
             truth_model: None,
             truth_model_cost: None,
             friction_curve: None,

@@ -158,6 +158,19 @@ fn sample() -> FitResult {
             rise_nats: vec![5.0, 31.1, -2.0],
             ridge_nats: 31.1,
         }),
+        truth_tolerance: Some(wiperlab::fit::tolerance::ToleranceCheck::of(
+            [(1e-8, 35.9, 160), (1e-9, 36.4, 158), (1e-10, 35.2, 160)]
+                .map(
+                    |(rtol, cost_nats, transitions)| wiperlab::fit::tolerance::TolerancePoint {
+                        rtol,
+                        atol: rtol / 100.0,
+                        cost_nats,
+                        transitions,
+                    },
+                )
+                .to_vec(),
+            Vec::new(),
+        )),
         truth_model: Some("blade2dof+shoulder".parse().expect("a model name")),
         truth_model_cost: Some(38.3),
         friction_curve: None,
