@@ -311,6 +311,20 @@ impl Calibration {
         (spreads.len(), wide)
     }
 
+    /// Fits that reached the truth: done, their chosen model contains the true one, not short of
+    /// the truth's cost (shortfall known and at most [`SHORTFALL_TOLERANCE_NATS`]), and their truth
+    /// not moving with the integrator by more than [`SPREAD_WARN_NATS`] where the result says. Their
+    /// intervals are the interval method's alone: a short fit's miss is its search's, and an
+    /// unresolved truth has no cost to be near.
+    pub fn reached(&self) -> impl Iterator<Item = &RecordingScore> {
+        self.done().filter(|r| {
+            r.model_contains_truth()
+                && r.shortfall_nats
+                    .is_some_and(|s| s <= SHORTFALL_TOLERANCE_NATS)
+                && r.truth_spread_nats.is_none_or(|w| w <= SPREAD_WARN_NATS)
+        })
+    }
+
     /// (fits whose shortfall is known, of them above [`SHORTFALL_TOLERANCE_NATS`], the largest).
     pub fn shortfalls(&self) -> (usize, usize, f64) {
         let s: Vec<f64> = self.done().filter_map(|r| r.shortfall_nats).collect();
@@ -697,6 +711,19 @@ pub fn to_markdown(c: &Calibration, notes: Option<&str>, command: &str) -> Strin
             of_model().count()
         );
         stats_table(&mut md, stats);
+    }
+    let reached = c.reached().count();
+    if reached > 0 {
+        let _ = writeln!(
+            md,
+            "\n### Where the search reached the truth\n\n\
+             Over the {reached} of the fits above that did not fall short of the truth's cost (by more than \
+             {SHORTFALL_TOLERANCE_NATS} nats) and whose truth the integrator resolves (its cost \
+             spreads by at most {SPREAD_WARN_NATS} nats over tenfold and hundredfold tighter \
+             tolerances, where the result has `truth_tolerance`): what the interval method covers \
+             when the search and the integrator leave it nothing else to cover.\n"
+        );
+        stats_table(&mut md, &param_stats(c.reached()));
     }
     let (known, over, max) = c.shortfalls();
     let _ = writeln!(
@@ -1106,6 +1133,8 @@ mod tests {
             by_model: Vec::new(),
         };
         assert_eq!(c.shortfall_unresolved(), (2, 1));
+        let reached: Vec<f64> = c.reached().filter_map(|r| r.shortfall_nats).collect();
+        assert_eq!(reached, vec![-1.0], "neither short nor unresolved");
         assert_eq!(c.unresolved_truths(), (4, 2));
         let (n, d, tr, k, _) = c.truth_ratios();
         assert_eq!(n, 1);
@@ -1116,6 +1145,10 @@ mod tests {
             "{md}"
         );
         assert!(md.contains("4 fits whose result prices the truth"), "{md}");
+        assert!(
+            md.contains("Over the 1 of the fits above that did not fall short"),
+            "{md}"
+        );
     }
 
     /// Ten recordings with z = ±0.5 (×6), ±1.5 (×3), 2.5: 6 covered at 68 %, 9 at 95 %, Σz² =
