@@ -644,27 +644,25 @@ fn truth_tolerance_words(r: &FitResult, short: f64) -> String {
     let Some(tc) = r.truth_tolerance.as_ref().filter(|t| t.points.len() > 1) else {
         return String::new();
     };
-    let costs: Vec<String> = tc
-        .points
-        .iter()
-        .map(|p| format!("{:.2}", p.cost_nats))
-        .collect();
-    let rtols: Vec<String> = tc
-        .points
-        .iter()
-        .map(|p| format!("{:.0e}", p.rtol))
-        .collect();
+    let (costs, rtols) = tolerance_lists(tc);
     let verdict = if tc.spread_nats > short.abs() {
         ": wider than the gap, so the integrator does not tell the fit from the truth"
     } else {
         ""
     };
     format!(
-        " (the truth costs {} nats at rtol {}, {:.2} apart{verdict})",
-        costs.join(", "),
-        rtols.join(", "),
+        " (the truth costs {costs} nats at rtol {rtols}, {:.2} apart{verdict})",
         tc.spread_nats
     )
+}
+
+/// A tolerance check's costs (nats, two decimals) and tolerances, each as a comma-separated list.
+fn tolerance_lists(t: &crate::fit::tolerance::ToleranceCheck) -> (String, String) {
+    let costs: Vec<String> = (t.points.iter())
+        .map(|p| format!("{:.2}", p.cost_nats))
+        .collect();
+    let rtols: Vec<String> = t.points.iter().map(|p| format!("{:e}", p.rtol)).collect();
+    (costs.join(", "), rtols.join(", "))
 }
 
 /// The summary's line on `[fit.priors]`: the prior's share of the cost and how far the fit lies
@@ -1092,17 +1090,10 @@ pub fn fit_summary(r: &FitResult) -> String {
     }
     if let Some(t) = &r.tolerance_check {
         use crate::fit::tolerance::Verdict;
-        let costs: Vec<String> = t
-            .points
-            .iter()
-            .map(|p| format!("{:.2}", p.cost_nats))
-            .collect();
-        let rtols: Vec<String> = t.points.iter().map(|p| format!("{:e}", p.rtol)).collect();
+        let (costs, rtols) = tolerance_lists(t);
         let _ = writeln!(
             s,
-            "  tolerance check: cost {} nats at rtol {} ({:.2} nats apart: {})",
-            costs.join(", "),
-            rtols.join(", "),
+            "  tolerance check: cost {costs} nats at rtol {rtols} ({:.2} nats apart: {})",
             t.spread_nats,
             match t.verdict() {
                 Verdict::Resolved => "resolved by the integrator",
