@@ -710,18 +710,14 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
         // The sample before `ta` (for the minimum test): the previous step's last interior sample.
         let (mut tb, mut gb) = self
             .prev
-            .as_ref()
-            .map_or((f64::NAN, [f64::NAN; N_EVENTS]), |(_, tp, gp)| (*tp, *gp));
+            .map_or((f64::NAN, [f64::NAN; N_EVENTS]), |(_, tp, gp)| (tp, gp));
+        let prev = self.prev;
+        let dense = a.dense;
         let (solves, kinematic) = (Cell::new(0), Cell::new(0));
         let (g_end, clear) = self.slip_end(a, t_new, &ga, &solves);
         if slip.is_some() && !clear && gb[2].is_nan() {
             gb = self.solved_prev_sample(gb)?;
         }
-        // Read in place, not copied: a continuous extension is a few hundred bytes, and this runs
-        // at every step.
-        let prev = self.prev.as_ref();
-        let dense = &a.dense;
-        let mut last_rhs = self.last_rhs.take();
         // State on [previous step, this step] from the continuous extensions.
         let y_at = |tt: f64| match prev {
             Some((pd, _, _)) if tt < t => pd.eval(tt),
@@ -757,7 +753,7 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
                     kinematic_event_values(model, &mode, s, tj, &yj)
                         .map_err(|e| self.fail(tj, &yj, e.into()))?
                 }
-                _ => match end_event_values(model, &mode, &mut last_rhs, at_end, tj, &yj) {
+                _ => match self.end_event_values(at_end, tj, &yj) {
                     Some(g) => g,
                     None => {
                         solves.set(solves.get() + 1);
@@ -813,12 +809,11 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
             ta = tj;
             ga = gj;
         }
-        self.last_rhs = last_rhs;
         self.stats.event_evals += solves.get();
         self.stats.kinematic_evals += kinematic.get();
         if found.is_none() {
             self.g_prev = ga;
-            self.prev = Some((a.dense, tb, gb));
+            self.prev = Some((dense, tb, gb));
             self.prev_normal_clear = clear;
         }
         Ok(found)
@@ -839,14 +834,12 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
         if self.mode.phase.slip_dir().is_none() {
             return (None, false);
         }
-        let (model, mode) = (self.model, self.mode);
-        let g_end = end_event_values(model, &mode, &mut self.last_rhs, true, t_new, &a.y_new)
-            .or_else(|| {
-                solves.set(solves.get() + 1);
-                event_values(self.model, &self.mode, t_new, &a.y_new)
-                    .ok()
-                    .map(|(g, _)| g)
-            });
+        let g_end = self.end_event_values(true, t_new, &a.y_new).or_else(|| {
+            solves.set(solves.get() + 1);
+            event_values(self.model, &self.mode, t_new, &a.y_new)
+                .ok()
+                .map(|(g, _)| g)
+        });
         let clear = self.prev_normal_clear
             && g_end.is_some_and(|ge| {
                 let (lo, hi) = self.stage_normal;
@@ -863,14 +856,37 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
     /// only the kinematic functions inside (`gb`'s normal force NaN): for the minimum test at this
     /// step's start. `gb` itself without a previous step.
     fn solved_prev_sample(&mut self, gb: [f64; N_EVENTS]) -> Result<[f64; N_EVENTS]> {
-        let Some((pd, tp, _)) = self.prev.as_ref() else {
+        let Some((pd, tp, _)) = self.prev else {
             return Ok(gb);
         };
-        let (tp, yb) = (*tp, pd.eval(*tp));
+        let yb = pd.eval(tp);
         self.stats.event_evals += 1;
         Ok(event_values(self.model, &self.mode, tp, &yb)
             .map_err(|e| self.fail(tp, &yb, e.into()))?
             .0)
+    }
+
+    /// The event functions at the accepted step's end `(t_end, y_end)` from the attempt's last
+    /// right-hand-side call, when that call was at exactly this time and state and the state is
+    /// already consistent with the mode (`complete` leaves it bitwise unchanged): the same function
+    /// of the same arguments as [`event_values`] there, without solving the model again. `None`
+    /// otherwise (`at_end` false, the last stage elsewhere, or a state `complete` changes).
+    fn end_event_values(
+        &mut self,
+        at_end: bool,
+        t_end: f64,
+        y_end: &[f64; N],
+    ) -> Option<[f64; N_EVENTS]> {
+        if !at_end {
+            return None;
+        }
+        let (tt, yy, c) = self.last_rhs.take()?;
+        if tt != t_end || yy != *y_end {
+            return None;
+        }
+        let mut yc = yy;
+        self.model.complete(&self.mode, tt, &mut yc).ok()?;
+        (yc == yy).then(|| event_values_of(self.model, &self.mode, tt, &yc, c))
     }
 
     /// Takes the accepted step without an event.
@@ -999,31 +1015,6 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
         self.mode = new_mode;
         Ok(())
     }
-}
-
-/// The event functions at an accepted step's end `(t_end, y_end)` from the attempt's last
-/// right-hand-side call `last_rhs` (taken), when that call was at exactly this time and state and
-/// the state is already consistent with `mode` (`complete` leaves it bitwise unchanged): the same
-/// function of the same arguments as [`event_values`] there, without solving the model again.
-/// `None` otherwise (`at_end` false, the last stage elsewhere, or a state `complete` changes).
-fn end_event_values<M: StickSlipModel<N>, const N: usize>(
-    model: &M,
-    mode: &Mode,
-    last_rhs: &mut Option<(f64, [f64; N], Contact)>,
-    at_end: bool,
-    t_end: f64,
-    y_end: &[f64; N],
-) -> Option<[f64; N_EVENTS]> {
-    if !at_end {
-        return None;
-    }
-    let (tt, yy, c) = last_rhs.take()?;
-    if tt != t_end || yy != *y_end {
-        return None;
-    }
-    let mut yc = yy;
-    model.complete(mode, tt, &mut yc).ok()?;
-    (yc == yy).then(|| event_values_of(model, mode, tt, &yc, c))
 }
 
 /// Integrates `model` from `(t0, y0)` in `mode0` to `t_end`, recording the state at `out_times`
