@@ -35,7 +35,7 @@ use super::run::{EntryPaths, State, read_status};
 use crate::fit::SHORTFALL_TOLERANCE_NATS;
 use crate::fit::result::{FitResult, FittedParam};
 use crate::fit::select::INDISTINGUISHABLE_TIC;
-use crate::fit::tolerance::SPREAD_WARN_NATS;
+use crate::fit::tolerance::{SPREAD_WARN_NATS, Verdict};
 use crate::fit::truth::{RIDGE_NATS, is_ridge};
 use crate::io::write_atomic;
 use crate::job::{Candidate, FreeParam};
@@ -175,6 +175,12 @@ pub struct RecordingScore {
 }
 
 impl RecordingScore {
+    /// Whether the integrator resolves the truth's cost: it spreads by at most
+    /// [`SPREAD_WARN_NATS`] over the tolerances (true where the result has no such check).
+    pub fn truth_resolved(&self) -> bool {
+        self.truth_spread_nats.is_none_or(|w| w <= SPREAD_WARN_NATS)
+    }
+
     /// Whether the chosen model contains the true one (true when the truth names no model).
     pub fn model_contains_truth(&self) -> bool {
         match (self.chosen, self.true_model) {
@@ -306,9 +312,9 @@ impl Calibration {
     /// Fits whose truth was priced at tighter tolerances, and of them those whose truth's cost
     /// spreads by more than [`SPREAD_WARN_NATS`]: a truth the integrator does not resolve.
     pub fn unresolved_truths(&self) -> (usize, usize) {
-        let spreads: Vec<f64> = self.done().filter_map(|r| r.truth_spread_nats).collect();
-        let wide = spreads.iter().filter(|w| **w > SPREAD_WARN_NATS).count();
-        (spreads.len(), wide)
+        let checked = self.done().filter(|r| r.truth_spread_nats.is_some());
+        let (all, wide): (Vec<_>, Vec<_>) = checked.partition(|r| r.truth_resolved());
+        (all.len() + wide.len(), wide.len())
     }
 
     /// Fits that reached the truth: done, their chosen model contains the true one, not short of
@@ -321,7 +327,7 @@ impl Calibration {
             r.model_contains_truth()
                 && r.shortfall_nats
                     .is_some_and(|s| s <= SHORTFALL_TOLERANCE_NATS)
-                && r.truth_spread_nats.is_none_or(|w| w <= SPREAD_WARN_NATS)
+                && r.truth_resolved()
         })
     }
 
@@ -341,7 +347,7 @@ impl Calibration {
     pub fn truth_ratios(&self) -> (usize, f64, f64, f64, usize) {
         let rows: Vec<(f64, usize, f64)> = self
             .done()
-            .filter(|r| r.truth_spread_nats.is_none_or(|w| w <= SPREAD_WARN_NATS))
+            .filter(|r| r.truth_resolved())
             .filter_map(|r| Some((-r.shortfall_nats?, r.true_model_k_tr?)))
             .filter(|(d, (k, tr))| *d >= -SHORTFALL_TOLERANCE_NATS && *k > 0 && *tr > 0.0)
             .map(|(d, (k, tr))| (d, k, tr))
@@ -494,7 +500,7 @@ fn score(r: &mut RecordingScore, result: &FitResult) {
     r.true_model_k_tr = true_trial.and_then(|(k, e)| Some((k, e.effective_parameters?)));
     r.ridge_nats = result.truth_segment.as_ref().map(|s| s.ridge_nats);
     r.truth_spread_nats = (result.truth_tolerance.as_ref())
-        .filter(|t| r.shortfall_nats.is_some() && t.points.len() > 1)
+        .filter(|t| r.shortfall_nats.is_some() && t.verdict() != Verdict::NotProbed)
         .map(|t| t.spread_nats);
     r.law = super::law::LawScore::of(result);
     r.gof_p = result.goodness_of_fit.as_ref().map(|g| g.p_value);
@@ -571,6 +577,36 @@ fn stats_table(md: &mut String, stats: &[ParamStats]) {
             num(s.chi2_p, 3),
             pct(s.median_abs_rel_error),
             pct(s.p90_abs_rel_error),
+        );
+    }
+}
+
+/// The coverage table over the fits that reached the truth ([`Calibration::reached`]).
+fn reached_section(md: &mut String, c: &Calibration) {
+    let reached = c.reached().count();
+    if reached > 0 {
+        let _ = writeln!(
+            md,
+            "\n### Where the search reached the truth\n\n\
+             Over the {reached} of the fits above that did not fall short of the truth's cost (by more than \
+             {SHORTFALL_TOLERANCE_NATS} nats) and whose truth the integrator resolves (its cost \
+             spreads by at most {SPREAD_WARN_NATS} nats over tenfold and hundredfold tighter \
+             tolerances, where the result has `truth_tolerance`): what the interval method covers \
+             when the search and the integrator leave it nothing else to cover.\n"
+        );
+        stats_table(md, &param_stats(c.reached()));
+    }
+}
+
+/// How many short fits lie within their truth's own spread over the tolerances.
+fn shortfall_unresolved_paragraph(md: &mut String, c: &Calibration) {
+    let (checked, wider) = c.shortfall_unresolved();
+    if checked > 0 {
+        let _ = writeln!(
+            md,
+            "\nOf the {checked} short fits whose truth was priced at tighter tolerances too, \
+             {wider} have a truth whose cost moves by more than the shortfall between them: \
+             there the integrator, not the search, may have put the fit above the truth."
         );
     }
 }
@@ -712,19 +748,7 @@ pub fn to_markdown(c: &Calibration, notes: Option<&str>, command: &str) -> Strin
         );
         stats_table(&mut md, stats);
     }
-    let reached = c.reached().count();
-    if reached > 0 {
-        let _ = writeln!(
-            md,
-            "\n### Where the search reached the truth\n\n\
-             Over the {reached} of the fits above that did not fall short of the truth's cost (by more than \
-             {SHORTFALL_TOLERANCE_NATS} nats) and whose truth the integrator resolves (its cost \
-             spreads by at most {SPREAD_WARN_NATS} nats over tenfold and hundredfold tighter \
-             tolerances, where the result has `truth_tolerance`): what the interval method covers \
-             when the search and the integrator leave it nothing else to cover.\n"
-        );
-        stats_table(&mut md, &param_stats(c.reached()));
-    }
+    reached_section(&mut md, c);
     let (known, over, max) = c.shortfalls();
     let _ = writeln!(
         md,
@@ -750,15 +774,7 @@ pub fn to_markdown(c: &Calibration, notes: Option<&str>, command: &str) -> Strin
             measured - beyond
         );
     }
-    let (checked, wider) = c.shortfall_unresolved();
-    if checked > 0 {
-        let _ = writeln!(
-            md,
-            "\nOf the {checked} short fits whose truth was priced at tighter tolerances too, \
-             {wider} have a truth whose cost moves by more than the shortfall between them: \
-             there the integrator, not the search, may have put the fit above the truth."
-        );
-    }
+    shortfall_unresolved_paragraph(&mut md, c);
     ratio_section(&mut md, c);
     confusion_section(&mut md, c);
     super::law::law_section(&mut md, c);
