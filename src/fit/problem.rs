@@ -48,6 +48,8 @@ pub struct SpectralProblem {
     pub solver: SolverOptions,
     /// The solver of the particle-swarm stage (`[fit] swarm_rtol`; else `solver`).
     pub swarm_solver: SolverOptions,
+    /// What the particle swarm ranks by under the likelihood objective (`[fit.search] swarm_cost`).
+    pub swarm_cost: crate::job::SwarmCost,
     /// What [`SpectralProblem::total_cost`] is: the likelihood or the weighted features.
     pub objective: Objective,
     pub weights: Weights,
@@ -274,15 +276,15 @@ impl SpectralProblem {
     }
 
     /// The cost a search `stage` ranks a simulation by: [`SpectralProblem::total_cost`], except
-    /// that with the likelihood objective the particle swarm ranks by the feature cost
-    /// ([`SpectralProblem::cost_of`], default weights). Its 1 %-scale peak-frequency term funnels the
-    /// swarm into the lines' basin; the Whittle likelihood is flat along valleys a short recording
-    /// leaves open (docs/fit.md, "How it works"), where the polish then finds its minimum.
+    /// that with the likelihood objective and `[fit.search] swarm_cost = "features"` (the default)
+    /// the particle swarm ranks by the feature cost ([`SpectralProblem::cost_of`], default
+    /// weights). Its 1 %-scale peak-frequency term funnels the swarm into the lines' basin; the
+    /// Whittle likelihood is flat along valleys a short recording leaves open (docs/fit.md, "How
+    /// it works"), where the polish then finds its minimum.
     fn stage_cost(&self, sim: &BladeSimulation, stage: SearchStage) -> Result<f64> {
-        if self.objective == Objective::Likelihood
-            && self.targets.is_none()
-            && stage != SearchStage::Swarm
-        {
+        let by_features =
+            stage == SearchStage::Swarm && self.swarm_cost == crate::job::SwarmCost::Features;
+        if self.objective == Objective::Likelihood && self.targets.is_none() && !by_features {
             let lik = self
                 .likelihood
                 .as_ref()

@@ -477,6 +477,7 @@ fn problem_of(
         window: (t[0], *t.last().unwrap_or(&t[0])),
         solver: job.job.solver,
         swarm_solver: swarm_solver(job),
+        swarm_cost: fit.search.swarm_cost,
         objective: fit.objective,
         weights: fit.weights,
         likelihood: Err(super::NoLikelihood::NotBuilt),
@@ -1937,6 +1938,31 @@ mod tests {
             cost,
             unconfirmed_ends: None,
         }
+    }
+
+    /// `[fit.search] swarm_cost`: by default the swarm ranks the shipped recording's truth
+    /// (`data/reversal/truth.json`) by the feature cost, a sum of squared log errors of order one
+    /// there; with `"likelihood"` by the recording's NLL, the polish's own cost (tens of nats)
+    /// whenever the two stages simulate at one tolerance.
+    #[test]
+    fn the_swarm_ranks_by_the_cost_the_job_names() {
+        let (job, candidate, _) = main_job_problem();
+        let truth: serde_json::Value =
+            serde_json::from_str(&repository_file("data/reversal/truth.json")).expect("truth json");
+        let mut problem = problem_for(&job, candidate).expect("problem");
+        problem.swarm_solver = problem.solver;
+        let u = coordinates(&problem, |name| {
+            truth["params"][name].as_f64().expect("true value")
+        });
+        let nll = problem.cost_at_stage(&u, SearchStage::Polish);
+        let features = problem.cost_at_stage(&u, SearchStage::Swarm);
+        problem.swarm_cost = job::SwarmCost::Likelihood;
+        let by_likelihood = problem.cost_at_stage(&u, SearchStage::Swarm);
+        assert_eq!(by_likelihood, nll, "the swarm's likelihood is the polish's");
+        assert!(
+            features < 2.0 && nll > 20.0,
+            "feature cost {features:.3} against NLL {nll:.3} nats at the truth"
+        );
     }
 
     /// A polish cut short (10 iterations) from A ×0.9 and B ×0.85 of the truth

@@ -1025,6 +1025,7 @@ impl ReplicateSource {
             window: problem.window,
             solver: problem.solver,
             swarm_solver: problem.swarm_solver,
+            swarm_cost: problem.swarm_cost,
             objective: problem.objective,
             weights: problem.weights,
             likelihood: Err(super::NoLikelihood::NotBuilt),

@@ -396,6 +396,23 @@ pub struct SearchSection {
     pub local: LocalSearch,
     /// `swarm` with `local = "cmaes"`: model evaluations each local run may spend.
     pub local_evaluations: usize,
+    /// `swarm`: what the particle swarm ranks its particles by (default `features`).
+    pub swarm_cost: SwarmCost,
+}
+
+crate::names::named_enum! {
+    /// What the particle swarm ranks its particles by, with the likelihood objective
+    /// (docs/fit.md, "How it works").
+    #[derive(Default)]
+    pub enum SwarmCost: "swarm cost" {
+        /// The feature cost (peak frequencies at a 1 % scale, levels, log-PSD shapes): it funnels
+        /// the swarm into the lines' basin.
+        #[default]
+        Features => "features",
+        /// The recording's negative log-likelihood, the cost the polish minimises, at the swarm's
+        /// tolerance (`[fit] swarm_rtol`).
+        Likelihood => "likelihood",
+    }
 }
 
 crate::names::named_enum! {
@@ -420,6 +437,7 @@ impl Default for SearchSection {
             max_evaluations: 4000,
             local: LocalSearch::NelderMead,
             local_evaluations: 1000,
+            swarm_cost: SwarmCost::Features,
         }
     }
 }
@@ -1088,12 +1106,12 @@ impl Check<'_> {
             ));
         }
         if search.method == SearchMethod::Cmaes {
-            for key in ["local", "local_evaluations"] {
+            for key in ["local", "local_evaluations", "swarm_cost"] {
                 if self.spans.contains(&at(key)) {
                     return Err(self.error(
                         &at(key),
                         format!(
-                            "[fit.search] {key} sets the local search after each swarm; with \
+                            "[fit.search] {key} belongs to the swarm search; with \
                              method = \"cmaes\" there is no swarm (docs/fit.md, \"Search\")"
                         ),
                     ));

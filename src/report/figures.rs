@@ -5,7 +5,7 @@ use super::plot::{ChartOpts, Marker, Series, Span, heatmap, line_chart};
 use crate::fit::features::{BandFeatures, Features, noise_floor};
 use crate::fit::result::{HistoryPoint, SearchStage};
 use crate::fit::{FitOutcome, FitResult};
-use crate::job::Objective;
+use crate::job::{Objective, SwarmCost};
 use crate::likelihood::instfreq::FreqSpeedComparison;
 use crate::model::FrictionLaw;
 use crate::simulate::blade::{BladeSimulation, ContactForces};
@@ -237,15 +237,13 @@ pub fn fit_figures(
     if let Some(c) = freq_speed {
         freq_vs_speed_figure(dir, c)?;
     }
-    let objective = o
-        .result
-        .fit_settings
-        .as_ref()
-        .map_or(Objective::Features, |f| f.objective);
+    let settings = o.result.fit_settings.as_ref();
+    let objective = settings.map_or(Objective::Features, |f| f.objective);
+    let swarm_cost = settings.map_or(SwarmCost::Features, |f| f.search.swarm_cost);
     if let Some(post) = &o.result.posterior {
         posterior_figure(dir, &o.result, post)?;
     }
-    cost_figure(dir, &o.result.history, objective)
+    cost_figure(dir, &o.result.history, objective, swarm_cost)
 }
 
 /// `posterior_corner.svg`: the corner plot of a posterior sample's draws, each parameter's
@@ -762,9 +760,16 @@ fn friction_title(r: &FitResult, law: &FrictionLaw, band: bool) -> String {
 
 /// Writes `cost.svg`: best cost against the restart's own model evaluations, one series per restart
 /// and stage (the restarts run in parallel, each from its own swarm). With the likelihood
-/// objective the swarm ranks by the feature cost and the polish by the NLL above the saturated
-/// model (nats), so the two stages are separate series and the axis names both.
-fn cost_figure(dir: &Path, history: &[HistoryPoint], objective: Objective) -> Result<()> {
+/// objective the swarm ranks by the feature cost (unless `[fit.search] swarm_cost =
+/// "likelihood"`) and the polish by the NLL above the saturated model (nats), so the stages are
+/// separate series and the axis names what each reads.
+fn cost_figure(
+    dir: &Path,
+    history: &[HistoryPoint],
+    objective: Objective,
+    swarm_cost: SwarmCost,
+) -> Result<()> {
+    let by_features = swarm_cost == SwarmCost::Features;
     let restarts = history.iter().map(|h| h.restart + 1).max().unwrap_or(0);
     let split = objective == Objective::Likelihood;
     let stages: &[Option<SearchStage>] = if split {
@@ -786,7 +791,8 @@ fn cost_figure(dir: &Path, history: &[HistoryPoint], objective: Objective) -> Re
                 .map(|h| (h.evaluations as f64, h.best_cost))
                 .unzip();
             let what = match st {
-                Some(SearchStage::Swarm) => "swarm, feature cost",
+                Some(SearchStage::Swarm) if by_features => "swarm, feature cost",
+                Some(SearchStage::Swarm) => "swarm, nats",
                 Some(SearchStage::Local) => "local CMA-ES, nats",
                 Some(SearchStage::Polish) => "Nelder–Mead, nats",
                 Some(SearchStage::Cmaes) => "CMA-ES",
@@ -803,8 +809,10 @@ fn cost_figure(dir: &Path, history: &[HistoryPoint], objective: Objective) -> Re
         })
         .filter(|s| !s.x.is_empty())
         .collect();
-    let y_label = if split {
+    let y_label = if split && by_features {
         "best cost (swarm: feature cost [-]; polish: NLL above saturated [nats])"
+    } else if split {
+        "best cost (NLL above saturated [nats])"
     } else {
         "best cost [-]"
     };

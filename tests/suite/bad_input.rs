@@ -920,6 +920,24 @@ fn fit_cases() -> Vec<Case> {
             &["$D/job.toml:", "local", "no swarm"],
         ),
         case(
+            "fit: an unknown swarm cost",
+            j(&[(
+                "[fit.uncertainty]",
+                "[fit.search]\nswarm_cost = \"nll\"\n\n[fit.uncertainty]",
+            )]),
+            fit,
+            &["$D/job.toml:", "swarm_cost", "features", "likelihood"],
+        ),
+        case(
+            "fit: a swarm cost beside the CMA-ES search",
+            j(&[(
+                "[fit.uncertainty]",
+                "[fit.search]\nmethod = \"cmaes\"\nswarm_cost = \"likelihood\"\n\n[fit.uncertainty]",
+            )]),
+            fit,
+            &["$D/job.toml:", "swarm_cost", "no swarm"],
+        ),
+        case(
             "fit: negative solver tolerance",
             j(&[("rtol = 1e-8", "rtol = -1e-8")]),
             fit,
