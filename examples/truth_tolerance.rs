@@ -60,14 +60,20 @@ fn solvers(job: &SolverOptions) -> Vec<(String, SolverOptions)> {
     out
 }
 
-/// The fitted point of `result` in the problem's freed parameters, when the result names them all.
-fn fitted_u(result: &FitResult, free: &[wiperlab::job::FreeParam]) -> Option<Vec<f64>> {
-    free.iter()
-        .map(|fp| {
-            let p = result.parameters.iter().find(|p| p.name == fp.name)?;
-            Some(fp.u_of(p.value))
-        })
-        .collect()
+/// The fitted point of `result` on the problem's base parameters, when the result names every
+/// freed parameter: its values set as given, which reproduces the result's cost. Taken through the
+/// normalised coordinates and back they change in the last bits, and the cost by up to the
+/// likelihood's ripple (0.08 nats at the main job's fit, 0.015 at its truth).
+fn fitted(
+    result: &FitResult,
+    problem: &wiperlab::fit::SpectralProblem,
+) -> Option<wiperlab::model::BladeParams> {
+    let mut at = problem.base;
+    for fp in &problem.free {
+        let p = result.parameters.iter().find(|p| p.name == fp.name)?;
+        fp.name.set(&mut at, p.value);
+    }
+    Some(at)
 }
 
 fn main() -> Fallible<()> {
@@ -80,22 +86,24 @@ fn main() -> Fallible<()> {
         .or(result_model)
         .unwrap_or(job.candidates()[0]);
     let problem = problem_for(&job, candidate)?;
-    let mut u_true = Vec::new();
+    // The truth at its values as given, as the fit prices it (not through the normalised
+    // coordinates, whose round trip moves the cost by the likelihood's ripple).
+    let mut truth = problem.base;
     for fp in &problem.free {
         let t = job
             .truth
             .get(&fp.name)
             .ok_or_else(|| format!("the truth has no value for {}", fp.name.name()))?;
-        u_true.push(fp.u_of(*t));
+        fp.name.set(&mut truth, *t);
     }
-    let u_fit = result
+    let fit = result
         .as_ref()
         .filter(|_| result_model == Some(candidate))
-        .and_then(|r| fitted_u(r, &problem.free));
+        .and_then(|r| fitted(r, &problem));
     println!(
         "{}: truth priced in {candidate}{}",
         args.job.display(),
-        if u_fit.is_some() {
+        if fit.is_some() {
             ", beside the fit"
         } else {
             ""
@@ -103,9 +111,10 @@ fn main() -> Fallible<()> {
     );
     println!("solver             truth (nats)  transitions   fit (nats)   truth − fit");
     for (name, s) in solvers(&problem.solver) {
-        let price = |u: &[f64]| problem.cost_with_solver(u, &s).ok();
-        let t = price(&u_true);
-        let f = u_fit.as_deref().map(price);
+        let t = problem.params_cost_with_solver(&truth, &s).ok();
+        let f = fit
+            .as_ref()
+            .map(|p| problem.params_cost_with_solver(p, &s).ok());
         let show = |c: Option<(f64, usize)>| c.map_or("failed".into(), |c| format!("{:.3}", c.0));
         println!(
             "{name:<18} {:>12} {:>12} {:>12} {:>12}",

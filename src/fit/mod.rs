@@ -239,7 +239,8 @@ fn choose_at_resolution(
     }
     let cf = &fits[selection.chosen];
     let at_job = (best.cost, best.sim.transitions.len());
-    let check = tolerance::ToleranceCheck::run(&cf.problem, &cf.best_u, at_job);
+    let check =
+        tolerance::ToleranceCheck::run(&cf.problem, &cf.problem.params_at(&cf.best_u), at_job);
     let mut checks = tolerance::checks_for_choice(fits, selection.chosen, check);
     let spreads: Vec<f64> = checks
         .iter()

@@ -15,6 +15,7 @@
 use super::problem::FAILED_COST;
 use super::search::CandidateFit;
 use super::{FitWarning, SpectralProblem, interrupt};
+use crate::model::BladeParams;
 use serde::{Deserialize, Serialize};
 
 /// Factors by which the probes divide the job's `rtol` and `atol`.
@@ -69,14 +70,14 @@ pub struct ToleranceCheck {
 }
 
 impl ToleranceCheck {
-    /// The check at normalised coordinates `u` of `problem`, whose cost there at the job's
+    /// The check at the parameters `params` of `problem`, whose cost there at the job's
     /// tolerance is `cost_nats` with `transitions` transitions. `None` when the cost is not the
     /// recording's NLL (a target job, the features objective) or the fit is joint (its other
     /// recordings' costs are not re-run). Each probe counts as a model evaluation of `problem`,
     /// and a failed one as a failed evaluation.
     pub fn run(
         problem: &SpectralProblem,
-        u: &[f64],
+        params: &BladeParams,
         (cost_nats, transitions): (f64, usize),
     ) -> Option<ToleranceCheck> {
         let tightest = problem.solver.rtol / PROBE_DIVISORS[0];
@@ -102,7 +103,7 @@ impl ToleranceCheck {
                 max_steps: job.max_steps.saturating_mul(PROBE_MAX_STEPS_FACTOR),
                 ..job
             };
-            match problem.cost_with_solver(u, &solver) {
+            match problem.params_cost_with_solver(params, &solver) {
                 Ok((cost_nats, transitions)) => points.push(TolerancePoint {
                     rtol,
                     atol: solver.atol,
@@ -189,7 +190,7 @@ pub(super) fn checks_for_choice(
             continue;
         }
         if let Ok(at_job) = f.problem.cost_with_solver(&f.best_u, &f.problem.solver) {
-            checks[i] = ToleranceCheck::run(&f.problem, &f.best_u, at_job);
+            checks[i] = ToleranceCheck::run(&f.problem, &f.problem.params_at(&f.best_u), at_job);
         }
     }
     checks[chosen] = chosen_check;

@@ -114,7 +114,7 @@ pub(super) fn check(
     let sim = p.simulate(&params).ok()?;
     let cost_nats = p.total_cost(&sim).ok()? + p.prior.nats(&params);
     let segment = inside.then(|| segment(cf, &u_true, fit_cost, cost_nats));
-    let tolerance = ToleranceCheck::run(p, &u_true, (cost_nats, sim.transitions.len()));
+    let tolerance = ToleranceCheck::run(p, &params, (cost_nats, sim.transitions.len()));
     Some(TruthCheck {
         cost_nats,
         segment,

@@ -76,9 +76,10 @@ fn the_spectra_do_not_tell_k1_from_theta_c_along_the_contact_moment_ridge() {
 fn the_tolerance_check_flags_the_often_crossed_shoulders_unresolved_likelihood() {
     use wiperlab::fit::tolerance::ToleranceCheck;
     let check = |p: &wiperlab::fit::SpectralProblem, u: &[f64]| -> ToleranceCheck {
-        let sim = p.simulate(&p.params_at(u)).unwrap();
+        let params = p.params_at(u);
+        let sim = p.simulate(&params).unwrap();
         let at_job = (p.total_cost(&sim).unwrap(), sim.transitions.len());
-        ToleranceCheck::run(p, u, at_job).expect("a likelihood job")
+        ToleranceCheck::run(p, &params, at_job).expect("a likelihood job")
     };
     let coordinates = |p: &wiperlab::fit::SpectralProblem, values: &[(&str, f64)]| -> Vec<f64> {
         p.free
