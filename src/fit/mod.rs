@@ -773,8 +773,8 @@ mod tests {
         // The feature objective, so that both stages read the same cost and only the tolerance
         // differs; the default (likelihood) objective is checked at the end.
         let features =
-            strip(&text).replace("restarts = 5", "restarts = 5\nobjective = \"features\"");
-        let with = features.replace("restarts = 5", "restarts = 5\nswarm_rtol = 1e-5");
+            strip(&text).replace("restarts = 3", "restarts = 3\nobjective = \"features\"");
+        let with = features.replace("restarts = 3", "restarts = 3\nswarm_rtol = 1e-5");
         let without = features.clone();
         let load = |name: &str, t: &str| {
             let path = dir.join(name);

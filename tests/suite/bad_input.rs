@@ -848,7 +848,7 @@ fn fit_cases() -> Vec<Case> {
         ),
         case(
             "fit: no restarts",
-            j(&[("restarts = 5", "restarts = 0")]),
+            j(&[("restarts = 3", "restarts = 0")]),
             fit,
             &["$D/job.toml:", "restarts"],
         ),
@@ -863,7 +863,7 @@ fn fit_cases() -> Vec<Case> {
         ),
         case(
             "fit: unknown objective",
-            j(&[("restarts = 5", "restarts = 5\nobjective = \"chi2\"")]),
+            j(&[("restarts = 3", "restarts = 3\nobjective = \"chi2\"")]),
             fit,
             &["$D/job.toml:", "chi2", "likelihood", "features"],
         ),
@@ -895,8 +895,8 @@ fn fit_cases() -> Vec<Case> {
         case(
             "fit: a local CMA-ES run of one evaluation",
             j(&[(
-                "[fit.uncertainty]",
-                "[fit.search]\nlocal = \"cmaes\"\nlocal_evaluations = 1\n\n[fit.uncertainty]",
+                "local = \"cmaes\"              #",
+                "local = \"cmaes\"\nlocal_evaluations = 1 #",
             )]),
             fit,
             &["$D/job.toml:", "local_evaluations", ">= 2"],
@@ -904,8 +904,8 @@ fn fit_cases() -> Vec<Case> {
         case(
             "fit: an unknown local search",
             j(&[(
-                "[fit.uncertainty]",
-                "[fit.search]\nlocal = \"bfgs\"\n\n[fit.uncertainty]",
+                "local = \"cmaes\"              #",
+                "local = \"bfgs\" #",
             )]),
             fit,
             &["$D/job.toml:", "local", "nelder-mead", "cmaes"],
@@ -913,8 +913,8 @@ fn fit_cases() -> Vec<Case> {
         case(
             "fit: a local search beside the CMA-ES search",
             j(&[(
-                "[fit.uncertainty]",
-                "[fit.search]\nmethod = \"cmaes\"\nlocal = \"cmaes\"\n\n[fit.uncertainty]",
+                "local = \"cmaes\"              #",
+                "method = \"cmaes\"\nlocal = \"cmaes\" #",
             )]),
             fit,
             &["$D/job.toml:", "local", "no swarm"],
@@ -922,8 +922,8 @@ fn fit_cases() -> Vec<Case> {
         case(
             "fit: an unknown swarm cost",
             j(&[(
-                "[fit.uncertainty]",
-                "[fit.search]\nswarm_cost = \"nll\"\n\n[fit.uncertainty]",
+                "local = \"cmaes\"              #",
+                "swarm_cost = \"nll\" #",
             )]),
             fit,
             &["$D/job.toml:", "swarm_cost", "features", "likelihood"],
@@ -931,8 +931,8 @@ fn fit_cases() -> Vec<Case> {
         case(
             "fit: a swarm cost beside the CMA-ES search",
             j(&[(
-                "[fit.uncertainty]",
-                "[fit.search]\nmethod = \"cmaes\"\nswarm_cost = \"likelihood\"\n\n[fit.uncertainty]",
+                "local = \"cmaes\"              #",
+                "method = \"cmaes\"\nswarm_cost = \"likelihood\" #",
             )]),
             fit,
             &["$D/job.toml:", "swarm_cost", "no swarm"],
@@ -1076,7 +1076,7 @@ fn prior_cases() -> Vec<Case> {
             vec![(
                 "job.toml",
                 job(&[
-                    ("restarts = 5 ", "objective = \"features\"\nrestarts = 5 "),
+                    ("restarts = 3 ", "objective = \"features\"\nrestarts = 3 "),
                     (
                         "[truth]",
                         "[fit.priors]\nk1 = { normal = { mean = 0.03, sd = 0.01 } }\n\n[truth]",

@@ -444,7 +444,7 @@ fn job_with_a_swarm_tolerance_out_of_range() {
         .filter(|l| !l.trim_start().starts_with("swarm_rtol"))
         .collect::<Vec<_>>()
         .join("\n");
-    let text = edit(&text, "restarts = 5", "restarts = 5\nswarm_rtol = 0.0");
+    let text = edit(&text, "restarts = 3", "restarts = 3\nswarm_rtol = 0.0");
     let job = dir.write("job.toml", &text);
     let o = run(&["fit", s(&job), "--quiet"]);
     let msg = input_error(&o, &[s(&job), "swarm_rtol must be in (0, 1)"]);
@@ -456,12 +456,12 @@ fn job_with_a_swarm_tolerance_out_of_range() {
 #[test]
 fn job_with_swarm_keys_beside_the_cmaes_search() {
     let dir = temp_dir("cmaes_swarm_keys");
-    // The main job's swarm settings with `[fit.search] method = "cmaes"` added: its `particles`
-    // line is refused, naming the CMA-ES search's own keys.
+    // The main job's swarm settings with `[fit.search] method = "cmaes"` instead of its local
+    // stage: its `particles` line is refused, naming the CMA-ES search's own keys.
     let text = edit(
         &job_text(),
-        "[fit.uncertainty]",
-        "[fit.search]\nmethod = \"cmaes\"\n\n[fit.uncertainty]",
+        "local = \"cmaes\"              #",
+        "method = \"cmaes\" #",
     );
     let job = dir.write("job.toml", &text);
     let o = run(&["fit", s(&job), "--quiet"]);
