@@ -1746,7 +1746,7 @@ where
     let nm = NelderMead::new(initial_simplex(start, step))
         .with_sd_tolerance(sd)
         .map_err(fit_err)?;
-    let mut ex = Executor::new(cost, nm).configure(|s| s.max_iters(iterations));
+    let mut ex = Executor::new(NoInterruptError(cost), nm).configure(|s| s.max_iters(iterations));
     if let Some(o) = observer {
         ex = ex.add_observer(o, ObserverMode::Always);
     }
@@ -1760,6 +1760,23 @@ where
         .map(|u| u.clamp(0.0, 1.0))
         .collect();
     Ok((u, res.state().get_iter(), res.state().get_best_cost()))
+}
+
+/// A cost for argmin's Nelder–Mead, which unwraps the costs of its first simplex: an interrupt's
+/// error there would panic, so it becomes the failure cost, which no vertex ranks below. Each later
+/// evaluation is then a failure too, made at once without a simulation, and the simplex keeps the
+/// best point it had.
+struct NoInterruptError<C>(C);
+
+impl<C: CostFunction<Param = Vec<f64>, Output = f64>> CostFunction for NoInterruptError<C> {
+    type Param = Vec<f64>;
+    type Output = f64;
+    fn cost(&self, u: &Vec<f64>) -> std::result::Result<f64, argmin::core::Error> {
+        match self.0.cost(u) {
+            Err(_) if interrupt::stop_requested() => Ok(super::problem::FAILED_COST),
+            other => other,
+        }
+    }
 }
 
 /// Where [`polish`] starts: `start` and, for each coordinate, `start` moved by `step` (back by

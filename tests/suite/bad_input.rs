@@ -903,10 +903,7 @@ fn fit_cases() -> Vec<Case> {
         ),
         case(
             "fit: an unknown local search",
-            j(&[(
-                "local = \"cmaes\"              #",
-                "local = \"bfgs\" #",
-            )]),
+            j(&[("local = \"cmaes\"              #", "local = \"bfgs\" #")]),
             fit,
             &["$D/job.toml:", "local", "nelder-mead", "cmaes"],
         ),
@@ -921,12 +918,9 @@ fn fit_cases() -> Vec<Case> {
         ),
         case(
             "fit: an unknown swarm cost",
-            j(&[(
-                "local = \"cmaes\"              #",
-                "swarm_cost = \"nll\" #",
-            )]),
+            j(&[("local = \"cmaes\"              #", "swarm_cost = \"nll\" #")]),
             fit,
-            &["$D/job.toml:", "swarm_cost", "features", "likelihood"],
+            &["$D/job.toml:", "swarm cost", "features", "likelihood"],
         ),
         case(
             "fit: a swarm cost beside the CMA-ES search",
