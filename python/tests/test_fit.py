@@ -3,7 +3,7 @@ wall times and the time stamp) and the same files; Ctrl-C; the GIL released mean
 
 The job is the shipped reversal job (fits/reversal.toml: the shipped recording, its bands and
 solver) made small enough for a test suite: the features objective, two free parameters, one
-restart and a handful of iterations (about 3 s of CPU). The full job takes about 40 s
+restart and a handful of iterations (about 3 s of CPU). The full job takes about a minute
 (docs/python.md says how to compare it by hand)."""
 
 import json
