@@ -491,6 +491,7 @@ fn fit_job_with_freq_speed_and_trace_terms_runs_and_reports_them() {
         .replace("name = \"reversal\"", "name = \"instfreq_terms\"")
         .replace("particles = 24", "particles = 2")
         .replace("swarm_iterations = 25", "swarm_iterations = 1")
+        .replace("local = \"cmaes\"", "local = \"nelder-mead\"")
         .replace(
             "polish_iterations = 60",
             "polish_iterations = 1\nobjective = \"features\"",
