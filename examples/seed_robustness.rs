@@ -1,11 +1,12 @@
 //! How often does the main job find the truth's basin? (issue 14, point 2.)
 //!
-//! The main job (`fits/reversal.toml`: the shipped recording, its three candidate models, 5
-//! restarts, Laplace intervals) run with swarm seeds 1 to 10, everything else as shipped. The
-//! reference values are the sample's truth (`data/reversal/truth.json`, the parameters the
-//! independent generator made the recording with), read through the job's `[truth]` section.
+//! The main job (`fits/reversal.toml`: the shipped recording, its three candidate models, 3
+//! restarts with the local CMA-ES stage, profile intervals) run with swarm seeds 1 to 10,
+//! everything else as shipped. The reference values are the sample's truth
+//! (`data/reversal/truth.json`, the parameters the independent generator made the recording
+//! with), read through the job's `[truth]` section.
 //!
-//! The table goes to `reports/seeds/table.md` (and `.csv`). It takes about 10 minutes on 2 idle
+//! The table goes to `reports/seeds/table.md` (and `.csv`). It takes about 12 minutes on 2 idle
 //! cores (the test suite runs seed 1, the shipped job, in `tests/suite/cli.rs`):
 //!
 //! ```sh
