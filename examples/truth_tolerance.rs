@@ -18,6 +18,7 @@ use std::path::PathBuf;
 use wiperlab::fit::problem_for;
 use wiperlab::fit::result::FitResult;
 use wiperlab::job::{Candidate, LoadedJob};
+use wiperlab::model::ParamId;
 use wiperlab::simulate::{Method, SolverOptions};
 
 #[derive(Parser)]
@@ -60,20 +61,20 @@ fn solvers(job: &SolverOptions) -> Vec<(String, SolverOptions)> {
     out
 }
 
-/// The fitted point of `result` on the problem's base parameters, when the result names every
-/// freed parameter: its values set as given, which reproduces the result's cost. Taken through the
-/// normalised coordinates and back they change in the last bits, and the cost by up to the
-/// likelihood's ripple (0.08 nats at the main job's fit, 0.015 at its truth).
-fn fitted(
-    result: &FitResult,
+/// The problem's base parameters with every freed one set to `value(its name)` as given, which
+/// reproduces the fit's pricing of a truth or of a result's values; the first name `value` has
+/// no value for as the error.
+/// Taken through the normalised coordinates and back the values change in the last bits, and the
+/// cost by up to the likelihood's ripple (0.08 nats at the main job's fit, 0.015 at its truth).
+fn at_values(
     problem: &wiperlab::fit::SpectralProblem,
-) -> Option<wiperlab::model::BladeParams> {
+    value: impl Fn(ParamId) -> Option<f64>,
+) -> Result<wiperlab::model::BladeParams, ParamId> {
     let mut at = problem.base;
     for fp in &problem.free {
-        let p = result.parameters.iter().find(|p| p.name == fp.name)?;
-        fp.name.set(&mut at, p.value);
+        fp.name.set(&mut at, value(fp.name).ok_or(fp.name)?);
     }
-    Some(at)
+    Ok(at)
 }
 
 fn main() -> Fallible<()> {
@@ -86,20 +87,18 @@ fn main() -> Fallible<()> {
         .or(result_model)
         .unwrap_or(job.candidates()[0]);
     let problem = problem_for(&job, candidate)?;
-    // The truth at its values as given, as the fit prices it (not through the normalised
-    // coordinates, whose round trip moves the cost by the likelihood's ripple).
-    let mut truth = problem.base;
-    for fp in &problem.free {
-        let t = job
-            .truth
-            .get(&fp.name)
-            .ok_or_else(|| format!("the truth has no value for {}", fp.name.name()))?;
-        fp.name.set(&mut truth, *t);
-    }
+    let truth = at_values(&problem, |name| job.truth.get(&name).copied())
+        .map_err(|name| format!("the truth has no value for {}", name.name()))?;
     let fit = result
         .as_ref()
         .filter(|_| result_model == Some(candidate))
-        .and_then(|r| fitted(r, &problem));
+        .and_then(|r| {
+            at_values(&problem, |name| {
+                let p = r.parameters.iter().find(|p| p.name == name)?;
+                Some(p.value)
+            })
+            .ok()
+        });
     println!(
         "{}: truth priced in {candidate}{}",
         args.job.display(),

@@ -35,7 +35,7 @@ use super::run::{EntryPaths, State, read_status};
 use crate::fit::SHORTFALL_TOLERANCE_NATS;
 use crate::fit::result::{FitResult, FittedParam};
 use crate::fit::select::INDISTINGUISHABLE_TIC;
-use crate::fit::tolerance::{SPREAD_WARN_NATS, Verdict};
+use crate::fit::tolerance::SPREAD_WARN_NATS;
 use crate::fit::truth::{RIDGE_NATS, is_ridge};
 use crate::io::write_atomic;
 use crate::job::{Candidate, FreeParam};
@@ -312,9 +312,11 @@ impl Calibration {
     /// Fits whose truth was priced at tighter tolerances, and of them those whose truth's cost
     /// spreads by more than [`SPREAD_WARN_NATS`]: a truth the integrator does not resolve.
     pub fn unresolved_truths(&self) -> (usize, usize) {
-        let checked = self.done().filter(|r| r.truth_spread_nats.is_some());
-        let (all, wide): (Vec<_>, Vec<_>) = checked.partition(|r| r.truth_resolved());
-        (all.len() + wide.len(), wide.len())
+        let checked: Vec<&RecordingScore> = (self.done())
+            .filter(|r| r.truth_spread_nats.is_some())
+            .collect();
+        let wide = checked.iter().filter(|r| !r.truth_resolved()).count();
+        (checked.len(), wide)
     }
 
     /// Fits that reached the truth: done, their chosen model contains the true one, not short of
@@ -500,7 +502,7 @@ fn score(r: &mut RecordingScore, result: &FitResult) {
     r.true_model_k_tr = true_trial.and_then(|(k, e)| Some((k, e.effective_parameters?)));
     r.ridge_nats = result.truth_segment.as_ref().map(|s| s.ridge_nats);
     r.truth_spread_nats = (result.truth_tolerance.as_ref())
-        .filter(|t| r.shortfall_nats.is_some() && t.verdict() != Verdict::NotProbed)
+        .filter(|t| r.shortfall_nats.is_some() && t.probed())
         .map(|t| t.spread_nats);
     r.law = super::law::LawScore::of(result);
     r.gof_p = result.goodness_of_fit.as_ref().map(|g| g.p_value);

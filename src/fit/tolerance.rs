@@ -142,6 +142,11 @@ impl ToleranceCheck {
         }
     }
 
+    /// Whether a probe ran, so that the spread compares tolerances.
+    pub fn probed(&self) -> bool {
+        self.verdict() != Verdict::NotProbed
+    }
+
     /// Whether a probe ran and the cost agrees across tolerances to within [`SPREAD_WARN_NATS`].
     pub fn resolved(&self) -> bool {
         self.verdict() == Verdict::Resolved
@@ -189,8 +194,12 @@ pub(super) fn checks_for_choice(
         if f.free.len() >= k || f.cost >= FAILED_COST || interrupt::stop_requested() {
             continue;
         }
-        if let Ok(at_job) = f.problem.cost_with_solver(&f.best_u, &f.problem.solver) {
-            checks[i] = ToleranceCheck::run(&f.problem, &f.problem.params_at(&f.best_u), at_job);
+        let params = f.problem.params_at(&f.best_u);
+        if let Ok(at_job) = f
+            .problem
+            .params_cost_with_solver(&params, &f.problem.solver)
+        {
+            checks[i] = ToleranceCheck::run(&f.problem, &params, at_job);
         }
     }
     checks[chosen] = chosen_check;

@@ -639,9 +639,7 @@ fn truth_line(r: &FitResult) -> String {
 /// tolerances and, when they spread by more than the fit's distance from the truth, that the
 /// integrator does not tell the two apart (empty without the check).
 fn truth_tolerance_words(r: &FitResult, short: f64) -> String {
-    let Some(tc) = (r.truth_tolerance.as_ref())
-        .filter(|t| t.verdict() != crate::fit::tolerance::Verdict::NotProbed)
-    else {
+    let Some(tc) = r.truth_tolerance.as_ref().filter(|t| t.probed()) else {
         return String::new();
     };
     let (costs, rtols) = tolerance_lists(tc);
