@@ -61,9 +61,8 @@ fn solvers(job: &SolverOptions) -> Vec<(String, SolverOptions)> {
     out
 }
 
-/// The problem's base parameters with every freed one set to `value(its name)` as given, which
-/// reproduces the fit's pricing of a truth or of a result's values; the first name `value` has
-/// no value for as the error.
+/// The problem's base parameters with every freed one set to `value(its name)` as given, as the
+/// fit prices a truth or a result's values; `Err` names the first freed parameter without a value.
 /// Taken through the normalised coordinates and back the values change in the last bits, and the
 /// cost by up to the likelihood's ripple (0.08 nats at the main job's fit, 0.015 at its truth).
 fn at_values(
