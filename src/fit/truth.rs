@@ -92,9 +92,10 @@ pub(super) fn truth_fit<'a>(
 /// The truth's cost and segment for the fit `cf` of cost `fit_cost`, at the fit's solver; `None`
 /// without a truth for every freed parameter or when the truth cannot be simulated. The segment is
 /// left out where a true value lies outside the search box; the truth's [`ToleranceCheck`] beside
-/// them. `1 + 9 + 2` simulations, counted as `cf`'s
-/// evaluations; none of them enters the intervals (already computed) or the search's record of
-/// near-best points. `model` is the true model when `cf` is not the chosen fit.
+/// them. `1 + 9 + 2` simulations: the segment's 9 and the tolerance check's 2 are counted as
+/// `cf`'s evaluations, the truth's own is not (a truth the model cannot simulate adds no failure
+/// to the fit's record); none of them enters the intervals (already computed) or the search's
+/// record of near-best points. `model` is the true model when `cf` is not the chosen fit.
 pub(super) fn check(
     job: &LoadedJob,
     cf: &CandidateFit,
