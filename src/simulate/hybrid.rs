@@ -590,15 +590,22 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
                     },
                 ));
             }
-            let Some((a, last)) = self.attempt()? else {
-                continue;
-            };
-            self.stats.steps += 1;
-            let t_new = if last { self.t_end } else { self.t + self.h };
-            return match self.locate(&a, t_new)? {
-                None => Ok(self.accept(a, t_new)),
-                Some((k, te)) => self.handle_event(&a, k, te, t_new),
-            };
+            // The accepted step is finished where the attempt made it, not moved out of it.
+            let finished = self.attempt(|solver, a, last| {
+                solver.stats.steps += 1;
+                let t_new = if last {
+                    solver.t_end
+                } else {
+                    solver.t + solver.h
+                };
+                match solver.locate(a, t_new)? {
+                    None => Ok(solver.accept(a, t_new)),
+                    Some((k, te)) => solver.handle_event(a, k, te, t_new),
+                }
+            })?;
+            if let Some(reason) = finished {
+                return reason;
+            }
         }
     }
 
@@ -628,9 +635,12 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
         Ok(())
     }
 
-    /// One attempt of size `h` (cut to the stop time): the accepted attempt and whether it
-    /// is the last step, or `None` after a rejection (the step size is reduced).
-    fn attempt(&mut self) -> Result<Option<(Step<N>, bool)>> {
+    /// One attempt of size `h` (cut to the stop time): `finish` of the accepted step and whether
+    /// it is the last one, or `None` after a rejection (the step size is reduced).
+    fn attempt<R>(
+        &mut self,
+        finish: impl FnOnce(&mut Self, &Step<N>, bool) -> R,
+    ) -> Result<Option<R>> {
         self.h = self.h.min(self.opts.h_max);
         let last = self.t + self.h >= self.t_end;
         if last {
@@ -685,7 +695,7 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
                 self.h = method.next_step(self.h, err).min(self.h * 0.9);
                 return Ok(None);
             }
-            Ok(Outcome::Accepted(a)) => return Ok(Some((a, last))),
+            Ok(Outcome::Accepted(a)) => return Ok(Some(finish(self, &a, last))),
         }
         self.stats.rejected += 1;
         self.rejected_last = true;
@@ -890,7 +900,7 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
     }
 
     /// Takes the accepted step without an event.
-    fn accept(&mut self, a: Step<N>, t_new: f64) -> StopReason {
+    fn accept(&mut self, a: &Step<N>, t_new: f64) -> StopReason {
         self.segments.push(Segment {
             t1: t_new,
             dense: a.dense,

@@ -54,6 +54,7 @@ impl Method {
     /// Attempts one step of size `h` from `(t, y)` with derivative `f0 = f(t, y)`, and finishes it
     /// when its error norm is ≤ 1. `rhs` fails (`Err`) where the derivative cannot be evaluated.
     #[allow(clippy::too_many_arguments)]
+    #[inline]
     pub fn attempt<const N: usize, E>(
         self,
         rhs: &mut impl FnMut(f64, &[f64; N], &mut [f64; N]) -> Result<(), E>,

@@ -89,6 +89,7 @@ pub struct Attempt<const N: usize> {
 ///
 /// `rhs(t, y, dy)` returns `Err(e)` when the derivative cannot be evaluated there (the caller
 /// shrinks the step). Uses 6 new right-hand-side evaluations.
+#[inline]
 pub fn attempt<const N: usize, E>(
     rhs: &mut impl FnMut(f64, &[f64; N], &mut [f64; N]) -> Result<(), E>,
     t: f64,
