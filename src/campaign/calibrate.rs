@@ -33,7 +33,7 @@
 use super::Campaign;
 use super::run::{EntryPaths, State, read_status};
 use crate::fit::SHORTFALL_TOLERANCE_NATS;
-use crate::fit::result::{FitResult, FittedParam};
+use crate::fit::result::{FitResult, FittedParam, TrialEvidence};
 use crate::fit::select::INDISTINGUISHABLE_TIC;
 use crate::fit::tolerance::SPREAD_WARN_NATS;
 use crate::fit::truth::{RIDGE_NATS, is_ridge};
@@ -120,10 +120,24 @@ pub fn standardised_error(p: &FittedParam, truth: f64) -> Option<f64> {
     Some((t - v) / half * sigmas)
 }
 
-/// Whether `chosen` can state the truth of `truth`'s model: the same model, or the same model with
-/// a shoulder added (a shoulder-free truth is that model with a contact never reached).
+/// Whether `chosen` is `truth`'s model: the same model and shoulder, and the same law where the
+/// truth names one. A truth without a law (a campaign's `/model` names the dynamics only) is
+/// matched by a fit of that model with any law (`[fit] laws`): the law is scored as a curve.
+pub fn same_model(chosen: Candidate, truth: Candidate) -> bool {
+    chosen.kind == truth.kind
+        && chosen.shoulder == truth.shoulder
+        && (truth.law.is_none() || chosen.law == truth.law)
+}
+
+/// Whether `chosen` can state the truth of `truth`'s model: the same model ([`same_model`]), or
+/// the same model with a shoulder added (a shoulder-free truth is that model with a contact never
+/// reached).
 pub fn contains(chosen: Candidate, truth: Candidate) -> bool {
-    chosen == truth || (chosen.kind == truth.kind && chosen.shoulder && !truth.shoulder)
+    let with_shoulder = Candidate {
+        shoulder: truth.shoulder || chosen.shoulder,
+        ..truth
+    };
+    same_model(chosen, truth) || (!truth.shoulder && same_model(chosen, with_shoulder))
 }
 
 /// One parameter of one recording, scored.
@@ -380,7 +394,11 @@ impl Calibration {
     pub fn wrong_choices(&self) -> (usize, usize, f64) {
         let wrong: Vec<Option<f64>> = self
             .done()
-            .filter(|r| r.true_model.is_some() && r.chosen != r.true_model)
+            .filter(|r| match (r.chosen, r.true_model) {
+                (Some(c), Some(t)) => !same_model(c, t),
+                (None, Some(_)) => true,
+                _ => false,
+            })
             .map(|r| r.true_model_delta_tic)
             .collect();
         let near = |d: &Option<f64>| d.is_some_and(|d| d <= INDISTINGUISHABLE_TIC);
@@ -495,9 +513,21 @@ fn truth_labels(path: &Path) -> Result<(Option<Candidate>, Option<String>)> {
 fn score(r: &mut RecordingScore, result: &FitResult) {
     r.chosen = Some(result.model);
     r.shortfall_nats = priced_shortfall(r, result.shortfall_nats(), result.truth_model.is_some());
+    // The true model's trial; with several laws of it (`[fit] laws`, a truth naming none), the
+    // one closest to the chosen model's TIC.
     let true_trial = (r.true_model)
-        .and_then(|t| result.model_trials.iter().find(|m| m.model == t))
-        .and_then(|m| Some((m.parameters.len(), m.evidence.as_ref()?)));
+        .into_iter()
+        .flat_map(|t| {
+            result
+                .model_trials
+                .iter()
+                .filter(move |m| same_model(m.model, t))
+        })
+        .filter_map(|m| Some((m.parameters.len(), m.evidence.as_ref()?)))
+        .min_by(|(_, a), (_, b)| {
+            let tic = |e: &TrialEvidence| e.delta_tic.unwrap_or(f64::INFINITY);
+            tic(a).total_cmp(&tic(b))
+        });
     r.true_model_delta_tic = true_trial.and_then(|(_, e)| e.delta_tic);
     r.true_model_k_tr = true_trial.and_then(|(k, e)| Some((k, e.effective_parameters?)));
     r.ridge_nats = result.truth_segment.as_ref().map(|s| s.ridge_nats);
@@ -1330,5 +1360,35 @@ mod tests {
         assert!(!contains(c("blade2dof"), c("blade2dof+shoulder")));
         assert!(!contains(c("blade2dof"), c("head1dof")));
         assert!(!contains(c("head1dof"), c("blade2dof")));
+    }
+
+    /// A truth that names no law (a campaign's `/model`) is the same model as a fit of it with any
+    /// law of `[fit] laws`; a truth that names one is matched by that law only.
+    #[test]
+    fn a_truth_without_a_law_is_matched_by_every_law_of_its_model() {
+        let c = |s: &str| s.parse::<Candidate>().unwrap();
+        assert!(same_model(c("blade2dof@exponential"), c("blade2dof")));
+        assert!(same_model(c("blade2dof@stribeck"), c("blade2dof")));
+        assert!(!same_model(
+            c("blade2dof+shoulder@exponential"),
+            c("blade2dof")
+        ));
+        assert!(contains(
+            c("blade2dof+shoulder@exponential"),
+            c("blade2dof")
+        ));
+        assert!(!contains(c("head1dof@exponential"), c("blade2dof")));
+        assert!(same_model(
+            c("blade2dof@exponential_viscous"),
+            c("blade2dof@exponential_viscous")
+        ));
+        assert!(!same_model(
+            c("blade2dof@exponential"),
+            c("blade2dof@exponential_viscous")
+        ));
+        assert!(!contains(
+            c("blade2dof+shoulder@exponential"),
+            c("blade2dof@exponential_viscous")
+        ));
     }
 }
