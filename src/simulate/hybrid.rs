@@ -666,7 +666,9 @@ impl<'m, M: StickSlipModel<N>, const N: usize> HybridSolver<'m, M, N> {
         let mut rhs = |tt: f64, yy: &[f64; N], dy: &mut [f64; N]| {
             evals += 1;
             let c = model.rhs(&mode, tt, yy, dy)?;
-            last_rhs = (tt == t_step_end).then_some((tt, *yy, c)).or(last_rhs);
+            if tt == t_step_end {
+                last_rhs = Some((tt, *yy, c));
+            }
             n_min = min_or_nan(n_min, c.normal);
             n_max = n_max.max(c.normal);
             Ok::<(), ModelFault>(())
