@@ -331,9 +331,10 @@ impl Scored<'_> {
             && (self.crit[i] - self.crit[self.chosen]).abs() <= m
             && self.scores[i].is_finite()
         {
+            let why = why_reported(fits[self.chosen].free.len(), k);
             r.push_str(&format!(
                 "; not distinguishable by this recording (within {m:.2} of the chosen model's \
-                 TIC, which has fewer parameters)"
+                 TIC{why})"
             ));
         }
         if let (Some(e), Some(best)) = (self.of(i), self.of(self.chosen)) {
@@ -445,6 +446,16 @@ pub(super) fn chosen_on_misfit(trials: &[ModelTrial]) -> Option<FitWarning> {
     nested_on_misfit(&outline)
 }
 
+/// Why the chosen candidate (`k_chosen` parameters) is reported before one of `k` parameters
+/// within the margin of its TIC, as the reason's clause ([`simplest_near_best`]'s order).
+fn why_reported(k_chosen: usize, k: usize) -> &'static str {
+    match k_chosen.cmp(&k) {
+        std::cmp::Ordering::Less => ", which has fewer parameters",
+        std::cmp::Ordering::Equal => ", which has as many parameters and the lower TIC",
+        std::cmp::Ordering::Greater => "",
+    }
+}
+
 /// [`chosen_on_misfit`] on each trial's candidate, whether it is chosen and its ΔTIC.
 fn nested_on_misfit(trials: &[(Candidate, bool, Option<f64>)]) -> Option<FitWarning> {
     let &(chosen, ..) = trials.iter().find(|t| t.1)?;
@@ -493,6 +504,12 @@ mod tests {
         );
         // Equal parameter counts: the lower TIC.
         assert_eq!(simplest_near_best(&[100.0, 99.0], &[5, 5], true, &[]), 1);
+        // The reasons say which of the two rules reported the chosen one.
+        assert_eq!(why_reported(4, 5), ", which has fewer parameters");
+        assert_eq!(
+            why_reported(4, 4),
+            ", which has as many parameters and the lower TIC"
+        );
     }
 
     /// A TIC lead the integrator does not resolve: blade2dof (k = 4) against a shoulder (k = 6)
