@@ -77,11 +77,24 @@ fn model_words(r: &FitResult) -> String {
         .filter(|(_, (_, d))| d.is_finite())
         .min_by(|a, b| a.1.1.total_cmp(&b.1.1));
     let near = crate::fit::select::INDISTINGUISHABLE_TIC;
+    // Which rule reported the chosen candidate before `t`: fewer parameters, or as many and the
+    // lower TIC.
+    let rule = |t: &crate::fit::ModelTrial| {
+        let chosen_k = r
+            .model_trials
+            .iter()
+            .find(|c| c.chosen)
+            .map(|c| c.parameters.len());
+        if chosen_k.is_some_and(|k| k < t.parameters.len()) {
+            "with fewer parameters"
+        } else {
+            "with the lower TIC"
+        }
+    };
     match next {
         Some((t, ("TIC", d))) if d <= near => format!(
             "{named}, chosen by TIC among {} candidates; {} is not distinguishable by this \
-             recording (TIC {d:+.1}, within {near}), and the {} with fewer parameters is \
-             reported.",
+             recording (TIC {d:+.1}, within {near}), and the {} {} is reported.",
             r.model_trials.len(),
             t.model,
             if t.model.law != r.model.law
@@ -90,7 +103,8 @@ fn model_words(r: &FitResult) -> String {
                 "friction law"
             } else {
                 "model"
-            }
+            },
+            rule(t)
         ),
         Some((t, (name, d))) => format!(
             "{named}, chosen by {name} among {} candidates; the next best, {}, has a {name} \
@@ -546,13 +560,18 @@ mod tests {
 
     /// Laws as candidates: the chosen exponential law with the viscous one 1.2 below it in TIC is
     /// "not distinguishable", and the sentence says the friction law with fewer parameters is
-    /// reported; a shoulder in the same place is a model.
+    /// reported; a shoulder in the same place is a model; a model of as many parameters trails
+    /// the chosen one's lower TIC.
     #[test]
     fn an_indistinguishable_law_is_said_in_words() {
         let mut r = crate::report::html::tests::result();
         let trial = |model: &str, chosen: bool, delta_tic: f64| crate::fit::ModelTrial {
             model: model.parse().unwrap(),
-            parameters: vec![ParamId::K1],
+            parameters: if model.contains("viscous") {
+                vec![ParamId::A, ParamId::B, ParamId::C, ParamId::D, ParamId::K1]
+            } else {
+                vec![ParamId::A, ParamId::B, ParamId::C, ParamId::K1]
+            },
             cost: 78.3,
             wall_time_s: 4.0,
             model_evaluations: 10,
@@ -592,6 +611,14 @@ mod tests {
         r.model_trials[1].model = "blade2dof+shoulder@exponential".parse().unwrap();
         assert!(
             model_words(&r).contains("the model with fewer parameters"),
+            "{words}"
+        );
+        // As many parameters (head1dof against blade2dof, A, B, C, k1 each): the lower TIC.
+        r.model = "head1dof".parse().unwrap();
+        r.model_trials = vec![trial("head1dof", true, 0.0), trial("blade2dof", false, 0.9)];
+        let words = model_words(&r);
+        assert!(
+            words.contains("within 2), and the model with the lower TIC is reported"),
             "{words}"
         );
     }
