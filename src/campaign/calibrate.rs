@@ -133,11 +133,11 @@ pub fn same_model(chosen: Candidate, truth: Candidate) -> bool {
 /// the same model with a shoulder added (a shoulder-free truth is that model with a contact never
 /// reached).
 pub fn contains(chosen: Candidate, truth: Candidate) -> bool {
-    let with_shoulder = Candidate {
-        shoulder: truth.shoulder || chosen.shoulder,
-        ..truth
+    let shoulder_as_truth = Candidate {
+        shoulder: truth.shoulder,
+        ..chosen
     };
-    same_model(chosen, truth) || (!truth.shoulder && same_model(chosen, with_shoulder))
+    same_model(shoulder_as_truth, truth) && (chosen.shoulder || !truth.shoulder)
 }
 
 /// One parameter of one recording, scored.
@@ -193,6 +193,15 @@ impl RecordingScore {
     /// [`SPREAD_WARN_NATS`] over the tolerances (true where the result has no such check).
     pub fn truth_resolved(&self) -> bool {
         self.truth_spread_nats.is_none_or(|w| w <= SPREAD_WARN_NATS)
+    }
+
+    /// Whether a truth that names a model saw another chosen ([`same_model`]).
+    pub fn chose_another_model(&self) -> bool {
+        match (self.chosen, self.true_model) {
+            (Some(c), Some(t)) => !same_model(c, t),
+            (None, Some(_)) => true,
+            _ => false,
+        }
     }
 
     /// Whether the chosen model contains the true one (true when the truth names no model).
@@ -394,11 +403,7 @@ impl Calibration {
     pub fn wrong_choices(&self) -> (usize, usize, f64) {
         let wrong: Vec<Option<f64>> = self
             .done()
-            .filter(|r| match (r.chosen, r.true_model) {
-                (Some(c), Some(t)) => !same_model(c, t),
-                (None, Some(_)) => true,
-                _ => false,
-            })
+            .filter(|r| r.chose_another_model())
             .map(|r| r.true_model_delta_tic)
             .collect();
         let near = |d: &Option<f64>| d.is_some_and(|d| d <= INDISTINGUISHABLE_TIC);
@@ -515,19 +520,13 @@ fn score(r: &mut RecordingScore, result: &FitResult) {
     r.shortfall_nats = priced_shortfall(r, result.shortfall_nats(), result.truth_model.is_some());
     // The true model's trial; with several laws of it (`[fit] laws`, a truth naming none), the
     // one closest to the chosen model's TIC.
-    let true_trial = (r.true_model)
-        .into_iter()
-        .flat_map(|t| {
-            result
-                .model_trials
-                .iter()
-                .filter(move |m| same_model(m.model, t))
-        })
-        .filter_map(|m| Some((m.parameters.len(), m.evidence.as_ref()?)))
-        .min_by(|(_, a), (_, b)| {
-            let tic = |e: &TrialEvidence| e.delta_tic.unwrap_or(f64::INFINITY);
-            tic(a).total_cmp(&tic(b))
-        });
+    let tic = |e: &TrialEvidence| e.delta_tic.unwrap_or(f64::INFINITY);
+    let true_trial = r.true_model.and_then(|t| {
+        (result.model_trials.iter())
+            .filter(|m| same_model(m.model, t))
+            .filter_map(|m| Some((m.parameters.len(), m.evidence.as_ref()?)))
+            .min_by(|(_, a), (_, b)| tic(a).total_cmp(&tic(b)))
+    });
     r.true_model_delta_tic = true_trial.and_then(|(_, e)| e.delta_tic);
     r.true_model_k_tr = true_trial.and_then(|(k, e)| Some((k, e.effective_parameters?)));
     r.ridge_nats = result.truth_segment.as_ref().map(|s| s.ridge_nats);
