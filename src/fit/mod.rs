@@ -198,7 +198,8 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
 }
 
 /// The fitted law over the slip speeds of the chosen optimum's simulation, its band from the
-/// result's 1σ and correlations, and the job's true law ([`LoadedJob::true_friction_law`]).
+/// result's 1σ and correlations, the envelope of the laws the recording does not distinguish
+/// from it, and the job's true law ([`LoadedJob::true_friction_law`]).
 fn friction_curve(
     job: &LoadedJob,
     r: &FitResult,
@@ -217,6 +218,13 @@ fn friction_curve(
         Some(spread),
         job.true_friction_law(),
     )
+    .map(|c| {
+        let others: Vec<_> = (r.model_trials.iter())
+            .filter(|t| t.not_distinguishable)
+            .filter_map(|t| t.friction)
+            .collect();
+        c.with_alternatives(&others)
+    })
 }
 
 /// The chosen optimum's tolerance check ([`tolerance::ToleranceCheck`]) and, where an optimum the

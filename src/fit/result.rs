@@ -288,6 +288,10 @@ pub struct ModelTrial {
     pub chosen: bool,
     /// Why it was (not) chosen, with numbers.
     pub reason: String,
+    /// Whether the recording does not distinguish it from the chosen model (its TIC within the
+    /// choice's margin, docs/model-choice.md); false for the chosen one.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub not_distinguishable: bool,
     /// The trial in likelihood units (absent for a target job, which has no likelihood).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub evidence: Option<TrialEvidence>,

@@ -99,6 +99,7 @@ pub(super) fn choose(
                 Some(note) => format!("{}; {note}", scored.reason(fits, i, bands, listed)),
                 None => scored.reason(fits, i, bands, listed),
             },
+            not_distinguishable: i != chosen && scored.not_distinguishable(i),
             evidence: scored.trial_evidence(fits, i),
             friction: Some(f.problem.params_at(&f.best_u).friction),
         })
@@ -240,6 +241,13 @@ impl Scored<'_> {
         })
     }
 
+    /// Whether candidate `i`'s TIC lies within the margin of the chosen one's.
+    fn not_distinguishable(&self, i: usize) -> bool {
+        self.evidence.is_some()
+            && (self.crit[i] - self.crit[self.chosen]).abs() <= margin(self.spreads, i, self.chosen)
+            && self.scores[i].is_finite()
+    }
+
     /// The criterion's name in the reasons.
     fn criterion(&self) -> &'static str {
         if self.evidence.is_some() {
@@ -327,10 +335,7 @@ impl Scored<'_> {
             self.crit[i] - self.crit[self.chosen]
         );
         let m = margin(self.spreads, i, self.chosen);
-        if self.evidence.is_some()
-            && (self.crit[i] - self.crit[self.chosen]).abs() <= m
-            && self.scores[i].is_finite()
-        {
+        if self.not_distinguishable(i) {
             let why = why_reported(fits[self.chosen].free.len(), k);
             r.push_str(&format!(
                 "; not distinguishable by this recording (within {m:.2} of the chosen model's \

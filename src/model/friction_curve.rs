@@ -45,6 +45,18 @@ pub struct FrictionCurve {
     /// Share of the grid's points where the true μ_d lies within μ_d ± 1σ.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub truth_within_band: Option<f64>,
+    /// The models the recording does not distinguish from the chosen one, on the grid: the
+    /// lowest and the highest of the fitted μ_d ± 1σ and each such candidate's own μ_d
+    /// ([`FrictionCurve::with_alternatives`]). Empty when every other candidate is distinguished
+    /// (or there is none): then the band alone says what the recording leaves open.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub mu_d_envelope: Vec<[f64; 2]>,
+    /// The laws of those candidates (each candidate's law at its own optimum).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub alternative_laws: Vec<FrictionLaw>,
+    /// Share of the grid's points where the true μ_d lies within the envelope.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truth_within_envelope: Option<f64>,
     /// The fitted law (its coefficients, for the curve beyond the range).
     pub fitted_law: FrictionLaw,
     /// The true law, when known.
@@ -153,9 +165,43 @@ impl FrictionCurve {
             mu_d_true,
             rms_rel_diff_to_truth,
             truth_within_band,
+            mu_d_envelope: Vec::new(),
+            alternative_laws: Vec::new(),
+            truth_within_envelope: None,
             fitted_law: law,
             true_law: truth,
         })
+    }
+
+    /// The curve with the envelope of `laws`, the friction laws of the candidates the recording
+    /// does not distinguish from the chosen one (docs/model-choice.md): on every grid point the
+    /// lowest and highest of μ_d ± 1σ (μ_d alone without a band) and of each law's μ_d. Model
+    /// choice reports the simplest of those candidates (Burnham & Anderson 2002, §2.6), so its
+    /// band alone is conditional on a choice the recording did not make; the envelope is what the
+    /// recording leaves open among the candidates. Unchanged when `laws` is empty.
+    pub fn with_alternatives(mut self, laws: &[FrictionLaw]) -> FrictionCurve {
+        if laws.is_empty() {
+            return self;
+        }
+        self.mu_d_envelope = (0..self.speed_m_per_s.len())
+            .map(|i| {
+                let s = self.mu_d_sigma.get(i).copied().unwrap_or(0.0);
+                let v = self.speed_m_per_s[i];
+                laws.iter()
+                    .map(|l| l.mu_slip(v))
+                    .fold([self.mu_d[i] - s, self.mu_d[i] + s], |[lo, hi], m| {
+                        [lo.min(m), hi.max(m)]
+                    })
+            })
+            .collect();
+        self.alternative_laws = laws.to_vec();
+        self.truth_within_envelope = (!self.mu_d_true.is_empty()).then(|| {
+            let inside = (self.mu_d_envelope.iter().zip(&self.mu_d_true))
+                .filter(|([lo, hi], t)| (*lo..=*hi).contains(*t))
+                .count();
+            inside as f64 / self.mu_d_true.len() as f64
+        });
+        self
     }
 
     /// Whether `speed_m_per_s` lies inside the measured range.
@@ -278,6 +324,36 @@ mod tests {
                 .mu_d_sigma
                 .is_empty()
         );
+    }
+
+    /// The envelope of two other laws against closed forms: a law 10 % above the fitted one
+    /// everywhere and one 10 % below it bound the envelope with the ±1σ band inside; the truth 5 %
+    /// above lies inside it everywhere, and outside a band of 1 %.
+    #[test]
+    fn the_envelope_spans_the_laws_the_recording_does_not_distinguish() {
+        let speeds: Vec<f64> = (0..=100).map(|i| i as f64 * 0.001).collect();
+        let scaled = |f: f64| FrictionLaw::Exponential {
+            a: 0.8 * f,
+            b_s_per_m: 10.0,
+            c: 0.2 * f,
+        };
+        let ids = [ParamId::C];
+        let spread = Spread {
+            ids: &ids,
+            sigma: &[0.002],
+            corr: &[vec![1.0]],
+        };
+        let c = FrictionCurve::new(LAW, &speeds, Some(spread), Some(scaled(1.05))).unwrap();
+        assert_eq!(c.truth_within_band, Some(0.0));
+        assert!(c.clone().with_alternatives(&[]) == c && c.mu_d_envelope.is_empty());
+        let c = c.with_alternatives(&[scaled(1.1), scaled(0.9)]);
+        for (i, [lo, hi]) in c.mu_d_envelope.iter().enumerate() {
+            assert!((lo - 0.9 * c.mu_d[i]).abs() < 1e-15 && (hi - 1.1 * c.mu_d[i]).abs() < 1e-15);
+        }
+        assert_eq!(c.truth_within_envelope, Some(1.0));
+        assert_eq!(c.alternative_laws.len(), 2);
+        let text = toml::to_string_pretty(&c).unwrap();
+        assert_eq!(toml::from_str::<FrictionCurve>(&text).unwrap(), c);
     }
 
     /// The curve as the result file holds it reads back the same.

@@ -561,6 +561,18 @@ pub fn friction_law_figure(
             mu(truth, &grid),
         ));
     }
+    if !c.mu_d_envelope.is_empty() {
+        opts.bands.push(super::plot::Band {
+            x: c.speed_m_per_s.clone(),
+            lo: c.mu_d_envelope.iter().map(|e| e[0]).collect(),
+            hi: c.mu_d_envelope.iter().map(|e| e[1]).collect(),
+            series: 0,
+            label: format!(
+                "with the {} model(s) the recording does not distinguish",
+                c.alternative_laws.len()
+            ),
+        });
+    }
     if !c.mu_d_sigma.is_empty() {
         opts.bands.push(super::plot::Band {
             x: c.speed_m_per_s.clone(),
@@ -729,6 +741,7 @@ fn measured_y_range(c: &crate::model::friction_curve::FrictionCurve) -> (f64, f6
     let values = (0..c.mu_d.len())
         .flat_map(|i| [c.mu_d[i] - sigma(i), c.mu_d[i] + sigma(i)])
         .chain(c.mu_d_true.iter().copied())
+        .chain(c.mu_d_envelope.iter().flatten().copied())
         .filter(|v| v.is_finite());
     let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
         (a.min(v), b.max(v))
@@ -964,8 +977,9 @@ pub fn fit_data_files(dir: &Path, o: &FitOutcome) -> Result<Vec<String>> {
 }
 
 /// Writes `friction_curve.csv`: the fitted law on the measured slip-speed range, `speed_m_per_s`,
-/// `mu_d`, then `mu_d_sigma`, `mu_d_lo`, `mu_d_hi` (±1σ) when the fit gives a band and `mu_d_true`
-/// when the truth is known.
+/// `mu_d`, then `mu_d_sigma`, `mu_d_lo`, `mu_d_hi` (±1σ) when the fit gives a band,
+/// `mu_d_envelope_lo`, `mu_d_envelope_hi` when models the recording does not distinguish give an
+/// envelope, and `mu_d_true` when the truth is known.
 fn friction_curve_csv(
     dir: &Path,
     c: &crate::model::friction_curve::FrictionCurve,
@@ -989,6 +1003,14 @@ fn friction_curve_csv(
             ("mu_d_sigma", c.mu_d_sigma.as_slice()),
             ("mu_d_lo", &lo),
             ("mu_d_hi", &hi),
+        ]);
+    }
+    let env_lo: Vec<f64> = c.mu_d_envelope.iter().map(|e| e[0]).collect();
+    let env_hi: Vec<f64> = c.mu_d_envelope.iter().map(|e| e[1]).collect();
+    if !c.mu_d_envelope.is_empty() {
+        cols.extend([
+            ("mu_d_envelope_lo", env_lo.as_slice()),
+            ("mu_d_envelope_hi", &env_hi),
         ]);
     }
     if !c.mu_d_true.is_empty() {
@@ -1200,6 +1222,14 @@ mod tests {
         ] {
             assert!(svg.contains(label), "no {label:?} in the figure");
         }
+        assert!(!svg.contains("does not distinguish"));
+        // A law the recording does not distinguish: the envelope is drawn and named.
+        let curve = r.friction_curve.clone();
+        r.friction_curve = curve.clone().map(|c| c.with_alternatives(&[truth]));
+        friction_law_figure(dir.path(), &r, &LAW, Some(0.167)).unwrap();
+        let svg = std::fs::read_to_string(dir.path().join("friction_law.svg")).unwrap();
+        assert!(svg.contains("with the 1 model(s) the recording does not distinguish"));
+        r.friction_curve = curve;
         // A rig curve: its points in the legend, each with a whisker and two caps.
         let lines = |svg: &str| svg.matches("<polyline").count();
         let before = lines(&svg);

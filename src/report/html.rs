@@ -1527,6 +1527,7 @@ pub(super) mod tests {
             failed_evaluations: 408,
             chosen,
             reason: "the fit's own sentence, with every number".into(),
+            not_distinguishable: false,
             evidence: Some(e),
             friction: None,
         };

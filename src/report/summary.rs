@@ -261,10 +261,24 @@ fn curve_words(c: &crate::model::friction_curve::FrictionCurve) -> String {
             " (1σ)"
         }
     );
+    if let (Some(first), Some(last)) = (c.mu_d_envelope.first(), c.mu_d_envelope.last()) {
+        s += &format!(
+            " With the {} model(s) the recording does not distinguish from this one, μ_d lies \
+             within {}–{} at the slowest and {}–{} at the fastest of these speeds.",
+            c.alternative_laws.len(),
+            num(first[0], 3),
+            num(first[1], 3),
+            num(last[0], 3),
+            num(last[1], 3)
+        );
+    }
     if let Some(rms) = c.rms_rel_diff_to_truth {
         s += &format!(" It lies {} rms from the true law there", pct_abs(rms));
         if let Some(f) = c.truth_within_band {
             s += &format!(", inside the ±1σ band at {} of the speeds", pct_abs(f));
+        }
+        if let Some(f) = c.truth_within_envelope {
+            s += &format!(", inside that envelope at {}", pct_abs(f));
         }
         s += ".";
     }
@@ -556,6 +570,16 @@ mod tests {
             "{:?}",
             s.findings
         );
+        // The truth as the one other candidate: the envelope runs from it (0.8 e^(−0.1) + 0.2 =
+        // 0.924 at 10 mm/s, 0.525 at 90 mm/s) to the fitted μ_d + 1σ (0.943, 0.537).
+        let words = curve_words(&r.friction_curve.unwrap().with_alternatives(&[truth]));
+        assert!(
+            words.contains(
+                "With the 1 model(s) the recording does not distinguish from this one, μ_d lies \
+                 within 0.924–0.943 at the slowest and 0.525–0.537 at the fastest of these speeds."
+            ) && words.ends_with("of the speeds, inside that envelope at 100 %."),
+            "{words}"
+        );
     }
 
     /// Laws as candidates: the chosen exponential law with the viscous one 1.2 below it in TIC is
@@ -578,6 +602,7 @@ mod tests {
             failed_evaluations: 0,
             chosen,
             reason: String::new(),
+            not_distinguishable: false,
             evidence: Some(crate::fit::TrialEvidence {
                 log_likelihood_nats: 5805.8,
                 spectral_nll_nats: vec![],

@@ -52,6 +52,7 @@ fn sample_trial() -> ModelTrial {
         failed_evaluations: 0,
         chosen: false,
         reason: "cost 3.0 > 1.5".into(),
+        not_distinguishable: false,
         evidence: Some(TrialEvidence {
             log_likelihood_nats: -12.5,
             spectral_nll_nats: vec![10.0, 2.5],
