@@ -99,7 +99,7 @@ pub(super) fn choose(
                 Some(note) => format!("{}; {note}", scored.reason(fits, i, bands, listed)),
                 None => scored.reason(fits, i, bands, listed),
             },
-            not_distinguishable: i != chosen && scored.not_distinguishable(i),
+            not_distinguishable: scored.not_distinguishable(i),
             evidence: scored.trial_evidence(fits, i),
             friction: Some(f.problem.params_at(&f.best_u).friction),
         })
@@ -241,9 +241,11 @@ impl Scored<'_> {
         })
     }
 
-    /// Whether candidate `i`'s TIC lies within the margin of the chosen one's.
+    /// Whether candidate `i`, another than the chosen one, has its TIC within the margin of the
+    /// chosen one's.
     fn not_distinguishable(&self, i: usize) -> bool {
-        self.evidence.is_some()
+        i != self.chosen
+            && self.evidence.is_some()
             && (self.crit[i] - self.crit[self.chosen]).abs() <= margin(self.spreads, i, self.chosen)
             && self.scores[i].is_finite()
     }

@@ -204,6 +204,28 @@ impl FrictionCurve {
         self
     }
 
+    /// The ±1σ band's lower and upper edges on the grid, μ_d ∓ σ; `None` without a band.
+    pub fn band_edges(&self) -> Option<[Vec<f64>; 2]> {
+        if self.mu_d_sigma.is_empty() {
+            return None;
+        }
+        let edge = |sign: f64| -> Vec<f64> {
+            (self.mu_d.iter().zip(&self.mu_d_sigma))
+                .map(|(m, s)| m + sign * s)
+                .collect()
+        };
+        Some([edge(-1.0), edge(1.0)])
+    }
+
+    /// The envelope's lower and upper edges on the grid; `None` without an envelope.
+    pub fn envelope_edges(&self) -> Option<[Vec<f64>; 2]> {
+        if self.mu_d_envelope.is_empty() {
+            return None;
+        }
+        let edge = |i: usize| self.mu_d_envelope.iter().map(|e| e[i]).collect();
+        Some([edge(0), edge(1)])
+    }
+
     /// Whether `speed_m_per_s` lies inside the measured range.
     pub fn measures(&self, speed_m_per_s: f64) -> bool {
         let [lo, hi] = self.measured_range_m_per_s;
@@ -352,6 +374,10 @@ mod tests {
         }
         assert_eq!(c.truth_within_envelope, Some(1.0));
         assert_eq!(c.alternative_laws.len(), 2);
+        let [lo, hi] = c.envelope_edges().unwrap();
+        assert!(lo[7] == c.mu_d_envelope[7][0] && hi[7] == c.mu_d_envelope[7][1]);
+        let [lo, hi] = c.band_edges().unwrap();
+        assert!(lo[7] == c.mu_d[7] - 0.002 && hi[7] == c.mu_d[7] + 0.002);
         let text = toml::to_string_pretty(&c).unwrap();
         assert_eq!(toml::from_str::<FrictionCurve>(&text).unwrap(), c);
     }

@@ -561,37 +561,7 @@ pub fn friction_law_figure(
             mu(truth, &grid),
         ));
     }
-    if !c.mu_d_envelope.is_empty() {
-        opts.bands.push(super::plot::Band {
-            x: c.speed_m_per_s.clone(),
-            lo: c.mu_d_envelope.iter().map(|e| e[0]).collect(),
-            hi: c.mu_d_envelope.iter().map(|e| e[1]).collect(),
-            series: 0,
-            label: format!(
-                "with the {} model(s) the recording does not distinguish",
-                c.alternative_laws.len()
-            ),
-        });
-    }
-    if !c.mu_d_sigma.is_empty() {
-        opts.bands.push(super::plot::Band {
-            x: c.speed_m_per_s.clone(),
-            lo: c
-                .mu_d
-                .iter()
-                .zip(&c.mu_d_sigma)
-                .map(|(m, s)| m - s)
-                .collect(),
-            hi: c
-                .mu_d
-                .iter()
-                .zip(&c.mu_d_sigma)
-                .map(|(m, s)| m + s)
-                .collect(),
-            series: 0,
-            label: "±1σ by the delta method from the fitted covariance".into(),
-        });
-    }
+    curve_bands(c, &mut opts);
     opts.spans.push(Span {
         lo,
         hi,
@@ -613,6 +583,29 @@ pub fn friction_law_figure(
         &series,
         &opts,
     )
+}
+
+/// The friction figure's shaded bands, both in the fitted curve's colour: the envelope of the
+/// models the recording does not distinguish (lighter alone, under the band) and the ±1σ band.
+fn curve_bands(c: &crate::model::friction_curve::FrictionCurve, opts: &mut ChartOpts) {
+    let band = |[lo, hi]: [Vec<f64>; 2], label: String| super::plot::Band {
+        x: c.speed_m_per_s.clone(),
+        lo,
+        hi,
+        series: 0,
+        label,
+    };
+    if let Some(edges) = c.envelope_edges() {
+        let label = format!(
+            "with the {} model(s) the recording does not distinguish",
+            c.alternative_laws.len()
+        );
+        opts.bands.push(band(edges, label));
+    }
+    if let Some(edges) = c.band_edges() {
+        let label = "±1σ by the delta method from the fitted covariance".into();
+        opts.bands.push(band(edges, label));
+    }
 }
 
 /// The friction figure's last slip speed: past the fastest slip speed `v_max_m_per_s` the model's
@@ -984,33 +977,21 @@ fn friction_curve_csv(
     dir: &Path,
     c: &crate::model::friction_curve::FrictionCurve,
 ) -> Result<String> {
-    let lo: Vec<f64> = c
-        .mu_d
-        .iter()
-        .zip(&c.mu_d_sigma)
-        .map(|(m, s)| m - s)
-        .collect();
-    let hi: Vec<f64> = c
-        .mu_d
-        .iter()
-        .zip(&c.mu_d_sigma)
-        .map(|(m, s)| m + s)
-        .collect();
+    let band = c.band_edges();
+    let envelope = c.envelope_edges();
     let mut cols: Vec<(&str, &[f64])> =
         vec![("speed_m_per_s", &c.speed_m_per_s), ("mu_d", &c.mu_d)];
-    if !c.mu_d_sigma.is_empty() {
+    if let Some([lo, hi]) = &band {
         cols.extend([
             ("mu_d_sigma", c.mu_d_sigma.as_slice()),
-            ("mu_d_lo", &lo),
-            ("mu_d_hi", &hi),
+            ("mu_d_lo", lo),
+            ("mu_d_hi", hi),
         ]);
     }
-    let env_lo: Vec<f64> = c.mu_d_envelope.iter().map(|e| e[0]).collect();
-    let env_hi: Vec<f64> = c.mu_d_envelope.iter().map(|e| e[1]).collect();
-    if !c.mu_d_envelope.is_empty() {
+    if let Some([lo, hi]) = &envelope {
         cols.extend([
-            ("mu_d_envelope_lo", env_lo.as_slice()),
-            ("mu_d_envelope_hi", &env_hi),
+            ("mu_d_envelope_lo", lo.as_slice()),
+            ("mu_d_envelope_hi", hi),
         ]);
     }
     if !c.mu_d_true.is_empty() {
