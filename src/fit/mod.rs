@@ -181,7 +181,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         },
     );
     let result = FitResult {
-        friction_curve: friction_curve(job, &result, &best),
+        friction_curve: friction_curve(job, &result, &best, &cf),
         posterior,
         ..result
     };
@@ -198,33 +198,48 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
 }
 
 /// The fitted law over the slip speeds of the chosen optimum's simulation, its band from the
-/// result's 1σ and correlations, the envelope of the laws the recording does not distinguish
-/// from it, and the job's true law ([`LoadedJob::true_friction_law`]).
+/// result's 1σ and correlations widened to the points the search evaluated within each speed's
+/// profile rise limit ([`uncertainty::mu_d_rise_limits`]), the envelope of the laws the recording
+/// does not distinguish from it, and the job's true law ([`LoadedJob::true_friction_law`]).
 fn friction_curve(
     job: &LoadedJob,
     r: &FitResult,
     best: &BestModel,
+    cf: &CandidateFit,
 ) -> Option<crate::model::friction_curve::FrictionCurve> {
+    use crate::model::friction_curve::{FrictionCurve, Spread};
     let ids: Vec<crate::model::ParamId> = r.parameters.iter().map(|p| p.name).collect();
     let sigma: Vec<f64> = r.parameters.iter().map(|p| p.std_error).collect();
-    let spread = crate::model::friction_curve::Spread {
+    let fisher_sigma: Vec<f64> = (r.parameters.iter())
+        .map(|p| p.fisher_std_error.unwrap_or(f64::NAN))
+        .collect();
+    let spread = Spread {
         ids: &ids,
         sigma: &sigma,
         corr: &r.correlation,
     };
-    crate::model::friction_curve::FrictionCurve::new(
-        best.params.friction,
+    let fisher = cf.fisher_corr.as_ref().map(|corr| Spread {
+        ids: &ids,
+        sigma: &fisher_sigma,
+        corr,
+    });
+    let law = best.params.friction;
+    let curve = FrictionCurve::new(
+        law,
         &best.sim.slip_speeds(),
         Some(spread),
         job.true_friction_law(),
+    )?;
+    let limits = uncertainty::mu_d_rise_limits(&law, &curve.speed_m_per_s, spread, fisher);
+    let others: Vec<_> = (r.model_trials.iter())
+        .filter(|t| t.not_distinguishable)
+        .filter_map(|t| t.friction)
+        .collect();
+    Some(
+        curve
+            .with_near_best(&uncertainty::near_best_laws(cf, &limits), &limits)
+            .with_alternatives(&others),
     )
-    .map(|c| {
-        let others: Vec<_> = (r.model_trials.iter())
-            .filter(|t| t.not_distinguishable)
-            .filter_map(|t| t.friction)
-            .collect();
-        c.with_alternatives(&others)
-    })
 }
 
 /// The chosen optimum's tolerance check ([`tolerance::ToleranceCheck`]) and, where an optimum the

@@ -756,6 +756,34 @@ fn secant_check(cf: &CandidateFit) -> Vec<FitWarning> {
         .collect()
 }
 
+/// The profile rise limit ([`profile_rise_limit`]) of μ_d of `law` at each of `speeds_m_per_s`,
+/// from its sandwich and Fisher 1σ by the delta method over the fit's spreads (`fisher` `None`:
+/// μ = 1, the limit [`PROFILE_68_NATS`]).
+pub fn mu_d_rise_limits(
+    law: &crate::model::FrictionLaw,
+    speeds_m_per_s: &[f64],
+    sandwich: crate::model::friction_curve::Spread<'_>,
+    fisher: Option<crate::model::friction_curve::Spread<'_>>,
+) -> Vec<f64> {
+    let sigma = |s: Option<crate::model::friction_curve::Spread<'_>>, v: f64| {
+        s.and_then(|s| s.mu_sigma(law, v)).unwrap_or(f64::NAN)
+    };
+    (speeds_m_per_s.iter())
+        .map(|&v| profile_rise_limit(sigma(Some(sandwich), v), sigma(fisher, v)))
+        .collect()
+}
+
+/// The friction laws of the points the chosen fit's search evaluated within the largest of
+/// `limits` (nats) of its cost, with each point's cost above the fit's
+/// ([`super::problem::EvaluatedNearBest`]).
+pub fn near_best_laws(cf: &CandidateFit, limits: &[f64]) -> Vec<(f64, crate::model::FrictionLaw)> {
+    let widest = limits.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let near = (cf.problem.near_best.lock()).unwrap_or_else(|e| e.into_inner());
+    near.at_most(cf.cost + widest)
+        .map(|(c, u)| (c - cf.cost, cf.problem.params_at(u).friction))
+        .collect()
+}
+
 /// Widens `interval` to contain `[lo, hi]`, keeping its ends before the first widening in
 /// [`Interval::widened_from`].
 fn widen(interval: &mut Interval, lo: f64, hi: f64) {
@@ -1167,6 +1195,36 @@ mod tests {
         assert!((profile_rise_limit(0.5, 1.0) - 0.125).abs() < 1e-15);
         assert_eq!(profile_rise_limit(1.0, f64::INFINITY), PROFILE_68_NATS);
         assert_eq!(profile_rise_limit(f64::NAN, 1.0), PROFILE_68_NATS);
+    }
+
+    /// μ_d's rise limit by the delta method: with A and C uncorrelated, σ_A = 0 and σ_C twice as
+    /// wide in the sandwich as in the Fisher information, μ_d's σ ratio is 2 at every speed and
+    /// the limit 0.5·4 = 2 nats; A alone enters with the weight e^(−Bv), which cancels in the
+    /// ratio (2 again); without a Fisher spread the limit is [`PROFILE_68_NATS`].
+    #[test]
+    fn mu_d_rise_limits_follow_the_ratio_of_the_two_spreads() {
+        use crate::model::friction_curve::Spread;
+        let law = crate::model::FrictionLaw::Exponential {
+            a: 0.8,
+            b_s_per_m: 10.0,
+            c: 0.2,
+        };
+        let speeds = [0.0, 0.01, 0.1];
+        let ids = [ParamId::A, ParamId::C];
+        let eye = vec![vec![1.0, 0.0], vec![0.0, 1.0]];
+        let spread = |sigma: &'static [f64; 2]| Spread {
+            ids: &ids,
+            sigma,
+            corr: &eye,
+        };
+        for (sandwich, fisher) in [(&[0.0, 0.02], &[0.0, 0.01]), (&[0.04, 0.0], &[0.02, 0.0])] {
+            let limits = mu_d_rise_limits(&law, &speeds, spread(sandwich), Some(spread(fisher)));
+            for l in limits {
+                assert!((l - 2.0).abs() < 1e-12, "{l}");
+            }
+        }
+        let limits = mu_d_rise_limits(&law, &speeds, spread(&[0.0, 0.02]), None);
+        assert_eq!(limits, vec![PROFILE_68_NATS; 3]);
     }
 
     #[test]

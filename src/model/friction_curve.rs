@@ -42,7 +42,13 @@ pub struct FrictionCurve {
     /// Root mean square over the grid of (μ_d − μ_d,true)/μ_d,true.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rms_rel_diff_to_truth: Option<f64>,
-    /// Share of the grid's points where the true μ_d lies within μ_d ± 1σ.
+    /// On each grid point, the lowest and highest μ_d among the points the fit's search evaluated
+    /// whose cost lies within that speed's profile rise limit of the fit
+    /// ([`FrictionCurve::with_near_best`]); empty when no such point was kept.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub mu_d_near_best: Vec<[f64; 2]>,
+    /// Share of the grid's points where the true μ_d lies within the band
+    /// ([`FrictionCurve::band_edges`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub truth_within_band: Option<f64>,
     /// The models the recording does not distinguish from the chosen one, on the grid: the
@@ -149,28 +155,70 @@ impl FrictionCurve {
                 .sum();
             (ss / CURVE_POINTS as f64).sqrt()
         });
-        let truth_within_band = (!mu_d_true.is_empty() && !mu_d_sigma.is_empty()).then(|| {
-            let inside = (0..CURVE_POINTS)
-                .filter(|&i| (mu_d[i] - mu_d_true[i]).abs() <= mu_d_sigma[i])
-                .count();
-            inside as f64 / CURVE_POINTS as f64
-        });
-        Some(FrictionCurve {
-            measured_range_m_per_s: range,
-            range_percentiles: RANGE_PERCENTILES,
-            slip_samples: sorted.len(),
-            speed_m_per_s: speed,
-            mu_d,
-            mu_d_sigma,
-            mu_d_true,
-            rms_rel_diff_to_truth,
-            truth_within_band,
-            mu_d_envelope: Vec::new(),
-            alternative_laws: Vec::new(),
-            truth_within_envelope: None,
-            fitted_law: law,
-            true_law: truth,
-        })
+        Some(
+            FrictionCurve {
+                measured_range_m_per_s: range,
+                range_percentiles: RANGE_PERCENTILES,
+                slip_samples: sorted.len(),
+                speed_m_per_s: speed,
+                mu_d,
+                mu_d_sigma,
+                mu_d_true,
+                rms_rel_diff_to_truth,
+                mu_d_near_best: Vec::new(),
+                truth_within_band: None,
+                mu_d_envelope: Vec::new(),
+                alternative_laws: Vec::new(),
+                truth_within_envelope: None,
+                fitted_law: law,
+                true_law: truth,
+            }
+            .with_truth_in_band(),
+        )
+    }
+
+    /// [`FrictionCurve::truth_within_band`] from the band's present edges.
+    fn with_truth_in_band(mut self) -> FrictionCurve {
+        self.truth_within_band = self
+            .band_edges()
+            .filter(|_| !self.mu_d_true.is_empty())
+            .map(|[lo, hi]| share_within(&lo, &hi, &self.mu_d_true));
+        self
+    }
+
+    /// The curve with its band widened to the points the fit's search evaluated that are about as
+    /// likely as the fit, as the parameters' intervals are: `points` holds each evaluated point's
+    /// cost above the fit's (nats) and its friction law, `rise_limit_nats` the profile rise limit
+    /// of μ_d on each grid point (the 68.27 % bound of μ_d(v)'s profile likelihood). A point
+    /// within that limit lies inside μ_d(v)'s 68.27 % profile-likelihood region: the profile at
+    /// its μ_d(v) is at most its cost, the other directions held instead of re-optimised (Pawitan
+    /// 2001, *In All Likelihood*, §2.6). Where the likelihood is flat along a direction the
+    /// curvature at the fit does not see, the search's own simulations outline it. Unchanged when
+    /// no point lies within a limit or `rise_limit_nats` does not match the grid.
+    pub fn with_near_best(
+        mut self,
+        points: &[(f64, FrictionLaw)],
+        rise_limit_nats: &[f64],
+    ) -> Self {
+        if rise_limit_nats.len() != self.speed_m_per_s.len() {
+            return self;
+        }
+        let ranges: Option<Vec<[f64; 2]>> = (self.speed_m_per_s.iter().zip(rise_limit_nats))
+            .map(|(&v, &limit)| {
+                (points.iter())
+                    .filter(|(rise, _)| *rise <= limit)
+                    .map(|(_, law)| law.mu_slip(v))
+                    .filter(|m| m.is_finite())
+                    .fold(None, |r: Option<[f64; 2]>, m| {
+                        Some(r.map_or([m, m], |[lo, hi]| [lo.min(m), hi.max(m)]))
+                    })
+            })
+            .collect();
+        if let Some(ranges) = ranges {
+            self.mu_d_near_best = ranges;
+            self = self.with_truth_in_band();
+        }
+        self
     }
 
     /// The curve with the envelope of `laws`, the friction laws of the candidates the recording
@@ -183,38 +231,57 @@ impl FrictionCurve {
         if laws.is_empty() {
             return self;
         }
+        let [band_lo, band_hi] = self
+            .band_edges()
+            .unwrap_or_else(|| [self.mu_d.clone(), self.mu_d.clone()]);
         self.mu_d_envelope = (0..self.speed_m_per_s.len())
             .map(|i| {
-                let s = self.mu_d_sigma.get(i).copied().unwrap_or(0.0);
                 let v = self.speed_m_per_s[i];
                 laws.iter()
                     .map(|l| l.mu_slip(v))
-                    .fold([self.mu_d[i] - s, self.mu_d[i] + s], |[lo, hi], m| {
+                    .fold([band_lo[i], band_hi[i]], |[lo, hi], m| {
                         [lo.min(m), hi.max(m)]
                     })
             })
             .collect();
         self.alternative_laws = laws.to_vec();
         self.truth_within_envelope = (!self.mu_d_true.is_empty()).then(|| {
-            let inside = (self.mu_d_envelope.iter().zip(&self.mu_d_true))
-                .filter(|([lo, hi], t)| (*lo..=*hi).contains(*t))
-                .count();
-            inside as f64 / self.mu_d_true.len() as f64
+            let [lo, hi] = self.envelope_edges().unwrap_or_default();
+            share_within(&lo, &hi, &self.mu_d_true)
         });
         self
     }
 
-    /// The ±1σ band's lower and upper edges on the grid, μ_d ∓ σ; `None` without a band.
+    /// The band's lower and upper edges on the grid: μ_d ∓ σ, widened to
+    /// [`FrictionCurve::mu_d_near_best`] where that reaches further; `None` without either.
     pub fn band_edges(&self) -> Option<[Vec<f64>; 2]> {
-        if self.mu_d_sigma.is_empty() {
+        if self.mu_d_sigma.is_empty() && self.mu_d_near_best.is_empty() {
             return None;
         }
         let edge = |sign: f64| -> Vec<f64> {
-            (self.mu_d.iter().zip(&self.mu_d_sigma))
-                .map(|(m, s)| m + sign * s)
+            (0..self.mu_d.len())
+                .map(|i| {
+                    let m = self.mu_d[i];
+                    let s = self.mu_d_sigma.get(i).map_or(m, |s| m + sign * s);
+                    match self.mu_d_near_best.get(i) {
+                        Some([lo, _]) if sign < 0.0 => s.min(*lo),
+                        Some([_, hi]) => s.max(*hi),
+                        None => s,
+                    }
+                })
                 .collect()
         };
         Some([edge(-1.0), edge(1.0)])
+    }
+
+    /// Whether the points the search evaluated reach beyond μ_d ± 1σ at some grid point by more
+    /// than a tenth of σ: the band is then wider than the delta method's.
+    pub fn band_widened(&self) -> bool {
+        (0..self.mu_d_near_best.len()).any(|i| {
+            let s = self.mu_d_sigma.get(i).copied().unwrap_or(0.0);
+            let [lo, hi] = self.mu_d_near_best[i];
+            lo < self.mu_d[i] - 1.1 * s || hi > self.mu_d[i] + 1.1 * s
+        })
     }
 
     /// The envelope's lower and upper edges on the grid; `None` without an envelope.
@@ -231,6 +298,14 @@ impl FrictionCurve {
         let [lo, hi] = self.measured_range_m_per_s;
         (lo..=hi).contains(&speed_m_per_s)
     }
+}
+
+/// The share of `truth`'s points that lie within `[lo, hi]` point by point.
+fn share_within(lo: &[f64], hi: &[f64], truth: &[f64]) -> f64 {
+    let inside = (0..truth.len())
+        .filter(|&i| (lo[i]..=hi[i]).contains(&truth[i]))
+        .count();
+    inside as f64 / truth.len().max(1) as f64
 }
 
 #[cfg(test)]
@@ -380,6 +455,55 @@ mod tests {
         assert!(lo[7] == c.mu_d[7] - 0.002 && hi[7] == c.mu_d[7] + 0.002);
         let text = toml::to_string_pretty(&c).unwrap();
         assert_eq!(toml::from_str::<FrictionCurve>(&text).unwrap(), c);
+    }
+
+    /// The band widened to evaluated points against closed forms: a law 3 % above the fitted one
+    /// 0.2 nats above the fit, and one 10 % below it 0.4 nats above. With a rise limit of 0.3
+    /// nats at the slower half of the grid and 0.5 at the faster, the band runs to 1.03·μ_d above
+    /// everywhere and down to 0.9·μ_d only where the limit admits the lower law; the truth 5 %
+    /// below is then inside it on the faster half alone. A limit below every point's rise, or
+    /// limits that do not match the grid, leave the curve as it was.
+    #[test]
+    fn the_band_reaches_the_evaluated_points_within_each_speeds_rise_limit() {
+        let speeds: Vec<f64> = (0..=100).map(|i| i as f64 * 0.001).collect();
+        let scaled = |f: f64| FrictionLaw::Exponential {
+            a: 0.8 * f,
+            b_s_per_m: 10.0,
+            c: 0.2 * f,
+        };
+        let spread = Spread {
+            ids: &[ParamId::C],
+            sigma: &[0.002],
+            corr: &[vec![1.0]],
+        };
+        let c = FrictionCurve::new(LAW, &speeds, Some(spread), Some(scaled(0.95))).unwrap();
+        assert_eq!(c.truth_within_band, Some(0.0));
+        let points = [(0.2, scaled(1.03)), (0.4, scaled(0.9))];
+        let half = CURVE_POINTS / 2;
+        let limits: Vec<f64> = (0..CURVE_POINTS)
+            .map(|i| if i < half { 0.3 } else { 0.5 })
+            .collect();
+        let w = c.clone().with_near_best(&points, &limits);
+        assert!(w.band_widened());
+        let [lo, hi] = w.band_edges().unwrap();
+        for i in 0..CURVE_POINTS {
+            let m = w.mu_d[i];
+            assert!((hi[i] - 1.03 * m).abs() < 1e-15, "{i}");
+            let want_lo = if i < half { m - 0.002 } else { 0.9 * m };
+            assert!(
+                (lo[i] - want_lo).abs() < 1e-15,
+                "{i}: {} against {want_lo}",
+                lo[i]
+            );
+        }
+        assert_eq!(w.truth_within_band, Some(0.5));
+        // The envelope starts from the widened band.
+        let e = w.clone().with_alternatives(&[scaled(1.01)]);
+        assert_eq!(e.envelope_edges().unwrap(), [lo, hi]);
+        assert_eq!(c.clone().with_near_best(&points, &[0.1; CURVE_POINTS]), c);
+        assert_eq!(c.clone().with_near_best(&points, &[0.5; 3]), c);
+        let text = toml::to_string_pretty(&w).unwrap();
+        assert_eq!(toml::from_str::<FrictionCurve>(&text).unwrap(), w);
     }
 
     /// The curve as the result file holds it reads back the same.

@@ -603,7 +603,11 @@ fn curve_bands(c: &crate::model::friction_curve::FrictionCurve, opts: &mut Chart
         opts.bands.push(band(edges, label));
     }
     if let Some(edges) = c.band_edges() {
-        let label = "±1σ by the delta method from the fitted covariance".into();
+        let label = if c.band_widened() {
+            "±1σ by the delta method, widened to the evaluated points as likely as the fit".into()
+        } else {
+            "±1σ by the delta method from the fitted covariance".into()
+        };
         opts.bands.push(band(edges, label));
     }
 }
@@ -730,9 +734,8 @@ fn rig_points(
 /// half their span (at least 0.01) above and below, so that the band is seen; the extrapolation
 /// leaves the box where it climbs to μ_s.
 fn measured_y_range(c: &crate::model::friction_curve::FrictionCurve) -> (f64, f64) {
-    let sigma = |i: usize| c.mu_d_sigma.get(i).copied().unwrap_or(0.0);
-    let values = (0..c.mu_d.len())
-        .flat_map(|i| [c.mu_d[i] - sigma(i), c.mu_d[i] + sigma(i)])
+    let values = (c.mu_d.iter().copied())
+        .chain(c.band_edges().into_iter().flatten().flatten())
         .chain(c.mu_d_true.iter().copied())
         .chain(c.mu_d_envelope.iter().flatten().copied())
         .filter(|v| v.is_finite());
@@ -756,7 +759,7 @@ fn friction_title(r: &FitResult, law: &FrictionLaw, band: bool) -> String {
         .iter()
         .any(|(id, _)| r.parameters.iter().any(|p| p.name == *id));
     match (band, fitted) {
-        (true, _) => format!("{head}, ±1σ from the fit"),
+        (true, _) => format!("{head}, 68 % band from the fit"),
         (false, true) => format!("{head}; no ±1σ: the coefficients' covariance is not finite"),
         (false, false) => format!("{head}; no ±1σ: no coefficient of the law was fitted"),
     }
@@ -970,7 +973,8 @@ pub fn fit_data_files(dir: &Path, o: &FitOutcome) -> Result<Vec<String>> {
 }
 
 /// Writes `friction_curve.csv`: the fitted law on the measured slip-speed range, `speed_m_per_s`,
-/// `mu_d`, then `mu_d_sigma`, `mu_d_lo`, `mu_d_hi` (±1σ) when the fit gives a band,
+/// `mu_d`, then `mu_d_sigma` (1σ by the delta method) and the band's edges `mu_d_lo`, `mu_d_hi`
+/// (±1σ, widened to the evaluated points as likely as the fit) when the fit gives a band,
 /// `mu_d_envelope_lo`, `mu_d_envelope_hi` when models the recording does not distinguish give an
 /// envelope, and `mu_d_true` when the truth is known.
 fn friction_curve_csv(
@@ -1198,7 +1202,7 @@ mod tests {
             ),
             "slip speed |v̇3| [m/s]",
             "dynamic friction coefficient μ_d [-]",
-            "law exponential, ±1σ from the fit",
+            "law exponential, 68 % band from the fit",
             "stroke-dasharray",
         ] {
             assert!(svg.contains(label), "no {label:?} in the figure");
@@ -1210,6 +1214,17 @@ mod tests {
         friction_law_figure(dir.path(), &r, &LAW, Some(0.167)).unwrap();
         let svg = std::fs::read_to_string(dir.path().join("friction_law.svg")).unwrap();
         assert!(svg.contains("with the 1 model(s) the recording does not distinguish"));
+        // The truth among the points the search evaluated within the rise limit: the band's
+        // legend says that it was widened.
+        let limits = [0.5; crate::model::friction_curve::CURVE_POINTS];
+        r.friction_curve = curve
+            .clone()
+            .map(|c| c.with_near_best(&[(0.2, truth)], &limits));
+        friction_law_figure(dir.path(), &r, &LAW, Some(0.167)).unwrap();
+        let svg = std::fs::read_to_string(dir.path().join("friction_law.svg")).unwrap();
+        assert!(svg.contains(
+            "±1σ by the delta method, widened to the evaluated points as likely as the fit"
+        ));
         r.friction_curve = curve;
         // A rig curve: its points in the legend, each with a whisker and two caps.
         let lines = |svg: &str| svg.matches("<polyline").count();

@@ -261,6 +261,18 @@ fn curve_words(c: &crate::model::friction_curve::FrictionCurve) -> String {
             " (1σ)"
         }
     );
+    if let Some([lo, hi]) = c.band_edges().filter(|_| c.band_widened()) {
+        let n = c.mu_d.len() - 1;
+        s += &format!(
+            " Points the search evaluated that are as likely as the fit within μ_d's profile \
+             rise limit widen that band to {}–{} at the slowest and {}–{} at the fastest of \
+             these speeds: the recording determines μ_d less well than its curvature says.",
+            num(lo[0], 3),
+            num(hi[0], 3),
+            num(lo[n], 3),
+            num(hi[n], 3)
+        );
+    }
     if let (Some(first), Some(last)) = (c.mu_d_envelope.first(), c.mu_d_envelope.last()) {
         s += &format!(
             " With the {} model(s) the recording does not distinguish from this one, μ_d lies \
@@ -275,7 +287,7 @@ fn curve_words(c: &crate::model::friction_curve::FrictionCurve) -> String {
     if let Some(rms) = c.rms_rel_diff_to_truth {
         s += &format!(" It lies {} rms from the true law there", pct_abs(rms));
         if let Some(f) = c.truth_within_band {
-            s += &format!(", inside the ±1σ band at {} of the speeds", pct_abs(f));
+            s += &format!(", inside the band at {} of the speeds", pct_abs(f));
         }
         if let Some(f) = c.truth_within_envelope {
             s += &format!(", inside that envelope at {}", pct_abs(f));
@@ -559,9 +571,25 @@ mod tests {
         );
         assert!(
             words.ends_with(
-                "It lies 2.0 % rms from the true law there, inside the ±1σ band at 0 % of the speeds."
+                "It lies 2.0 % rms from the true law there, inside the band at 0 % of the speeds."
             ),
             "{words}"
+        );
+        // The truth as a point the search evaluated 0.3 nats above the fit, inside a 0.5-nat rise
+        // limit: the band reaches it (the numbers of the envelope below) and covers the truth.
+        let curve = r.friction_curve.clone().unwrap();
+        let limits = [0.5; crate::model::friction_curve::CURVE_POINTS];
+        let widened = curve_words(&curve.clone().with_near_best(&[(0.3, truth)], &limits));
+        assert!(
+            widened.contains(
+                "widen that band to 0.924–0.943 at the slowest and 0.525–0.537 at the fastest"
+            ) && widened.ends_with("inside the band at 100 % of the speeds."),
+            "{widened}"
+        );
+        // 0.6 nats above the fit it lies beyond the limit: the words are those without it.
+        assert_eq!(
+            curve_words(&curve.with_near_best(&[(0.6, truth)], &limits)),
+            words
         );
         let s = summary(&r, &[]);
         assert!(s.findings.contains(&words), "{:?}", s.findings);
