@@ -198,8 +198,9 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
 }
 
 /// The fitted law over the slip speeds of the chosen optimum's simulation, its band from the
-/// result's 1σ and correlations widened to the points the search evaluated within each speed's
-/// profile rise limit ([`uncertainty::mu_d_rise_limits`]), the envelope of the laws the recording
+/// result's 1σ and correlations widened, as Laplace and profile intervals are, to the points the
+/// search evaluated within each speed's profile rise limit ([`uncertainty::mu_d_rise_limits`]),
+/// the envelope of the laws the recording
 /// does not distinguish from it, and the job's true law ([`LoadedJob::true_friction_law`]).
 fn friction_curve(
     job: &LoadedJob,
@@ -231,13 +232,28 @@ fn friction_curve(
         job.true_friction_law(),
     )?;
     let limits = uncertainty::mu_d_rise_limits(&law, &curve.speed_m_per_s, spread, fisher);
+    // Widened as the intervals are: Laplace and profile intervals, not a posterior sample's or a
+    // bootstrap's, which cover the region themselves.
+    let widens = (r.parameters.iter())
+        .filter_map(|p| p.interval.as_ref())
+        .any(|iv| {
+            matches!(
+                iv.method,
+                result::IntervalMethod::Laplace { .. } | result::IntervalMethod::Profile { .. }
+            )
+        });
+    let near = if widens {
+        uncertainty::near_best_laws(cf, &limits)
+    } else {
+        Vec::new()
+    };
     let others: Vec<_> = (r.model_trials.iter())
         .filter(|t| t.not_distinguishable)
         .filter_map(|t| t.friction)
         .collect();
     Some(
         curve
-            .with_near_best(&uncertainty::near_best_laws(cf, &limits), &limits)
+            .with_near_best(&near, &limits)
             .with_alternatives(&others),
     )
 }
