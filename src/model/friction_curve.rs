@@ -423,17 +423,21 @@ mod tests {
         );
     }
 
+    /// [`LAW`] times `f` at every slip speed.
+    fn scaled(f: f64) -> FrictionLaw {
+        FrictionLaw::Exponential {
+            a: 0.8 * f,
+            b_s_per_m: 10.0,
+            c: 0.2 * f,
+        }
+    }
+
     /// The envelope of two other laws against closed forms: a law 10 % above the fitted one
     /// everywhere and one 10 % below it bound the envelope with the ±1σ band inside; the truth 5 %
     /// above lies inside it everywhere, and outside a band of 1 %.
     #[test]
     fn the_envelope_spans_the_laws_the_recording_does_not_distinguish() {
         let speeds: Vec<f64> = (0..=100).map(|i| i as f64 * 0.001).collect();
-        let scaled = |f: f64| FrictionLaw::Exponential {
-            a: 0.8 * f,
-            b_s_per_m: 10.0,
-            c: 0.2 * f,
-        };
         let ids = [ParamId::C];
         let spread = Spread {
             ids: &ids,
@@ -466,11 +470,6 @@ mod tests {
     #[test]
     fn the_band_reaches_the_evaluated_points_within_each_speeds_rise_limit() {
         let speeds: Vec<f64> = (0..=100).map(|i| i as f64 * 0.001).collect();
-        let scaled = |f: f64| FrictionLaw::Exponential {
-            a: 0.8 * f,
-            b_s_per_m: 10.0,
-            c: 0.2 * f,
-        };
         let spread = Spread {
             ids: &[ParamId::C],
             sigma: &[0.002],
