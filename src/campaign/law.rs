@@ -19,7 +19,7 @@ pub const LAW_TOLERANCE: f64 = 0.03;
 pub struct LawScore {
     /// Root mean square of (μ_d − μ_d,true)/μ_d,true over the measured slip speeds.
     pub rms_rel_diff: f64,
-    /// Share of the measured speeds where the true μ_d lies within the fitted ±1σ band.
+    /// Share of the measured speeds where the true μ_d lies within the fitted 68 % band.
     pub within_band: Option<f64>,
     /// Share where it lies within the envelope of the models the recording does not distinguish
     /// (the band where there are none).
@@ -58,7 +58,8 @@ pub fn law_section(md: &mut String, c: &Calibration) {
          The fitted μ_d(v) against the true law over the 10th–90th percentile of the fitted motion's \
          slip speeds (the result's `[friction_curve]`), by the departure the recording was made with \
          (none: the fitted model itself). Found: rms relative difference below {}. Band: the share \
-         of the range's speeds where the true μ_d lies inside the fitted ±1σ (68 % if calibrated). \
+         of the range's speeds where the true μ_d lies inside the fitted 68 % band (±1σ, widened \
+         to the points the search evaluated within μ_d's profile rise limit). \
          Envelope: inside that band or the laws of the models the recording does not distinguish \
          from the chosen one (the band where there are none). \
          Invented shoulder: a shoulder chosen for a blade without one. Misfit: the goodness-of-fit \
