@@ -200,8 +200,8 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
 /// The fitted law over the slip speeds of the chosen optimum's simulation, its band from the
 /// result's 1σ and correlations widened, as Laplace and profile intervals are, to the points the
 /// search evaluated within each speed's profile rise limit ([`uncertainty::mu_d_rise_limits`]),
-/// the envelope of the laws the recording
-/// does not distinguish from it, and the job's true law ([`LoadedJob::true_friction_law`]).
+/// the envelope of the laws the recording does not distinguish from it, and the job's true law
+/// ([`LoadedJob::true_friction_law`]).
 fn friction_curve(
     job: &LoadedJob,
     r: &FitResult,
