@@ -232,16 +232,9 @@ fn friction_curve(
         job.true_friction_law(),
     )?;
     let limits = uncertainty::mu_d_rise_limits(&law, &curve.speed_m_per_s, spread, fisher);
-    // Widened as the intervals are: Laplace and profile intervals, not a posterior sample's or a
-    // bootstrap's, which cover the region themselves.
     let widens = (r.parameters.iter())
         .filter_map(|p| p.interval.as_ref())
-        .any(|iv| {
-            matches!(
-                iv.method,
-                result::IntervalMethod::Laplace { .. } | result::IntervalMethod::Profile { .. }
-            )
-        });
+        .any(|iv| iv.method.widens_to_near_best());
     let near = if widens {
         uncertainty::near_best_laws(cf, &limits)
     } else {

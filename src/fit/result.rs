@@ -133,6 +133,18 @@ pub enum IntervalMethod {
     },
 }
 
+impl IntervalMethod {
+    /// Whether intervals of this method are widened to the points the search evaluated
+    /// ([`crate::fit::widen_to_near_best`]): Laplace and profile intervals; a posterior sample
+    /// and a bootstrap cover the region themselves.
+    pub fn widens_to_near_best(&self) -> bool {
+        matches!(
+            self,
+            IntervalMethod::Laplace { .. } | IntervalMethod::Profile { .. }
+        )
+    }
+}
+
 impl std::fmt::Display for IntervalMethod {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {

@@ -12,6 +12,10 @@ use super::{FrictionLaw, ParamId};
 /// Points of the curve's grid, evenly spaced over the measured range.
 pub const CURVE_POINTS: usize = 50;
 
+/// How far beyond ±1σ (a fraction of σ) the evaluated points must reach for
+/// [`FrictionCurve::band_widened`]: a tenth, as a widened interval is reported.
+pub const BAND_WIDENED_SIGMA: f64 = 0.1;
+
 /// The percentiles of the slipping samples' |slip speed| that bound the measured range.
 pub const RANGE_PERCENTILES: [f64; 2] = [10.0, 90.0];
 
@@ -275,12 +279,13 @@ impl FrictionCurve {
     }
 
     /// Whether the points the search evaluated reach beyond μ_d ± 1σ at some grid point by more
-    /// than a tenth of σ: the band is then wider than the delta method's.
+    /// than [`BAND_WIDENED_SIGMA`] of σ: the band is then wider than the delta method's.
     pub fn band_widened(&self) -> bool {
+        let reach = 1.0 + BAND_WIDENED_SIGMA;
         (0..self.mu_d_near_best.len()).any(|i| {
             let s = self.mu_d_sigma.get(i).copied().unwrap_or(0.0);
             let [lo, hi] = self.mu_d_near_best[i];
-            lo < self.mu_d[i] - 1.1 * s || hi > self.mu_d[i] + 1.1 * s
+            lo < self.mu_d[i] - reach * s || hi > self.mu_d[i] + reach * s
         })
     }
 
