@@ -338,8 +338,14 @@ pub(super) fn progress_bar(job: &LoadedJob, candidates: &[Candidate]) -> indicat
 }
 
 /// How many warm points a nested candidate's search starts from ([`nested_warm_points`]): its
-/// local search polishes from each, and restarts 0–3 of its global search start a particle at one.
-pub(super) const NESTED_WARM_POINTS: u64 = 4;
+/// local search polishes from each, and the first restarts of its global search start a particle
+/// at one.
+pub(super) const NESTED_WARM_POINTS: u64 = 3 + RESTING_QUANTILES.len() as u64;
+
+/// The quantiles of |θ| in the smaller model's motion at which [`nested_warm_points`] puts a
+/// resting neck's contact angle: from the 10th percentile, a neck resting nearly all the window,
+/// to the 75th, one that leaves its shoulder for a quarter of it.
+const RESTING_QUANTILES: [f64; 4] = [0.1, 0.25, 0.5, 0.75];
 
 /// Model runs of one Nelder–Mead polish over `n` parameters: its simplex and two per iteration.
 pub(super) fn polish_budget(fit: &job::FitSection, n: usize) -> u64 {
@@ -1212,12 +1218,15 @@ fn nested_search(
 /// (inside the contact-angle bounds): the same motion, but a polish from there feels k1_contact at
 /// once, while from the first it must first bring θ_c into the range the neck visits. On the
 /// confusion table's often-crossed shoulder (docs/validation.md, "Model choice") the search from the first point alone
-/// does not leave blade2dof's optimum. The last reads X's stiffness as that of a neck resting on the
-/// shoulder: k1_contact = X's k1, θ_c at the 10th percentile of |θ|, and the free k1 halfway (log
-/// scale) between its lower bound and X's k1 (along the resting neck's ridge, where only
-/// `(k1_contact − k1)·θ_c` matters, any free k1 moves the neck alike while θ_c is small). Without
-/// it the global search on the confusion table's neck resting on a shoulder (0.025 rad) stops
-/// short of the truth's likelihood and chooses blade2dof; with it the shoulder model is chosen.
+/// does not leave blade2dof's optimum. The last [`RESTING_QUANTILES`] points read X's stiffness as
+/// that of a neck resting on the shoulder: k1_contact = X's k1, the free k1 halfway (log scale)
+/// between its lower bound and X's k1, and θ_c swept from the 10th to the 75th percentile of |θ|.
+/// Beyond θ_c the moment is `k1_contact·|θ| + (k1 − k1_contact)·θ_c`: such a neck has X's stiffness
+/// while it rests and is soft (k1) within ±θ_c, which it crosses at each reversal. The contact
+/// angle sets how long that crossing lasts, and a polish from one contact angle stops at the first
+/// ridge in it. Without the resting points the global
+/// search on the confusion table's neck resting on a shoulder (0.025 rad) stops short of the
+/// truth's likelihood and chooses blade2dof.
 ///
 /// A candidate nested by its law (`X@exponential` in `X@exponential_viscous` or `X@stribeck`)
 /// starts from the one point where its law is `X`'s: D = 0, or δ = 1 with v_s = 1/B.
@@ -1270,20 +1279,40 @@ fn nested_warm_points(
         p[i] = free[i].u_of(crate::spectrum::stats::quantile_sorted(&abs_theta, q));
         points.push(p);
     }
-    // X's stiffness read as the contact stiffness of a neck resting on the shoulder: θ_c at the
-    // 10th percentile of |θ|, k1_contact = X's k1, the free k1 halfway (log scale) between its
-    // lower bound and X's k1.
-    if let (Some(j), Some(c)) = (
-        free.iter().position(|fp| fp.name == ParamId::K1),
-        free.iter().position(|fp| fp.name == ParamId::K1c),
-    ) {
-        let mut p = first.clone();
-        p[i] = free[i].u_of(crate::spectrum::stats::quantile_sorted(&abs_theta, 0.1));
-        p[c] = free[c].u_of(params.k1_nm_per_rad);
-        p[j] = free[j].u_of((free[j].lower * params.k1_nm_per_rad).sqrt());
-        points.push(p);
-    }
+    points.extend(resting_neck_points(
+        &first,
+        free,
+        &abs_theta,
+        params.k1_nm_per_rad,
+    ));
     points
+}
+
+/// `first` with X's neck stiffness `k1_x` (N·m/rad) read as the contact stiffness of a neck resting
+/// on its shoulder, one point per [`RESTING_QUANTILES`] of `abs_theta` (X's |θ|, rad, ascending) as
+/// the contact angle, the free k1 halfway (log scale) between its lower bound and `k1_x`. Empty
+/// unless `free` holds k1, k1_contact and θ_c.
+fn resting_neck_points(
+    first: &[f64],
+    free: &[FreeParam],
+    abs_theta: &[f64],
+    k1_x: f64,
+) -> Vec<Vec<f64>> {
+    let at = |id| free.iter().position(|fp| fp.name == id);
+    let (Some(i), Some(j), Some(c)) = (at(ParamId::ThetaC), at(ParamId::K1), at(ParamId::K1c))
+    else {
+        return Vec::new();
+    };
+    RESTING_QUANTILES
+        .iter()
+        .map(|&q| {
+            let mut p = first.to_vec();
+            p[i] = free[i].u_of(crate::spectrum::stats::quantile_sorted(abs_theta, q));
+            p[c] = free[c].u_of(k1_x);
+            p[j] = free[j].u_of((free[j].lower * k1_x).sqrt());
+            p
+        })
+        .collect()
 }
 
 /// |θ| of the neck in `fit`'s simulation at its optimum, finite samples in ascending order: where
@@ -1910,6 +1939,33 @@ mod tests {
         let candidate: Candidate = "blade2dof".parse().expect("candidate");
         let problem = Arc::new(problem_for(&job, candidate).expect("problem"));
         (job, candidate, problem)
+    }
+
+    /// The resting-neck starts: the contact stiffness is X's k1, so beyond θ_c the neck is as stiff
+    /// as X's; θ_c sweeps X's |θ| from its 10th to its 75th percentile (here |θ| = 0.01, 0.02, …,
+    /// 0.10 rad, whose percentiles by linear interpolation are 0.019, 0.0325, 0.055, 0.0775 rad);
+    /// the free k1 is the geometric mean of its lower bound and X's k1.
+    #[test]
+    fn resting_neck_starts_sweep_the_contact_angle_at_the_neck_s_stiffness() {
+        let free = [
+            FreeParam::new(ParamId::A, 0.2, 1.5),
+            FreeParam::new(ParamId::K1, 0.005, 0.15),
+            FreeParam::new(ParamId::ThetaC, 0.005, 0.2),
+            FreeParam::new(ParamId::K1c, 0.005, 0.15),
+        ];
+        let abs_theta: Vec<f64> = (1..=10).map(|k| 0.01 * k as f64).collect();
+        let first = vec![0.3, 0.6, 1.0, 0.6];
+        let points = resting_neck_points(&first, &free, &abs_theta, 0.08);
+        let theta_c: Vec<f64> = points.iter().map(|p| free[2].value(p[2])).collect();
+        for (got, want) in theta_c.iter().zip([0.019, 0.0325, 0.055, 0.0775]) {
+            assert!((got - want).abs() < 1e-12, "{theta_c:?}");
+        }
+        for p in &points {
+            assert_eq!(p[0], first[0], "A stays X's");
+            assert!((free[3].value(p[3]) - 0.08).abs() < 1e-12);
+            assert!((free[1].value(p[1]) - (0.005f64 * 0.08).sqrt()).abs() < 1e-12);
+        }
+        assert!(resting_neck_points(&first, &free[..3], &abs_theta, 0.08).is_empty());
     }
 
     /// The normalised coordinates of `value(name)` for every freed parameter of `problem`.
