@@ -344,7 +344,7 @@ pub(super) const NESTED_WARM_POINTS: u64 = 3 + RESTING_QUANTILES.len() as u64;
 
 /// The quantiles of |θ| in the smaller model's motion at which [`nested_warm_points`] puts a
 /// resting neck's contact angle: from the 10th percentile, a neck resting nearly all the window,
-/// to the 75th, one that leaves its shoulder for a quarter of it.
+/// to the 75th, one that touches its shoulder for a quarter of it.
 const RESTING_QUANTILES: [f64; 4] = [0.1, 0.25, 0.5, 0.75];
 
 /// Model runs of one Nelder–Mead polish over `n` parameters: its simplex and two per iteration.
@@ -1224,9 +1224,10 @@ fn nested_search(
 /// Beyond θ_c the moment is `k1_contact·|θ| + (k1 − k1_contact)·θ_c`: such a neck has X's stiffness
 /// while it rests and is soft (k1) within ±θ_c, which it crosses at each reversal. The contact
 /// angle sets how long that crossing lasts, and a polish from one contact angle stops at the first
-/// ridge in it. Without the resting points the global
-/// search on the confusion table's neck resting on a shoulder (0.025 rad) stops short of the
-/// truth's likelihood and chooses blade2dof.
+/// ridge in it. Without a resting point the global search on the confusion table's neck resting on
+/// a shoulder (0.025 rad) stops short of the truth's likelihood and chooses blade2dof; with one
+/// resting point, the calibration recording cal_067's search stops short in the local polishes
+/// (docs/validation.md, "Resting-neck starts of a shoulder candidate").
 ///
 /// A candidate nested by its law (`X@exponential` in `X@exponential_viscous` or `X@stribeck`)
 /// starts from the one point where its law is `X`'s: D = 0, or δ = 1 with v_s = 1/B.
