@@ -340,7 +340,13 @@ pub(super) fn progress_bar(job: &LoadedJob, candidates: &[Candidate]) -> indicat
 /// How many warm points a nested candidate's search starts from ([`nested_warm_points`]): its
 /// local search polishes from each, and the first restarts of its global search start a particle
 /// at one.
-pub(super) const NESTED_WARM_POINTS: u64 = 3 + RESTING_QUANTILES.len() as u64;
+pub(super) const NESTED_WARM_POINTS: u64 =
+    1 + (FREE_NECK_QUANTILES.len() + RESTING_QUANTILES.len()) as u64;
+
+/// The quantiles of |θ| in the smaller model's motion at which [`nested_warm_points`] puts the
+/// contact angle of a shoulder that changes no moment (k1_contact = k1): the median and the 90th
+/// percentile, where a polish feels k1_contact at once.
+const FREE_NECK_QUANTILES: [f64; 2] = [0.5, 0.9];
 
 /// The quantiles of |θ| in the smaller model's motion at which [`nested_warm_points`] puts a
 /// resting neck's contact angle: from the 10th percentile, a neck resting nearly all the window,
@@ -1275,7 +1281,7 @@ fn nested_warm_points(
     ) else {
         return points;
     };
-    for q in [0.5, 0.9] {
+    for q in FREE_NECK_QUANTILES {
         let mut p = first.clone();
         p[i] = free[i].u_of(crate::spectrum::stats::quantile_sorted(&abs_theta, q));
         points.push(p);
