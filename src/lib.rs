@@ -5,7 +5,7 @@
 //! The module tree is the pipeline; a stage uses only the stages before it (checked by
 //! `tests/suite/architecture.rs`):
 //!
-//! Pipeline order: `error` → `names` → `io` → `trace` → `import` → `spectrum` → `model` → `simulate` → `job` → `likelihood` → `posterior` → `fit` → `explore` → `campaign` → `report` → `bench` → `cli`.
+//! Pipeline order: `error` → `names` → `io` → `trace` → `import` → `spectrum` → `model` → `simulate` → `job` → `likelihood` → `posterior` → `estimate` → `fit` → `explore` → `campaign` → `report` → `bench` → `cli`.
 //!
 //! * [`error`]: the crate's error type, shared by every stage.
 //! * [`names`]: typed names (model kinds, parameter ids, ...), each spelled once.
@@ -24,6 +24,8 @@
 //!   frequency against tip speed) and the calibrated likelihood that reads its spectra.
 //! * [`posterior`]: the affine-invariant ensemble sampler, its convergence diagnostics and the
 //!   posterior summary a fit reports.
+//! * [`estimate`]: what an estimate is made of, as data: each fitted parameter's interval and its
+//!   method, and the warnings that qualify a fit (their sentences are written in [`fit`]).
 //! * [`fit`]: the friction law A, B, C and the neck stiffness fitted with `argmin`; model choice,
 //!   intervals, results.
 //! * [`explore`]: where a job's freed parameters can take the model's lines (`wiperlab explore`).
@@ -41,6 +43,7 @@ pub mod bench;
 pub mod campaign;
 pub mod cli;
 pub mod error;
+pub mod estimate;
 pub mod explore;
 pub mod fit;
 pub mod import;

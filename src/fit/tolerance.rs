@@ -15,6 +15,7 @@
 use super::problem::FAILED_COST;
 use super::search::CandidateFit;
 use super::{FitWarning, SpectralProblem, interrupt};
+pub use crate::estimate::TolerancePoint;
 use crate::model::BladeParams;
 use serde::{Deserialize, Serialize};
 
@@ -44,17 +45,6 @@ pub enum Verdict {
     Unresolved,
     /// Every probe failed: there is nothing to compare.
     NotProbed,
-}
-
-/// The cost of one simulation of the optimum at one tolerance.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TolerancePoint {
-    pub rtol: f64,
-    pub atol: f64,
-    /// The fit's cost there: the recording's NLL above the saturated model's, nats.
-    pub cost_nats: f64,
-    /// Stick–slip and contact transitions of the simulation.
-    pub transitions: usize,
 }
 
 /// The chosen optimum's cost at the job's tolerance and at each probe's.

@@ -21,6 +21,7 @@ const STAGES: &[&str] = &[
     "job",
     "likelihood",
     "posterior",
+    "estimate",
     "fit",
     "explore",
     "campaign",
