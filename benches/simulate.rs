@@ -5,11 +5,11 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::sync::atomic::AtomicUsize;
 use std::sync::{Arc, Mutex};
-use wiperlab::fit::SpectralProblem;
-use wiperlab::fit::evidence::RecordingLikelihood;
 use wiperlab::fit::features::{SignalKind, default_bands, features};
 use wiperlab::job::{Objective, Weights};
 use wiperlab::model::{Blade, BladeParams, StickForm};
+use wiperlab::search::SpectralProblem;
+use wiperlab::search::evidence::RecordingLikelihood;
 use wiperlab::simulate::blade::{default_window, simulate_blade};
 use wiperlab::simulate::hybrid::{Mode, Phase, SolverOptions, StickSlipModel};
 

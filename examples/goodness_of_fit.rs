@@ -1,5 +1,5 @@
 //! The goodness of fit of a job's candidate at given parameters: the recording's spectral excess
-//! NLL against noise replicates of the model (`wiperlab::fit::evidence`, `goodness_of_fit`).
+//! NLL against noise replicates of the model (`wiperlab::search::evidence`, `goodness_of_fit`).
 //!
 //! `cargo run --release --example goodness_of_fit -- JOB CANDIDATE NAME=VALUE...`, e.g.
 //! `fits/reversal.toml blade2dof A=0.88 B=69.747 C=0.56 k1=0.029748` (freed parameters not
@@ -14,7 +14,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let job = LoadedJob::load(std::path::Path::new(&args[1]))?;
     let candidate: Candidate = args[2].parse()?;
-    let problem = wiperlab::fit::problem_for(&job, candidate)?;
+    let problem = wiperlab::search::problem_for(&job, candidate)?;
     let mut u = vec![0.5; problem.free.len()];
     for kv in &args[3..] {
         let (name, value) = kv

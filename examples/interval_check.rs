@@ -5,7 +5,7 @@
 //! 1. **The likelihood along the segment from the fit to the truth**: the NLL at 11 points of the
 //!    straight line between them in the search's normalised coordinates (one simulation each).
 //! 2. **The rise the Laplace method predicts there**: `½ dᵀ F d` with `F` the Gauss–Newton Fisher
-//!    information the Laplace intervals come from (`wiperlab::fit::evidence::at_fit_smoothed`), and
+//!    information the Laplace intervals come from (`wiperlab::search::evidence::at_fit_smoothed`), and
 //!    the truth's Mahalanobis distance under the reported sandwich covariance.
 //! 3. **A posterior sample** (the affine-invariant ensemble of `[fit.uncertainty] method = "mcmc"`,
 //!    32 walkers, the likelihood tempered by `k/tr(F⁻¹V)`): its 68 % and 95 % intervals and the
@@ -26,13 +26,14 @@
 use clap::Parser;
 use nalgebra::{DMatrix, DVector};
 use std::path::PathBuf;
-use wiperlab::fit::evidence::{LocalFit, at_fit_smoothed};
-use wiperlab::fit::{FAILED_COST, SpectralProblem, posterior_tempering, problem_for};
+use wiperlab::fit::posterior_tempering;
 use wiperlab::job::{Candidate, LoadedJob, NoiseSpectrum};
 use wiperlab::likelihood::covariance::{cholesky_of_covariance, covariance_of};
 use wiperlab::likelihood::secant::{SECANT_PROBE_SIGMA, flat_axes};
 use wiperlab::posterior::tempering::{geometric_ladder, sample_tempered};
 use wiperlab::posterior::{EnsembleSettings, ensemble::gaussian_ball_with};
+use wiperlab::search::evidence::{LocalFit, at_fit_smoothed};
+use wiperlab::search::{FAILED_COST, SpectralProblem, problem_for};
 
 #[derive(Parser)]
 struct Args {

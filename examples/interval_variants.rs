@@ -22,10 +22,11 @@
 use clap::Parser;
 use std::path::PathBuf;
 use std::sync::Arc;
-use wiperlab::fit::evidence::at_fit_smoothed;
 use wiperlab::fit::result::FitResult;
-use wiperlab::fit::{ProfileStart, problem_for, profile_intervals_at};
+use wiperlab::fit::{ProfileStart, profile_intervals_at};
 use wiperlab::job::LoadedJob;
+use wiperlab::search::evidence::at_fit_smoothed;
+use wiperlab::search::problem_for;
 
 #[derive(Parser)]
 struct Args {

@@ -65,7 +65,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     ] {
         std::fs::write(&path, job_text)?;
         let job = LoadedJob::load(&path)?;
-        let p = wiperlab::fit::problem_for(&job, job.candidates()[0])?;
+        let p = wiperlab::search::problem_for(&job, job.candidates()[0])?;
         let u: Vec<f64> = (p.free.iter())
             .map(|f| f.u_of(job.truth[&f.name]))
             .collect();

@@ -17,8 +17,8 @@ use clap::Parser;
 use rand::SeedableRng;
 use std::path::PathBuf;
 use std::sync::Arc;
-use wiperlab::fit::{SpectralProblem, problem_for};
 use wiperlab::job::{Candidate, LoadedJob};
+use wiperlab::search::{SpectralProblem, problem_for};
 
 #[derive(Parser)]
 struct Args {

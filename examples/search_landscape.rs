@@ -18,8 +18,8 @@
 use clap::Parser;
 use rayon::prelude::*;
 use std::path::PathBuf;
-use wiperlab::fit::{SpectralProblem, problem_for};
 use wiperlab::job::{Candidate, LoadedJob};
+use wiperlab::search::{SpectralProblem, problem_for};
 use wiperlab::simulate::SolverOptions;
 
 #[derive(Parser)]

@@ -1,4 +1,4 @@
-//! Does settling the likelihood's optimum (`wiperlab::fit::evidence::settle`) make the main job's
+//! Does settling the likelihood's optimum (`wiperlab::search::evidence::settle`) make the main job's
 //! Laplace intervals independent of where the search ended?
 //!
 //! The starts are the ten points where the main job's blade2dof search (Nelder–Mead polish, no
@@ -22,9 +22,9 @@
 #[path = "../tests/common/fixtures.rs"]
 mod fixtures;
 
-use wiperlab::fit::{SpectralProblem, problem_for};
 use wiperlab::job::Candidate;
 use wiperlab::job::LoadedJob;
+use wiperlab::search::{SpectralProblem, problem_for};
 
 /// The true A, B, C, k1 (`data/reversal/truth.json` /params).
 const TRUTH: [f64; 4] = [0.88, 69.74712740275162, 0.56, 0.029748408887917077];
@@ -83,10 +83,10 @@ fn main() {
             .map(|(f, (t, e))| f.u_of(t * (1.0 + e / 100.0)))
             .collect();
         let c0 = p.cost_at(&u0);
-        let at_start = wiperlab::fit::evidence::at_fit_smoothed(&p, &u0).unwrap();
+        let at_start = wiperlab::search::evidence::at_fit_smoothed(&p, &u0).unwrap();
         before.push(ends(&p, &u0, &at_start.sigma_u));
-        let (u, c) = wiperlab::fit::evidence::settle_point(&p, &u0, c0).unwrap();
-        let local = wiperlab::fit::evidence::at_fit_smoothed(&p, &u).unwrap();
+        let (u, c) = wiperlab::search::evidence::settle_point(&p, &u0, c0).unwrap();
+        let local = wiperlab::search::evidence::at_fit_smoothed(&p, &u).unwrap();
         after.push(ends(&p, &u, &local.sigma_u));
         let pct: Vec<String> = p
             .free

@@ -15,10 +15,10 @@
 
 use clap::Parser;
 use std::path::PathBuf;
-use wiperlab::fit::problem_for;
 use wiperlab::fit::result::FitResult;
 use wiperlab::job::{Candidate, LoadedJob};
 use wiperlab::model::ParamId;
+use wiperlab::search::problem_for;
 use wiperlab::simulate::{Method, SolverOptions};
 
 #[derive(Parser)]
@@ -66,7 +66,7 @@ fn solvers(job: &SolverOptions) -> Vec<(String, SolverOptions)> {
 /// Taken through the normalised coordinates and back the values change in the last bits, and the
 /// cost by up to the likelihood's ripple (0.08 nats at the main job's fit, 0.015 at its truth).
 fn at_values(
-    problem: &wiperlab::fit::SpectralProblem,
+    problem: &wiperlab::search::SpectralProblem,
     value: impl Fn(ParamId) -> Option<f64>,
 ) -> Result<wiperlab::model::BladeParams, ParamId> {
     let mut at = problem.base;

@@ -5,7 +5,7 @@
 //! The module tree is the pipeline; a stage uses only the stages before it (checked by
 //! `tests/suite/architecture.rs`):
 //!
-//! Pipeline order: `error` → `names` → `io` → `trace` → `import` → `spectrum` → `model` → `simulate` → `job` → `likelihood` → `posterior` → `estimate` → `fit` → `explore` → `campaign` → `report` → `bench` → `cli`.
+//! Pipeline order: `error` → `names` → `io` → `trace` → `import` → `spectrum` → `model` → `simulate` → `job` → `likelihood` → `posterior` → `estimate` → `search` → `fit` → `explore` → `campaign` → `report` → `bench` → `cli`.
 //!
 //! * [`error`]: the crate's error type, shared by every stage.
 //! * [`names`]: typed names (model kinds, parameter ids, ...), each spelled once.
@@ -26,6 +26,9 @@
 //!   posterior summary a fit reports.
 //! * [`estimate`]: what an estimate is made of, as data: each fitted parameter's interval and its
 //!   method, and the warnings that qualify a fit (their sentences are written in [`fit`]).
+//! * [`search`]: the optimum of each candidate model's cost: the cost of one parameter set
+//!   ([`search::SpectralProblem`]), the optimisers (particle swarm, IPOP CMA-ES, Nelder–Mead) and
+//!   the strategy that restarts, confirms and polishes them.
 //! * [`fit`]: the friction law A, B, C and the neck stiffness fitted with `argmin`; model choice,
 //!   intervals, results.
 //! * [`explore`]: where a job's freed parameters can take the model's lines (`wiperlab explore`).
@@ -54,6 +57,7 @@ pub mod model;
 pub mod names;
 pub mod posterior;
 pub mod report;
+pub mod search;
 pub mod simulate;
 pub mod spectrum;
 pub mod trace;

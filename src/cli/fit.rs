@@ -116,12 +116,12 @@ fn fit_and_write(
     report_dir: &Path,
     progress: bool,
 ) -> Result<(crate::fit::FitResult, PathBuf)> {
-    crate::fit::interrupt::install_signal_handler()?;
+    crate::search::interrupt::install_signal_handler()?;
     fit_files(job, report_dir, progress)
 }
 
 /// What `wiperlab fit` writes, without installing a signal handler: a caller that has its own
-/// (the Python package) stops the fit with [`crate::fit::interrupt::request_stop`], and gets
+/// (the Python package) stops the fit with [`crate::search::interrupt::request_stop`], and gets
 /// [`Error::Interrupted`] naming the best-so-far result as the command does. `report_dir`:
 /// [`default_fit_dir`] unless the caller chooses another.
 pub fn fit_files(
@@ -134,7 +134,7 @@ pub fn fit_files(
     crate::io::check_writable_file(&interrupted_path(job))?;
     crate::io::check_creatable_dir(report_dir)?;
     let mut outcome = match crate::fit::run_fit(job, progress) {
-        Err(_) if crate::fit::interrupt::stop_requested() => {
+        Err(_) if crate::search::interrupt::stop_requested() => {
             return Err(Error::Interrupted { written: None });
         }
         other => other?,

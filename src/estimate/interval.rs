@@ -59,7 +59,7 @@ pub enum IntervalMethod {
     },
     /// Laplace's approximation: ±1σ of the estimate's sandwich covariance `F⁻¹ V F⁻¹` at the fit,
     /// with `F` the Fisher information of the recording's likelihood and `V` the variance of its
-    /// gradient under the recording's noise ([`crate::fit::evidence::at_fit`]), mapped through
+    /// gradient under the recording's noise ([`crate::search::evidence::at_fit`]), mapped through
     /// the search's coordinates.
     Laplace {
         /// Central-difference step of the Fisher information, normalised coordinates.
@@ -177,7 +177,7 @@ pub struct FittedParam {
     pub lower: f64,
     pub upper: f64,
     /// 1σ of the estimate: with a likelihood, from the sandwich covariance of
-    /// [`crate::fit::evidence::at_fit`]; for a target job, from the cost's curvature (indicative).
+    /// [`crate::search::evidence::at_fit`]; for a target job, from the cost's curvature (indicative).
     pub std_error: f64,
     /// 1σ from the likelihood's Fisher information alone (`F⁻¹`, the width of the likelihood's
     /// bowl), when the fit has a likelihood; `std_error` is the estimate's spread, the sandwich

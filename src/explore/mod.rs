@@ -16,9 +16,10 @@
 
 pub mod reach;
 
-use crate::fit::{FitError, SpectralProblem, problem_for};
+use crate::fit::FitError;
 use crate::job::{Candidate, FreeParam, LoadedJob, smallest_capable_model};
 use crate::model::BladeParams;
+use crate::search::{SpectralProblem, problem_for};
 use crate::simulate::failure::FailureCause;
 use crate::spectrum::features::line_origin;
 use crate::{Error, Result};

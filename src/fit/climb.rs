@@ -13,27 +13,17 @@
 //! [`PROFILE_CLIMBS`] times. The last walk, at the optimum the fit reports, is kept for the
 //! profile intervals ([`ProfileWalk`]), so a fit that does not move pays for one walk.
 
-use super::evidence::LocalFit;
-use super::search::{
-    CONFIRM_NATS, CandidateFit, Optimised, POLISH_STEP_U, Reporting, VALLEY_GAIN_NATS, add_note,
-    keep_nested_above, polish, settle_anew,
-};
+use super::Result;
 use super::uncertainty::{ProfileStart, profile_walk};
-use super::{FitWarning, Interval, Result, interrupt};
 use crate::job;
+use crate::search::interrupt;
+use crate::search::strategy::{
+    CONFIRM_NATS, CandidateFit, Optimised, POLISH_STEP_U, ProfileWalk, Reporting, VALLEY_GAIN_NATS,
+    add_note, keep_nested_above, polish, settle_anew,
+};
 
 /// The most times the climb moves the fit: each move costs a polish, a settling and a walk.
 pub const PROFILE_CLIMBS: usize = 3;
-
-/// A profile walk of a fit's optimum: its intervals and warnings, the point it was walked at, and
-/// the spread there it was walked with (what [`CandidateFit::with_smoothed_spread`] reports).
-pub(super) struct ProfileWalk {
-    /// The normalised coordinates the walk started from (the intervals apply only there).
-    pub(super) at_u: Vec<f64>,
-    pub(super) spread: LocalFit,
-    pub(super) intervals: Vec<Interval>,
-    pub(super) warnings: Vec<FitWarning>,
-}
 
 /// The profile climb on the chosen candidate `fits[chosen]` (`[fit.uncertainty] method =
 /// "profile"`): walks its profile; where a walk met a point more than [`CONFIRM_NATS`] more likely
@@ -117,7 +107,7 @@ fn climb_note(moves: usize, gain_nats: f64) -> String {
 }
 
 /// The profile walk of `f` at its optimum, with the 1σ of the spread its intervals report
-/// ([`super::evidence::at_fit_smoothed`]); `None` after an interrupt or where that spread fails.
+/// ([`crate::search::evidence::at_fit_smoothed`]); `None` after an interrupt or where that spread fails.
 fn walk(
     f: &CandidateFit,
     polish_iterations: u64,
@@ -126,7 +116,7 @@ fn walk(
     if interrupt::stop_requested() {
         return Ok(None);
     }
-    let Ok(spread) = super::evidence::at_fit_smoothed(&f.problem, &f.best_u) else {
+    let Ok(spread) = crate::search::evidence::at_fit_smoothed(&f.problem, &f.best_u) else {
         return Ok(None);
     };
     let at = ProfileStart {
@@ -147,7 +137,7 @@ fn walk(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fit::problem::EvaluatedNearBest;
+    use crate::search::problem::EvaluatedNearBest;
 
     /// The climb starts from the lowest point kept, and only when it lies more than the margin
     /// below the fit: a fit at 10 nats with points kept at 9.7, 9.2 and 9.4 nats climbs from the

@@ -11,29 +11,20 @@
 //! coordinates `u ∈ [0, 1]` (logarithmic for bounds spanning a factor ≥ 10).
 
 mod climb;
-mod error;
-pub mod evidence;
-pub mod ipop;
 /// The spectral features the fit compares (they belong to the spectrum stage).
 pub use crate::spectrum::features;
-pub mod interrupt;
-mod problem;
 pub mod result;
-pub mod scan;
-mod search;
 pub mod select;
 pub mod tolerance;
 pub mod truth;
 mod uncertainty;
 pub mod warning;
 
-pub use error::{FitError, NoEvidence, NoLikelihood};
-pub use problem::{FAILED_COST, SpectralProblem, target_cost};
+pub use crate::search::{FitError, NoEvidence, NoLikelihood};
 pub use result::{
     FitResult, FittedParam, HistoryPoint, Interval, IntervalMethod, ModelTrial, PeakComparison,
     RatioTest, SearchStage, SpreadSource, TrialEvidence,
 };
-pub use search::{NESTED_GLOBAL_GAIN_NATS, problem_for};
 pub use select::aic;
 pub use truth::SHORTFALL_TOLERANCE_NATS;
 pub use uncertainty::{
@@ -47,12 +38,14 @@ use crate::job::{self, LoadedJob};
 use crate::likelihood;
 use crate::likelihood::measure::measure;
 use crate::model::BladeParams;
+use crate::search::strategy::{
+    self as search, CandidateFit, confirm_deferred, descend_chosen, fit_candidates, progress_bar,
+};
+use crate::search::{SpectralProblem, interrupt, scan};
 use crate::simulate::blade::BladeSimulation;
 use crate::trace::Trace;
 use features::{Features, SignalKind};
 use std::sync::atomic::Ordering;
-
-use search::{CandidateFit, confirm_deferred, descend_chosen, fit_candidates, progress_bar};
 
 /// The result plus what the report draws.
 pub struct FitOutcome {
@@ -316,7 +309,7 @@ fn optimum_checks(
 }
 
 /// The chosen fit's goodness of fit to the recording's spectra
-/// ([`evidence::RecordingLikelihood::goodness_of_fit`]); `None` without a likelihood, for a joint
+/// ([`crate::search::evidence::RecordingLikelihood::goodness_of_fit`]); `None` without a likelihood, for a joint
 /// fit (whose other recordings the test does not read) and when interrupted.
 ///
 /// # Errors
@@ -750,6 +743,7 @@ fn blade_modes(
 mod tests {
     use super::*;
     use crate::model::ParamId;
+    use crate::search::problem_for;
 
     /// The misfit warning fires only when the recording's statistic is beyond all but 1 % of its
     /// replicates', and quotes the numbers.

@@ -9,27 +9,11 @@ use crate::job::Candidate;
 use crate::job::{FitSection, SpectrumSection};
 use crate::model::ParamId;
 use crate::names::named_enum;
+pub use crate::search::history::{HistoryPoint, SearchStage};
 use crate::simulate::blade::ModelKind;
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
-
-named_enum! {
-    /// A stage of the optimiser. The swarm may simulate at a looser tolerance (`[fit] swarm_rtol`)
-    /// than the polish and everything after it.
-    pub enum SearchStage: "search stage" {
-        /// The global particle swarm.
-        Swarm => "swarm",
-        /// The Nelder–Mead polish from the swarm's best particle.
-        Polish => "polish",
-        /// A CMA-ES run (`[fit.search] method = "cmaes"`), on the recording's likelihood at the
-        /// job's tolerance.
-        Cmaes => "cmaes",
-        /// The local CMA-ES run from a swarm's best particle (`[fit.search] local = "cmaes"`),
-        /// before its Nelder–Mead polish.
-        Local => "local",
-    }
-}
 
 named_enum! {
     /// Where the fitted parameters' 1σ and correlations come from.
@@ -49,20 +33,6 @@ named_enum! {
 
 fn default_spread_source() -> SpreadSource {
     SpreadSource::CostCurvature
-}
-
-/// Best cost after each iteration of each stage.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct HistoryPoint {
-    pub stage: SearchStage,
-    /// Which of the fit's independent swarm-and-polish runs (`[fit] restarts`), or which CMA-ES
-    /// run (`[fit.search] restarts`), from 0; 0 in results written before this field.
-    #[serde(default)]
-    pub restart: usize,
-    pub iteration: u64,
-    pub best_cost: f64,
-    /// Model evaluations of this restart so far (its swarm and polish).
-    pub evaluations: usize,
 }
 
 /// Measured against model peak in one band.

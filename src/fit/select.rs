@@ -1,6 +1,6 @@
 //! Model-selection stage: which candidate the result reports, and why, in numbers.
 //!
-//! With a recording, candidates are compared in likelihood units ([`super::evidence`]): Takeuchi's
+//! With a recording, candidates are compared in likelihood units ([`crate::search::evidence`]): Takeuchi's
 //! `TIC = 2·tr(F⁺V) + 2·NLL` chooses ([`Evidence::tic`]), the AIC of a likelihood that is composite
 //! and does not describe the ordinates' spread (its calibrated penalty `tr(F⁺V)` is a fraction of
 //! `k` on the shipped recording, where Akaike's `2k` would overcharge each parameter). Candidates
@@ -11,12 +11,12 @@
 //! `cost + 2k` ([`aic`]).
 
 use super::features::BandSpec;
-use super::problem::FAILED_COST;
 use super::result::{ModelTrial, RatioTest, TrialEvidence};
-use super::search::CandidateFit;
 use super::warning::FitWarning;
 use crate::job::Candidate;
 use crate::likelihood::{self, Evidence};
+use crate::search::FAILED_COST;
+use crate::search::strategy::CandidateFit;
 use std::sync::atomic::Ordering;
 
 /// Akaike's information criterion with the cost read as −2 ln L (a χ² on the cost's scales):

@@ -12,11 +12,12 @@
 //! smaller than the spread do not tell parameter sets apart, and intervals read from the local
 //! curvature at the 0.5-nat scale understate the uncertainty. The check costs two simulations.
 
-use super::problem::FAILED_COST;
-use super::search::CandidateFit;
-use super::{FitWarning, SpectralProblem, interrupt};
+use super::FitWarning;
 pub use crate::estimate::TolerancePoint;
 use crate::model::BladeParams;
+use crate::search::FAILED_COST;
+use crate::search::strategy::CandidateFit;
+use crate::search::{SpectralProblem, interrupt};
 use serde::{Deserialize, Serialize};
 
 /// Factors by which the probes divide the job's `rtol` and `atol`.

@@ -11,10 +11,10 @@
 //! measures it (`examples/interval_check.rs`, docs/validation.md, "Intervals against the
 //! likelihood").
 
-use super::search::CandidateFit;
 use super::tolerance::ToleranceCheck;
 use super::warning::FitWarning;
 use crate::job::{Candidate, LoadedJob};
+use crate::search::strategy::CandidateFit;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 

@@ -1,18 +1,18 @@
 //! Uncertainty stage: bootstrap intervals and identifiability warnings for the chosen model.
 
-use super::evidence::RecordingLikelihood;
 use super::features::{features, noise_floor};
-use super::problem::SpectralProblem;
 use super::result::{FittedParam, Interval, IntervalMethod};
-use super::search::{
-    CandidateFit, Confirmation, POLISH_STEP_U, ProgressObserver, Reporting, optimise, polish,
-    polish_pinned,
-};
 use super::warning::{End, FitWarning};
 use crate::Result;
 use crate::job::FreeParam;
 use crate::job::{self, NoiseSpectrum, UncertaintyMethod};
 use crate::posterior::PosteriorSummary;
+use crate::search::evidence::RecordingLikelihood;
+use crate::search::problem::SpectralProblem;
+use crate::search::strategy::{
+    CandidateFit, Confirmation, POLISH_STEP_U, ProgressObserver, Reporting, optimise, polish,
+    polish_pinned,
+};
 use crate::simulate::blade::BladeSimulation;
 use crate::spectrum::stats::quantile_sorted;
 use rand::SeedableRng;
@@ -148,13 +148,16 @@ pub(super) type Intervals = (
 
 /// [`FitWarning::ShortOfBestEvaluation`] when a point evaluated at the polish's tolerance (`near`:
 /// by the search, or by the posterior sample's walkers, which can cross into a basin the search
-/// missed) is more likely than the fit's `cost` by more than [`super::search::CONFIRM_NATS`]. On a development
+/// missed) is more likely than the fit's `cost` by more than [`crate::search::strategy::CONFIRM_NATS`]. On a development
 /// recording whose search ended 1.1 nats short of the truth, the walkers moved into the truth's
 /// basin (docs/validation.md, "Intervals against the likelihood"): the sample's intervals then
 /// describe another point than the fit's.
-fn short_of_best(cost: f64, near: &super::problem::EvaluatedNearBest) -> Option<FitWarning> {
+fn short_of_best(
+    cost: f64,
+    near: &crate::search::problem::EvaluatedNearBest,
+) -> Option<FitWarning> {
     let gain = cost - near.lowest();
-    (gain > super::search::CONFIRM_NATS)
+    (gain > crate::search::strategy::CONFIRM_NATS)
         .then_some(FitWarning::ShortOfBestEvaluation { gain_nats: gain })
 }
 
@@ -259,7 +262,9 @@ pub(super) fn mcmc_intervals(
     // The likelihood tempered, the prior not, as a density in θ (or ln θ): docs/priors.md, "Priors".
     let prior = &cf.problem.prior;
     let log_parts = |u: &[f64]| match inside(u).then(|| cf.problem.cost_at(u)) {
-        Some(c) if c < super::FAILED_COST => prior.log_parts(c, w, &cf.free, &cf.problem.base, u),
+        Some(c) if c < crate::search::FAILED_COST => {
+            prior.log_parts(c, w, &cf.free, &cf.problem.base, u)
+        }
         _ => (f64::NEG_INFINITY, 0.0),
     };
     let spread = crate::likelihood::covariance::cholesky_of_covariance(&cf.sigma_u, &cf.corr);
@@ -295,7 +300,7 @@ pub(super) fn mcmc_intervals(
                     );
                 }
             }
-            !super::interrupt::stop_requested()
+            !crate::search::interrupt::stop_requested()
         },
     )?;
     let chains = &run.cold;
@@ -348,7 +353,7 @@ pub(super) fn mcmc_intervals(
 
 /// Laplace intervals (68.27 %): `[θ(u − σ_u), θ(u + σ_u)]` for each freed parameter, with `σ_u`
 /// the 1σ of its normalised coordinate from the sandwich covariance `F⁻¹ V F⁻¹` of the recording's
-/// likelihood at the fit ([`super::evidence::at_fit`]); through the search's coordinates, so a parameter
+/// likelihood at the fit ([`crate::search::evidence::at_fit`]); through the search's coordinates, so a parameter
 /// searched on a log scale gets an interval symmetric in `ln θ`. Every interval contains its
 /// estimate. A parameter the likelihood does not inform (`σ_u = ∞`) gets its search range.
 ///
@@ -371,9 +376,9 @@ pub fn laplace_intervals(free: &[FreeParam], best_u: &[f64], sigma_u: &[f64]) ->
                 hi,
                 level: 0.6827,
                 method: IntervalMethod::Laplace {
-                    fisher_step_u: super::evidence::FISHER_STEP_U,
-                    noise_replicates: super::evidence::NOISE_REPLICATES,
-                    span_sigma: super::evidence::SANDWICH_SPAN_SIGMA,
+                    fisher_step_u: crate::search::evidence::FISHER_STEP_U,
+                    noise_replicates: crate::search::evidence::NOISE_REPLICATES,
+                    span_sigma: crate::search::evidence::SANDWICH_SPAN_SIGMA,
                 },
                 widened_from: None,
             }
@@ -524,7 +529,7 @@ pub struct ProfileStart<'a> {
     pub u: &'a [f64],
     /// The problem's cost there (the recording's NLL), nats.
     pub cost_nats: f64,
-    /// 1σ of each coordinate from the sandwich `F⁻¹ V F⁻¹` ([`super::evidence::at_fit_smoothed`]).
+    /// 1σ of each coordinate from the sandwich `F⁻¹ V F⁻¹` ([`crate::search::evidence::at_fit_smoothed`]).
     pub sigma_u: &'a [f64],
     /// 1σ of each coordinate from the Fisher information `F⁻¹` alone.
     pub fisher_sigma_u: &'a [f64],
@@ -554,11 +559,11 @@ impl<'a> ProfileStart<'a> {
 /// failed simulation counts as an infinite rise. Warnings name a parameter whose profile reaches
 /// its search bound or runs out of steps below the limit, and a walk that met a point more likely
 /// than the fit by more than
-/// [`super::search::CONFIRM_NATS`] (the search ended short of the optimum). The problem's
+/// [`crate::search::strategy::CONFIRM_NATS`] (the search ended short of the optimum). The problem's
 /// evaluation and failure counters include the polishes.
 ///
 /// # Errors
-/// [`super::FitError::Optimiser`] when argmin fails during an interrupt (otherwise a polish that
+/// [`crate::search::FitError::Optimiser`] when argmin fails during an interrupt (otherwise a polish that
 /// fails counts as an infinite rise).
 pub fn profile_intervals_at(
     problem: &Arc<SpectralProblem>,
@@ -608,7 +613,7 @@ fn profile_with(
             }
         });
         match failure {
-            Some(e) if super::interrupt::stop_requested() => Err(e),
+            Some(e) if crate::search::interrupt::stop_requested() => Err(e),
             _ => Ok(end),
         }
     };
@@ -663,7 +668,7 @@ fn profile_warnings(fp: &FreeParam, limit: f64, lo: ProfileEnd, hi: ProfileEnd) 
     } else {
         hi
     };
-    if lowest.lowest_rise_nats < -super::search::CONFIRM_NATS {
+    if lowest.lowest_rise_nats < -crate::search::strategy::CONFIRM_NATS {
         warnings.push(FitWarning::ProfileMoreLikely {
             parameter: fp.name,
             gain_nats: -lowest.lowest_rise_nats,
@@ -690,17 +695,17 @@ fn near_best_of(cf: &CandidateFit, intervals: &mut [Interval]) -> Vec<FitWarning
 /// re-optimised), so such a point lies inside that parameter's 68.27 % profile-likelihood region
 /// (Pawitan 2001, *In All Likelihood*, §2.6), and a profile interval would contain it. The search's
 /// own simulations (its polishes, settling, valley polishes, profile walks: every evaluation at the
-/// polish's tolerance, [`super::problem::EvaluatedNearBest`]) thereby sample the region a
+/// polish's tolerance, [`crate::search::problem::EvaluatedNearBest`]) thereby sample the region a
 /// curvature at the fit can understate where the likelihood is flat or bent: a valley whose
 /// floor the polishes walked along, a resting neck's ridge. Costs no simulation.
 ///
 /// Returns a warning for each parameter whose interval grew by more than a tenth of its width,
 /// naming the span the points reach, and one when a point was more likely than the fit by more
-/// than [`super::search::CONFIRM_NATS`] (the search ended short of its own best evaluation).
+/// than [`crate::search::strategy::CONFIRM_NATS`] (the search ended short of its own best evaluation).
 pub fn widen_to_near_best(
     free: &[FreeParam],
     at: ProfileStart,
-    near: &super::problem::EvaluatedNearBest,
+    near: &crate::search::problem::EvaluatedNearBest,
     intervals: &mut [Interval],
 ) -> Vec<FitWarning> {
     let mut warnings = Vec::new();
@@ -739,10 +744,11 @@ fn secant_check(cf: &CandidateFit) -> Vec<FitWarning> {
     let (Some(fs), Some(fc)) = (&cf.fisher_sigma_u, &cf.fisher_corr) else {
         return Vec::new();
     };
-    if super::interrupt::stop_requested() {
+    if crate::search::interrupt::stop_requested() {
         return Vec::new();
     }
-    let cost_at = |u: &[f64]| Some(cf.problem.cost_at(u)).filter(|c| *c < super::FAILED_COST);
+    let cost_at =
+        |u: &[f64]| Some(cf.problem.cost_at(u)).filter(|c| *c < crate::search::FAILED_COST);
     flat_axes(cost_at, &cf.best_u, cf.cost, (fs, fc))
         .iter()
         .map(|a| {
@@ -775,7 +781,7 @@ pub fn mu_d_rise_limits(
 
 /// The friction laws of the points the chosen fit's search evaluated within the largest of
 /// `limits` (nats) of its cost, with each point's cost above the fit's
-/// ([`super::problem::EvaluatedNearBest`]).
+/// ([`crate::search::problem::EvaluatedNearBest`]).
 pub fn near_best_laws(cf: &CandidateFit, limits: &[f64]) -> Vec<(f64, crate::model::FrictionLaw)> {
     let widest = limits.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let near = (cf.problem.near_best.lock()).unwrap_or_else(|e| e.into_inner());
@@ -945,7 +951,7 @@ pub fn bootstrap_intervals(
             };
             // The estimator's last stage, as in the fit (`search::fit_candidate`).
             let u = if rep.cost_is_nll() {
-                super::evidence::settle_point(&rep, &u, cost)?.0
+                crate::search::evidence::settle_point(&rep, &u, cost)?.0
             } else {
                 u
             };
@@ -1000,14 +1006,14 @@ impl ReplicateSource {
         let floor = problem.floors.last().copied().unwrap_or(0.0);
         let sigma = (floor * problem.fs_hz / 2.0).sqrt();
         if !(sigma.is_finite() && sigma > 0.0) {
-            return Err(super::FitError::NoNoise {
+            return Err(crate::search::FitError::NoNoise {
                 label: problem.label.clone(),
                 floor,
             }
             .into());
         }
         let normal = rand_distr::Normal::new(0.0, sigma)
-            .map_err(|source| super::FitError::NoiseDistribution { sigma, source })?;
+            .map_err(|source| crate::search::FitError::NoiseDistribution { sigma, source })?;
         Ok(ReplicateSource {
             x_model,
             sigma,
@@ -1056,7 +1062,7 @@ impl ReplicateSource {
             swarm_cost: problem.swarm_cost,
             objective: problem.objective,
             weights: problem.weights,
-            likelihood: Err(super::NoLikelihood::NotBuilt),
+            likelihood: Err(crate::search::NoLikelihood::NotBuilt),
             evaluations: problem.evaluations.clone(),
             failures: problem.failures.clone(),
             failure_causes: problem.failure_causes.clone(),
@@ -1076,7 +1082,7 @@ impl ReplicateSource {
             rep.likelihood = RecordingLikelihood::new(&rep, &x, time_domain)
                 .map(|l| l.with_noise(noise).with_blocks(blocks))
                 .map(Arc::new)
-                .map_err(|e| super::NoLikelihood::Recording(Arc::new(e)));
+                .map_err(|e| crate::search::NoLikelihood::Recording(Arc::new(e)));
             rep
         })
     }
@@ -1374,8 +1380,8 @@ mod tests {
         u0: &[f64],
         half: f64,
         cost: impl Fn(&[f64]) -> f64,
-    ) -> super::super::problem::EvaluatedNearBest {
-        let mut near = super::super::problem::EvaluatedNearBest::default();
+    ) -> crate::search::problem::EvaluatedNearBest {
+        let mut near = crate::search::problem::EvaluatedNearBest::default();
         for i in 0..21 {
             for j in 0..21 {
                 let u = [
@@ -1392,7 +1398,7 @@ mod tests {
     /// gain; one 0.3 nats below is the likelihood's ripple and is not.
     #[test]
     fn a_point_more_likely_than_the_fit_is_reported() {
-        let mut near = super::super::problem::EvaluatedNearBest::default();
+        let mut near = crate::search::problem::EvaluatedNearBest::default();
         near.record(&[0.5], 8.0);
         match short_of_best(9.0, &near) {
             Some(FitWarning::ShortOfBestEvaluation { gain_nats }) => assert_eq!(gain_nats, 1.0),
@@ -1403,7 +1409,7 @@ mod tests {
 
     #[test]
     fn near_best_keeps_what_lies_within_the_margin_of_the_lowest() {
-        let mut near = super::super::problem::EvaluatedNearBest::default();
+        let mut near = crate::search::problem::EvaluatedNearBest::default();
         near.record(&[0.5], 10.0);
         near.record(&[0.6], 11.5);
         near.record(&[0.7], f64::NAN);
@@ -1418,7 +1424,7 @@ mod tests {
         assert_eq!(near.lowest(), 8.0);
         assert!(
             near.at_most(f64::INFINITY)
-                .all(|(c, _)| c <= 8.0 + super::super::problem::NEAR_BEST_MARGIN_NATS)
+                .all(|(c, _)| c <= 8.0 + crate::search::problem::NEAR_BEST_MARGIN_NATS)
         );
         assert_eq!(near.at_most(8.0).count(), 2);
     }

@@ -165,7 +165,7 @@ impl Default for SpectrumSection {
     }
 }
 
-/// Cost weights (see [`crate::fit::SpectralProblem::cost_of`]).
+/// Cost weights (see [`crate::search::SpectralProblem::cost_of`]).
 #[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct Weights {
@@ -255,7 +255,7 @@ pub struct FitSection {
     #[serde(default = "d_nested_search")]
     pub nested_search: NestedSearch,
     /// Whether a `+shoulder` candidate is searched again slice by slice in θ_c when the chosen
-    /// model fails its goodness-of-fit test (default `on-misfit`; [`crate::fit::scan`]).
+    /// model fails its goodness-of-fit test (default `on-misfit`; [`crate::search::scan`]).
     #[serde(default)]
     pub contact_angle_scan: ContactAngleScan,
     /// Fresh Nelder–Mead polishes from the chosen model's settled optimum, each kept while it
@@ -271,7 +271,7 @@ pub struct FitSection {
     /// bootstrap (see [`crate::fit::bootstrap_intervals`]).
     #[serde(default)]
     pub uncertainty: UncertaintySection,
-    /// The likelihood that model choice and Laplace intervals read ([`crate::fit::evidence`]).
+    /// The likelihood that model choice and Laplace intervals read ([`crate::search::evidence`]).
     #[serde(default)]
     pub likelihood: LikelihoodSection,
     /// What the user knows before the recording (`[fit.priors]`; docs/priors.md, "Priors").
@@ -301,7 +301,7 @@ crate::names::named_enum! {
         /// fit.
         White => "white",
         /// AR(1) noise whose σ and ρ maximise the recording's likelihood at every simulation (the
-        /// profile likelihood; [`crate::fit::evidence::RecordingLikelihood::profile_noise`]).
+        /// profile likelihood; [`crate::search::evidence::RecordingLikelihood::profile_noise`]).
         /// The default: white noise is its case ρ = 0, which it finds on a white recording, and
         /// trackers correlate neighbouring frames (docs/validation.md, "Tracking-noise
         /// departures").
@@ -314,11 +314,11 @@ crate::names::named_enum! {
     /// What the fit's search minimises (docs/fit.md, "How it works").
     pub enum Objective: "objective" {
         /// The recording's negative log-likelihood in nats above the saturated model's
-        /// ([`crate::fit::evidence::RecordingLikelihood::excess_nll`]): the Whittle NLL of every
+        /// ([`crate::search::evidence::RecordingLikelihood::excess_nll`]): the Whittle NLL of every
         /// band's Welch ordinates, plus the time-domain term with `[fit.likelihood] time_domain`.
         /// Model choice, intervals and the search then read one quantity.
         Likelihood => "likelihood",
-        /// The weighted feature cost ([`crate::fit::SpectralProblem::cost_of`]): squared log
+        /// The weighted feature cost ([`crate::search::SpectralProblem::cost_of`]): squared log
         /// errors of each band's peak frequency (1 % scale), level (factor-2 scale) and shape, with
         /// `[fit.weights]` and their optional frequency-against-speed and trace terms.
         Features => "features",
@@ -333,7 +333,7 @@ crate::names::named_enum! {
         /// percentile of |θ|; and X's k1 as the contact stiffness with θ_c at the 10th) first; the
         /// global search (`restarts` swarms) follows only when they
         /// lower the recording's NLL by more than
-        /// [`crate::fit::NESTED_GLOBAL_GAIN_NATS`]. With the features objective, or a target job
+        /// [`crate::search::NESTED_GLOBAL_GAIN_NATS`]. With the features objective, or a target job
         /// (no likelihood), always the global search.
         Adaptive => "adaptive",
         /// Always the global search, warm-started from `X`'s optimum.
@@ -423,7 +423,7 @@ crate::names::named_enum! {
         #[default]
         NelderMead => "nelder-mead",
         /// One CMA-ES run from the particle with step size 0.1 box widths
-        /// ([`crate::fit::ipop::local`]), at most `[fit.search] local_evaluations` evaluations.
+        /// ([`crate::search::ipop::local`]), at most `[fit.search] local_evaluations` evaluations.
         Cmaes => "cmaes",
     }
 }
@@ -456,7 +456,7 @@ pub fn default_population(n: usize) -> usize {
 }
 
 crate::names::named_enum! {
-    /// When the contact-angle scan ([`crate::fit::scan`]) runs.
+    /// When the contact-angle scan ([`crate::search::scan`]) runs.
     #[derive(Default)]
     pub enum ContactAngleScan: "contact-angle scan" {
         /// When the chosen model's spectra fail the goodness-of-fit test (p ≤ 0.01): the search

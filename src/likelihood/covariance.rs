@@ -2,7 +2,7 @@
 //! information (its pseudo-inverse over the directions the data inform), the sandwich
 //! `F⁺ V F⁺` with the variability `V` of the score, the sample covariance `V` is estimated with,
 //! and the Cholesky factor that maps whitened coordinates onto the estimate's. The fit reads them
-//! at its optimum ([`crate::fit::evidence`]).
+//! at its optimum ([`crate::search::evidence`]).
 
 use nalgebra::DMatrix;
 
@@ -47,7 +47,7 @@ pub fn covariance(f: &DMatrix<f64>) -> (Vec<f64>, Vec<Vec<f64>>) {
 
 /// The sandwich covariance `F⁺ V F⁺` of the normalised coordinates for a Fisher information (the
 /// NLL's expected Hessian) `f` and a variability (the variance of the NLL's gradient) `v`, with
-/// `F⁺` the pseudo-inverse over the directions `f` informs (see [`crate::fit::evidence::at_fit`] for why): per
+/// `F⁺` the pseudo-inverse over the directions `f` informs (see [`crate::search::evidence::at_fit`] for why): per
 /// parameter the standard deviation (∞ where the parameter loads on a direction with no
 /// information) and the correlation matrix (NaN there). With `v = f` it is `F⁺`.
 pub fn sandwich_covariance(f: &DMatrix<f64>, v: &DMatrix<f64>) -> (Vec<f64>, Vec<Vec<f64>>) {

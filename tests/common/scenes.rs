@@ -278,7 +278,7 @@ keys = {{ {keys} }}
 /// found parameters the recording likes better than the truth (the recording does not determine
 /// them that closely).
 pub fn log_likelihood_at_truth(job: &LoadedJob, s: &Scene) -> Result<f64, String> {
-    let p = wiperlab::fit::problem_for(job, s.truth_model).map_err(|e| e.to_string())?;
+    let p = wiperlab::search::problem_for(job, s.truth_model).map_err(|e| e.to_string())?;
     let lik = p.likelihood.as_ref().map_err(|e| e.to_string())?;
     let sim = p.simulate(&truth_params(s)).map_err(|e| e.to_string())?;
     let parts = lik.nll(&p, &sim).map_err(|e| e.to_string())?;

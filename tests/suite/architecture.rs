@@ -22,6 +22,7 @@ const STAGES: &[&str] = &[
     "likelihood",
     "posterior",
     "estimate",
+    "search",
     "fit",
     "explore",
     "campaign",

@@ -10,12 +10,12 @@
 
 use crate::common;
 
-use wiperlab::fit::problem_for;
 use wiperlab::job::Candidate;
 use wiperlab::job::LoadedJob;
 use wiperlab::job::NoiseSpectrum;
 use wiperlab::likelihood::misfit::{BandMisfit, describe};
 use wiperlab::likelihood::{GOODNESS_OF_FIT_LEVEL, GoodnessOfFit};
+use wiperlab::search::problem_for;
 
 /// `data/reversal/truth.json` /params: A, B (s/m), C, k1 (N·m/rad).
 const TRUTH: [(&str, f64); 4] = [

@@ -19,13 +19,13 @@ fn scene_problem(
 ) -> (
     &'static Scene,
     tempfile::TempDir,
-    wiperlab::fit::SpectralProblem,
+    wiperlab::search::SpectralProblem,
 ) {
     let s = &SCENES[i];
     let dir = common::temp_dir(tag);
     let (job, _) = write_scene(dir.path(), i, s).unwrap();
     let job = LoadedJob::load(&job).unwrap();
-    let p = wiperlab::fit::problem_for(&job, s.truth_model).unwrap();
+    let p = wiperlab::search::problem_for(&job, s.truth_model).unwrap();
     (s, dir, p)
 }
 
@@ -75,13 +75,13 @@ fn the_spectra_do_not_tell_k1_from_theta_c_along_the_contact_moment_ridge() {
 #[test]
 fn the_tolerance_check_flags_the_often_crossed_shoulders_unresolved_likelihood() {
     use wiperlab::fit::tolerance::ToleranceCheck;
-    let check = |p: &wiperlab::fit::SpectralProblem, u: &[f64]| -> ToleranceCheck {
+    let check = |p: &wiperlab::search::SpectralProblem, u: &[f64]| -> ToleranceCheck {
         let params = p.params_at(u);
         let sim = p.simulate(&params).unwrap();
         let at_job = (p.total_cost(&sim).unwrap(), sim.transitions.len());
         ToleranceCheck::run(p, &params, at_job).expect("a likelihood job")
     };
-    let coordinates = |p: &wiperlab::fit::SpectralProblem, values: &[(&str, f64)]| -> Vec<f64> {
+    let coordinates = |p: &wiperlab::search::SpectralProblem, values: &[(&str, f64)]| -> Vec<f64> {
         p.free
             .iter()
             .map(|f| {
@@ -92,7 +92,7 @@ fn the_tolerance_check_flags_the_often_crossed_shoulders_unresolved_likelihood()
             .collect()
     };
     // A freed parameter's value in `b`.
-    let true_coordinates = |p: &wiperlab::fit::SpectralProblem, b: &BladeParams| -> Vec<f64> {
+    let true_coordinates = |p: &wiperlab::search::SpectralProblem, b: &BladeParams| -> Vec<f64> {
         p.free
             .iter()
             .map(|f| f.u_of(f.name.get(b).unwrap()))
@@ -100,7 +100,7 @@ fn the_tolerance_check_flags_the_often_crossed_shoulders_unresolved_likelihood()
     };
 
     let main = LoadedJob::load(std::path::Path::new("fits/reversal.toml")).unwrap();
-    let p = wiperlab::fit::problem_for(&main, "blade2dof".parse().unwrap()).unwrap();
+    let p = wiperlab::search::problem_for(&main, "blade2dof".parse().unwrap()).unwrap();
     let at_truth = check(&p, &true_coordinates(&p, &common::true_blade()));
     println!("main job at the truth: {at_truth:?}");
     assert_eq!(at_truth.points.len(), 3, "{at_truth:?}");

@@ -244,11 +244,11 @@ fn a_jobs_priors_enter_the_cost_and_the_curvature() {
     let cands = job.candidates();
     let shoulder = *cands.iter().find(|c| c.shoulder).unwrap();
     let blade = *cands.iter().find(|c| c.name() == "blade2dof").unwrap();
-    let p = wiperlab::fit::problem_for(&job, shoulder).unwrap();
+    let p = wiperlab::search::problem_for(&job, shoulder).unwrap();
     assert_eq!(p.prior.terms.len(), 5);
-    let q = wiperlab::fit::problem_for(&job, blade).unwrap();
+    let q = wiperlab::search::problem_for(&job, blade).unwrap();
     assert_eq!(q.prior.terms.len(), 4);
-    let q0 = wiperlab::fit::problem_for(&plain, blade).unwrap();
+    let q0 = wiperlab::search::problem_for(&plain, blade).unwrap();
     assert!(q0.prior.is_empty());
     let u = vec![0.5; q.free.len()];
     let expected = q0.cost_at(&u) + q.prior.nats(&q.params_at(&u));
@@ -262,8 +262,8 @@ fn a_jobs_priors_enter_the_cost_and_the_curvature() {
         .map(|f| f.u_of(job.truth[&f.name]))
         .collect();
     let k1 = q.free.iter().position(|f| f.name == ParamId::K1).unwrap();
-    let with = wiperlab::fit::evidence::at_fit(&q, &u).unwrap();
-    let without = wiperlab::fit::evidence::at_fit(&q0, &u).unwrap();
+    let with = wiperlab::search::evidence::at_fit(&q, &u).unwrap();
+    let without = wiperlab::search::evidence::at_fit(&q0, &u).unwrap();
     let prior_sigma_u = 0.0005 / 30f64.ln();
     println!(
         "k1 σ_u: {:.3e} with the prior, {:.3e} without, prior alone {prior_sigma_u:.3e}",
@@ -507,7 +507,7 @@ fn a_prior_on_one_laws_coefficient_applies_to_that_laws_candidates() {
             .iter()
             .find(|c| c.name() == name)
             .unwrap_or_else(|| panic!("no candidate {name} in {cands:?}"));
-        let p = wiperlab::fit::problem_for(&job, c).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let p = wiperlab::search::problem_for(&job, c).unwrap_or_else(|e| panic!("{name}: {e}"));
         let mut got: Vec<ParamId> = (p.prior.terms.iter())
             .map(|t| match t {
                 PriorTerm::Parameter { id, .. } => *id,

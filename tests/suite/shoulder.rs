@@ -172,8 +172,8 @@ fn a_shoulder_never_reached_changes_nothing() {
 #[test]
 fn the_fits_shoulder_never_softens_the_neck() {
     use std::sync::atomic::Ordering;
-    use wiperlab::fit::{FAILED_COST, problem_for};
     use wiperlab::model::ParamId;
+    use wiperlab::search::{FAILED_COST, problem_for};
     let job = wiperlab::job::LoadedJob::load(&common::root().join("fits/reversal.toml"))
         .expect("the shipped job loads");
     let p = problem_for(&job, "blade2dof+shoulder".parse().unwrap()).expect("problem");

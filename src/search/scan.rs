@@ -17,7 +17,7 @@
 //! overlapping slices of [`SLICE_LOG_WIDTH`] on the log scale.
 
 use super::interrupt;
-use super::search::{
+use super::strategy::{
     CandidateFit, Confirmation, NESTED_WARM_POINTS, Optimised, Reporting, VALLEY_GAIN_NATS,
     add_note, fit_candidate, polish_budget, settle_anew, sorted_abs_theta,
 };
@@ -70,7 +70,7 @@ pub fn contact_angle_slices(lo: f64, hi: f64) -> Vec<(f64, f64)> {
 
 /// Why the scan runs after the first choice, or `None` when it does not: `setting` the job's,
 /// `chosen` the chosen candidate's name, `gof` its goodness-of-fit test (`None` when there is none).
-pub(super) fn scan_reason(
+pub(crate) fn scan_reason(
     setting: ContactAngleScan,
     chosen: &str,
     gof: Option<&GoodnessOfFit>,
@@ -87,7 +87,7 @@ pub(super) fn scan_reason(
 /// Scans every `+shoulder` candidate of `fits` whose model without shoulder was fitted too, when the
 /// job bounds the shoulder in `[fit.shoulder]`. `why` goes into each scanned candidate's search
 /// note. Returns whether any candidate moved.
-pub(super) fn scan_contact_angle(
+pub(crate) fn scan_contact_angle(
     job: &LoadedJob,
     meas: &Measurement,
     fits: &mut [CandidateFit],

@@ -1,8 +1,7 @@
 //! The fit's cost problem: everything one cost evaluation needs ([`SpectralProblem`]), as argmin
 //! sees it ([`Shared`]).
 
-use super::features::{BandSpec, Features, SignalKind, features};
-use super::result::SearchStage;
+use super::history::SearchStage;
 use crate::Result;
 use crate::job::{FreeParam, Objective, Weights};
 use crate::likelihood::instfreq;
@@ -10,6 +9,7 @@ use crate::model::BladeParams;
 use crate::model::blade::StickForm;
 use crate::simulate::SolverOptions;
 use crate::simulate::blade::{BladeSimulation, ModelKind, simulate_model};
+use crate::spectrum::features::{BandSpec, Features, SignalKind, features};
 use argmin::core::CostFunction;
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -167,7 +167,7 @@ impl SpectralProblem {
     /// by a softening neck the blade does not have and reported as a shoulder. `k1_contact = k1`, the
     /// shoulder that changes nothing, is allowed (to a relative 1e-9, the round trip of a value
     /// through another parameter's normalised coordinate): the nested candidates start there.
-    pub(super) fn softening_shoulder(&self, p: &BladeParams) -> bool {
+    pub(crate) fn softening_shoulder(&self, p: &BladeParams) -> bool {
         self.free
             .iter()
             .any(|f| f.name == crate::model::ParamId::K1c)
@@ -365,7 +365,7 @@ impl SpectralProblem {
     ///
     /// With the likelihood as the cost, a polish-stage evaluation inside the box is kept in
     /// [`SpectralProblem::near_best`] when it is near the lowest seen.
-    pub(super) fn cost_at_stage(&self, u: &[f64], stage: SearchStage) -> f64 {
+    pub(crate) fn cost_at_stage(&self, u: &[f64], stage: SearchStage) -> f64 {
         let c = self.unrecorded_cost_at_stage(u, stage);
         let inside = u.iter().all(|x| (0.0..=1.0).contains(x));
         if stage != SearchStage::Swarm && inside && c < FAILED_COST && self.cost_is_nll() {
@@ -413,10 +413,10 @@ impl SpectralProblem {
 /// The problem as argmin sees it in one stage: shared by the swarm's threads. The third field counts
 /// this run's evaluations (restarts run in parallel; the problem's own counter sums them all).
 #[derive(Clone)]
-pub(super) struct Shared(
-    pub(super) Arc<SpectralProblem>,
-    pub(super) SearchStage,
-    pub(super) Arc<AtomicUsize>,
+pub(crate) struct Shared(
+    pub(crate) Arc<SpectralProblem>,
+    pub(crate) SearchStage,
+    pub(crate) Arc<AtomicUsize>,
 );
 
 impl CostFunction for Shared {
@@ -434,17 +434,17 @@ impl CostFunction for Shared {
 /// [`Shared`] with one normalised coordinate held: the cost as a function of the others (a
 /// profile likelihood's inner minimisation, [`super::uncertainty::profile_intervals`]).
 #[derive(Clone)]
-pub(super) struct Pinned {
-    pub(super) shared: Shared,
+pub(crate) struct Pinned {
+    pub(crate) shared: Shared,
     /// The held coordinate's index in the full vector.
-    pub(super) index: usize,
+    pub(crate) index: usize,
     /// Its value, normalised.
-    pub(super) u: f64,
+    pub(crate) u: f64,
 }
 
 impl Pinned {
     /// The full coordinates: `others` with the held one inserted at its index.
-    pub(super) fn full(&self, others: &[f64]) -> Vec<f64> {
+    pub(crate) fn full(&self, others: &[f64]) -> Vec<f64> {
         let mut u = others.to_vec();
         u.insert(self.index, self.u);
         u

@@ -2,11 +2,13 @@
 //! history and progress reported through argmin observers, and the cost's curvature at the optimum.
 
 use super::FitError;
+use super::evidence::LocalFit;
 use super::evidence::RecordingLikelihood;
+use super::history::{HistoryPoint, SearchStage};
 use super::interrupt;
 use super::problem::{Pinned, Shared, SpectralProblem};
-use super::result::{HistoryPoint, SearchStage};
 use crate::Result;
+use crate::estimate::{FitWarning, Interval};
 use crate::job::Candidate;
 use crate::job::FreeParam;
 use crate::job::{self, LoadedJob};
@@ -25,28 +27,28 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// A point of the normalised search space with its cost.
-pub(super) type Scored = (Vec<f64>, f64);
+pub(crate) type Scored = (Vec<f64>, f64);
 
 /// What a candidate's search reports, and where: its cost history and the job's progress bar.
 #[derive(Clone)]
-pub(super) struct Reporting {
-    pub(super) history: Arc<Mutex<Vec<HistoryPoint>>>,
+pub(crate) struct Reporting {
+    pub(crate) history: Arc<Mutex<Vec<HistoryPoint>>>,
     /// The best point any iteration of this candidate's search reached, with its cost: what an
     /// interrupted search returns.
-    pub(super) best: Arc<Mutex<Option<Scored>>>,
-    pub(super) progress: Option<indicatif::ProgressBar>,
+    pub(crate) best: Arc<Mutex<Option<Scored>>>,
+    pub(crate) progress: Option<indicatif::ProgressBar>,
     /// The progress bar's position when this candidate started: its model runs count on from here.
-    pub(super) base: u64,
+    pub(crate) base: u64,
     /// When stderr is not a terminal (the bar is not drawn): the time of the last one-line
     /// progress message, so that one is printed at most every [`piped_interval`].
-    pub(super) last_line: Option<Arc<Mutex<std::time::Instant>>>,
-    pub(super) candidate: Candidate,
+    pub(crate) last_line: Option<Arc<Mutex<std::time::Instant>>>,
+    pub(crate) candidate: Candidate,
 }
 
 impl Reporting {
     /// The reporting of `candidate`'s search on the progress bar `pb` (from its position now), with
     /// one-line messages instead when stderr is not a terminal.
-    pub(super) fn new(pb: &Option<indicatif::ProgressBar>, candidate: Candidate) -> Reporting {
+    pub(crate) fn new(pb: &Option<indicatif::ProgressBar>, candidate: Candidate) -> Reporting {
         let last_line = pb
             .as_ref()
             .filter(|_| !std::io::IsTerminal::is_terminal(&std::io::stderr()))
@@ -64,7 +66,7 @@ impl Reporting {
     /// The reporting of a fitted candidate `f`'s later work (valley polishes, a scan, taking the
     /// smaller model's optimum): its history continued, its model runs counting on from the
     /// progress bar's position now.
-    pub(super) fn continuing(f: &CandidateFit, pb: &Option<indicatif::ProgressBar>) -> Reporting {
+    pub(crate) fn continuing(f: &CandidateFit, pb: &Option<indicatif::ProgressBar>) -> Reporting {
         Reporting {
             history: Arc::new(Mutex::new(f.history.clone())),
             ..Reporting::new(pb, f.candidate)
@@ -137,7 +139,7 @@ impl Reporting {
     }
 
     /// Names the stage on the progress bar.
-    pub(super) fn stage(&self, what: std::fmt::Arguments) {
+    pub(crate) fn stage(&self, what: std::fmt::Arguments) {
         if let Some(pb) = &self.progress {
             pb.set_message(format!("{} {what}", self.candidate));
         }
@@ -147,7 +149,7 @@ impl Reporting {
 /// An argmin observer of the search: after every iteration it appends the best cost to the
 /// history and moves the progress bar to the model runs done so far. The cost function itself
 /// reports nothing; it only counts its evaluations.
-pub(super) struct SearchObserver {
+pub(crate) struct SearchObserver {
     stage: SearchStage,
     restart: usize,
     reporting: Reporting,
@@ -158,7 +160,7 @@ pub(super) struct SearchObserver {
 }
 
 /// A point of the search space as the solvers' states hold it.
-pub(super) trait AsPoint {
+pub(crate) trait AsPoint {
     fn point(&self) -> &[f64];
 }
 
@@ -216,9 +218,9 @@ where
 /// after the search ([`super::uncertainty::profile_intervals_at`]). `evals` counts the model runs
 /// of all of them.
 #[derive(Clone)]
-pub(super) struct ProgressObserver {
-    pub(super) reporting: Reporting,
-    pub(super) evals: Arc<AtomicUsize>,
+pub(crate) struct ProgressObserver {
+    pub(crate) reporting: Reporting,
+    pub(crate) evals: Arc<AtomicUsize>,
 }
 
 impl<I: State> Observe<I> for ProgressObserver {
@@ -229,35 +231,35 @@ impl<I: State> Observe<I> for ProgressObserver {
 }
 
 /// One candidate fitted.
-pub(super) struct CandidateFit {
-    pub(super) candidate: Candidate,
-    pub(super) free: Vec<FreeParam>,
-    pub(super) problem: Arc<SpectralProblem>,
-    pub(super) best_u: Vec<f64>,
-    pub(super) sigma_u: Vec<f64>,
-    pub(super) corr: Vec<Vec<f64>>,
+pub(crate) struct CandidateFit {
+    pub(crate) candidate: Candidate,
+    pub(crate) free: Vec<FreeParam>,
+    pub(crate) problem: Arc<SpectralProblem>,
+    pub(crate) best_u: Vec<f64>,
+    pub(crate) sigma_u: Vec<f64>,
+    pub(crate) corr: Vec<Vec<f64>>,
     /// 1σ of the normalised coordinates from the Fisher information alone, with a likelihood.
-    pub(super) fisher_sigma_u: Option<Vec<f64>>,
+    pub(crate) fisher_sigma_u: Option<Vec<f64>>,
     /// The correlations of `F⁻¹`, with `fisher_sigma_u`.
-    pub(super) fisher_corr: Option<Vec<Vec<f64>>>,
+    pub(crate) fisher_corr: Option<Vec<Vec<f64>>>,
     /// The recording's NLL at the optimum (`sigma_u` and `corr` then come from its sandwich
     /// covariance, [`super::evidence::at_fit`]), or why there is none (then from the cost's
     /// curvature).
-    pub(super) evidence: std::result::Result<super::evidence::NllParts, super::NoEvidence>,
-    pub(super) swarm_iters: u64,
-    pub(super) polish_iters: u64,
-    pub(super) wall_time_s: f64,
-    pub(super) history: Vec<HistoryPoint>,
-    pub(super) cost: f64,
+    pub(crate) evidence: std::result::Result<super::evidence::NllParts, super::NoEvidence>,
+    pub(crate) swarm_iters: u64,
+    pub(crate) polish_iters: u64,
+    pub(crate) wall_time_s: f64,
+    pub(crate) history: Vec<HistoryPoint>,
+    pub(crate) cost: f64,
     /// The cost where the search ended, before settling (nats with the likelihood objective).
-    pub(super) search_cost: f64,
+    pub(crate) search_cost: f64,
     /// How a nested candidate was searched (adaptive search), and whether a deferred confirmation
     /// was skipped, for the model-choice reason.
-    pub(super) search_note: Option<String>,
+    pub(crate) search_note: Option<String>,
     /// The deferred confirmation of an unconfirmed best end, until [`confirm_deferred`].
-    pub(super) unconfirmed: Option<Unconfirmed>,
-    /// The profile walk at the optimum ([`super::climb::climb_chosen`]), kept for its intervals.
-    pub(super) profile_walk: Option<super::climb::ProfileWalk>,
+    pub(crate) unconfirmed: Option<Unconfirmed>,
+    /// The profile walk at the optimum ([`crate::fit::climb::climb_chosen`]), kept for its intervals.
+    pub(crate) profile_walk: Option<ProfileWalk>,
 }
 
 impl CandidateFit {
@@ -265,7 +267,7 @@ impl CandidateFit {
     /// Jacobian averaged over the bowl's centre ([`super::evidence::at_fit_smoothed`]): the 1σ
     /// and correlations its intervals and result report. Unchanged where the fit has no
     /// likelihood, was interrupted, or the smoothed spread fails.
-    pub(super) fn with_smoothed_spread(mut self) -> Self {
+    pub(crate) fn with_smoothed_spread(mut self) -> Self {
         if self.evidence.is_err() || interrupt::stop_requested() {
             return self;
         }
@@ -288,9 +290,19 @@ impl CandidateFit {
     }
 }
 
+/// A profile walk of a fit's optimum: its intervals and warnings, the point it was walked at, and
+/// the spread there it was walked with (what [`CandidateFit::with_smoothed_spread`] reports).
+pub(crate) struct ProfileWalk {
+    /// The normalised coordinates the walk started from (the intervals apply only there).
+    pub(crate) at_u: Vec<f64>,
+    pub(crate) spread: LocalFit,
+    pub(crate) intervals: Vec<Interval>,
+    pub(crate) warnings: Vec<FitWarning>,
+}
+
 /// How often a fit whose stderr is not a terminal prints a one-line progress message: 5 s, or
 /// `WIPERLAB_PROGRESS_INTERVAL_S` seconds when set (tests use 0).
-pub(super) fn piped_interval() -> std::time::Duration {
+pub(crate) fn piped_interval() -> std::time::Duration {
     let s = std::env::var("WIPERLAB_PROGRESS_INTERVAL_S")
         .ok()
         .and_then(|v| v.parse::<f64>().ok())
@@ -304,7 +316,7 @@ pub(super) fn piped_interval() -> std::time::Duration {
 /// runs per iteration, and the curvature's stencil. A nested candidate searched adaptively counts
 /// its local polishes only; its global search, when it runs, lengthens the bar
 /// ([`nested_search`]).
-pub(super) fn progress_bar(job: &LoadedJob, candidates: &[Candidate]) -> indicatif::ProgressBar {
+pub(crate) fn progress_bar(job: &LoadedJob, candidates: &[Candidate]) -> indicatif::ProgressBar {
     let fit = &job.job.fit;
     let mut budget = 0u64;
     for (i, c) in candidates.iter().enumerate() {
@@ -340,7 +352,7 @@ pub(super) fn progress_bar(job: &LoadedJob, candidates: &[Candidate]) -> indicat
 /// How many warm points a nested candidate's search starts from ([`nested_warm_points`]): its
 /// local search polishes from each, and the first restarts of its global search start a particle
 /// at one.
-pub(super) const NESTED_WARM_POINTS: u64 =
+pub(crate) const NESTED_WARM_POINTS: u64 =
     1 + (FREE_NECK_QUANTILES.len() + RESTING_QUANTILES.len()) as u64;
 
 /// The quantiles of |θ| in the smaller model's motion at which [`nested_warm_points`] puts the
@@ -354,7 +366,7 @@ const FREE_NECK_QUANTILES: [f64; 2] = [0.5, 0.9];
 const RESTING_QUANTILES: [f64; 4] = [0.1, 0.25, 0.5, 0.75];
 
 /// Model runs of one Nelder–Mead polish over `n` parameters: its simplex and two per iteration.
-pub(super) fn polish_budget(fit: &job::FitSection, n: usize) -> u64 {
+pub(crate) fn polish_budget(fit: &job::FitSection, n: usize) -> u64 {
     n as u64 + 1 + 2 * fit.polish_iterations
 }
 
@@ -369,7 +381,7 @@ fn restarts_budget(fit: &job::FitSection, n: usize) -> u64 {
 /// the confirmation of a best end that no second restart reached is deferred
 /// ([`Confirmation::Deferred`], [`confirm_deferred`]) for every candidate that no later one starts
 /// from.
-pub(super) fn fit_candidates(
+pub(crate) fn fit_candidates(
     job: &LoadedJob,
     meas: &Measurement,
     candidates: &[Candidate],
@@ -396,7 +408,7 @@ pub(super) fn fit_candidates(
 /// The cost problem of one candidate: its freed parameters (the job's, plus the shoulder's when
 /// the candidate has one) and the measurement as that model sees it, with any further recordings
 /// of a joint fit attached.
-pub(super) fn build_problem(
+pub(crate) fn build_problem(
     job: &LoadedJob,
     meas: &Measurement,
     candidate: Candidate,
@@ -536,7 +548,7 @@ pub fn problem_for(job: &LoadedJob, candidate: Candidate) -> Result<SpectralProb
 /// the larger model then cannot end above the smaller one's cost, which the AIC comparison of
 /// nested models assumes. Without the warm particle a swarm can leave the larger candidate above
 /// the optimum of the model it contains.
-pub(super) fn fit_candidate(
+pub(crate) fn fit_candidate(
     job: &LoadedJob,
     meas: &Measurement,
     candidate: Candidate,
@@ -654,7 +666,7 @@ fn descend_the_valley(
 /// as the likelihood-ratio test assumes. The chosen candidate's score only falls, so the choice
 /// stands. The candidate's search note says how many polishes were kept and what they gained.
 /// Returns whether the chosen candidate moved.
-pub(super) fn descend_chosen(
+pub(crate) fn descend_chosen(
     job: &LoadedJob,
     fits: &mut Vec<CandidateFit>,
     chosen: usize,
@@ -696,7 +708,7 @@ pub(super) fn descend_chosen(
 }
 
 /// `text` appended to a candidate's search note (the trial's `reason` in the result).
-pub(super) fn add_note(note: &mut Option<String>, text: String) {
+pub(crate) fn add_note(note: &mut Option<String>, text: String) {
     *note = Some(match note.take() {
         Some(n) => format!("{n}; {text}"),
         None => text,
@@ -717,7 +729,7 @@ fn valley_note(kept: usize, polishes: usize, gain_nats: f64) -> String {
 
 /// The candidate `f` settled anew ([`finish`] with [`Settling::Settle`]) from a better search end
 /// `found`, keeping its search note (its wall time is the caller's).
-pub(super) fn settle_anew(
+pub(crate) fn settle_anew(
     f: &mut CandidateFit,
     found: Optimised,
     reporting: &Reporting,
@@ -744,7 +756,7 @@ pub(super) fn settle_anew(
 /// (a viscous term at D = 0, a shoulder the neck never reaches) that `X`'s shorter search missed;
 /// `X` would then lose the choice to a larger model that adds nothing, or be reported short of
 /// its own optimum. One simulation per nested pair.
-pub(super) fn take_nested_optima(
+pub(crate) fn take_nested_optima(
     fits: &mut Vec<CandidateFit>,
     pb: &Option<indicatif::ProgressBar>,
 ) -> Result<()> {
@@ -812,7 +824,7 @@ fn projection(smaller: &CandidateFit, larger: &CandidateFit) -> Option<Vec<f64>>
 
 /// Every candidate nested on `fits[smaller]` (`X+shoulder` on `X`) that is less likely than it
 /// takes its optimum ([`keep_the_smaller_optimum`]).
-pub(super) fn keep_nested_above(
+pub(crate) fn keep_nested_above(
     fits: &mut Vec<CandidateFit>,
     smaller: usize,
     pb: &Option<indicatif::ProgressBar>,
@@ -981,7 +993,7 @@ fn finish(
 /// A candidate's search whose best end no second end confirmed, its second batch of restarts
 /// deferred ([`Confirmation::Deferred`]).
 #[derive(Clone)]
-pub(super) struct Unconfirmed {
+pub(crate) struct Unconfirmed {
     /// The search ends' finite costs, nats.
     ends: Vec<f64>,
     reporting: Reporting,
@@ -1028,10 +1040,10 @@ fn confirmation_skipped(ends: &[f64], score_gap: f64) -> Option<String> {
 /// unconfirmed, unless its AIC trails the chosen candidate's by more than
 /// `2 · (spread of its ends + DEFERRED_CONFIRM_MARGIN_NATS)` or it cannot be chosen: then more
 /// restarts of it could not change the choice, and its reason says so. `score_gaps[i]`: candidate
-/// `i`'s score minus the chosen one's ([`super::select::score_gaps`]; +∞ when it cannot be chosen).
+/// `i`'s score minus the chosen one's ([`crate::fit::select::score_gaps`]; +∞ when it cannot be chosen).
 /// A batch that ends below the candidate's search end replaces it, and the candidate is settled
 /// anew.
-pub(super) fn confirm_deferred(
+pub(crate) fn confirm_deferred(
     job: &LoadedJob,
     fits: &mut [CandidateFit],
     score_gaps: &[f64],
@@ -1325,7 +1337,7 @@ fn resting_neck_points(
 /// |θ| of the neck in `fit`'s simulation at its optimum, finite samples in ascending order: where
 /// a shoulder's contact angle would act on that motion. `None` when it cannot be simulated or has
 /// no finite sample.
-pub(super) fn sorted_abs_theta(fit: &CandidateFit) -> Option<Vec<f64>> {
+pub(crate) fn sorted_abs_theta(fit: &CandidateFit) -> Option<Vec<f64>> {
     let sim = fit
         .problem
         .simulate(&fit.problem.params_at(&fit.best_u))
@@ -1354,7 +1366,7 @@ pub(super) fn sorted_abs_theta(fit: &CandidateFit) -> Option<Vec<f64>> {
 /// With the likelihood as the cost and more than one restart, a best end that no second end
 /// confirms ([`confirmed`]) runs the restarts once more (restarts `R..2R`, new seeds), at once or,
 /// with [`Confirmation::Deferred`], when [`confirm_deferred`] finds it could change the choice.
-pub(super) fn optimise(
+pub(crate) fn optimise(
     problem: &Arc<SpectralProblem>,
     fit: &job::FitSection,
     seed: u64,
@@ -1539,23 +1551,23 @@ fn more_restarts(
 /// candidate starts, or it is the only one), or leaves it to [`confirm_deferred`] once every
 /// candidate is fitted (`Deferred`), which runs it only where it could change the model choice.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Confirmation {
+pub(crate) enum Confirmation {
     Now,
     Deferred,
 }
 
 /// What [`optimise`] found.
-pub(super) struct Optimised {
+pub(crate) struct Optimised {
     /// The best end, normalised coordinates.
-    pub(super) u: Vec<f64>,
+    pub(crate) u: Vec<f64>,
     /// Iterations summed over the restarts.
-    pub(super) swarm_iters: u64,
-    pub(super) polish_iters: u64,
+    pub(crate) swarm_iters: u64,
+    pub(crate) polish_iters: u64,
     /// The best end's cost (nats with the likelihood objective).
-    pub(super) cost: f64,
+    pub(crate) cost: f64,
     /// With [`Confirmation::Deferred`], the search ends' finite costs when no second end confirms
     /// the best one.
-    pub(super) unconfirmed_ends: Option<Vec<f64>>,
+    pub(crate) unconfirmed_ends: Option<Vec<f64>>,
 }
 
 /// The depth (nats) within which a second search end confirms the best one: 0.5 nats, the
@@ -1568,7 +1580,7 @@ pub const CONFIRM_NATS: f64 = 0.5;
 /// is confirmed: a second end lies within [`CONFIRM_NATS`] of it. A best end no other restart
 /// reaches is a basin the swarms find by chance, and a better one may lie where none looked, so
 /// [`optimise`] then runs its restarts once more with new seeds (restarts `R..2R`).
-pub(super) fn confirmed(ends: &[f64]) -> bool {
+pub(crate) fn confirmed(ends: &[f64]) -> bool {
     let mut e: Vec<f64> = ends.iter().copied().filter(|c| c.is_finite()).collect();
     e.sort_by(f64::total_cmp);
     e.len() < 2 || e[1] - e[0] <= CONFIRM_NATS
@@ -1703,7 +1715,7 @@ fn local_cmaes(
 
 /// A swarm's first population with one particle at `warm` and the others drawn uniformly over
 /// `[0, 1]^n` (velocities uniform in `[−1, 1]^n`, as argmin draws them); costs evaluated in parallel.
-pub(super) fn warm_population(
+pub(crate) fn warm_population(
     problem: &Arc<SpectralProblem>,
     warm: &[f64],
     particles: usize,
@@ -1741,7 +1753,7 @@ pub const POLISH_SD_NATS: f64 = 0.05;
 
 /// The edge of a polish's initial simplex, normalised units: every polish of the fit (after a
 /// swarm, from a warm point, down a valley), of a bootstrap replicate and of a profile step.
-pub(super) const POLISH_STEP_U: f64 = 0.05;
+pub(crate) const POLISH_STEP_U: f64 = 0.05;
 
 /// When a polish of any other cost (the feature cost, a target job's) stops: the standard
 /// deviation of its values over the simplex's vertices below 1e-3.
@@ -1749,7 +1761,7 @@ const POLISH_SD_OTHER: f64 = 1e-3;
 
 /// Nelder–Mead from `start` with an initial simplex of edge `step` (normalised units), stopping at
 /// [`POLISH_SD_NATS`] with the likelihood, [`POLISH_SD_OTHER`] otherwise, or after `iterations`.
-pub(super) fn polish(
+pub(crate) fn polish(
     problem: &Arc<SpectralProblem>,
     start: &[f64],
     step: f64,
@@ -1843,7 +1855,7 @@ fn polish_sd(problem: &SpectralProblem) -> f64 {
 /// [`polish`] of every coordinate but `index`, which is held at `u_held`: the minimum of the cost
 /// over the others from `start` (full coordinates; its `index` entry is replaced). Returns the full
 /// coordinates of the best point and its cost.
-pub(super) fn polish_pinned(
+pub(crate) fn polish_pinned(
     problem: &Arc<SpectralProblem>,
     start: &[f64],
     (index, u_held): (usize, f64),
@@ -1869,7 +1881,7 @@ pub(super) fn polish_pinned(
 /// Finite-difference curvature of the cost at `u0` (step 0.03 in normalised units, stencil kept
 /// inside the box). Returns the 1σ half-widths in normalised units from the
 /// covariance `2 H⁻¹` (cost read as χ²), and the correlation matrix.
-pub(super) fn curvature(problem: &SpectralProblem, u0: &[f64]) -> (Vec<f64>, Vec<Vec<f64>>) {
+pub(crate) fn curvature(problem: &SpectralProblem, u0: &[f64]) -> (Vec<f64>, Vec<Vec<f64>>) {
     use rayon::prelude::*;
     let n = u0.len();
     let d = 0.03;

@@ -1,0 +1,30 @@
+//! The search: the optimum of each candidate model's cost over its freed parameters.
+//!
+//! * [`problem`]: the cost of one parameter set ([`SpectralProblem`]): simulate, measure the
+//!   model's spectra as the recording's, compare (features or the recording's likelihood).
+//! * [`evidence`]: the recording's likelihood at a point of the search, the settling of its
+//!   optimum at the intervals' scale and the sandwich covariance there.
+//! * [`strategy`]: each candidate searched (particle swarm or IPOP CMA-ES, restarts that confirm
+//!   their ends, Nelder–Mead polishes, nested and warm starts) into a
+//!   [`strategy::CandidateFit`], with its history and progress reported through argmin observers.
+//! * [`ipop`]: CMA-ES with restarts of increasing population over the unit box.
+//! * [`scan`]: the contact-angle scan of a shoulder candidate.
+//! * [`history`]: the stages of the optimiser and the best cost after each iteration.
+//! * [`interrupt`]: SIGINT/SIGTERM stop a running search, which keeps its best point.
+//! * [`error`]: what can go wrong in a fit ([`FitError`]).
+//!
+//! Parameters are searched in normalised coordinates `u ∈ [0, 1]` (logarithmic for bounds spanning
+//! a factor ≥ 10).
+
+pub mod error;
+pub mod evidence;
+pub mod history;
+pub mod interrupt;
+pub mod ipop;
+pub mod problem;
+pub mod scan;
+pub mod strategy;
+
+pub use error::{FitError, NoEvidence, NoLikelihood};
+pub use problem::{FAILED_COST, SpectralProblem, target_cost};
+pub use strategy::{NESTED_GLOBAL_GAIN_NATS, problem_for};
