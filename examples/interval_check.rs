@@ -26,7 +26,6 @@
 use clap::Parser;
 use nalgebra::{DMatrix, DVector};
 use std::path::PathBuf;
-use wiperlab::fit::posterior_tempering;
 use wiperlab::job::{Candidate, LoadedJob, NoiseSpectrum};
 use wiperlab::likelihood::covariance::{cholesky_of_covariance, covariance_of};
 use wiperlab::likelihood::secant::{SECANT_PROBE_SIGMA, flat_axes};
@@ -34,6 +33,7 @@ use wiperlab::posterior::tempering::{geometric_ladder, sample_tempered};
 use wiperlab::posterior::{EnsembleSettings, ensemble::gaussian_ball_with};
 use wiperlab::search::evidence::{LocalFit, at_fit_smoothed};
 use wiperlab::search::{FAILED_COST, SpectralProblem, problem_for};
+use wiperlab::uncertainty::posterior_tempering;
 
 #[derive(Parser)]
 struct Args {

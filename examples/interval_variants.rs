@@ -23,10 +23,10 @@ use clap::Parser;
 use std::path::PathBuf;
 use std::sync::Arc;
 use wiperlab::fit::result::FitResult;
-use wiperlab::fit::{ProfileStart, profile_intervals_at};
 use wiperlab::job::LoadedJob;
 use wiperlab::search::evidence::at_fit_smoothed;
 use wiperlab::search::problem_for;
+use wiperlab::uncertainty::{ProfileStart, profile_intervals_at};
 
 #[derive(Parser)]
 struct Args {

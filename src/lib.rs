@@ -5,7 +5,7 @@
 //! The module tree is the pipeline; a stage uses only the stages before it (checked by
 //! `tests/suite/architecture.rs`):
 //!
-//! Pipeline order: `error` → `names` → `io` → `trace` → `import` → `spectrum` → `model` → `simulate` → `job` → `likelihood` → `posterior` → `estimate` → `search` → `fit` → `explore` → `campaign` → `report` → `bench` → `cli`.
+//! Pipeline order: `error` → `names` → `io` → `trace` → `import` → `spectrum` → `model` → `simulate` → `job` → `likelihood` → `posterior` → `estimate` → `search` → `uncertainty` → `fit` → `explore` → `campaign` → `report` → `bench` → `cli`.
 //!
 //! * [`error`]: the crate's error type, shared by every stage.
 //! * [`names`]: typed names (model kinds, parameter ids, ...), each spelled once.
@@ -29,8 +29,10 @@
 //! * [`search`]: the optimum of each candidate model's cost: the cost of one parameter set
 //!   ([`search::SpectralProblem`]), the optimisers (particle swarm, IPOP CMA-ES, Nelder–Mead) and
 //!   the strategy that restarts, confirms and polishes them.
-//! * [`fit`]: the friction law A, B, C and the neck stiffness fitted with `argmin`; model choice,
-//!   intervals, results.
+//! * [`uncertainty`]: the chosen fit's intervals (Laplace, profile likelihood, parametric
+//!   bootstrap, posterior sample) and the profile climb that walks them.
+//! * [`fit`]: a fit job run: its candidates searched, the model chosen (TIC), the chosen optimum
+//!   checked (solver tolerance, the job's truth), its intervals and warnings, and the result.
 //! * [`explore`]: where a job's freed parameters can take the model's lines (`wiperlab explore`).
 //! * [`campaign`]: one fit job over many recordings, locally in parallel or as a Slurm job array,
 //!   collected into one table.
@@ -61,5 +63,6 @@ pub mod search;
 pub mod simulate;
 pub mod spectrum;
 pub mod trace;
+pub mod uncertainty;
 
 pub use error::{Error, Result};

@@ -16,7 +16,7 @@ pub struct Interval {
     pub method: IntervalMethod,
     /// `[lo, hi]` of the method alone, when the interval was then widened to points the fit
     /// evaluated inside the parameter's profile region (the search's own near-best points,
-    /// [`crate::fit::widen_to_near_best`], or the shoulder's contact-moment ridge); absent when
+    /// [`crate::uncertainty::widen_to_near_best`], or the shoulder's contact-moment ridge); absent when
     /// it was not widened.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub widened_from: Option<[f64; 2]>,
@@ -26,7 +26,7 @@ pub struct Interval {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum IntervalMethod {
-    /// Profile likelihood ([`crate::fit::profile_intervals_at`]): where the NLL, minimised over
+    /// Profile likelihood ([`crate::uncertainty::profile_intervals_at`]): where the NLL, minimised over
     /// the other parameters, has risen by `rise_limit_nats` from the fit.
     Profile {
         /// The rise at the interval's ends, nats: 0.5·σ²_sandwich/σ²_Fisher of the parameter (0 in
@@ -34,7 +34,7 @@ pub enum IntervalMethod {
         #[serde(default)]
         rise_limit_nats: f64,
     },
-    /// Basic parametric bootstrap ([`crate::fit::bootstrap_intervals`]).
+    /// Basic parametric bootstrap ([`crate::uncertainty::bootstrap_intervals`]).
     Bootstrap {
         replicates: usize,
         /// White-noise σ added to each recording (the best-fit model's signal plus this noise),
@@ -76,7 +76,7 @@ pub enum IntervalMethod {
 
 impl IntervalMethod {
     /// Whether intervals of this method are widened to the points the search evaluated
-    /// ([`crate::fit::widen_to_near_best`]): Laplace and profile intervals; a posterior sample
+    /// ([`crate::uncertainty::widen_to_near_best`]): Laplace and profile intervals; a posterior sample
     /// and a bootstrap cover the region themselves.
     pub fn widens_to_near_best(&self) -> bool {
         matches!(

@@ -175,7 +175,7 @@ pub enum FitWarning {
         reason: String,
     },
     /// The posterior sample's chains have not mixed for a parameter: split R̂ above
-    /// [`crate::fit::RHAT_LIMIT`] or fewer effective draws than [`crate::fit::MIN_ESS`].
+    /// [`crate::uncertainty::RHAT_LIMIT`] or fewer effective draws than [`crate::uncertainty::MIN_ESS`].
     PosteriorUnconverged {
         parameter: ParamId,
         r_hat: f64,

@@ -1,23 +1,17 @@
 //! Fitting the friction law (A, B, C) and the neck stiffness (and any other blade parameter a job
 //! frees) so that the model's spectra match the measured ones.
 //!
-//! Cost (per band `b`, measured `d`, model `m`, model PSD plus the measurement's noise floor):
-//! `w_peak·(ln f_m/f_d / 0.01)² + w_level·(ln L_m/L_d / ln 2)² + w_shape·mean_k (ln P_m,k − ln P_d,k)²`.
-//! Two peak frequencies alone cannot pin down four parameters, hence the level and shape terms; the
-//! result still says which parameters the data leave undetermined (from the cost's curvature).
-//!
-//! Optimisation (argmin): a particle swarm over the bounded box (parallel cost evaluations with
-//! rayon), then a Nelder–Mead polish from the best particle. Parameters are searched in normalised
-//! coordinates `u ∈ [0, 1]` (logarithmic for bounds spanning a factor ≥ 10).
+//! This stage runs a job: each candidate model searched ([`crate::search`]), the model chosen
+//! ([`select`]), the chosen optimum checked against the integrator's tolerance ([`tolerance`]) and
+//! the job's truth ([`truth`]), its intervals ([`crate::uncertainty`]) and warnings attached
+//! ([`warning`]), and the [`FitResult`] assembled ([`result`]).
 
-mod climb;
 /// The spectral features the fit compares (they belong to the spectrum stage).
 pub use crate::spectrum::features;
 pub mod result;
 pub mod select;
 pub mod tolerance;
 pub mod truth;
-mod uncertainty;
 pub mod warning;
 
 pub use crate::search::{FitError, NoEvidence, NoLikelihood};
@@ -27,10 +21,6 @@ pub use result::{
 };
 pub use select::aic;
 pub use truth::SHORTFALL_TOLERANCE_NATS;
-pub use uncertainty::{
-    MIN_ESS, ProfileStart, RHAT_LIMIT, bootstrap_intervals, identifiability_warnings,
-    laplace_intervals, posterior_tempering, profile_intervals_at, widen_to_near_best,
-};
 pub use warning::{FitWarning, Severity, Warnings};
 
 use crate::Result;
@@ -44,6 +34,7 @@ use crate::search::strategy::{
 use crate::search::{SpectralProblem, interrupt, scan};
 use crate::simulate::blade::BladeSimulation;
 use crate::trace::Trace;
+use crate::uncertainty::{self, climb, identifiability_warnings};
 use features::{Features, SignalKind};
 use std::sync::atomic::Ordering;
 

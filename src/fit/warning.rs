@@ -17,7 +17,6 @@
 
 use super::select::INDISTINGUISHABLE_TIC;
 use super::tolerance::{SPREAD_WARN_NATS, TolerancePoint};
-use super::uncertainty::{PROFILE_68_NATS, PROFILE_MAX_STEPS};
 pub use crate::estimate::warning::{
     End, FAILED_ATTENTION_FRACTION, FAILED_WARN_FRACTION, FitWarning, LineSource, SampledReason,
     Severity,
@@ -29,6 +28,7 @@ use crate::likelihood::prior::PriorsReport;
 use crate::likelihood::secant::FlatAxisReport;
 use crate::model::ParamId;
 use crate::spectrum::harmonics::LineOrigin;
+use crate::uncertainty::intervals::{PROFILE_68_NATS, PROFILE_MAX_STEPS};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -463,8 +463,8 @@ fn posterior_unconverged(
         f,
         "the posterior sample of {parameter} has not converged: split R̂ {r_hat:.3} (limit {}), \
          {ess:.0} effective draws (at least {}); run more steps or walkers",
-        super::RHAT_LIMIT,
-        super::MIN_ESS
+        crate::uncertainty::RHAT_LIMIT,
+        crate::uncertainty::MIN_ESS
     )
 }
 

@@ -268,7 +268,7 @@ pub struct FitSection {
     #[serde(default)]
     pub search: SearchSection,
     /// Confidence intervals: Laplace (from the likelihood's Fisher information) or parametric
-    /// bootstrap (see [`crate::fit::bootstrap_intervals`]).
+    /// bootstrap (see [`crate::uncertainty::bootstrap_intervals`]).
     #[serde(default)]
     pub uncertainty: UncertaintySection,
     /// The likelihood that model choice and Laplace intervals read ([`crate::search::evidence`]).

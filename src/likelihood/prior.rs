@@ -154,7 +154,7 @@ impl Prior {
 
     /// The log density (up to a constant) a posterior sample draws at `u`, from the fit's cost
     /// there (`cost_nats`: the recording's NLL plus [`Prior::nats`]): the likelihood tempered by
-    /// `w` ([`crate::fit::posterior_tempering`]), the prior not, and the prior's parameters
+    /// `w` ([`crate::uncertainty::posterior_tempering`]), the prior not, and the prior's parameters
     /// distributed with its own density in θ or ln θ ([`Prior::log_jacobian_u`]).
     pub fn log_posterior(
         &self,

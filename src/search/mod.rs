@@ -13,6 +13,12 @@
 //! * [`interrupt`]: SIGINT/SIGTERM stop a running search, which keeps its best point.
 //! * [`error`]: what can go wrong in a fit ([`FitError`]).
 //!
+//! The features cost (per band `b`, measured `d`, model `m`, model PSD plus the measurement's noise
+//! floor): `w_peak·(ln f_m/f_d / 0.01)² + w_level·(ln L_m/L_d / ln 2)² + w_shape·mean_k (ln P_m,k −
+//! ln P_d,k)²`. Two peak frequencies alone cannot pin down four parameters, hence the level and
+//! shape terms; the result still says which parameters the data leave undetermined (from the
+//! cost's curvature). With a recording, the default cost is its likelihood ([`evidence`]).
+//!
 //! Parameters are searched in normalised coordinates `u ∈ [0, 1]` (logarithmic for bounds spanning
 //! a factor ≥ 10).
 

@@ -258,7 +258,7 @@ pub(crate) struct CandidateFit {
     pub(crate) search_note: Option<String>,
     /// The deferred confirmation of an unconfirmed best end, until [`confirm_deferred`].
     pub(crate) unconfirmed: Option<Unconfirmed>,
-    /// The profile walk at the optimum ([`crate::fit::climb::climb_chosen`]), kept for its intervals.
+    /// The profile walk at the optimum ([`crate::uncertainty::climb::climb_chosen`]), kept for its intervals.
     pub(crate) profile_walk: Option<ProfileWalk>,
 }
 

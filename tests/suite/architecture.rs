@@ -23,6 +23,7 @@ const STAGES: &[&str] = &[
     "posterior",
     "estimate",
     "search",
+    "uncertainty",
     "fit",
     "explore",
     "campaign",

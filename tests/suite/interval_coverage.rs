@@ -3,7 +3,7 @@
 //! Synthetic recordings of the 1-DOF head model (cheap enough to fit many times) around the reversal,
 //! each with its own tracking noise (Gaussian, σ = 0.1 px per coordinate, as in the shipped sample:
 //! data/reversal/README.md), are fitted for k1 and C with parametric-bootstrap intervals at 68.27 %
-//! (`wiperlab::fit::bootstrap_intervals`). The recordings are simulated at rtol 1e-10, a hundred
+//! (`wiperlab::uncertainty::bootstrap_intervals`). The recordings are simulated at rtol 1e-10, a hundred
 //! times tighter than the fit's 1e-8, so that the fit's integrator error is part of what the
 //! intervals must cover (no inverse crime) while staying far below the tracking noise. With R recordings the number
 //! covering the truth is Binomial(R, 0.6827); the test accepts the central ~98 % of that law.
@@ -199,7 +199,7 @@ fn laplace_intervals_cover_the_truth_at_their_rate() {
 }
 
 /// Profile-likelihood intervals (each parameter walked out from the fit with the other re-polished,
-/// to the sandwich-calibrated rise, `wiperlab::fit::profile_intervals_at`) on the same 24
+/// to the sandwich-calibrated rise, `wiperlab::uncertainty::profile_intervals_at`) on the same 24
 /// recordings cover the truth at their rate (measured with these seeds: C 17/24, k1 14/24), and each
 /// contains its estimate. Where the likelihood
 /// is quadratic they are the Laplace intervals; the rise limit μ/2 with μ = σ²_sandwich/σ²_Fisher is

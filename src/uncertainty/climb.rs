@@ -2,7 +2,7 @@
 //! the fit moved on where a walk meets a point more likely than the search's end.
 //!
 //! Why: a walk re-polishes the other parameters at every step of one parameter
-//! ([`super::uncertainty::profile_intervals_at`]), so it follows the likelihood's valleys out to
+//! ([`super::intervals::profile_intervals_at`]), so it follows the likelihood's valleys out to
 //! where the interval ends, and it crosses the low ridges between shallow basins of a stick–slip
 //! likelihood that a search's polish stops in front of. On a calibration recording whose search
 //! ended 2.4 nats short of the truth's own cost, with B 41 % off and every Laplace interval but A's
@@ -13,8 +13,8 @@
 //! [`PROFILE_CLIMBS`] times. The last walk, at the optimum the fit reports, is kept for the
 //! profile intervals ([`ProfileWalk`]), so a fit that does not move pays for one walk.
 
-use super::Result;
-use super::uncertainty::{ProfileStart, profile_walk};
+use super::intervals::{ProfileStart, profile_walk};
+use crate::Result;
 use crate::job;
 use crate::search::interrupt;
 use crate::search::strategy::{
@@ -36,7 +36,7 @@ pub const PROFILE_CLIMBS: usize = 3;
 /// # Errors
 /// The polish's, the settling's and the walk's (a walk's failed simulations count as an infinite
 /// rise, not an error).
-pub(super) fn climb_chosen(
+pub(crate) fn climb_chosen(
     job: &job::LoadedJob,
     fits: &mut Vec<CandidateFit>,
     chosen: usize,

@@ -1,9 +1,8 @@
 //! Uncertainty stage: bootstrap intervals and identifiability warnings for the chosen model.
 
-use super::features::{features, noise_floor};
-use super::result::{FittedParam, Interval, IntervalMethod};
-use super::warning::{End, FitWarning};
 use crate::Result;
+use crate::estimate::warning::{End, FitWarning, SampledReason};
+use crate::estimate::{FittedParam, Interval, IntervalMethod};
 use crate::job::FreeParam;
 use crate::job::{self, NoiseSpectrum, UncertaintyMethod};
 use crate::posterior::PosteriorSummary;
@@ -14,6 +13,7 @@ use crate::search::strategy::{
     polish_pinned,
 };
 use crate::simulate::blade::BladeSimulation;
+use crate::spectrum::features::{features, noise_floor};
 use crate::spectrum::stats::quantile_sorted;
 use rand::SeedableRng;
 use std::sync::atomic::AtomicUsize;
@@ -29,7 +29,7 @@ use std::sync::{Arc, Mutex};
 ///
 /// # Errors
 /// As [`bootstrap_intervals`] and [`mcmc_intervals`].
-pub(super) fn intervals(
+pub(crate) fn intervals(
     cf: &CandidateFit,
     best_sim: &BladeSimulation,
     fit: &job::FitSection,
@@ -104,7 +104,7 @@ fn auto_intervals(
     }
     match widest_beyond(&factor) {
         Some(i) => {
-            let why = FitWarning::IntervalsSampled(super::warning::SampledReason {
+            let why = FitWarning::IntervalsSampled(SampledReason {
                 parameter: cf.free[i].name,
                 width_factor: factor[i],
             });
@@ -140,7 +140,7 @@ fn width_ratio((laplace, reached): (&Interval, &Interval)) -> f64 {
 }
 
 /// [`intervals`]' intervals, warnings and posterior sample.
-pub(super) type Intervals = (
+pub(crate) type Intervals = (
     Option<Vec<Interval>>,
     Vec<FitWarning>,
     Option<PosteriorSummary>,
@@ -782,7 +782,10 @@ pub fn mu_d_rise_limits(
 /// The friction laws of the points the chosen fit's search evaluated within the largest of
 /// `limits` (nats) of its cost, with each point's cost above the fit's
 /// ([`crate::search::problem::EvaluatedNearBest`]).
-pub fn near_best_laws(cf: &CandidateFit, limits: &[f64]) -> Vec<(f64, crate::model::FrictionLaw)> {
+pub(crate) fn near_best_laws(
+    cf: &CandidateFit,
+    limits: &[f64],
+) -> Vec<(f64, crate::model::FrictionLaw)> {
     let widest = limits.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let near = (cf.problem.near_best.lock()).unwrap_or_else(|e| e.into_inner());
     near.at_most(cf.cost + widest)
