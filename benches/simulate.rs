@@ -122,7 +122,7 @@ fn cost(c: &mut Criterion) {
         swarm_cost: Default::default(),
         objective: Objective::Likelihood,
         weights: Weights::default(),
-        likelihood: Err(wiperlab::fit::NoLikelihood::NotBuilt),
+        likelihood: Err(wiperlab::search::NoLikelihood::NotBuilt),
         evaluations: Arc::new(AtomicUsize::new(0)),
         failures: std::sync::Arc::new(AtomicUsize::new(0)),
         failure_causes: Default::default(),

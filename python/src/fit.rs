@@ -2,7 +2,7 @@
 //!
 //! The fit runs on a thread of its own while the calling thread waits without the GIL and looks
 //! for signals every [`POLL`]: Python's SIGINT handler (Ctrl-C) raises `KeyboardInterrupt` there,
-//! the fit is asked to stop ([`wiperlab::fit::interrupt::request_stop`]) and, as on the command
+//! the fit is asked to stop ([`wiperlab::search::interrupt::request_stop`]) and, as on the command
 //! line, writes its best-so-far result to `<name>.interrupted.result.toml` before the exception
 //! reaches the caller. No signal handler of wiperlab's own is installed, so Python keeps its.
 
@@ -13,8 +13,8 @@ use std::time::Duration;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError};
 use pyo3::prelude::*;
 use wiperlab::Error;
-use wiperlab::fit::interrupt;
 use wiperlab::job::LoadedJob;
+use wiperlab::search::interrupt;
 
 use crate::errors::{guard, panic_error, to_py};
 

@@ -20,7 +20,7 @@ named_enum! {
     pub enum SpreadSource: "spread source" {
         /// The sandwich `F⁻¹ V F⁻¹` of the recording's likelihood: its Gauss–Newton Fisher
         /// information `F` and its gradient's variance `V` under the recording's noise (positive
-        /// semi-definite by construction: [`crate::fit::evidence::at_fit`]).
+        /// semi-definite by construction: [`crate::search::evidence::at_fit`]).
         Sandwich => "sandwich",
         /// The inverse Fisher information of the recording's likelihood alone (results written
         /// before the sandwich).
@@ -93,7 +93,7 @@ pub struct ModelTrial {
     pub friction: Option<crate::model::FrictionLaw>,
 }
 
-/// One candidate's fit in likelihood units ([`crate::fit::evidence`], docs/likelihood.md, "Likelihood").
+/// One candidate's fit in likelihood units ([`crate::search::evidence`], docs/likelihood.md, "Likelihood").
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TrialEvidence {
     /// `ln L` at the candidate's fit, nats.
@@ -227,7 +227,7 @@ pub struct FitResult {
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub interrupted: bool,
     /// Whether the chosen model explains the recording's spectra to the recording's own noise: the
-    /// parametric-bootstrap test of [`crate::fit::evidence::RecordingLikelihood::goodness_of_fit`];
+    /// parametric-bootstrap test of [`crate::search::evidence::RecordingLikelihood::goodness_of_fit`];
     /// `None` without a likelihood (a target job, a joint fit), when interrupted, and in results
     /// written before this field.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -410,7 +410,7 @@ fn band_psd_figure(
     m: &BandFeatures,
     targets_only: bool,
 ) -> Result<()> {
-    // The cost adds the measurement's noise floor to the model PSD (src/fit/problem.rs, `cost_of`);
+    // The cost adds the measurement's noise floor to the model PSD (src/search/problem.rs, `cost_of`);
     // without it the model's deep stick–slip troughs look like misfits they are not.
     let floor = noise_floor(d);
     let markers = band_psd_markers(o, d, m, targets_only);

@@ -80,7 +80,7 @@ pub struct SpectralProblem {
 
 /// How far above the lowest cost seen (nats) [`EvaluatedNearBest`] keeps a point: above the
 /// profile rise limits the intervals use (0.5 nats times σ²_sandwich/σ²_Fisher,
-/// [`super::uncertainty::profile_rise_limit`]) for a sandwich up to twice the Fisher 1σ.
+/// [`crate::uncertainty::intervals::profile_rise_limit`]) for a sandwich up to twice the Fisher 1σ.
 pub const NEAR_BEST_MARGIN_NATS: f64 = 2.0;
 
 /// The points a problem's search evaluated at the polish's tolerance, inside the search box, with a
@@ -88,7 +88,7 @@ pub const NEAR_BEST_MARGIN_NATS: f64 = 2.0;
 /// the recording's likelihood found about as likely as the best. Each simulation the search runs
 /// is a sample of the likelihood; those near the best one outline the region it leaves open, which
 /// a curvature at the fit can miss where the likelihood is flat or bent
-/// ([`super::uncertainty::widen_to_near_best`]).
+/// ([`crate::uncertainty::intervals::widen_to_near_best`]).
 #[derive(Debug, Clone)]
 pub struct EvaluatedNearBest {
     lowest: f64,
@@ -432,7 +432,7 @@ impl CostFunction for Shared {
 }
 
 /// [`Shared`] with one normalised coordinate held: the cost as a function of the others (a
-/// profile likelihood's inner minimisation, [`super::uncertainty::profile_intervals`]).
+/// profile likelihood's inner minimisation, [`crate::uncertainty::intervals::profile_intervals`]).
 #[derive(Clone)]
 pub(crate) struct Pinned {
     pub(crate) shared: Shared,

@@ -215,7 +215,7 @@ where
 }
 
 /// An argmin observer that only moves the progress bar (no history, no best point): the polishes
-/// after the search ([`super::uncertainty::profile_intervals_at`]). `evals` counts the model runs
+/// after the search ([`crate::uncertainty::intervals::profile_intervals_at`]). `evals` counts the model runs
 /// of all of them.
 #[derive(Clone)]
 pub(crate) struct ProgressObserver {

@@ -224,7 +224,7 @@ fn main_job_end_to_end() {
     }
     // The shoulder candidate contains blade2dof (k1_contact = k1) and starts its search at its
     // optimum, bitwise the same parameters, which it keeps if no polish or restart ends lower
-    // (src/fit/search.rs, `nested_warm_points` and `nested_search`). There |θ| stays below 0.15 rad, under θ_c's upper
+    // (src/search/strategy.rs, `nested_warm_points` and `nested_search`). There |θ| stays below 0.15 rad, under θ_c's upper
     // bound 0.2, so the shoulder's simulation is bitwise blade2dof's: it cannot end above it.
     let cost_of = |m: &str| {
         num(
@@ -245,7 +245,7 @@ fn main_job_end_to_end() {
     let lnl = |m: &str| num(&evidence(m), "/log_likelihood_nats");
     let (full, shoulder, head1) = (lnl("blade2dof"), lnl("blade2dof+shoulder"), lnl("head1dof"));
     println!("ln L: blade2dof {full:.3}, +shoulder {shoulder:.3}, head1dof {head1:.3} nats");
-    // The search minimises the NLL above the saturated model's (src/fit/evidence.rs,
+    // The search minimises the NLL above the saturated model's (src/search/evidence.rs,
     // `excess_nll`), which differs from −ln L by a constant of the recording: cost differences
     // between candidates are their ln L differences.
     for m in ["head1dof", "blade2dof+shoulder"] {
