@@ -1,4 +1,5 @@
-//! What can go wrong in the fit stage: [`FitError`], each variant with its numbers and names.
+//! What can go wrong in a fit (setting up its problem, the search, the intervals): [`FitError`], each
+//! variant with its numbers and names.
 //!
 //! [`FitError::is_input`] tells the settings a user can fix (exit code 2) from a fit that failed
 //! (exit code 1).

@@ -1,5 +1,6 @@
-//! Search stage: each candidate fitted by particle swarm and Nelder–Mead polish (argmin), with its
-//! history and progress reported through argmin observers, and the cost's curvature at the optimum.
+//! The search strategy: each candidate fitted by particle swarm and Nelder–Mead polish (argmin),
+//! with its history and progress reported through argmin observers, and the cost's curvature at
+//! the optimum.
 
 use super::FitError;
 use super::evidence::LocalFit;
