@@ -119,6 +119,7 @@ fn cost(c: &mut Criterion) {
         window,
         solver,
         swarm_solver: solver,
+        local_solver: solver,
         swarm_cost: Default::default(),
         objective: Objective::Likelihood,
         weights: Weights::default(),

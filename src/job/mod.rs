@@ -396,6 +396,10 @@ pub struct SearchSection {
     pub local: LocalSearch,
     /// `swarm` with `local = "cmaes"`: model evaluations each local run may spend.
     pub local_evaluations: usize,
+    /// `swarm` with `local = "cmaes"`: the tolerance the local runs simulate at (atol scaled
+    /// alike). Default (`None`): `[solver]`'s. The polish after each run and everything the
+    /// result reports stay at `[solver]`'s.
+    pub local_rtol: Option<f64>,
     /// `swarm`: what the particle swarm ranks its particles by (default `features`).
     pub swarm_cost: SwarmCost,
 }
@@ -437,6 +441,7 @@ impl Default for SearchSection {
             max_evaluations: 4000,
             local: LocalSearch::NelderMead,
             local_evaluations: 1000,
+            local_rtol: None,
             swarm_cost: SwarmCost::Features,
         }
     }
@@ -1106,7 +1111,7 @@ impl Check<'_> {
             ));
         }
         if search.method == SearchMethod::Cmaes {
-            for key in ["local", "local_evaluations", "swarm_cost"] {
+            for key in ["local", "local_evaluations", "local_rtol", "swarm_cost"] {
                 if self.spans.contains(&at(key)) {
                     return Err(self.error(
                         &at(key),
@@ -1129,6 +1134,21 @@ impl Check<'_> {
                         ),
                     ));
                 }
+            }
+        }
+        if let Some(r) = search.local_rtol {
+            if !(r.is_finite() && r > 0.0 && r < 1.0) {
+                return Err(self.error(
+                    &at("local_rtol"),
+                    format!("[fit.search] local_rtol must be in (0, 1) (got {r})"),
+                ));
+            }
+            if search.local != LocalSearch::Cmaes {
+                return Err(self.error(
+                    &at("local_rtol"),
+                    "[fit.search] local_rtol sets the tolerance of the local CMA-ES runs: it \
+                     needs local = \"cmaes\" (docs/fit.md, \"The local CMA-ES stage\")",
+                ));
             }
         }
         Ok(())

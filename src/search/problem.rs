@@ -48,6 +48,8 @@ pub struct SpectralProblem {
     pub solver: SolverOptions,
     /// The solver of the particle-swarm stage (`[fit] swarm_rtol`; else `solver`).
     pub swarm_solver: SolverOptions,
+    /// The solver of the local CMA-ES stage (`[fit.search] local_rtol`; else `solver`).
+    pub local_solver: SolverOptions,
     /// What the particle swarm ranks by under the likelihood objective (`[fit.search] swarm_cost`).
     pub swarm_cost: crate::job::SwarmCost,
     /// What [`SpectralProblem::total_cost`] is: the likelihood or the weighted features.
@@ -363,12 +365,18 @@ impl SpectralProblem {
 
     /// [`SpectralProblem::cost_at`] with the simulations of `stage` (the swarm's may be coarser).
     ///
-    /// With the likelihood as the cost, a polish-stage evaluation inside the box is kept in
+    /// With the likelihood as the cost, an evaluation inside the box at the job's own tolerance
+    /// (not the swarm's, nor a looser local stage's, whose costs are not comparable) is kept in
     /// [`SpectralProblem::near_best`] when it is near the lowest seen.
     pub(crate) fn cost_at_stage(&self, u: &[f64], stage: SearchStage) -> f64 {
         let c = self.unrecorded_cost_at_stage(u, stage);
         let inside = u.iter().all(|x| (0.0..=1.0).contains(x));
-        if stage != SearchStage::Swarm && inside && c < FAILED_COST && self.cost_is_nll() {
+        if stage != SearchStage::Swarm
+            && *self.solver_of(stage) == self.solver
+            && inside
+            && c < FAILED_COST
+            && self.cost_is_nll()
+        {
             self.near_best
                 .lock()
                 .unwrap_or_else(|e| e.into_inner())
@@ -377,13 +385,19 @@ impl SpectralProblem {
         c
     }
 
+    /// The integrator settings `stage` simulates with.
+    fn solver_of(&self, stage: SearchStage) -> &SolverOptions {
+        match stage {
+            SearchStage::Swarm => &self.swarm_solver,
+            SearchStage::Local => &self.local_solver,
+            SearchStage::Polish | SearchStage::Cmaes => &self.solver,
+        }
+    }
+
     /// [`SpectralProblem::cost_at_stage`] without keeping the point (a joint fit's other
     /// recordings, whose cost is a part of the whole).
     fn unrecorded_cost_at_stage(&self, u: &[f64], stage: SearchStage) -> f64 {
-        let solver = match stage {
-            SearchStage::Swarm => &self.swarm_solver,
-            SearchStage::Polish | SearchStage::Cmaes | SearchStage::Local => &self.solver,
-        };
+        let solver = self.solver_of(stage);
         let outside: f64 = u
             .iter()
             .map(|x| (x - x.clamp(0.0, 1.0)).powi(2))

@@ -444,11 +444,11 @@ struct Recording<'a> {
     label: String,
 }
 
-/// The solver settings of the particle swarm: the job's, with `rtol` replaced by `[fit]
-/// swarm_rtol` (and `atol` scaled with it) when that is set.
-fn swarm_solver(job: &LoadedJob) -> SolverOptions {
+/// The job's solver settings with `rtol` replaced by `rtol` (and `atol` scaled with it) when that
+/// is set: a search stage's own tolerance (`[fit] swarm_rtol`, `[fit.search] local_rtol`).
+fn solver_at(job: &LoadedJob, rtol: Option<f64>) -> SolverOptions {
     let solver = job.job.solver;
-    match job.job.fit.swarm_rtol {
+    match rtol {
         Some(r) => SolverOptions {
             rtol: r,
             atol: solver.atol * r / solver.rtol,
@@ -501,7 +501,8 @@ fn problem_of(
         max_fill: job.job.spectrum.max_fill,
         window: (t[0], *t.last().unwrap_or(&t[0])),
         solver: job.job.solver,
-        swarm_solver: swarm_solver(job),
+        swarm_solver: solver_at(job, fit.swarm_rtol),
+        local_solver: solver_at(job, fit.search.local_rtol),
         swarm_cost: fit.search.swarm_cost,
         objective: fit.objective,
         weights: fit.weights,
@@ -2056,6 +2057,35 @@ mod tests {
             features < 2.0 && nll > 20.0,
             "feature cost {features:.3} against NLL {nll:.3} nats at the truth"
         );
+    }
+
+    /// `[fit.search] local_rtol = 1e-7` in the main job (`fits/reversal.toml`, `[solver]` rtol
+    /// 1e-8, atol 1e-10): the local stage simulates at rtol 1e-7 with atol scaled alike (1e-9),
+    /// so its cost at the truth differs from the polish's; only the polish's point enters the
+    /// near-best points the intervals read, whose costs must be the job's own.
+    #[test]
+    fn the_local_stage_simulates_at_its_own_tolerance_and_keeps_no_near_best_point() {
+        let (job, candidate, _) = main_job_problem();
+        let truth: serde_json::Value =
+            serde_json::from_str(&repository_file("data/reversal/truth.json")).expect("truth json");
+        let problem = problem_for(&job, candidate).expect("problem");
+        assert_eq!(problem.local_solver.rtol, 1e-7);
+        assert!((problem.local_solver.atol / 1e-9 - 1.0).abs() < 1e-12);
+        assert_eq!(problem.solver.rtol, 1e-8);
+        let u = coordinates(&problem, |name| {
+            truth["params"][name].as_f64().expect("true value")
+        });
+        let near = |p: &SpectralProblem| p.near_best.lock().unwrap().at_most(f64::INFINITY).count();
+        let local = problem.cost_at_stage(&u, SearchStage::Local);
+        assert_eq!(
+            near(&problem),
+            0,
+            "a local-stage point kept among the near-best"
+        );
+        let polish = problem.cost_at_stage(&u, SearchStage::Polish);
+        assert_eq!(near(&problem), 1, "the polish's point not kept");
+        assert!(local.is_finite() && polish.is_finite());
+        assert_ne!(local, polish, "rtol 1e-7 and 1e-8 gave the same cost");
     }
 
     /// A polish cut short (10 iterations) from A ×0.9 and B ×0.85 of the truth

@@ -1062,6 +1062,7 @@ impl ReplicateSource {
             window: problem.window,
             solver: problem.solver,
             swarm_solver: problem.swarm_solver,
+            local_solver: problem.local_solver,
             swarm_cost: problem.swarm_cost,
             objective: problem.objective,
             weights: problem.weights,

@@ -917,6 +917,21 @@ fn fit_cases() -> Vec<Case> {
             &["$D/job.toml:", "local", "no swarm"],
         ),
         case(
+            "fit: a local stage's tolerance of zero",
+            j(&[("local_rtol = 1e-7", "local_rtol = 0.0")]),
+            fit,
+            &["$D/job.toml:", "local_rtol must be in (0, 1)", "0"],
+        ),
+        case(
+            "fit: a local stage's tolerance without the local stage",
+            j(&[(
+                "local = \"cmaes\"              #",
+                "local = \"nelder-mead\" #",
+            )]),
+            fit,
+            &["$D/job.toml:", "local_rtol", "needs local = \"cmaes\""],
+        ),
+        case(
             "fit: an unknown swarm cost",
             j(&[("local = \"cmaes\"              #", "swarm_cost = \"nll\" #")]),
             fit,
@@ -924,10 +939,13 @@ fn fit_cases() -> Vec<Case> {
         ),
         case(
             "fit: a swarm cost beside the CMA-ES search",
-            j(&[(
-                "local = \"cmaes\"              #",
-                "method = \"cmaes\"\nswarm_cost = \"likelihood\" #",
-            )]),
+            j(&[
+                (
+                    "local = \"cmaes\"              #",
+                    "method = \"cmaes\"\nswarm_cost = \"likelihood\" #",
+                ),
+                ("local_rtol = 1e-7", "#"),
+            ]),
             fit,
             &["$D/job.toml:", "swarm_cost", "no swarm"],
         ),

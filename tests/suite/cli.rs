@@ -493,6 +493,7 @@ fn job_with_swarm_keys_beside_the_cmaes_search() {
         "local = \"cmaes\"              #",
         "method = \"cmaes\" #",
     );
+    let text = edit(&text, "local_rtol = 1e-7", "#");
     let job = dir.write("job.toml", &text);
     let o = run(&["fit", s(&job), "--quiet"]);
     let msg = input_error(
