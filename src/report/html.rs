@@ -620,14 +620,22 @@ fn fit_settings_line(f: &FitSection) -> String {
             f.weights.shape
         );
     }
+    let at_rtol = |rtol: Option<f64>| rtol.map_or_else(String::new, |r| format!(" at rtol {r:e}"));
+    let local = match f.search.local {
+        crate::job::LocalSearch::Cmaes => format!(
+            ", CMA-ES ≤ {} evaluations{}",
+            f.search.local_evaluations,
+            at_rtol(f.search.local_rtol)
+        ),
+        crate::job::LocalSearch::NelderMead => String::new(),
+    };
     format!(
-        "{} × (particle swarm {} particles × {} iterations{}, Nelder–Mead ≤ {} iterations), \
+        "{} × (particle swarm {} particles × {} iterations{}{local}, Nelder–Mead ≤ {} iterations), \
          best kept (seed {}); weights peak {}, level {}, shape {}",
         f.restarts.max(1),
         f.particles,
         f.swarm_iterations,
-        f.swarm_rtol
-            .map_or_else(String::new, |r| format!(" at rtol {r:e}")),
+        at_rtol(f.swarm_rtol),
         f.polish_iterations,
         f.seed,
         f.weights.peak,
@@ -1105,6 +1113,23 @@ fn result_warnings(r: &FitResult) -> Vec<PageWarning> {
 pub(super) mod tests {
     use super::*;
     use crate::io::sha256_hex;
+
+    /// The main job's search (`fits/reversal.toml`: 3 restarts of a 24 × 25 swarm at rtol 1e-6, a
+    /// local CMA-ES run of at most 1,000 evaluations at rtol 1e-7, a 60-iteration polish) in the
+    /// report's one line, each stage with its own tolerance.
+    #[test]
+    fn the_settings_line_names_each_search_stage_and_its_tolerance() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        let job = crate::job::LoadedJob::load(&root.join("fits/reversal.toml")).expect("main job");
+        let line = fit_settings_line(&job.job.fit);
+        assert!(
+            line.starts_with(
+                "3 × (particle swarm 24 particles × 25 iterations at rtol 1e-6, CMA-ES ≤ 1000 \
+                 evaluations at rtol 1e-7, Nelder–Mead ≤ 60 iterations), best kept (seed 1)"
+            ),
+            "{line}"
+        );
+    }
 
     #[test]
     fn line_words_give_the_origin_and_the_prominence() {
