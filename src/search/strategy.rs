@@ -444,8 +444,8 @@ struct Recording<'a> {
     label: String,
 }
 
-/// The job's solver settings with `rtol` replaced by `rtol` (and `atol` scaled with it) when that
-/// is set: a search stage's own tolerance (`[fit] swarm_rtol`, `[fit.search] local_rtol`).
+/// The job's solver settings with their rtol replaced by a search stage's own `rtol` (and atol
+/// scaled with it) when the job sets one (`[fit] swarm_rtol`, `[fit.search] local_rtol`).
 fn solver_at(job: &LoadedJob, rtol: Option<f64>) -> SolverOptions {
     let solver = job.job.solver;
     match rtol {
