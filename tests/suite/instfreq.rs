@@ -492,6 +492,7 @@ fn fit_job_with_freq_speed_and_trace_terms_runs_and_reports_them() {
         .replace("particles = 24", "particles = 2")
         .replace("swarm_iterations = 25", "swarm_iterations = 1")
         .replace("local = \"cmaes\"", "local = \"nelder-mead\"")
+        .replace("local_rtol = 1e-7", "#")
         .replace(
             "polish_iterations = 60",
             "polish_iterations = 1\nobjective = \"features\"",
