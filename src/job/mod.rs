@@ -1136,22 +1136,30 @@ impl Check<'_> {
                 }
             }
         }
-        if let Some(r) = search.local_rtol {
-            if !(r.is_finite() && r > 0.0 && r < 1.0) {
-                return Err(self.error(
-                    &at("local_rtol"),
-                    format!("[fit.search] local_rtol must be in (0, 1) (got {r})"),
-                ));
-            }
-            if search.local != LocalSearch::Cmaes {
-                return Err(self.error(
-                    &at("local_rtol"),
-                    "[fit.search] local_rtol sets the tolerance of the local CMA-ES runs: it \
-                     needs local = \"cmaes\" (docs/fit.md, \"The local CMA-ES stage\")",
-                ));
-            }
+        self.stage_rtol(
+            &at("local_rtol"),
+            "[fit.search] local_rtol",
+            search.local_rtol,
+        )?;
+        if search.local_rtol.is_some() && search.local != LocalSearch::Cmaes {
+            return Err(self.error(
+                &at("local_rtol"),
+                "[fit.search] local_rtol sets the tolerance of the local CMA-ES runs: it \
+                 needs local = \"cmaes\" (docs/fit.md, \"The local CMA-ES stage\")",
+            ));
         }
         Ok(())
+    }
+
+    /// A search stage's own tolerance (`[fit] swarm_rtol`, `[fit.search] local_rtol`), when set:
+    /// a relative tolerance in (0, 1).
+    fn stage_rtol(&self, at: &[Key], name: &str, rtol: Option<f64>) -> Result<()> {
+        match rtol {
+            Some(r) if !(r.is_finite() && r > 0.0 && r < 1.0) => {
+                Err(self.error(at, format!("{name} must be in (0, 1) (got {r})")))
+            }
+            _ => Ok(()),
+        }
     }
 
     /// Optimiser settings, candidate models and shoulder bounds.
@@ -1244,14 +1252,11 @@ impl Check<'_> {
                  them (the default objective, \"likelihood\", has no weights)",
             ));
         }
-        if let Some(r) = fit.swarm_rtol
-            && !(r.is_finite() && r > 0.0 && r < 1.0)
-        {
-            return Err(self.error(
-                &[Key::Name("fit"), Key::Name("swarm_rtol")],
-                format!("[fit] swarm_rtol must be in (0, 1) (got {r})"),
-            ));
-        }
+        self.stage_rtol(
+            &[Key::Name("fit"), Key::Name("swarm_rtol")],
+            "[fit] swarm_rtol",
+            fit.swarm_rtol,
+        )?;
         if let Some(b) = fit.likelihood.block_s {
             let at = [
                 Key::Name("fit"),
