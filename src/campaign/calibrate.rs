@@ -120,6 +120,41 @@ pub fn standardised_error(p: &FittedParam, truth: f64) -> Option<f64> {
     Some((t - v) / half * sigmas)
 }
 
+/// [`standardised_error`] of the interval the method gave before it was widened to the search's
+/// near-best points or the contact ridge (`widened_from`; the reported interval where it was
+/// not widened): what the method alone covers.
+pub fn method_standardised_error(p: &FittedParam, truth: f64) -> Option<f64> {
+    let iv = p.interval.as_ref()?;
+    let Some([lo, hi]) = iv.widened_from else {
+        return standardised_error(p, truth);
+    };
+    let own = FittedParam {
+        interval: Some(crate::fit::result::Interval {
+            lo,
+            hi,
+            widened_from: None,
+            ..iv.clone()
+        }),
+        ..p.clone()
+    };
+    standardised_error(&own, truth)
+}
+
+/// `p`'s standardised error against `truth` in units of its sandwich 1σ (`std_error`, carried to
+/// the search's coordinate by the derivative of `ln` on a log scale): the Laplace interval's, which
+/// the curvature and the noise replicates at the fit give; `None` without a finite positive 1σ.
+pub fn sandwich_standardised_error(p: &FittedParam, truth: f64) -> Option<f64> {
+    let sigma = if searched_on_log_scale(p) {
+        p.std_error / p.value
+    } else {
+        p.std_error
+    };
+    let g = |x: f64| {
+        if searched_on_log_scale(p) { x.ln() } else { x }
+    };
+    (sigma.is_finite() && sigma > 0.0).then(|| (g(truth) - g(p.value)) / sigma)
+}
+
 /// Whether `chosen` is `truth`'s model: the same model and shoulder, and the same law where the
 /// truth names one. A truth without a law (a campaign's `/model` names the dynamics only) is
 /// matched by a fit of that model with any law (`[fit] laws`): the law is scored as a curve.
@@ -150,6 +185,11 @@ pub struct Scored {
     pub z: Option<f64>,
     /// The reported interval's level (NaN without one).
     pub level: f64,
+    /// Standardised error of the method's own interval, before any widening
+    /// ([`method_standardised_error`]).
+    pub z_method: Option<f64>,
+    /// Standardised error in sandwich σ ([`sandwich_standardised_error`]).
+    pub z_sandwich: Option<f64>,
 }
 
 /// One recording of the calibration.
@@ -549,6 +589,8 @@ fn score(r: &mut RecordingScore, result: &FitResult) {
             truth,
             z: standardised_error(p, truth),
             level: p.interval.as_ref().map_or(f64::NAN, |i| i.level),
+            z_method: method_standardised_error(p, truth),
+            z_sandwich: sandwich_standardised_error(p, truth),
         });
     }
 }
@@ -626,6 +668,87 @@ fn reached_section(md: &mut String, c: &Calibration) {
              when the search and the integrator leave it nothing else to cover.\n"
         );
         stats_table(md, &param_stats(c.reached()));
+        variants_section(md, c);
+    }
+}
+
+/// One parameter's coverage by three intervals over a set of recordings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VariantCoverage {
+    pub param: ParamId,
+    /// Recordings scored by all three intervals.
+    pub n: usize,
+    /// `(68 %, 95 %)` counts of the reported interval, the method's own and the sandwich's.
+    pub reported: (usize, usize),
+    pub method: (usize, usize),
+    pub sandwich: (usize, usize),
+}
+
+/// Coverage of the reported interval, the method's own before widening and the sandwich Laplace
+/// interval, per parameter, over `recordings` where all three exist; 68.27 % is `|z| ≤ 1`, 95 %
+/// `|z| ≤ 1.96`.
+pub fn variant_coverage<'a>(
+    recordings: impl IntoIterator<Item = &'a RecordingScore>,
+) -> Vec<VariantCoverage> {
+    let wide = Normal::standard().inverse_cdf(0.5 * (1.0 + WIDE_LEVEL));
+    let mut by: BTreeMap<ParamId, VariantCoverage> = BTreeMap::new();
+    let count = |c: &mut (usize, usize), z: f64| {
+        c.0 += usize::from(z.abs() <= 1.0);
+        c.1 += usize::from(z.abs() <= wide);
+    };
+    for s in recordings.into_iter().flat_map(|r| &r.params) {
+        let (Some(z), Some(zm), Some(zs)) = (s.z, s.z_method, s.z_sandwich) else {
+            continue;
+        };
+        let v = by.entry(s.param).or_insert(VariantCoverage {
+            param: s.param,
+            n: 0,
+            reported: (0, 0),
+            method: (0, 0),
+            sandwich: (0, 0),
+        });
+        v.n += 1;
+        count(&mut v.reported, z);
+        count(&mut v.method, zm);
+        count(&mut v.sandwich, zs);
+    }
+    by.into_values().collect()
+}
+
+/// What the widening adds: [`variant_coverage`] over the fits that reached the truth.
+fn variants_section(md: &mut String, c: &Calibration) {
+    let rows = variant_coverage(c.reached());
+    if rows.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "\n### The method alone and the sandwich\n\n\
+         Over the same fits: how many truths the reported interval contains, the interval method's \
+         own before it was widened to the points the search evaluated within the rise limit or to \
+         the contact ridge (`widened_from`), and the Laplace interval of the sandwich 1σ \
+         (`std_error`, ±1σ and ±1.96σ in the search's coordinate). 68 % counts, then 95 %, with \
+         their bands (`{{p}}_z`, `{{p}}_z_method`, `{{p}}_z_sandwich` in \
+         calibration_recordings.csv).\n\n\
+         | parameter | scored | reported | method alone | sandwich | 68 % band | 95 % band |\n\
+         |---|---|---|---|---|---|---|"
+    );
+    for v in rows {
+        let (b68, b95) = (binomial_band(v.n, 0.6827), binomial_band(v.n, WIDE_LEVEL));
+        let pair = |c: (usize, usize)| format!("{}, {}", c.0, c.1);
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {}–{} | {}–{} |",
+            v.param,
+            v.n,
+            pair(v.reported),
+            pair(v.method),
+            pair(v.sandwich),
+            b68.0,
+            b68.1,
+            b95.0,
+            b95.1
+        );
     }
 }
 
@@ -812,10 +935,12 @@ pub fn to_markdown(c: &Calibration, notes: Option<&str>, command: &str) -> Strin
     let times: Vec<f64> = c.done().map(|r| r.wall_time_s).collect();
     let _ = writeln!(
         md,
-        "\n## Fit time\n\nWall time per fitted recording: median {} s, 90th percentile {} s, over {} fits.",
+        "\n## Fit time\n\nWall time per fitted recording: median {} s, 90th percentile {} s, over {} fits; \
+         {} h in all, one fit after another.",
         num(quantile(&times, 0.5), 1),
         num(quantile(&times, 0.9), 1),
-        times.len()
+        times.len(),
+        num(times.iter().sum::<f64>() / 3600.0, 2)
     );
     let failed: Vec<&RecordingScore> = c
         .recordings
@@ -944,7 +1069,13 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
     .map(String::from)
     .to_vec();
     for p in &params {
-        header.extend([format!("{p}"), format!("{p}_true"), format!("{p}_z")]);
+        header.extend([
+            format!("{p}"),
+            format!("{p}_true"),
+            format!("{p}_z"),
+            format!("{p}_z_method"),
+            format!("{p}_z_sandwich"),
+        ]);
     }
     w.write_record(&header).map_err(err)?;
     let name = |m: Option<Candidate>| m.map(|m| m.to_string()).unwrap_or_default();
@@ -983,8 +1114,10 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
                     csv_num(s.value),
                     csv_num(s.truth),
                     s.z.map(csv_num).unwrap_or_default(),
+                    s.z_method.map(csv_num).unwrap_or_default(),
+                    s.z_sandwich.map(csv_num).unwrap_or_default(),
                 ]),
-                None => rec.extend([String::new(), String::new(), String::new()]),
+                None => rec.extend(std::iter::repeat_n(String::new(), 5)),
             }
         }
         w.write_record(&rec).map_err(err)?;
@@ -1129,6 +1262,42 @@ mod tests {
         assert_eq!(standardised_error(&flat, 0.4), Some(f64::NEG_INFINITY));
     }
 
+    /// A profile interval [0.48, 0.52] around A = 0.5 widened to [0.40, 0.52], sandwich 1σ 0.01:
+    /// a truth at 0.45 lies inside the reported interval (z = −0.5), 2.5 half-widths outside the
+    /// method's own and 5σ outside the sandwich's; a truth at 0.51 is inside all three (z = 0.5, 0.5, 1).
+    #[test]
+    fn the_method_alone_and_the_sandwich_are_scored_beside_the_reported_interval() {
+        let mut a = param(ParamId::A, 0.5, [0.2, 1.5], [0.40, 0.52]);
+        a.std_error = 0.01;
+        if let Some(iv) = a.interval.as_mut() {
+            iv.widened_from = Some([0.48, 0.52]);
+        }
+        let sigma = Normal::standard().inverse_cdf(0.5 * 1.6827);
+        let close = |x: Option<f64>, want: f64| (x.unwrap() - want).abs() < 1e-9;
+        assert!(close(standardised_error(&a, 0.45), -0.5 * sigma));
+        assert!(close(method_standardised_error(&a, 0.45), -2.5 * sigma));
+        assert!(close(sandwich_standardised_error(&a, 0.45), -5.0));
+        assert!(close(method_standardised_error(&a, 0.51), 0.5 * sigma));
+        assert!(close(sandwich_standardised_error(&a, 0.51), 1.0));
+        // Not widened: the method's own interval is the reported one.
+        let b = param(ParamId::A, 0.5, [0.2, 1.5], [0.45, 0.6]);
+        assert_eq!(
+            method_standardised_error(&b, 0.7),
+            standardised_error(&b, 0.7)
+        );
+        assert_eq!(sandwich_standardised_error(&b, 0.7), None);
+        // Counted per interval over a recording whose three z differ.
+        let mut r = recording(&[0.5]);
+        r.params[0].z_method = Some(1.5);
+        r.params[0].z_sandwich = Some(2.5);
+        let v = variant_coverage([&r]);
+        assert_eq!(v.len(), 1);
+        assert_eq!(
+            (v[0].n, v[0].reported, v[0].method, v[0].sandwich),
+            (1, (1, 1), (0, 1), (0, 0))
+        );
+    }
+
     fn recording(z: &[f64]) -> RecordingScore {
         RecordingScore {
             id: "r".into(),
@@ -1148,6 +1317,8 @@ mod tests {
                     truth: 1.0,
                     z: Some(z),
                     level: 0.6827,
+                    z_method: Some(z),
+                    z_sandwich: Some(z),
                 })
                 .collect(),
             departure: None,
