@@ -8,7 +8,10 @@
 //! - `sandwich`: `0.5·σ²_sandwich/σ²_Fisher` nats, the fit's own (the composite likelihood's
 //!   magnitude adjustment at the optimum: Kent 1982; Varin, Reid & Firth 2011);
 //! - `wilks68`: 0.5 nats, the 68.27 % point of χ²₁/2 for a likelihood taken at face value;
-//! - `wilks95`: 1.92 nats, its 95 % point.
+//! - `wilks95`: 1.92 nats, its 95 % point;
+//! - `no-valley`: the fit's own limit, each step's polish started where the previous one ended
+//!   instead of on the valley of `F⁻¹` ([`wiperlab::uncertainty::valley_start`]): what the
+//!   predictor step changes.
 //!
 //! For each it prints every parameter's interval and whether it contains the truth, and the NLL at
 //! the truth above the fit (the likelihood-ratio statistic the thresholds are compared with). The
@@ -45,10 +48,12 @@ enum Limit {
     Fixed(f64),
 }
 
-const LIMITS: [(&str, Limit); 3] = [
-    ("sandwich", Limit::Sandwich),
-    ("wilks68", Limit::Fixed(0.5)),
-    ("wilks95", Limit::Fixed(1.920_729_410_347_062)),
+/// The walks: name, limit, and whether each step's polish may start on the valley of `F⁻¹`.
+const LIMITS: [(&str, Limit, bool); 4] = [
+    ("sandwich", Limit::Sandwich, true),
+    ("no-valley", Limit::Sandwich, false),
+    ("wilks68", Limit::Fixed(0.5), true),
+    ("wilks95", Limit::Fixed(1.920_729_410_347_062), true),
 ];
 
 fn main() -> Fallible<()> {
@@ -78,7 +83,7 @@ fn main() -> Fallible<()> {
         p.cost_at(&u_true) - cost
     );
     let lf = at_fit_smoothed(&p, &u_fit)?;
-    for (name, limit) in LIMITS {
+    for (name, limit, valley) in LIMITS {
         // `profile_rise_limit` is 0.5·(σ_s/σ_f)²: a Fisher 1σ of σ_s·√(0.5/limit) gives `limit`.
         let fisher: Vec<f64> = match limit {
             Limit::Sandwich => lf.curvature_sigma_u.clone(),
@@ -89,6 +94,7 @@ fn main() -> Fallible<()> {
             cost_nats: cost,
             sigma_u: &lf.sigma_u,
             fisher_sigma_u: &fisher,
+            fisher_corr: valley.then_some(lf.curvature_corr.as_slice()),
         };
         let (intervals, _) = profile_intervals_at(&p, at, job.job.fit.polish_iterations)?;
         let cells: Vec<String> = p

@@ -124,6 +124,7 @@ fn walk(
         cost_nats: f.cost,
         sigma_u: &spread.sigma_u,
         fisher_sigma_u: &spread.curvature_sigma_u,
+        fisher_corr: Some(&spread.curvature_corr),
     };
     let (intervals, warnings) = profile_walk(f, at, polish_iterations, pb)?;
     Ok(Some(ProfileWalk {

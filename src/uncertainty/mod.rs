@@ -12,7 +12,7 @@ pub mod intervals;
 
 pub use intervals::{
     MIN_ESS, ProfileStart, RHAT_LIMIT, bootstrap_intervals, identifiability_warnings,
-    laplace_intervals, mu_d_rise_limits, posterior_tempering, profile_intervals_at,
+    laplace_intervals, mu_d_rise_limits, posterior_tempering, profile_intervals_at, valley_start,
     widen_to_near_best,
 };
 /// The chosen fit's intervals by the job's method ([`intervals::intervals`]), and the friction laws
