@@ -595,7 +595,8 @@ pub fn valley_start(
 /// Raue et al. 2009, *Bioinformatics* 25:15, for models of this kind): for each freed parameter
 /// and each side, [`profile_end`] with the other parameters re-polished by Nelder–Mead
 /// (`polish_iterations`, initial simplex [`POLISH_STEP_U`]) at every step, each polish starting where the
-/// previous one ended, and the limit [`profile_rise_limit`] from the parameter's sandwich and
+/// previous one ended or, where that is more likely, on the valley of `F⁻¹` ([`valley_start`],
+/// with `at.fisher_corr`), and the limit [`profile_rise_limit`] from the parameter's sandwich and
 /// Fisher 1σ. Where the likelihood is quadratic this gives the Laplace interval; where it is flat
 /// or bent (a ridge, a valley) the interval follows the likelihood instead of its curvature at the
 /// fit. The 2k walks run in parallel; each costs one polish per step, typically two or three. A
