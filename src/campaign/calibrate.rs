@@ -100,24 +100,24 @@ fn searched_on_log_scale(p: &FittedParam) -> bool {
     FreeParam::new(p.name, p.lower, p.upper).log
 }
 
+/// The search's coordinate of `p` (`ln` on a log scale, [`searched_on_log_scale`]).
+fn search_coordinate(p: &FittedParam) -> impl Fn(f64) -> f64 {
+    let log = searched_on_log_scale(p);
+    move |x: f64| if log { x.ln() } else { x }
+}
+
+/// The z of a 1σ-equivalent half-width at `level`: `Φ⁻¹((1 + level)/2)`.
+fn sigmas_at(level: f64) -> f64 {
+    Normal::standard().inverse_cdf(0.5 * (1.0 + level))
+}
+
 /// `p`'s standardised error against `truth`: `(g(truth) − g(value)) / h · Φ⁻¹((1 + level)/2)`,
 /// with `g` the search's coordinate (`ln` on a log scale) and `h` the interval's half-width in
 /// it on the truth's side; `±∞` when that side has no width and the truth lies beyond it; `None`
 /// without an interval.
 pub fn standardised_error(p: &FittedParam, truth: f64) -> Option<f64> {
     let iv = p.interval.as_ref()?;
-    let log = searched_on_log_scale(p);
-    let g = |x: f64| if log { x.ln() } else { x };
-    let (v, t) = (g(p.value), g(truth));
-    let half = if t >= v { g(iv.hi) - v } else { v - g(iv.lo) };
-    let sigmas = Normal::standard().inverse_cdf(0.5 * (1.0 + iv.level));
-    if t == v {
-        return Some(0.0);
-    }
-    if half.is_nan() || half <= 0.0 {
-        return Some(f64::INFINITY.copysign(t - v));
-    }
-    Some((t - v) / half * sigmas)
+    Some(error_in_interval(p, [iv.lo, iv.hi], iv.level, truth))
 }
 
 /// [`standardised_error`] of the interval the method gave before it was widened to the search's
@@ -125,19 +125,22 @@ pub fn standardised_error(p: &FittedParam, truth: f64) -> Option<f64> {
 /// not widened): what the method alone covers.
 pub fn method_standardised_error(p: &FittedParam, truth: f64) -> Option<f64> {
     let iv = p.interval.as_ref()?;
-    let Some([lo, hi]) = iv.widened_from else {
-        return standardised_error(p, truth);
-    };
-    let own = FittedParam {
-        interval: Some(crate::fit::result::Interval {
-            lo,
-            hi,
-            widened_from: None,
-            ..iv.clone()
-        }),
-        ..p.clone()
-    };
-    standardised_error(&own, truth)
+    let own = iv.widened_from.unwrap_or([iv.lo, iv.hi]);
+    Some(error_in_interval(p, own, iv.level, truth))
+}
+
+/// [`standardised_error`] for the interval `[lo, hi]` at `level` around `p`'s value.
+fn error_in_interval(p: &FittedParam, [lo, hi]: [f64; 2], level: f64, truth: f64) -> f64 {
+    let g = search_coordinate(p);
+    let (v, t) = (g(p.value), g(truth));
+    if t == v {
+        return 0.0;
+    }
+    let half = if t >= v { g(hi) - v } else { v - g(lo) };
+    if half.is_nan() || half <= 0.0 {
+        return f64::INFINITY.copysign(t - v);
+    }
+    (t - v) / half * sigmas_at(level)
 }
 
 /// `p`'s standardised error against `truth` in units of its sandwich 1σ (`std_error`, carried to
@@ -149,9 +152,7 @@ pub fn sandwich_standardised_error(p: &FittedParam, truth: f64) -> Option<f64> {
     } else {
         p.std_error
     };
-    let g = |x: f64| {
-        if searched_on_log_scale(p) { x.ln() } else { x }
-    };
+    let g = search_coordinate(p);
     (sigma.is_finite() && sigma > 0.0).then(|| (g(truth) - g(p.value)) / sigma)
 }
 
@@ -292,7 +293,7 @@ pub fn param_stats<'a>(
             by.entry(s.param).or_default().push(s);
         }
     }
-    let wide_sigmas = Normal::standard().inverse_cdf(0.5 * (1.0 + WIDE_LEVEL));
+    let wide_sigmas = sigmas_at(WIDE_LEVEL);
     by.into_iter()
         .map(|(param, scored)| {
             let zs: Vec<(f64, f64)> = scored
@@ -301,10 +302,7 @@ pub fn param_stats<'a>(
                 .collect();
             let n = zs.len();
             let level = zs.first().map_or(f64::NAN, |z| z.1);
-            let covered = zs
-                .iter()
-                .filter(|(z, l)| z.abs() <= Normal::standard().inverse_cdf(0.5 * (1.0 + l)))
-                .count();
+            let covered = zs.iter().filter(|(z, l)| z.abs() <= sigmas_at(*l)).count();
             let covered_wide = zs.iter().filter(|(z, _)| z.abs() <= wide_sigmas).count();
             let sum_z2: f64 = zs.iter().map(|(z, _)| z * z).sum();
             let rel: Vec<f64> = scored
@@ -690,7 +688,7 @@ pub struct VariantCoverage {
 pub fn variant_coverage<'a>(
     recordings: impl IntoIterator<Item = &'a RecordingScore>,
 ) -> Vec<VariantCoverage> {
-    let wide = Normal::standard().inverse_cdf(0.5 * (1.0 + WIDE_LEVEL));
+    let wide = sigmas_at(WIDE_LEVEL);
     let mut by: BTreeMap<ParamId, VariantCoverage> = BTreeMap::new();
     let count = |c: &mut (usize, usize), z: f64| {
         c.0 += usize::from(z.abs() <= 1.0);
