@@ -180,7 +180,7 @@ fn search_slices(
             candidate,
             pb,
             Some(smaller),
-            Confirmation::Now,
+            (Confirmation::Now, None),
         )?;
         found.evaluations += f.problem.evaluations.load(Ordering::Relaxed);
         found.failures += f.problem.failures.load(Ordering::Relaxed);

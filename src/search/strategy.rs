@@ -381,7 +381,8 @@ fn restarts_budget(fit: &job::FitSection, n: usize) -> u64 {
 /// without shoulder when that came first (see [`fit_candidate`]). With more than one candidate,
 /// the confirmation of a best end that no second restart reached is deferred
 /// ([`Confirmation::Deferred`], [`confirm_deferred`]) for every candidate that no later one starts
-/// from.
+/// from, and for one that trails a candidate fitted before it by more than its ends' spread
+/// ([`hopelessly_behind`]).
 pub(crate) fn fit_candidates(
     job: &LoadedJob,
     meas: &Measurement,
@@ -397,13 +398,23 @@ pub(crate) fn fit_candidates(
         } else {
             Confirmation::Now
         };
-        let fitted = fit_candidate(job, meas, *c, pb, nested, confirmation)?;
+        let fitted = fit_candidate(job, meas, *c, pb, nested, (confirmation, leader(&fits)))?;
         fits.push(fitted);
         if interrupt::stop_requested() {
             break;
         }
     }
     Ok(fits)
+}
+
+/// The lowest cost (nats: the recording's NLL) among the candidates fitted so far, the one a
+/// later candidate's search is measured against ([`hopelessly_behind`]); `None` before the first
+/// or without a likelihood.
+fn leader(fits: &[CandidateFit]) -> Option<f64> {
+    fits.iter()
+        .filter(|f| f.problem.cost_is_nll() && f.cost.is_finite())
+        .map(|f| f.cost)
+        .min_by(f64::total_cmp)
 }
 
 /// The cost problem of one candidate: its freed parameters (the job's, plus the shoulder's when
@@ -550,13 +561,17 @@ pub fn problem_for(job: &LoadedJob, candidate: Candidate) -> Result<SpectralProb
 /// the larger model then cannot end above the smaller one's cost, which the AIC comparison of
 /// nested models assumes. Without the warm particle a swarm can leave the larger candidate above
 /// the optimum of the model it contains.
+///
+/// `leader`: the lowest cost of the candidates fitted before ([`leader`]). A search that ends
+/// hopelessly behind it ([`hopelessly_behind`]) leaves its confirmation, or a nested candidate's
+/// global search, to [`confirm_deferred`], which runs it only where it could change the choice.
 pub(crate) fn fit_candidate(
     job: &LoadedJob,
     meas: &Measurement,
     candidate: Candidate,
     pb: &Option<indicatif::ProgressBar>,
     nested: Option<&CandidateFit>,
-    confirmation: Confirmation,
+    (confirmation, leader): (Confirmation, Option<f64>),
 ) -> Result<CandidateFit> {
     let started = std::time::Instant::now();
     let reporting = Reporting::new(pb, candidate);
@@ -572,7 +587,7 @@ pub(crate) fn fit_candidate(
         nested.map(|s| (s.search_cost, candidate.nested_phrase(&s.candidate))),
         &warm,
         &reporting,
-        confirmation,
+        (confirmation, leader),
     )?;
     let unconfirmed = found.unconfirmed_ends.clone().map(|ends| Unconfirmed {
         ends,
@@ -1014,15 +1029,8 @@ pub const DEFERRED_CONFIRM_MARGIN_NATS: f64 = 5.0;
 /// candidate's (+∞ when it cannot be chosen). It is skipped when the candidate trails by more than
 /// the spread of its ends plus [`DEFERRED_CONFIRM_MARGIN_NATS`] (in nats: half the TIC gap).
 fn confirmation_skipped(ends: &[f64], score_gap: f64) -> Option<String> {
-    let (lo, hi) = ends
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &c| {
-            (lo.min(c), hi.max(c))
-        });
     let behind_nats = 0.5 * score_gap;
-    if behind_nats.is_nan() || behind_nats <= (hi - lo) + DEFERRED_CONFIRM_MARGIN_NATS {
-        return None;
-    }
+    let (lo, hi) = hopelessly_behind(ends, behind_nats)?;
     let why = if behind_nats.is_finite() {
         format!(
             "{behind_nats:.1} nats behind the chosen model, more than that spread + \
@@ -1036,6 +1044,22 @@ fn confirmation_skipped(ends: &[f64], score_gap: f64) -> Option<String> {
          {why}",
         ends.len()
     ))
+}
+
+/// The range `(lowest, highest)` of a search's finite ends `ends` (nats) when the search trails
+/// by `behind_nats` more than their spread plus [`DEFERRED_CONFIRM_MARGIN_NATS`]: a basin as far
+/// below the best end as the ends spread above it would still leave the candidate that far
+/// behind, so more restarts could not make it the choice. `None` otherwise (or when `behind_nats`
+/// is NaN).
+pub(crate) fn hopelessly_behind(ends: &[f64], behind_nats: f64) -> Option<(f64, f64)> {
+    let (lo, hi) = ends
+        .iter()
+        .filter(|c| c.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &c| {
+            (lo.min(c), hi.max(c))
+        });
+    let beyond = behind_nats > (hi - lo) + DEFERRED_CONFIRM_MARGIN_NATS;
+    (lo <= hi && beyond).then_some((lo, hi))
 }
 
 /// Runs the deferred second batch of restarts (`R..2R`) of each candidate whose best end is
@@ -1110,7 +1134,7 @@ fn search(
     nested: Option<(f64, String)>,
     warm: &[Vec<f64>],
     reporting: &Reporting,
-    confirmation: Confirmation,
+    (confirmation, leader): (Confirmation, Option<f64>),
 ) -> Result<(Optimised, Option<String>)> {
     let fit = &job.job.fit;
     if fit.search.method == job::SearchMethod::Cmaes {
@@ -1122,7 +1146,7 @@ fn search(
         && fit.objective == job::Objective::Likelihood
         && job.job.targets.is_none();
     if configured && problem.cost_is_nll() {
-        return nested_search(problem, fit, warm, nested, reporting, confirmation);
+        return nested_search(problem, fit, warm, nested, reporting, (confirmation, leader));
     }
     if configured && let Some(pb) = &reporting.progress {
         // The bar counted an adaptive search, but this problem has no likelihood to gauge it.
@@ -1131,6 +1155,10 @@ fn search(
             restarts_budget(fit, n).saturating_sub(NESTED_WARM_POINTS * polish_budget(fit, n)),
         );
     }
+    let confirmation = match (confirmation, leader) {
+        (Confirmation::Now, Some(l)) => Confirmation::NowUnlessBehind(l),
+        (c, _) => c,
+    };
     let found = optimise(problem, fit, fit.seed, warm, Some(reporting), confirmation)?;
     Ok((found, None))
 }
@@ -1159,7 +1187,7 @@ fn nested_search(
     warm: &[Vec<f64>],
     smaller: Option<(f64, String)>,
     reporting: &Reporting,
-    confirmation: Confirmation,
+    (confirmation, leader): (Confirmation, Option<f64>),
 ) -> Result<(Optimised, Option<String>)> {
     use rayon::prelude::*;
     reporting.stage(format_args!("local search"));
@@ -1188,6 +1216,7 @@ fn nested_search(
         })
         .collect();
     let mut local: Option<(Vec<f64>, f64)> = warm.first().map(|w| (w.clone(), at_warm));
+    let mut ends = vec![at_warm, smaller_search_cost];
     let mut polish_iters = 0;
     for run in runs {
         let (u, iters, cost) = match run {
@@ -1195,12 +1224,37 @@ fn nested_search(
             other => other?,
         };
         polish_iters += iters;
+        ends.push(cost);
         if local.as_ref().is_none_or(|b| cost < b.1) {
             local = Some((u, cost));
         }
     }
     let (u, cost) = local.ok_or(FitError::NoNestedStart)?;
     let gain = base - cost;
+    let behind = match (confirmation, leader) {
+        (Confirmation::Deferred, Some(l)) if gain > NESTED_GLOBAL_GAIN_NATS => {
+            hopelessly_behind(&ends, cost - l).map(|_| cost - l)
+        }
+        _ => None,
+    };
+    if let Some(behind_nats) = behind {
+        // The global search is the deferred confirmation's second batch of restarts.
+        let ends: Vec<f64> = ends.into_iter().filter(|c| c.is_finite()).collect();
+        let note = format!(
+            "local search ended {gain:.3} nats below {smaller}'s search (> \
+             {NESTED_GLOBAL_GAIN_NATS}), {behind_nats:.1} nats behind the best candidate fitted \
+             before it, more than its ends' spread + {DEFERRED_CONFIRM_MARGIN_NATS} nats: global \
+             search only where it could change the choice"
+        );
+        let found = Optimised {
+            u,
+            swarm_iters: 0,
+            polish_iters,
+            cost,
+            unconfirmed_ends: Some(ends),
+        };
+        return Ok((found, Some(note)));
+    }
     if gain <= NESTED_GLOBAL_GAIN_NATS || interrupt::stop_requested() {
         let note = format!(
             "local search only: it ended {gain:.3} nats below {smaller}'s search, not more than {NESTED_GLOBAL_GAIN_NATS} nats: its extra parameters do \
@@ -1399,7 +1453,16 @@ pub(crate) fn optimise(
     );
     let unconfirmed =
         restarts > 1 && problem.cost_is_nll() && !confirmed(&ends) && !interrupt::stop_requested();
-    if unconfirmed && confirmation == Confirmation::Now {
+    let deferred = unconfirmed
+        && match confirmation {
+            Confirmation::Now => false,
+            Confirmation::Deferred => true,
+            Confirmation::NowUnlessBehind(leader) => {
+                let best = ends.iter().copied().fold(f64::INFINITY, f64::min);
+                hopelessly_behind(&ends, best - leader).is_some()
+            }
+        };
+    if unconfirmed && !deferred {
         // No second restart reached the best one's basin: one more batch of restarts.
         runs.extend(more_restarts(problem, fit, seed, log));
     }
@@ -1427,7 +1490,6 @@ pub(crate) fn optimise(
             FitError::NoRun
         }
     })?;
-    let deferred = unconfirmed && confirmation == Confirmation::Deferred;
     Ok(Optimised {
         u,
         swarm_iters,
@@ -1552,10 +1614,13 @@ fn more_restarts(
 /// second batch of restarts at once (`Now`: the candidate's optimum is needed before the next
 /// candidate starts, or it is the only one), or leaves it to [`confirm_deferred`] once every
 /// candidate is fitted (`Deferred`), which runs it only where it could change the model choice.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum Confirmation {
     Now,
     Deferred,
+    /// At once, unless the best end trails the lowest cost of the candidates fitted before (nats)
+    /// hopelessly ([`hopelessly_behind`]): then deferred, as no restart could make it the choice.
+    NowUnlessBehind(f64),
 }
 
 /// What [`optimise`] found.
@@ -2160,6 +2225,21 @@ mod tests {
         let never = confirmation_skipped(&ends, f64::INFINITY).unwrap();
         assert!(never.contains("cannot be chosen"), "{never}");
         assert!(confirmation_skipped(&ends, f64::NAN).is_none());
+    }
+
+    #[test]
+    fn a_search_is_hopelessly_behind_only_beyond_the_spread_of_its_finite_ends() {
+        // Shaped like a head-only recording's blade2dof+shoulder (calibration cal_091): the smaller
+        // model's search end, a warm point that could not be simulated, two local polish ends,
+        // and the candidate 2533.7 nats behind head1dof.
+        let ends = [2914.0, f64::INFINITY, 2602.67, 2750.0];
+        assert_eq!(hopelessly_behind(&ends, 2533.7), Some((2602.67, 2914.0)));
+        let edge = 2914.0 - 2602.67 + DEFERRED_CONFIRM_MARGIN_NATS;
+        assert!(hopelessly_behind(&ends, 0.999 * edge).is_none());
+        assert!(hopelessly_behind(&ends, 1.001 * edge).is_some());
+        // No finite end, or no gap to read: never behind.
+        assert!(hopelessly_behind(&[f64::INFINITY], 1e9).is_none());
+        assert!(hopelessly_behind(&ends, f64::NAN).is_none());
     }
 
     #[test]
