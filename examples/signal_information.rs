@@ -1,0 +1,439 @@
+//! How much each tracked signal, and the signals together, tell about the freed parameters: the
+//! Fisher information of a Whittle likelihood at the truth of a job with a `[truth]`, for each
+//! signal alone (the univariate Whittle likelihood the fit reads, with `[spectrum] signal`) and for
+//! the signals together (the multivariate Whittle likelihood of their Welch cross-spectral matrix).
+//!
+//! Per band and interior bin `k` the expected cross-spectral matrix is `S_k = S_sim,k + N`: the
+//! simulation's Welch cross-spectra plus the tracking noise's, and the Fisher information of a
+//! complex-Wishart Welch matrix with `ν` equivalent degrees of freedom is
+//! `F_ij = (ν/2)/φ · Σ_k Re tr(S_k⁻¹ ∂_i S_k S_k⁻¹ ∂_j S_k)` (Whittle 1953, *Ark. Mat.* 2:423;
+//! Brillinger, *Time Series: Data Analysis and Theory*, 1981, §7.2 and §9.2 for the complex
+//! Wishart law of a smoothed cross-spectral matrix). For one signal it is the fit's own
+//! Gauss–Newton information `(α/φ)·Σ_k (∂ln S_k)²` (`src/search/evidence.rs`), with `ν` and the
+//! correlated-bin factor `φ` of the band ([`wiperlab::likelihood::WelchLikelihood`]). Derivatives are
+//! central differences of step [`FISHER_STEP_U`] in the search's normalised coordinates.
+//!
+//! The tracking noise is read as white, independent between coordinates and of one σ per
+//! coordinate, `σ = σ̂/√2` from the recording's own estimate `σ̂` of tip − head x (the fit's,
+//! `1.4826·MAD(Δ²x)/√6`): so each signal's noise and the noise shared by two signals (tip − head y
+//! and head y share the head's y) follow from which coordinates they difference. The simulated
+//! signals have no gaps (the recording's lost frames are not masked), so this is the information of
+//! a complete recording.
+//!
+//! Prints, per configuration, each parameter's 1σ from `F⁻¹` (normalised units, and relative to
+//! the truth's value), and the ratio of the first signal's 1σ to the joint one.
+//!
+//! ```sh
+//! cargo run --release --example signal_information -- JOB.toml --model blade2dof+shoulder \
+//!     --signals tip_rel_x,head_y,tip_rel_y
+//! ```
+
+use clap::Parser;
+use nalgebra::{Complex, DMatrix};
+use realfft::RealFftPlanner;
+use std::path::PathBuf;
+use wiperlab::job::{Candidate, LoadedJob};
+use wiperlab::likelihood::{WelchLikelihood, interior_bin};
+use wiperlab::search::evidence::FISHER_STEP_U;
+use wiperlab::search::problem_for;
+use wiperlab::spectrum::features::SignalKind;
+use wiperlab::spectrum::welch::{Detrend, WelchConfig, WelchPlan};
+
+#[derive(Parser)]
+struct Args {
+    /// Fit jobs (each with `[truth]` for every freed parameter of the candidate).
+    jobs: Vec<PathBuf>,
+    /// Also every recording of this campaign: its jobs are generated as `wiperlab campaign`
+    /// generates them, into `<--out-dir>/jobs/`.
+    #[arg(long)]
+    campaign: Option<PathBuf>,
+    /// The campaign's output directory (as `wiperlab campaign --out-dir`).
+    #[arg(long)]
+    out_dir: Option<PathBuf>,
+    /// The candidate model (`blade2dof`, `head1dof`, `blade2dof+shoulder`, ...); default: each
+    /// job's true model (`[truth] model`).
+    #[arg(long)]
+    model: Option<String>,
+    /// The signals, the fit's own first.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "tip_rel_x,head_y,tip_rel_y"
+    )]
+    signals: Vec<String>,
+    /// Append one row per configuration and parameter to this CSV (`job,model,signals,parameter,
+    /// truth,sigma_u,relative_sigma`; a header when the file is new).
+    #[arg(long)]
+    csv: Option<PathBuf>,
+}
+
+type Fallible<T> = Result<T, Box<dyn std::error::Error>>;
+
+/// Coefficients of a signal on the tracked coordinates (head x, head y, tip x, tip y).
+fn coordinates(s: SignalKind) -> [f64; 4] {
+    match s {
+        SignalKind::TipRelX => [-1.0, 0.0, 1.0, 0.0],
+        SignalKind::TipRelY => [0.0, -1.0, 0.0, 1.0],
+        SignalKind::HeadY => [0.0, 1.0, 0.0, 0.0],
+        SignalKind::TipX => [0.0, 0.0, 1.0, 0.0],
+    }
+}
+
+/// One band's Welch segments' spectra of several signals: `[bin][signal]` per segment.
+struct BandSpectra {
+    /// Per interior bin, the averaged cross-spectral matrix (signals × signals), one-sided density.
+    matrices: Vec<DMatrix<Complex<f64>>>,
+}
+
+/// The averaged Welch cross-spectral matrices of `signals` (equal length) over `cfg`'s segments,
+/// at the interior bins of the band `range_hz`; one-sided density scaling `2/(fs Σw²)`.
+fn cross_spectra(
+    signals: &[Vec<f64>],
+    fs_hz: f64,
+    cfg: &WelchConfig,
+    range_hz: [f64; 2],
+) -> Fallible<(BandSpectra, usize, Vec<usize>)> {
+    let plan = WelchPlan::new(*cfg)?;
+    let w = plan.window().to_vec();
+    let n = signals[0].len();
+    let step = cfg.nperseg - cfg.noverlap;
+    let mut fft = RealFftPlanner::<f64>::new();
+    let r2c = fft.plan_fft_forward(cfg.nfft);
+    let bins: Vec<usize> = (0..cfg.nfft / 2 + 1)
+        .filter(|&k| {
+            let f = k as f64 * fs_hz / cfg.nfft as f64;
+            f >= range_hz[0] && f <= range_hz[1] && interior_bin(f, fs_hz, cfg)
+        })
+        .collect();
+    let p = signals.len();
+    let mut sum = vec![DMatrix::<Complex<f64>>::zeros(p, p); bins.len()];
+    let scale = 2.0 / (fs_hz * w.iter().map(|v| v * v).sum::<f64>());
+    let mut segments = 0;
+    let mut start = 0;
+    while start + cfg.nperseg <= n {
+        let spectra: Vec<Vec<Complex<f64>>> = signals
+            .iter()
+            .map(|x| {
+                let seg = &x[start..start + cfg.nperseg];
+                let mut buf = detrended(seg, cfg.detrend);
+                for (b, wi) in buf.iter_mut().zip(&w) {
+                    *b *= wi;
+                }
+                buf.resize(cfg.nfft, 0.0);
+                let mut out = r2c.make_output_vec();
+                r2c.process(&mut buf, &mut out)
+                    .expect("lengths of the plan");
+                out
+            })
+            .collect();
+        for (m, &k) in sum.iter_mut().zip(&bins) {
+            for a in 0..p {
+                for b in 0..p {
+                    m[(a, b)] += spectra[a][k] * spectra[b][k].conj() * scale;
+                }
+            }
+        }
+        segments += 1;
+        start += step;
+    }
+    let k = segments.max(1) as f64;
+    let matrices = sum.into_iter().map(|m| m / Complex::new(k, 0.0)).collect();
+    Ok((BandSpectra { matrices }, segments, bins))
+}
+
+/// `seg` with its mean or least-squares line removed, as `detrend` says.
+fn detrended(seg: &[f64], detrend: Detrend) -> Vec<f64> {
+    let n = seg.len() as f64;
+    match detrend {
+        Detrend::None => seg.to_vec(),
+        Detrend::Constant => {
+            let mean = seg.iter().sum::<f64>() / n;
+            seg.iter().map(|v| v - mean).collect()
+        }
+        Detrend::Linear => {
+            let tm = (n - 1.0) / 2.0;
+            let mean = seg.iter().sum::<f64>() / n;
+            let (mut sxy, mut sxx) = (0.0, 0.0);
+            for (i, v) in seg.iter().enumerate() {
+                let dt = i as f64 - tm;
+                sxy += dt * (v - mean);
+                sxx += dt * dt;
+            }
+            let slope = sxy / sxx;
+            seg.iter()
+                .enumerate()
+                .map(|(i, v)| v - mean - slope * (i as f64 - tm))
+                .collect()
+        }
+    }
+}
+
+fn main() -> Fallible<()> {
+    let args = Args::parse();
+    let mut jobs = args.jobs.clone();
+    if let Some(path) = &args.campaign {
+        jobs.extend(campaign_jobs(path, args.out_dir.as_deref())?);
+    }
+    for path in &jobs {
+        // A truth on the edge of contact loss may not simulate at a displaced point.
+        if let Err(e) = information(&args, path) {
+            let e = e.to_string();
+            println!("{}: skipped: {}", path.display(), &e[..e.len().min(300)]);
+        }
+    }
+    Ok(())
+}
+
+/// Writes the job and blade file of every recording of the campaign at `path` (output directory
+/// `out_dir`, else the campaign's own) and returns the jobs' paths.
+fn campaign_jobs(
+    path: &std::path::Path,
+    out_dir: Option<&std::path::Path>,
+) -> Fallible<Vec<PathBuf>> {
+    use wiperlab::campaign::{
+        Campaign,
+        run::{EntryPaths, generate},
+    };
+    let campaign = Campaign::load(path)?.with_out_dir(out_dir)?;
+    let mut jobs = Vec::new();
+    for entry in &campaign.entries {
+        let paths = EntryPaths::new(&campaign.out_dir(), entry);
+        let g = generate(&campaign, entry, &paths)?;
+        std::fs::create_dir_all(paths.job.parent().unwrap_or(std::path::Path::new(".")))?;
+        wiperlab::io::write_atomic(&paths.blade, g.blade_text.as_bytes())?;
+        wiperlab::io::write_atomic(&paths.job, g.job_text.as_bytes())?;
+        jobs.push(paths.job);
+    }
+    Ok(jobs)
+}
+
+/// The information table of one job (see the module docs).
+fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
+    let job = LoadedJob::load(path)?;
+    let candidate: Candidate = match (&args.model, job.truth_model) {
+        (Some(m), _) => m.parse()?,
+        (None, Some(m)) => m,
+        (None, None) => {
+            return Err(format!("{}: no --model and no [truth] model", path.display()).into());
+        }
+    };
+    let problem = problem_for(&job, candidate)?;
+    let kinds: Vec<SignalKind> = args
+        .signals
+        .iter()
+        .map(|s| s.parse::<SignalKind>())
+        .collect::<Result<_, _>>()?;
+    let truth: Vec<f64> = problem
+        .free
+        .iter()
+        .map(|f| {
+            job.truth
+                .get(&f.name)
+                .map(|t| f.u_of(*t))
+                .ok_or(format!("no truth for {}", f.name))
+        })
+        .collect::<Result<_, _>>()?;
+    let lik = problem
+        .likelihood
+        .as_ref()
+        .map_err(|e| format!("no likelihood: {e:?}"))?;
+    let sigma_coord = lik.sigma_m / 2f64.sqrt();
+    let p = kinds.len();
+    // White noise's cross-spectral density, one-sided: 2·Cov/fs.
+    let noise = DMatrix::<Complex<f64>>::from_fn(p, p, |a, b| {
+        let (ca, cb) = (coordinates(kinds[a]), coordinates(kinds[b]));
+        let cov: f64 = ca.iter().zip(&cb).map(|(x, y)| x * y).sum::<f64>() * sigma_coord.powi(2);
+        Complex::new(2.0 * cov / problem.fs_hz, 0.0)
+    });
+    let spectra_at = |u: &[f64]| -> Fallible<Vec<(BandSpectra, f64)>> {
+        let sim = problem.simulate(&problem.params_at(u))?;
+        let trace = sim.to_trace();
+        let signals: Vec<Vec<f64>> = kinds
+            .iter()
+            .map(|k| k.extract(&trace))
+            .collect::<Result<_, _>>()?;
+        problem
+            .bands
+            .iter()
+            .map(|b| {
+                let cfg = b.welch_config()?;
+                let (s, segments, bins) = cross_spectra(&signals, problem.fs_hz, &cfg, b.range_hz)?;
+                let wl = WelchLikelihood::new(&cfg, segments, bins.len())?;
+                Ok((s, wl.dof / 2.0 / wl.bin_factor))
+            })
+            .collect()
+    };
+    let k = truth.len();
+    let centre = spectra_at(&truth)?;
+    let mut derivs: Vec<Vec<Vec<DMatrix<Complex<f64>>>>> = Vec::with_capacity(k);
+    for i in 0..k {
+        let (lo, hi) = (
+            (truth[i] - FISHER_STEP_U).max(0.0),
+            (truth[i] + FISHER_STEP_U).min(1.0),
+        );
+        let mut u = truth.clone();
+        u[i] = lo;
+        let a = spectra_at(&u)?;
+        u[i] = hi;
+        let b = spectra_at(&u)?;
+        let h = Complex::new(hi - lo, 0.0);
+        derivs.push(
+            a.iter()
+                .zip(&b)
+                .map(|(a, b)| {
+                    a.0.matrices
+                        .iter()
+                        .zip(&b.0.matrices)
+                        .map(|(ma, mb)| (mb - ma) / h)
+                        .collect()
+                })
+                .collect(),
+        );
+    }
+    println!(
+        "{}: candidate {candidate}, σ per coordinate {:.3e} m, signals {}",
+        path.display(),
+        sigma_coord,
+        args.signals.join(", ")
+    );
+    let mut configs: Vec<Vec<usize>> = (0..p).map(|i| vec![i]).collect();
+    if p > 1 {
+        configs.push((0..p).collect());
+    }
+    let mut first: Option<Vec<f64>> = None;
+    let mut single: Vec<DMatrix<f64>> = Vec::new();
+    for sel in configs {
+        let mut f = DMatrix::<f64>::zeros(k, k);
+        for (band, (c, weight)) in centre.iter().enumerate() {
+            for (bin, s) in c.matrices.iter().enumerate() {
+                let pick = |m: &DMatrix<Complex<f64>>| {
+                    DMatrix::from_fn(sel.len(), sel.len(), |a, b| m[(sel[a], sel[b])])
+                };
+                let s = pick(&(s + &noise));
+                let Some(inv) = s.try_inverse() else { continue };
+                let t: Vec<DMatrix<Complex<f64>>> =
+                    (0..k).map(|i| &inv * pick(&derivs[i][band][bin])).collect();
+                for i in 0..k {
+                    for j in 0..=i {
+                        let v = (&t[i] * &t[j]).trace().re * weight;
+                        f[(i, j)] += v;
+                        if i != j {
+                            f[(j, i)] += v;
+                        }
+                    }
+                }
+            }
+        }
+        let label: Vec<&str> = sel.iter().map(|&i| args.signals[i].as_str()).collect();
+        let mut rows = vec![(label.join(" + "), f.clone())];
+        if sel.len() == 1 {
+            single.push(f);
+        } else {
+            // The signals' own likelihoods summed, as if their ordinates were independent.
+            let sum = single
+                .iter()
+                .fold(DMatrix::<f64>::zeros(k, k), |a, b| a + b);
+            rows.push((
+                format!("{} (sum, no cross-spectra)", label.join(" + ")),
+                sum,
+            ));
+        }
+        for (label, f) in rows {
+            let sigma = report(&label, &f, &problem.free, &truth, &mut first);
+            if let (Some(csv), Some(sigma)) = (&args.csv, sigma) {
+                append_csv(csv, path, &candidate, &label, &problem.free, &truth, &sigma)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// One configuration's rows of the CSV (see [`Args::csv`]).
+fn append_csv(
+    path: &std::path::Path,
+    job: &std::path::Path,
+    candidate: &Candidate,
+    label: &str,
+    free: &[wiperlab::job::FreeParam],
+    truth: &[f64],
+    sigma: &[f64],
+) -> Fallible<()> {
+    let new = !path.exists();
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)?;
+    let mut w = csv::WriterBuilder::new()
+        .has_headers(false)
+        .from_writer(file);
+    if new {
+        w.write_record([
+            "job",
+            "model",
+            "signals",
+            "parameter",
+            "truth",
+            "sigma_u",
+            "relative_sigma",
+        ])?;
+    }
+    let name = job
+        .file_stem()
+        .map_or(String::new(), |s| s.to_string_lossy().into_owned());
+    for ((fp, u), s) in free.iter().zip(truth).zip(sigma) {
+        w.write_record([
+            name.clone(),
+            candidate.to_string(),
+            label.to_string(),
+            fp.name.to_string(),
+            format!("{:.6e}", fp.value(*u)),
+            format!("{s:.4e}"),
+            format!("{:.4e}", relative(fp, *u, *s)),
+        ])?;
+    }
+    w.flush()?;
+    Ok(())
+}
+
+/// The 1σ `s` (normalised) at `u` as a fraction of the value: half the span of `u ± s` (clipped to
+/// the box) over the value.
+fn relative(fp: &wiperlab::job::FreeParam, u: f64, s: f64) -> f64 {
+    (fp.value((u + s).min(1.0)) - fp.value((u - s).max(0.0))) / (2.0 * fp.value(u))
+}
+
+/// Prints each parameter's 1σ from the information `f` at `truth` (normalised units and relative
+/// to the value), and how much narrower than `first`'s (the first row's, which this sets).
+/// Returns the 1σ, `None` when `f` is singular.
+fn report(
+    label: &str,
+    f: &DMatrix<f64>,
+    free: &[wiperlab::job::FreeParam],
+    truth: &[f64],
+    first: &mut Option<Vec<f64>>,
+) -> Option<Vec<f64>> {
+    let k = truth.len();
+    let Some(cov) = f.clone().try_inverse() else {
+        println!("  {label}: singular information");
+        return None;
+    };
+    let sigma: Vec<f64> = (0..k).map(|i| cov[(i, i)].max(0.0).sqrt()).collect();
+    let cells: Vec<String> = free
+        .iter()
+        .zip(&sigma)
+        .zip(truth)
+        .enumerate()
+        .map(|(i, ((fp, s), u))| {
+            let rel = relative(fp, *u, *s);
+            let ratio = first
+                .as_ref()
+                .map(|f0| format!(", {:.2}× narrower", f0[i] / s))
+                .unwrap_or_default();
+            format!("{} ±{s:.2e} u (±{:.2} %{ratio})", fp.name, 100.0 * rel)
+        })
+        .collect();
+    println!("  {label}: {}", cells.join("; "));
+    if first.is_none() {
+        *first = Some(sigma.clone());
+    }
+    Some(sigma)
+}
