@@ -1146,7 +1146,14 @@ fn search(
         && fit.objective == job::Objective::Likelihood
         && job.job.targets.is_none();
     if configured && problem.cost_is_nll() {
-        return nested_search(problem, fit, warm, nested, reporting, (confirmation, leader));
+        return nested_search(
+            problem,
+            fit,
+            warm,
+            nested,
+            reporting,
+            (confirmation, leader),
+        );
     }
     if configured && let Some(pb) = &reporting.progress {
         // The bar counted an adaptive search, but this problem has no likelihood to gauge it.
