@@ -4,14 +4,12 @@
 //! the signals together (the multivariate Whittle likelihood of their Welch cross-spectral matrix).
 //!
 //! Per band and interior bin `k` the expected cross-spectral matrix is `S_k = S_sim,k + N`: the
-//! simulation's Welch cross-spectra plus the tracking noise's, and the Fisher information of a
-//! complex-Wishart Welch matrix with `ν` equivalent degrees of freedom is
-//! `F_ij = (ν/2)/φ · Σ_k Re tr(S_k⁻¹ ∂_i S_k S_k⁻¹ ∂_j S_k)` (Whittle 1953, *Ark. Mat.* 2:423;
-//! Brillinger, *Time Series: Data Analysis and Theory*, 1981, §7.2 and §9.2 for the complex
-//! Wishart law of a smoothed cross-spectral matrix). For one signal it is the fit's own
-//! Gauss–Newton information `(α/φ)·Σ_k (∂ln S_k)²` (`src/search/evidence.rs`), with `ν` and the
-//! correlated-bin factor `φ` of the band ([`wiperlab::likelihood::WelchLikelihood`]). Derivatives are
-//! central differences of step [`FISHER_STEP_U`] in the search's normalised coordinates.
+//! simulation's Welch cross-spectra ([`WelchPlan::cross_spectra`]) plus the tracking noise's, and
+//! the information is [`MultivariateWhittle::fisher`]'s, `(ν/2)/φ · Σ_k Re tr(S_k⁻¹ ∂_i S_k S_k⁻¹ ∂_j S_k)`.
+//! For one signal it is the fit's own Gauss–Newton information `(α/φ)·Σ_k (∂ln S_k)²`
+//! (`src/search/evidence.rs`). Derivatives are central differences of step [`FISHER_STEP_U`] in the
+//! search's normalised coordinates. A row "sum, no cross-spectra" adds the signals' own
+//! informations, as if their ordinates were independent.
 //!
 //! The tracking noise is read as white, independent between coordinates and of one σ per
 //! coordinate, `σ = σ̂/√2` from the recording's own estimate `σ̂` of tip − head x (the fit's,
@@ -30,14 +28,14 @@
 
 use clap::Parser;
 use nalgebra::{Complex, DMatrix};
-use realfft::RealFftPlanner;
 use std::path::PathBuf;
 use wiperlab::job::{Candidate, LoadedJob};
-use wiperlab::likelihood::{WelchLikelihood, interior_bin};
+use wiperlab::likelihood::interior_bin;
+use wiperlab::likelihood::multivariate::MultivariateWhittle;
 use wiperlab::search::evidence::FISHER_STEP_U;
 use wiperlab::search::problem_for;
 use wiperlab::spectrum::features::SignalKind;
-use wiperlab::spectrum::welch::{Detrend, WelchConfig, WelchPlan};
+use wiperlab::spectrum::welch::{CrossSpectra, WelchConfig, WelchPlan};
 
 #[derive(Parser)]
 struct Args {
@@ -76,95 +74,6 @@ fn coordinates(s: SignalKind) -> [f64; 4] {
         SignalKind::TipRelY => [0.0, -1.0, 0.0, 1.0],
         SignalKind::HeadY => [0.0, 1.0, 0.0, 0.0],
         SignalKind::TipX => [0.0, 0.0, 1.0, 0.0],
-    }
-}
-
-/// One band's Welch segments' spectra of several signals: `[bin][signal]` per segment.
-struct BandSpectra {
-    /// Per interior bin, the averaged cross-spectral matrix (signals × signals), one-sided density.
-    matrices: Vec<DMatrix<Complex<f64>>>,
-}
-
-/// The averaged Welch cross-spectral matrices of `signals` (equal length) over `cfg`'s segments,
-/// at the interior bins of the band `range_hz`; one-sided density scaling `2/(fs Σw²)`.
-fn cross_spectra(
-    signals: &[Vec<f64>],
-    fs_hz: f64,
-    cfg: &WelchConfig,
-    range_hz: [f64; 2],
-) -> Fallible<(BandSpectra, usize, Vec<usize>)> {
-    let plan = WelchPlan::new(*cfg)?;
-    let w = plan.window().to_vec();
-    let n = signals[0].len();
-    let step = cfg.nperseg - cfg.noverlap;
-    let mut fft = RealFftPlanner::<f64>::new();
-    let r2c = fft.plan_fft_forward(cfg.nfft);
-    let bins: Vec<usize> = (0..cfg.nfft / 2 + 1)
-        .filter(|&k| {
-            let f = k as f64 * fs_hz / cfg.nfft as f64;
-            f >= range_hz[0] && f <= range_hz[1] && interior_bin(f, fs_hz, cfg)
-        })
-        .collect();
-    let p = signals.len();
-    let mut sum = vec![DMatrix::<Complex<f64>>::zeros(p, p); bins.len()];
-    let scale = 2.0 / (fs_hz * w.iter().map(|v| v * v).sum::<f64>());
-    let mut segments = 0;
-    let mut start = 0;
-    while start + cfg.nperseg <= n {
-        let spectra: Vec<Vec<Complex<f64>>> = signals
-            .iter()
-            .map(|x| {
-                let seg = &x[start..start + cfg.nperseg];
-                let mut buf = detrended(seg, cfg.detrend);
-                for (b, wi) in buf.iter_mut().zip(&w) {
-                    *b *= wi;
-                }
-                buf.resize(cfg.nfft, 0.0);
-                let mut out = r2c.make_output_vec();
-                r2c.process(&mut buf, &mut out)
-                    .expect("lengths of the plan");
-                out
-            })
-            .collect();
-        for (m, &k) in sum.iter_mut().zip(&bins) {
-            for a in 0..p {
-                for b in 0..p {
-                    m[(a, b)] += spectra[a][k] * spectra[b][k].conj() * scale;
-                }
-            }
-        }
-        segments += 1;
-        start += step;
-    }
-    let k = segments.max(1) as f64;
-    let matrices = sum.into_iter().map(|m| m / Complex::new(k, 0.0)).collect();
-    Ok((BandSpectra { matrices }, segments, bins))
-}
-
-/// `seg` with its mean or least-squares line removed, as `detrend` says.
-fn detrended(seg: &[f64], detrend: Detrend) -> Vec<f64> {
-    let n = seg.len() as f64;
-    match detrend {
-        Detrend::None => seg.to_vec(),
-        Detrend::Constant => {
-            let mean = seg.iter().sum::<f64>() / n;
-            seg.iter().map(|v| v - mean).collect()
-        }
-        Detrend::Linear => {
-            let tm = (n - 1.0) / 2.0;
-            let mean = seg.iter().sum::<f64>() / n;
-            let (mut sxy, mut sxx) = (0.0, 0.0);
-            for (i, v) in seg.iter().enumerate() {
-                let dt = i as f64 - tm;
-                sxy += dt * (v - mean);
-                sxx += dt * dt;
-            }
-            let slope = sxy / sxx;
-            seg.iter()
-                .enumerate()
-                .map(|(i, v)| v - mean - slope * (i as f64 - tm))
-                .collect()
-        }
     }
 }
 
@@ -239,33 +148,49 @@ fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
         .map_err(|e| format!("no likelihood: {e:?}"))?;
     let sigma_coord = lik.sigma_m / 2f64.sqrt();
     let p = kinds.len();
-    // White noise's cross-spectral density, one-sided: 2·Cov/fs.
-    let noise = DMatrix::<Complex<f64>>::from_fn(p, p, |a, b| {
-        let (ca, cb) = (coordinates(kinds[a]), coordinates(kinds[b]));
-        let cov: f64 = ca.iter().zip(&cb).map(|(x, y)| x * y).sum::<f64>() * sigma_coord.powi(2);
-        Complex::new(2.0 * cov / problem.fs_hz, 0.0)
-    });
-    let spectra_at = |u: &[f64]| -> Fallible<Vec<(BandSpectra, f64)>> {
+    // White noise's cross-spectral density, one-sided: 2·Cov/fs (row-major p × p).
+    let noise: Vec<Complex<f64>> = (0..p * p)
+        .map(|ab| {
+            let (ca, cb) = (coordinates(kinds[ab / p]), coordinates(kinds[ab % p]));
+            let cov: f64 =
+                ca.iter().zip(&cb).map(|(x, y)| x * y).sum::<f64>() * sigma_coord.powi(2);
+            Complex::new(2.0 * cov / problem.fs_hz, 0.0)
+        })
+        .collect();
+    // Per band: its settings, interior bins in range, and the cross-spectral matrices at `u`.
+    let bands: Vec<(WelchConfig, Vec<usize>)> = problem
+        .bands
+        .iter()
+        .map(|b| {
+            let cfg = b.welch_config()?;
+            let bins = (0..cfg.n_freqs())
+                .filter(|&k| {
+                    let f = k as f64 * problem.fs_hz / cfg.nfft as f64;
+                    f >= b.range_hz[0] && f <= b.range_hz[1] && interior_bin(f, problem.fs_hz, &cfg)
+                })
+                .collect();
+            Ok((cfg, bins))
+        })
+        .collect::<Fallible<_>>()?;
+    let spectra_at = |u: &[f64]| -> Fallible<Vec<CrossSpectra>> {
         let sim = problem.simulate(&problem.params_at(u))?;
         let trace = sim.to_trace();
         let signals: Vec<Vec<f64>> = kinds
             .iter()
             .map(|k| k.extract(&trace))
             .collect::<Result<_, _>>()?;
-        problem
-            .bands
+        let refs: Vec<&[f64]> = signals.iter().map(Vec::as_slice).collect();
+        bands
             .iter()
-            .map(|b| {
-                let cfg = b.welch_config()?;
-                let (s, segments, bins) = cross_spectra(&signals, problem.fs_hz, &cfg, b.range_hz)?;
-                let wl = WelchLikelihood::new(&cfg, segments, bins.len())?;
-                Ok((s, wl.dof / 2.0 / wl.bin_factor))
+            .map(|(cfg, bins)| {
+                Ok(WelchPlan::new(*cfg)?.cross_spectra(&refs, problem.fs_hz, bins)?)
             })
             .collect()
     };
     let k = truth.len();
     let centre = spectra_at(&truth)?;
-    let mut derivs: Vec<Vec<Vec<DMatrix<Complex<f64>>>>> = Vec::with_capacity(k);
+    // derivs[i][band][bin]: the matrices' central difference in parameter i.
+    let mut derivs: Vec<Vec<Vec<Vec<Complex<f64>>>>> = Vec::with_capacity(k);
     for i in 0..k {
         let (lo, hi) = (
             (truth[i] - FISHER_STEP_U).max(0.0),
@@ -276,15 +201,19 @@ fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
         let a = spectra_at(&u)?;
         u[i] = hi;
         let b = spectra_at(&u)?;
-        let h = Complex::new(hi - lo, 0.0);
         derivs.push(
             a.iter()
                 .zip(&b)
                 .map(|(a, b)| {
-                    a.0.matrices
+                    a.matrices
                         .iter()
-                        .zip(&b.0.matrices)
-                        .map(|(ma, mb)| (mb - ma) / h)
+                        .zip(&b.matrices)
+                        .map(|(ma, mb)| {
+                            ma.iter()
+                                .zip(mb)
+                                .map(|(x, y)| (y - x) / (hi - lo))
+                                .collect()
+                        })
                         .collect()
                 })
                 .collect(),
@@ -303,26 +232,25 @@ fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
     let mut first: Option<Vec<f64>> = None;
     let mut single: Vec<DMatrix<f64>> = Vec::new();
     for sel in configs {
+        // The entries of the selected signals, row-major.
+        let pick = |m: &[Complex<f64>]| -> Vec<Complex<f64>> {
+            sel.iter()
+                .flat_map(|&a| sel.iter().map(move |&b| m[a * p + b]))
+                .collect()
+        };
         let mut f = DMatrix::<f64>::zeros(k, k);
-        for (band, (c, weight)) in centre.iter().enumerate() {
-            for (bin, s) in c.matrices.iter().enumerate() {
-                let pick = |m: &DMatrix<Complex<f64>>| {
-                    DMatrix::from_fn(sel.len(), sel.len(), |a, b| m[(sel[a], sel[b])])
-                };
-                let s = pick(&(s + &noise));
-                let Some(inv) = s.try_inverse() else { continue };
-                let t: Vec<DMatrix<Complex<f64>>> =
-                    (0..k).map(|i| &inv * pick(&derivs[i][band][bin])).collect();
-                for i in 0..k {
-                    for j in 0..=i {
-                        let v = (&t[i] * &t[j]).trace().re * weight;
-                        f[(i, j)] += v;
-                        if i != j {
-                            f[(j, i)] += v;
-                        }
-                    }
-                }
-            }
+        for (band, (c, (cfg, bins))) in centre.iter().zip(&bands).enumerate() {
+            let model: Vec<Vec<Complex<f64>>> = c
+                .matrices
+                .iter()
+                .map(|m| pick(&m.iter().zip(&noise).map(|(s, n)| s + n).collect::<Vec<_>>()))
+                .collect();
+            let d: Vec<Vec<Vec<Complex<f64>>>> = derivs
+                .iter()
+                .map(|di| di[band].iter().map(|m| pick(m)).collect())
+                .collect();
+            let w = MultivariateWhittle::new(cfg, c.n_segments, bins.len(), sel.len())?;
+            f += w.fisher(&model, &d)?;
         }
         let label: Vec<&str> = sel.iter().map(|&i| args.signals[i].as_str()).collect();
         let mut rows = vec![(label.join(" + "), f.clone())];

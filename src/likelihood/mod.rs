@@ -84,6 +84,7 @@ mod error;
 pub mod instfreq;
 pub mod measure;
 pub mod misfit;
+pub mod multivariate;
 pub mod prior;
 pub mod secant;
 

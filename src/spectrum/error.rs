@@ -120,6 +120,17 @@ pub enum SpectrumError {
     /// Spectrogram: fewer samples than one segment.
     #[error("spectrogram: record has {len} samples, expected at least nperseg = {nperseg}")]
     SpectrogramTooShort { len: usize, nperseg: usize },
+    /// Cross-spectra: signals of different lengths.
+    #[error("cross-spectra: signals of {lengths:?} samples (expected one length for every signal)")]
+    UnequalLengths { lengths: Vec<usize> },
+    /// Cross-spectra: a bin past the last frequency.
+    #[error("cross-spectra: bin {bin} requested of {n_freqs} (expected bins below nfft/2 + 1)")]
+    BinOutOfRange { bin: usize, n_freqs: usize },
+    /// Cross-spectra with the median average, which has no cross-spectral counterpart.
+    #[error(
+        "cross-spectra: the median average has no cross-spectral form (expected average = \"mean\")"
+    )]
+    MedianCrossSpectra,
 }
 
 impl SpectrumError {
@@ -138,6 +149,8 @@ impl SpectrumError {
                 | SpectrumError::DetectorSettings { .. }
                 | SpectrumError::MissingPoint { .. }
                 | SpectrumError::EmptyBand { .. }
+                | SpectrumError::BinOutOfRange { .. }
+                | SpectrumError::MedianCrossSpectra
         )
     }
 }
