@@ -406,14 +406,7 @@ impl WelchPlan {
     /// once `out` has been used with this plan).
     pub fn process_into(&mut self, x: &[f64], fs_hz: f64, out: &mut Psd) -> Result<()> {
         check_fs(fs_hz)?;
-        if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-            return Err(SpectrumError::NonFinite {
-                index: i,
-                len: x.len(),
-                value: x[i],
-            }
-            .into());
-        }
+        check_finite(x)?;
         if x.len() < self.cfg.nperseg {
             return Err(SpectrumError::TooShort {
                 len: x.len(),
@@ -648,14 +641,7 @@ impl WelchPlan {
             .into());
         }
         for x in signals {
-            if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-                return Err(SpectrumError::NonFinite {
-                    index: i,
-                    len: x.len(),
-                    value: x[i],
-                }
-                .into());
-            }
+            check_finite(x)?;
         }
         let p = signals.len();
         let n_seg = self.cfg.n_segments(len);
@@ -755,6 +741,19 @@ fn scale_one_sided(p: &mut [f64], nfft: usize, inv_n: f64, norm: f64) {
             d *= 2.0;
         }
         *v = d;
+    }
+}
+
+/// [`SpectrumError::NonFinite`] at the first non-finite sample of `x`.
+fn check_finite(x: &[f64]) -> Result<()> {
+    match x.iter().position(|v| !v.is_finite()) {
+        Some(i) => Err(SpectrumError::NonFinite {
+            index: i,
+            len: x.len(),
+            value: x[i],
+        }
+        .into()),
+        None => Ok(()),
     }
 }
 
