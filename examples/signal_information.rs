@@ -30,9 +30,10 @@ use clap::Parser;
 use nalgebra::{Complex, DMatrix};
 use std::path::PathBuf;
 use wiperlab::job::{Candidate, LoadedJob};
+use wiperlab::likelihood::covariance::sample_covariance;
 use wiperlab::likelihood::interior_bin;
 use wiperlab::likelihood::multivariate::MultivariateWhittle;
-use wiperlab::search::evidence::FISHER_STEP_U;
+use wiperlab::search::evidence::{FISHER_STEP_U, NOISE_REPLICATES, NOISE_SEED};
 use wiperlab::search::problem_for;
 use wiperlab::spectrum::features::SignalKind;
 use wiperlab::spectrum::welch::{CrossSpectra, WelchConfig, WelchPlan};
@@ -59,10 +60,13 @@ struct Args {
         default_value = "tip_rel_x,head_y,tip_rel_y"
     )]
     signals: Vec<String>,
-    /// Append one row per configuration and parameter to this CSV (`job,model,signals,parameter,
-    /// truth,sigma_u,relative_sigma`; a header when the file is new).
+    /// Append one row per configuration, spread and parameter to this CSV (`job,model,signals,
+    /// spread,parameter,truth,sigma_u,relative_sigma`; a header when the file is new).
     #[arg(long)]
     csv: Option<PathBuf>,
+    /// Noise replicates for the sandwich's variability.
+    #[arg(long, default_value_t = NOISE_REPLICATES)]
+    replicates: usize,
 }
 
 type Fallible<T> = Result<T, Box<dyn std::error::Error>>;
@@ -157,7 +161,7 @@ fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
             Complex::new(2.0 * cov / problem.fs_hz, 0.0)
         })
         .collect();
-    // Per band: its settings, interior bins in range, and the cross-spectral matrices at `u`.
+    // Per band: its settings and its interior bins in range.
     let bands: Vec<(WelchConfig, Vec<usize>)> = problem
         .bands
         .iter()
@@ -172,13 +176,14 @@ fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
             Ok((cfg, bins))
         })
         .collect::<Fallible<_>>()?;
-    let spectra_at = |u: &[f64]| -> Fallible<Vec<CrossSpectra>> {
-        let sim = problem.simulate(&problem.params_at(u))?;
-        let trace = sim.to_trace();
-        let signals: Vec<Vec<f64>> = kinds
+    let signals_at = |u: &[f64]| -> Fallible<Vec<Vec<f64>>> {
+        let trace = problem.simulate(&problem.params_at(u))?.to_trace();
+        Ok(kinds
             .iter()
             .map(|k| k.extract(&trace))
-            .collect::<Result<_, _>>()?;
+            .collect::<Result<_, _>>()?)
+    };
+    let spectra_of = |signals: &[Vec<f64>]| -> Fallible<Vec<CrossSpectra>> {
         let refs: Vec<&[f64]> = signals.iter().map(Vec::as_slice).collect();
         bands
             .iter()
@@ -188,21 +193,130 @@ fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
             .collect()
     };
     let k = truth.len();
-    let centre = spectra_at(&truth)?;
-    // derivs[i][band][bin]: the matrices' central difference in parameter i.
-    let mut derivs: Vec<Vec<Vec<Vec<Complex<f64>>>>> = Vec::with_capacity(k);
-    for i in 0..k {
-        let (lo, hi) = (
-            (truth[i] - FISHER_STEP_U).max(0.0),
-            (truth[i] + FISHER_STEP_U).min(1.0),
-        );
-        let mut u = truth.clone();
-        u[i] = lo;
-        let a = spectra_at(&u)?;
-        u[i] = hi;
-        let b = spectra_at(&u)?;
-        derivs.push(
-            a.iter()
+    let clean = signals_at(&truth)?;
+    let centre = spectra_of(&clean)?;
+    let derivs = derivatives(&truth, |u| spectra_of(&signals_at(u)?))?;
+    // The noise replicates' cross-spectra: the truth's signals plus fresh white noise on each
+    // tracked coordinate, as the fit's sandwich draws them.
+    let replicates: Vec<Vec<CrossSpectra>> = (0..args.replicates)
+        .map(|r| spectra_of(&with_noise(&clean, &kinds, sigma_coord, r as u64)))
+        .collect::<Fallible<_>>()?;
+    println!(
+        "{}: candidate {candidate}, σ per coordinate {:.3e} m, signals {}",
+        path.display(),
+        sigma_coord,
+        args.signals.join(", ")
+    );
+    let mut configs: Vec<Vec<usize>> = (0..p).map(|i| vec![i]).collect();
+    if p > 1 {
+        configs.push((0..p).collect());
+    }
+    let mut first: Option<Vec<f64>> = None;
+    let mut first_sandwich: Option<Vec<f64>> = None;
+    let mut single: Vec<(DMatrix<f64>, Vec<Vec<f64>>)> = Vec::new();
+    for sel in configs {
+        // The entries of the selected signals, row-major.
+        let pick = |m: &[Complex<f64>]| -> Vec<Complex<f64>> {
+            sel.iter()
+                .flat_map(|&a| sel.iter().map(move |&b| m[a * p + b]))
+                .collect()
+        };
+        let mut f = DMatrix::<f64>::zeros(k, k);
+        let mut scores = vec![vec![0.0; k]; replicates.len()];
+        for (band, (c, (cfg, bins))) in centre.iter().zip(&bands).enumerate() {
+            let model: Vec<Vec<Complex<f64>>> = c
+                .matrices
+                .iter()
+                .map(|m| pick(&m.iter().zip(&noise).map(|(s, n)| s + n).collect::<Vec<_>>()))
+                .collect();
+            let d: Vec<Vec<Vec<Complex<f64>>>> = derivs
+                .iter()
+                .map(|di| di[band].iter().map(|m| pick(m)).collect())
+                .collect();
+            let w = MultivariateWhittle::new(cfg, c.n_segments, bins.len(), sel.len())?;
+            f += w.fisher(&model, &d)?;
+            for (score, rep) in scores.iter_mut().zip(&replicates) {
+                let measured: Vec<Vec<Complex<f64>>> =
+                    rep[band].matrices.iter().map(|m| pick(m)).collect();
+                for (s, g) in score.iter_mut().zip(w.score(&measured, &model, &d)?) {
+                    *s += g;
+                }
+            }
+        }
+        let label: Vec<&str> = sel.iter().map(|&i| args.signals[i].as_str()).collect();
+        let mut rows = vec![(label.join(" + "), f.clone(), scores.clone())];
+        if sel.len() == 1 {
+            single.push((f, scores));
+        } else {
+            // The signals' own likelihoods summed, as if their ordinates were independent.
+            let f_sum = single
+                .iter()
+                .fold(DMatrix::<f64>::zeros(k, k), |a, b| a + &b.0);
+            let s_sum: Vec<Vec<f64>> = (0..replicates.len())
+                .map(|r| {
+                    (0..k)
+                        .map(|i| single.iter().map(|s| s.1[r][i]).sum())
+                        .collect()
+                })
+                .collect();
+            rows.push((
+                format!("{} (sum, no cross-spectra)", label.join(" + ")),
+                f_sum,
+                s_sum,
+            ));
+        }
+        for (label, f, scores) in rows {
+            let Some(inv) = f.clone().try_inverse() else {
+                println!("  {label}: singular information");
+                continue;
+            };
+            let sandwich = &inv * sample_covariance(&scores) * &inv;
+            for (what, cov, first) in [
+                ("Fisher", &inv, &mut first),
+                ("sandwich", &sandwich, &mut first_sandwich),
+            ] {
+                let sigma = report(
+                    &format!("{label} [{what}]"),
+                    cov,
+                    &problem.free,
+                    &truth,
+                    first,
+                );
+                if let Some(csv) = &args.csv {
+                    append_csv(
+                        csv,
+                        path,
+                        &candidate,
+                        (&label, what),
+                        &problem.free,
+                        &truth,
+                        &sigma,
+                    )?;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The central differences, step [`FISHER_STEP_U`] (one-sided at a bound), of the cross-spectral
+/// matrices `spectra_at` gives: `[parameter][band][bin]`.
+fn derivatives(
+    u0: &[f64],
+    spectra_at: impl Fn(&[f64]) -> Fallible<Vec<CrossSpectra>>,
+) -> Fallible<Vec<Vec<Vec<Vec<Complex<f64>>>>>> {
+    (0..u0.len())
+        .map(|i| {
+            let (lo, hi) = (
+                (u0[i] - FISHER_STEP_U).max(0.0),
+                (u0[i] + FISHER_STEP_U).min(1.0),
+            );
+            let mut u = u0.to_vec();
+            u[i] = lo;
+            let a = spectra_at(&u)?;
+            u[i] = hi;
+            let b = spectra_at(&u)?;
+            Ok(a.iter()
                 .zip(&b)
                 .map(|(a, b)| {
                     a.matrices
@@ -216,64 +330,33 @@ fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
                         })
                         .collect()
                 })
-                .collect(),
-        );
-    }
-    println!(
-        "{}: candidate {candidate}, σ per coordinate {:.3e} m, signals {}",
-        path.display(),
-        sigma_coord,
-        args.signals.join(", ")
-    );
-    let mut configs: Vec<Vec<usize>> = (0..p).map(|i| vec![i]).collect();
-    if p > 1 {
-        configs.push((0..p).collect());
-    }
-    let mut first: Option<Vec<f64>> = None;
-    let mut single: Vec<DMatrix<f64>> = Vec::new();
-    for sel in configs {
-        // The entries of the selected signals, row-major.
-        let pick = |m: &[Complex<f64>]| -> Vec<Complex<f64>> {
-            sel.iter()
-                .flat_map(|&a| sel.iter().map(move |&b| m[a * p + b]))
+                .collect())
+        })
+        .collect()
+}
+
+/// `clean` (the signals `kinds`) plus white noise of `sigma_m` on each tracked coordinate, drawn
+/// from seed [`NOISE_SEED`]` + r`: a signal differencing two coordinates gets both their noises.
+fn with_noise(clean: &[Vec<f64>], kinds: &[SignalKind], sigma_m: f64, r: u64) -> Vec<Vec<f64>> {
+    use rand::SeedableRng;
+    use rand_distr::Distribution;
+    let mut rng = rand::rngs::StdRng::seed_from_u64(NOISE_SEED.wrapping_add(r));
+    let normal = rand_distr::Normal::new(0.0, sigma_m).expect("a positive σ");
+    let n = clean.first().map_or(0, Vec::len);
+    let coords: Vec<Vec<f64>> = (0..4)
+        .map(|_| (0..n).map(|_| normal.sample(&mut rng)).collect())
+        .collect();
+    clean
+        .iter()
+        .zip(kinds)
+        .map(|(x, &kind)| {
+            let c = coordinates(kind);
+            x.iter()
+                .enumerate()
+                .map(|(t, v)| v + (0..4).map(|j| c[j] * coords[j][t]).sum::<f64>())
                 .collect()
-        };
-        let mut f = DMatrix::<f64>::zeros(k, k);
-        for (band, (c, (cfg, bins))) in centre.iter().zip(&bands).enumerate() {
-            let model: Vec<Vec<Complex<f64>>> = c
-                .matrices
-                .iter()
-                .map(|m| pick(&m.iter().zip(&noise).map(|(s, n)| s + n).collect::<Vec<_>>()))
-                .collect();
-            let d: Vec<Vec<Vec<Complex<f64>>>> = derivs
-                .iter()
-                .map(|di| di[band].iter().map(|m| pick(m)).collect())
-                .collect();
-            let w = MultivariateWhittle::new(cfg, c.n_segments, bins.len(), sel.len())?;
-            f += w.fisher(&model, &d)?;
-        }
-        let label: Vec<&str> = sel.iter().map(|&i| args.signals[i].as_str()).collect();
-        let mut rows = vec![(label.join(" + "), f.clone())];
-        if sel.len() == 1 {
-            single.push(f);
-        } else {
-            // The signals' own likelihoods summed, as if their ordinates were independent.
-            let sum = single
-                .iter()
-                .fold(DMatrix::<f64>::zeros(k, k), |a, b| a + b);
-            rows.push((
-                format!("{} (sum, no cross-spectra)", label.join(" + ")),
-                sum,
-            ));
-        }
-        for (label, f) in rows {
-            let sigma = report(&label, &f, &problem.free, &truth, &mut first);
-            if let (Some(csv), Some(sigma)) = (&args.csv, sigma) {
-                append_csv(csv, path, &candidate, &label, &problem.free, &truth, &sigma)?;
-            }
-        }
-    }
-    Ok(())
+        })
+        .collect()
 }
 
 /// One configuration's rows of the CSV (see [`Args::csv`]).
@@ -281,7 +364,7 @@ fn append_csv(
     path: &std::path::Path,
     job: &std::path::Path,
     candidate: &Candidate,
-    label: &str,
+    (label, what): (&str, &str),
     free: &[wiperlab::job::FreeParam],
     truth: &[f64],
     sigma: &[f64],
@@ -299,6 +382,7 @@ fn append_csv(
             "job",
             "model",
             "signals",
+            "spread",
             "parameter",
             "truth",
             "sigma_u",
@@ -313,6 +397,7 @@ fn append_csv(
             name.clone(),
             candidate.to_string(),
             label.to_string(),
+            what.to_string(),
             fp.name.to_string(),
             format!("{:.6e}", fp.value(*u)),
             format!("{s:.4e}"),
@@ -329,22 +414,19 @@ fn relative(fp: &wiperlab::job::FreeParam, u: f64, s: f64) -> f64 {
     (fp.value((u + s).min(1.0)) - fp.value((u - s).max(0.0))) / (2.0 * fp.value(u))
 }
 
-/// Prints each parameter's 1σ from the information `f` at `truth` (normalised units and relative
-/// to the value), and how much narrower than `first`'s (the first row's, which this sets).
-/// Returns the 1σ, `None` when `f` is singular.
+/// Prints each parameter's 1σ from the covariance `cov` at `truth` (normalised units and relative
+/// to the value), and how much narrower than `first`'s (the first row's of its kind, which this
+/// sets). Returns the 1σ.
 fn report(
     label: &str,
-    f: &DMatrix<f64>,
+    cov: &DMatrix<f64>,
     free: &[wiperlab::job::FreeParam],
     truth: &[f64],
     first: &mut Option<Vec<f64>>,
-) -> Option<Vec<f64>> {
-    let k = truth.len();
-    let Some(cov) = f.clone().try_inverse() else {
-        println!("  {label}: singular information");
-        return None;
-    };
-    let sigma: Vec<f64> = (0..k).map(|i| cov[(i, i)].max(0.0).sqrt()).collect();
+) -> Vec<f64> {
+    let sigma: Vec<f64> = (0..truth.len())
+        .map(|i| cov[(i, i)].max(0.0).sqrt())
+        .collect();
     let cells: Vec<String> = free
         .iter()
         .zip(&sigma)
@@ -363,5 +445,5 @@ fn report(
     if first.is_none() {
         *first = Some(sigma.clone());
     }
-    Some(sigma)
+    sigma
 }

@@ -137,6 +137,39 @@ impl MultivariateWhittle {
         Ok(f * (self.welch.dof / 2.0 / self.welch.bin_factor))
     }
 
+    /// The gradient of [`MultivariateWhittle::nll`] in `k` parameters that move the model:
+    /// `(n/φ)·Σ_k Re tr(S_k⁻¹ ∂_i S_k S_k⁻¹ (S_k − P̂_k))`, with `measured` the matrices `P̂`,
+    /// `model` the expected `S` and `derivatives[i]` their derivatives in parameter `i`. Its
+    /// variance over noise replicates is the sandwich's `V` (Godambe information).
+    ///
+    /// # Errors
+    /// As [`MultivariateWhittle::nll`] and [`MultivariateWhittle::fisher`].
+    pub fn score(
+        &self,
+        measured: &[Vec<Complex<f64>>],
+        model: &[Vec<Complex<f64>>],
+        derivatives: &[Vec<Vec<Complex<f64>>>],
+    ) -> Result<Vec<f64>> {
+        if measured.len() != model.len() || derivatives.iter().any(|d| d.len() != model.len()) {
+            return Err(LikelihoodError::LengthMismatch {
+                measured: measured.len(),
+                model: model.len(),
+            });
+        }
+        let mut g = vec![0.0; derivatives.len()];
+        for (index, (pm, sm)) in measured.iter().zip(model).enumerate() {
+            let s = self.matrix(sm, Side::Model, index)?;
+            let residual = &s - self.matrix(pm, Side::Measured, index)?;
+            let (_, chol) = ln_det(&s, Side::Model, index)?;
+            let r = chol.solve(&residual);
+            for (gi, d) in g.iter_mut().zip(derivatives) {
+                *gi += (chol.solve(&self.matrix_any(&d[index])?) * &r).trace().re;
+            }
+        }
+        let scale = self.welch.dof / 2.0 / self.welch.bin_factor;
+        Ok(g.into_iter().map(|v| v * scale).collect())
+    }
+
     /// `entries` as a `p × p` matrix, any values.
     fn matrix_any(&self, entries: &[Complex<f64>]) -> Result<DMatrix<Complex<f64>>> {
         let p = self.signals;
@@ -224,7 +257,9 @@ mod tests {
             Complex::new(0.6, -0.4),
             Complex::new(1.0, 0.0),
         ];
-        let at = w.nll(std::slice::from_ref(&p_hat), std::slice::from_ref(&p_hat)).unwrap();
+        let at = w
+            .nll(std::slice::from_ref(&p_hat), std::slice::from_ref(&p_hat))
+            .unwrap();
         for (i, d) in [(0, 0.05), (3, -0.05), (1, 0.05)] {
             let mut s = p_hat.clone();
             s[i] += Complex::new(d, 0.0);
@@ -243,6 +278,47 @@ mod tests {
                 ..
             })
         ));
+    }
+
+    #[test]
+    fn the_score_is_the_likelihood_s_slope() {
+        // S(t) = S₀ + t·D: the score at t = 0 against a central difference of the NLL.
+        let cfg = WelchConfig::new(128);
+        let w = MultivariateWhittle::new(&cfg, 20, 2, 2).unwrap();
+        let p_hat = vec![
+            vec![
+                Complex::new(2.0, 0.0),
+                Complex::new(0.6, 0.4),
+                Complex::new(0.6, -0.4),
+                Complex::new(1.0, 0.0),
+            ],
+            real(&[1.5, 0.2, 0.2, 0.8]),
+        ];
+        let s0 = vec![real(&[1.8, 0.5, 0.5, 1.2]), real(&[1.4, 0.1, 0.1, 0.9])];
+        let d = vec![
+            vec![
+                Complex::new(0.3, 0.0),
+                Complex::new(0.1, 0.2),
+                Complex::new(0.1, -0.2),
+                Complex::new(-0.2, 0.0),
+            ],
+            real(&[0.0, 0.05, 0.05, 0.1]),
+        ];
+        let at = |t: f64| -> f64 {
+            let s: Vec<Vec<Complex<f64>>> = s0
+                .iter()
+                .zip(&d)
+                .map(|(a, b)| a.iter().zip(b).map(|(x, y)| x + y * t).collect())
+                .collect();
+            w.nll(&p_hat, &s).unwrap()
+        };
+        let h = 1e-5;
+        let numeric = (at(h) - at(-h)) / (2.0 * h);
+        let score = w.score(&p_hat, &s0, std::slice::from_ref(&d)).unwrap()[0];
+        assert!(
+            (score - numeric).abs() < 1e-6 * numeric.abs().max(1.0),
+            "{score} against {numeric}"
+        );
     }
 
     /// Golden-section minimum of `f` on `[a, b]`.
