@@ -11,12 +11,13 @@
 //! search's normalised coordinates. A row "sum, no cross-spectra" adds the signals' own
 //! informations, as if their ordinates were independent.
 //!
-//! The tracking noise is read as white, independent between coordinates and of one σ per
-//! coordinate, `σ = σ̂/√2` from the recording's own estimate `σ̂` of tip − head x (the fit's,
-//! `1.4826·MAD(Δ²x)/√6`): so each signal's noise and the noise shared by two signals (tip − head y
-//! and head y share the head's y) follow from which coordinates they difference. The simulated
-//! signals have no gaps (the recording's lost frames are not masked), so this is the information of
-//! a complete recording.
+//! The tracking noise is read as white and independent between the tracked coordinates, each with
+//! its own σ̂ from the recording (`1.4826·MAD(Δ²x)/√6`, as the fit estimates its signal's): each
+//! signal's noise and the noise two signals share (tip − head y and head y share the head's y)
+//! follow from which coordinates they difference. The simulated signals miss the samples the
+//! recording misses, short gaps filled as the fit fills them ([`WelchPlan::cross_spectra_gappy`]).
+//! The sandwich's `V` is the variance of the score over noise replicates of the truth's signals,
+//! as the fit's sandwich draws them.
 //!
 //! Prints, per configuration, each parameter's 1σ from `F⁻¹` (normalised units, and relative to
 //! the truth's value), and the ratio of the first signal's 1σ to the joint one.
@@ -31,12 +32,13 @@ use nalgebra::{Complex, DMatrix};
 use std::path::PathBuf;
 use wiperlab::job::{Candidate, LoadedJob};
 use wiperlab::likelihood::covariance::sample_covariance;
-use wiperlab::likelihood::interior_bin;
 use wiperlab::likelihood::multivariate::MultivariateWhittle;
+use wiperlab::likelihood::{interior_bin, tracking_noise_sigma};
 use wiperlab::search::evidence::{FISHER_STEP_U, NOISE_REPLICATES, NOISE_SEED};
 use wiperlab::search::problem_for;
 use wiperlab::spectrum::features::SignalKind;
 use wiperlab::spectrum::welch::{CrossSpectra, WelchConfig, WelchPlan};
+use wiperlab::trace::Role;
 
 #[derive(Parser)]
 struct Args {
@@ -146,18 +148,32 @@ fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
                 .ok_or(format!("no truth for {}", f.name))
         })
         .collect::<Result<_, _>>()?;
-    let lik = problem
-        .likelihood
+    // The recording: each tracked coordinate's own white-noise σ̂, and where each signal is
+    // missing.
+    let rec = job
+        .job
+        .recording
         .as_ref()
-        .map_err(|e| format!("no likelihood: {e:?}"))?;
-    let sigma_coord = lik.sigma_m / 2f64.sqrt();
+        .ok_or("a job without a recording")?;
+    let trace = wiperlab::import::read_trace(&job.recording_path, &rec.import)?;
+    let (head, tip) = (
+        trace.role(Role::Head).ok_or("no head point")?,
+        trace.role(Role::Tip).ok_or("no tip point")?,
+    );
+    let sigma: Vec<f64> = [&head.x_m, &head.y_m, &tip.x_m, &tip.y_m]
+        .iter()
+        .map(|c| tracking_noise_sigma(c))
+        .collect::<Result<_, _>>()?;
+    let missing: Vec<Vec<bool>> = kinds
+        .iter()
+        .map(|k| Ok(k.extract(&trace)?.iter().map(|v| !v.is_finite()).collect()))
+        .collect::<Fallible<_>>()?;
     let p = kinds.len();
     // White noise's cross-spectral density, one-sided: 2·Cov/fs (row-major p × p).
     let noise: Vec<Complex<f64>> = (0..p * p)
         .map(|ab| {
             let (ca, cb) = (coordinates(kinds[ab / p]), coordinates(kinds[ab % p]));
-            let cov: f64 =
-                ca.iter().zip(&cb).map(|(x, y)| x * y).sum::<f64>() * sigma_coord.powi(2);
+            let cov: f64 = (0..4).map(|c| ca[c] * cb[c] * sigma[c] * sigma[c]).sum();
             Complex::new(2.0 * cov / problem.fs_hz, 0.0)
         })
         .collect();
@@ -183,28 +199,52 @@ fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
             .map(|k| k.extract(&trace))
             .collect::<Result<_, _>>()?)
     };
+    // The signals' cross-spectra with the recording's missing samples missing.
     let spectra_of = |signals: &[Vec<f64>]| -> Fallible<Vec<CrossSpectra>> {
-        let refs: Vec<&[f64]> = signals.iter().map(Vec::as_slice).collect();
+        let masked: Vec<Vec<f64>> = signals
+            .iter()
+            .zip(&missing)
+            .map(|(x, m)| {
+                x.iter()
+                    .zip(m)
+                    .map(|(v, m)| if *m { f64::NAN } else { *v })
+                    .collect()
+            })
+            .collect();
+        let refs: Vec<&[f64]> = masked.iter().map(Vec::as_slice).collect();
         bands
             .iter()
             .map(|(cfg, bins)| {
-                Ok(WelchPlan::new(*cfg)?.cross_spectra(&refs, problem.fs_hz, bins)?)
+                Ok(WelchPlan::new(*cfg)?.cross_spectra_gappy(
+                    &refs,
+                    problem.fs_hz,
+                    bins,
+                    problem.max_fill,
+                )?)
             })
             .collect()
     };
     let k = truth.len();
     let clean = signals_at(&truth)?;
     let centre = spectra_of(&clean)?;
+    // Every band must hold enough segments for the signals together (else no row is written).
+    for (c, (cfg, bins)) in centre.iter().zip(&bands) {
+        MultivariateWhittle::new(cfg, c.n_segments, bins.len(), p)?;
+    }
     let derivs = derivatives(&truth, |u| spectra_of(&signals_at(u)?))?;
     // The noise replicates' cross-spectra: the truth's signals plus fresh white noise on each
     // tracked coordinate, as the fit's sandwich draws them.
     let replicates: Vec<Vec<CrossSpectra>> = (0..args.replicates)
-        .map(|r| spectra_of(&with_noise(&clean, &kinds, sigma_coord, r as u64)))
+        .map(|r| spectra_of(&with_noise(&clean, &kinds, &sigma, r as u64)))
         .collect::<Fallible<_>>()?;
     println!(
-        "{}: candidate {candidate}, σ per coordinate {:.3e} m, signals {}",
+        "{}: candidate {candidate}, σ̂ of head x, head y, tip x, tip y {:.2e}, {:.2e}, {:.2e}, \
+         {:.2e} m, signals {}",
         path.display(),
-        sigma_coord,
+        sigma[0],
+        sigma[1],
+        sigma[2],
+        sigma[3],
         args.signals.join(", ")
     );
     let mut configs: Vec<Vec<usize>> = (0..p).map(|i| vec![i]).collect();
@@ -335,16 +375,20 @@ fn derivatives(
         .collect()
 }
 
-/// `clean` (the signals `kinds`) plus white noise of `sigma_m` on each tracked coordinate, drawn
-/// from seed [`NOISE_SEED`]` + r`: a signal differencing two coordinates gets both their noises.
-fn with_noise(clean: &[Vec<f64>], kinds: &[SignalKind], sigma_m: f64, r: u64) -> Vec<Vec<f64>> {
+/// `clean` (the signals `kinds`) plus white noise of `sigma_m[c]` on each tracked coordinate `c`
+/// (head x, head y, tip x, tip y), drawn from seed [`NOISE_SEED`]` + r`: a signal differencing
+/// two coordinates gets both their noises.
+fn with_noise(clean: &[Vec<f64>], kinds: &[SignalKind], sigma_m: &[f64], r: u64) -> Vec<Vec<f64>> {
     use rand::SeedableRng;
     use rand_distr::Distribution;
     let mut rng = rand::rngs::StdRng::seed_from_u64(NOISE_SEED.wrapping_add(r));
-    let normal = rand_distr::Normal::new(0.0, sigma_m).expect("a positive σ");
     let n = clean.first().map_or(0, Vec::len);
-    let coords: Vec<Vec<f64>> = (0..4)
-        .map(|_| (0..n).map(|_| normal.sample(&mut rng)).collect())
+    let coords: Vec<Vec<f64>> = sigma_m
+        .iter()
+        .map(|&s| {
+            let normal = rand_distr::Normal::new(0.0, s).expect("a finite σ");
+            (0..n).map(|_| normal.sample(&mut rng)).collect()
+        })
         .collect();
     clean
         .iter()

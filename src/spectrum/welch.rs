@@ -429,52 +429,11 @@ impl WelchPlan {
         max_fill: usize,
     ) -> Result<(Psd, GapReport)> {
         check_fs(fs_hz)?;
-        let (Some(first), Some(last)) = (
-            x.iter().position(|v| v.is_finite()),
-            x.iter().rposition(|v| v.is_finite()),
-        ) else {
-            return Err(SpectrumError::AllMissing {
-                len: x.len(),
-                nperseg: self.cfg.nperseg,
-            }
-            .into());
-        };
-        let mut report = GapReport {
-            dropped: first + (x.len() - 1 - last),
-            ..GapReport::default()
-        };
-        let mut y = x[first..=last].to_vec();
-        let mut runs: Vec<(usize, usize)> = Vec::new();
-        let mut run_start = 0;
-        let mut i = 0;
-        while i < y.len() {
-            if y[i].is_finite() {
-                i += 1;
-                continue;
-            }
-            // y[0] and y[len-1] are finite, so the gap [i, j) has finite neighbours.
-            let mut j = i;
-            while !y[j].is_finite() {
-                j += 1;
-            }
-            let gap = j - i;
-            if gap <= max_fill {
-                let (a, b) = (y[i - 1], y[j]);
-                let denom = (gap + 1) as f64;
-                for m in 0..gap {
-                    y[i + m] = a + (b - a) * ((m + 1) as f64 / denom);
-                }
-                report.filled += gap;
-            } else {
-                runs.push((run_start, i));
-                run_start = j;
-                report.dropped += gap;
-            }
-            i = j;
-        }
-        runs.push((run_start, y.len()));
-        report.runs = runs.len();
-
+        let Filled {
+            y,
+            runs,
+            mut report,
+        } = fill_and_split(x, max_fill, self.cfg.nperseg)?;
         self.acc.fill(0.0);
         self.segments.clear();
         let mut n_seg = 0;
@@ -619,20 +578,8 @@ impl WelchPlan {
         bins: &[usize],
     ) -> Result<CrossSpectra> {
         check_fs(fs_hz)?;
-        if self.cfg.average == Average::Median {
-            return Err(SpectrumError::MedianCrossSpectra.into());
-        }
-        let nf = self.cfg.n_freqs();
-        if let Some(&bin) = bins.iter().find(|&&k| k >= nf) {
-            return Err(SpectrumError::BinOutOfRange { bin, n_freqs: nf }.into());
-        }
-        let len = signals.iter().map(|x| x.len()).min().unwrap_or(0);
-        if signals.iter().any(|x| x.len() != len) {
-            return Err(SpectrumError::UnequalLengths {
-                lengths: signals.iter().map(|x| x.len()).collect(),
-            }
-            .into());
-        }
+        self.check_cross(signals, bins)?;
+        let len = signals.first().map_or(0, |x| x.len());
         if len < self.cfg.nperseg {
             return Err(SpectrumError::TooShort {
                 len,
@@ -643,13 +590,99 @@ impl WelchPlan {
         for x in signals {
             check_finite(x)?;
         }
+        let starts: Vec<usize> = (0..self.cfg.n_segments(len))
+            .map(|s| s * self.cfg.step())
+            .collect();
+        Ok(self.cross_spectra_at(signals, &starts, fs_hz, bins))
+    }
+
+    /// [`cross_spectra`](Self::cross_spectra) of signals tracked together with gaps (NaN): a
+    /// sample missing in one signal is dropped from all, gaps of at most `max_fill` samples are
+    /// filled linearly in each signal, and the segments are taken from the finite runs between
+    /// longer gaps, as [`process_gappy`](Self::process_gappy) takes them (so for one signal the
+    /// diagonal is its gappy Welch PSD).
+    ///
+    /// Errors: those of [`cross_spectra`](Self::cross_spectra) but
+    /// [`SpectrumError::NonFinite`]; [`SpectrumError::AllMissing`] and
+    /// [`SpectrumError::NoFiniteRun`] as [`process_gappy`](Self::process_gappy).
+    pub fn cross_spectra_gappy(
+        &mut self,
+        signals: &[&[f64]],
+        fs_hz: f64,
+        bins: &[usize],
+        max_fill: usize,
+    ) -> Result<CrossSpectra> {
+        check_fs(fs_hz)?;
+        self.check_cross(signals, bins)?;
+        let len = signals.first().map_or(0, |x| x.len());
+        let missing: Vec<bool> = (0..len)
+            .map(|t| signals.iter().any(|x| !x[t].is_finite()))
+            .collect();
+        let filled: Vec<Filled> = signals
+            .iter()
+            .map(|x| {
+                let masked: Vec<f64> = x
+                    .iter()
+                    .zip(&missing)
+                    .map(|(v, m)| if *m { f64::NAN } else { *v })
+                    .collect();
+                fill_and_split(&masked, max_fill, self.cfg.nperseg)
+            })
+            .collect::<Result<_>>()?;
+        // Every signal has the same missing samples, so the same runs.
+        let runs = &filled[0].runs;
+        let cfg = self.cfg;
+        let starts: Vec<usize> = runs
+            .iter()
+            .flat_map(|&(s, e)| (0..cfg.n_segments(e - s)).map(move |k| s + k * cfg.step()))
+            .collect();
+        if starts.is_empty() {
+            return Err(SpectrumError::NoFiniteRun {
+                nperseg: self.cfg.nperseg,
+                longest: runs.iter().map(|(s, e)| e - s).max().unwrap_or(0),
+                len,
+                runs: runs.len(),
+                max_fill,
+            }
+            .into());
+        }
+        let ys: Vec<&[f64]> = filled.iter().map(|f| f.y.as_slice()).collect();
+        Ok(self.cross_spectra_at(&ys, &starts, fs_hz, bins))
+    }
+
+    /// The settings' and the arguments' errors of the cross-spectra: median average, a bin out
+    /// of range, signals of different lengths.
+    fn check_cross(&self, signals: &[&[f64]], bins: &[usize]) -> Result<()> {
+        if self.cfg.average == Average::Median {
+            return Err(SpectrumError::MedianCrossSpectra.into());
+        }
+        let nf = self.cfg.n_freqs();
+        if let Some(&bin) = bins.iter().find(|&&k| k >= nf) {
+            return Err(SpectrumError::BinOutOfRange { bin, n_freqs: nf }.into());
+        }
+        let len = signals.first().map_or(0, |x| x.len());
+        if signals.iter().any(|x| x.len() != len) {
+            return Err(SpectrumError::UnequalLengths {
+                lengths: signals.iter().map(|x| x.len()).collect(),
+            }
+            .into());
+        }
+        Ok(())
+    }
+
+    /// The cross-spectral matrices at `bins` averaged over the segments starting at `starts`
+    /// (finite samples, `nperseg` from each start).
+    fn cross_spectra_at(
+        &mut self,
+        signals: &[&[f64]],
+        starts: &[usize],
+        fs_hz: f64,
+        bins: &[usize],
+    ) -> CrossSpectra {
         let p = signals.len();
-        let n_seg = self.cfg.n_segments(len);
-        let step = self.cfg.step();
         let mut sum = vec![vec![Complex::new(0.0, 0.0); p * p]; bins.len()];
         let mut column = vec![Complex::new(0.0, 0.0); p * bins.len()];
-        for s in 0..n_seg {
-            let start = s * step;
+        for &start in starts {
             for (a, x) in signals.iter().enumerate() {
                 self.segment_power(&x[start..start + self.cfg.nperseg]);
                 for (j, &k) in bins.iter().enumerate() {
@@ -665,8 +698,9 @@ impl WelchPlan {
                 }
             }
         }
+        let n_seg = starts.len();
         let norm = self.norm(fs_hz) / n_seg as f64;
-        let last = nf - 1;
+        let last = self.cfg.n_freqs() - 1;
         let matrices = sum
             .into_iter()
             .zip(bins)
@@ -681,12 +715,12 @@ impl WelchPlan {
             .collect();
         let mut freq_hz = Vec::new();
         fill_freqs(&mut freq_hz, self.cfg.nfft, fs_hz);
-        Ok(CrossSpectra {
+        CrossSpectra {
             freq_hz: bins.iter().map(|&k| freq_hz[k]).collect(),
             signals: p,
             matrices,
             n_segments: n_seg,
-        })
+        }
     }
 
     /// The factor on one segment's `|X_k|²`: `1/(fs·Σw²)` for density, `1/(Σw)²` for spectrum.
@@ -710,6 +744,66 @@ pub struct CrossSpectra {
     pub matrices: Vec<Vec<Complex<f64>>>,
     /// Segments averaged.
     pub n_segments: usize,
+}
+
+/// A record with short gaps filled: the samples from its first to its last finite one, gaps of
+/// at most `max_fill` samples linearly interpolated, and the finite runs between longer gaps
+/// (`[start, end)` into `y`).
+struct Filled {
+    y: Vec<f64>,
+    runs: Vec<(usize, usize)>,
+    report: GapReport,
+}
+
+/// Fills the short gaps of `x` and splits it at the long ones ([`Filled`]).
+/// [`SpectrumError::AllMissing`] when no sample is finite.
+fn fill_and_split(x: &[f64], max_fill: usize, nperseg: usize) -> Result<Filled> {
+    let (Some(first), Some(last)) = (
+        x.iter().position(|v| v.is_finite()),
+        x.iter().rposition(|v| v.is_finite()),
+    ) else {
+        return Err(SpectrumError::AllMissing {
+            len: x.len(),
+            nperseg,
+        }
+        .into());
+    };
+    let mut report = GapReport {
+        dropped: first + (x.len() - 1 - last),
+        ..GapReport::default()
+    };
+    let mut y = x[first..=last].to_vec();
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    let mut run_start = 0;
+    let mut i = 0;
+    while i < y.len() {
+        if y[i].is_finite() {
+            i += 1;
+            continue;
+        }
+        // y[0] and y[len-1] are finite, so the gap [i, j) has finite neighbours.
+        let mut j = i;
+        while !y[j].is_finite() {
+            j += 1;
+        }
+        let gap = j - i;
+        if gap <= max_fill {
+            let (a, b) = (y[i - 1], y[j]);
+            let denom = (gap + 1) as f64;
+            for m in 0..gap {
+                y[i + m] = a + (b - a) * ((m + 1) as f64 / denom);
+            }
+            report.filled += gap;
+        } else {
+            runs.push((run_start, i));
+            run_start = j;
+            report.dropped += gap;
+        }
+        i = j;
+    }
+    runs.push((run_start, y.len()));
+    report.runs = runs.len();
+    Ok(Filled { y, runs, report })
 }
 
 /// `f_k = k·(1/(nfft·(1/fs)))`, exactly as `numpy.fft.rfftfreq(nfft, 1/fs)`.
@@ -878,6 +972,49 @@ mod tests {
         // A delay of 3 of 256 samples loses about 3/256 of the coherent product to the taper.
         assert!((along - 1.0).abs() < 0.03, "in phase {along}");
         assert!(across.abs() < 0.02, "in quadrature {across}");
+    }
+
+    #[test]
+    fn gappy_cross_spectra_drop_a_sample_missing_in_any_signal() {
+        // Lost frames: a short gap in x (filled) and a long one in y (split); the diagonal is each
+        // signal's gappy Welch PSD with the other's missing samples dropped too.
+        let (fs, n) = (500.0, 4000);
+        let mut x = white(n, 1.0, 21);
+        let mut y = white(n, 2.0, 22);
+        for t in 1000..1003 {
+            x[t] = f64::NAN;
+        }
+        for t in 2500..2700 {
+            y[t] = f64::NAN;
+        }
+        let union = |v: &[f64]| -> Vec<f64> {
+            (0..n)
+                .map(|t| {
+                    if x[t].is_finite() && y[t].is_finite() {
+                        v[t]
+                    } else {
+                        f64::NAN
+                    }
+                })
+                .collect()
+        };
+        let cfg = WelchConfig::new(128);
+        let mut plan = WelchPlan::new(cfg).unwrap();
+        let bins: Vec<usize> = (3..60).collect();
+        let c = plan.cross_spectra_gappy(&[&x, &y], fs, &bins, 5).unwrap();
+        let (px, rx) = plan.process_gappy(&union(&x), fs, 5).unwrap();
+        let (py, _) = plan.process_gappy(&union(&y), fs, 5).unwrap();
+        assert_eq!(c.n_segments, rx.segments_used);
+        assert_eq!(rx.runs, 2);
+        for (m, &k) in c.matrices.iter().zip(&bins) {
+            assert!((m[0].re - px.density[k]).abs() <= 1e-12 * px.density[k]);
+            assert!((m[3].re - py.density[k]).abs() <= 1e-12 * py.density[k]);
+        }
+        // Without a gap it is the plain estimate.
+        let z = white(n, 1.0, 23);
+        let plain = plan.cross_spectra(&[&z], fs, &bins).unwrap();
+        let gappy = plan.cross_spectra_gappy(&[&z], fs, &bins, 5).unwrap();
+        assert_eq!(plain, gappy);
     }
 
     #[test]
