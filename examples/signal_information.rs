@@ -73,6 +73,9 @@ struct Args {
 
 type Fallible<T> = Result<T, Box<dyn std::error::Error>>;
 
+/// One band's cross-spectral matrices, one per bin (row-major entries).
+type BandMatrices = Vec<Vec<Complex<f64>>>;
+
 /// Coefficients of a signal on the tracked coordinates (head x, head y, tip x, tip y).
 fn coordinates(s: SignalKind) -> [f64; 4] {
     match s {
@@ -344,7 +347,7 @@ fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
 fn derivatives(
     u0: &[f64],
     spectra_at: impl Fn(&[f64]) -> Fallible<Vec<CrossSpectra>>,
-) -> Fallible<Vec<Vec<Vec<Vec<Complex<f64>>>>>> {
+) -> Fallible<Vec<Vec<BandMatrices>>> {
     (0..u0.len())
         .map(|i| {
             let (lo, hi) = (

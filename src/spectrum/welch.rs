@@ -981,12 +981,8 @@ mod tests {
         let (fs, n) = (500.0, 4000);
         let mut x = white(n, 1.0, 21);
         let mut y = white(n, 2.0, 22);
-        for t in 1000..1003 {
-            x[t] = f64::NAN;
-        }
-        for t in 2500..2700 {
-            y[t] = f64::NAN;
-        }
+        x[1000..1003].fill(f64::NAN);
+        y[2500..2700].fill(f64::NAN);
         let union = |v: &[f64]| -> Vec<f64> {
             (0..n)
                 .map(|t| {
