@@ -1046,15 +1046,16 @@ fn confirmation_skipped(ends: &[f64], score_gap: f64) -> Option<String> {
     ))
 }
 
-/// The range `(lowest, highest)` of a search's finite ends `ends` (nats) when the search trails
-/// by `behind_nats` more than their spread plus [`DEFERRED_CONFIRM_MARGIN_NATS`]: a basin as far
+/// The range `(lowest, highest)` of a search's ends `ends` (nats) when the search trails by
+/// `behind_nats` more than their spread plus [`DEFERRED_CONFIRM_MARGIN_NATS`]: a basin as far
 /// below the best end as the ends spread above it would still leave the candidate that far
-/// behind, so more restarts could not make it the choice. `None` otherwise (or when `behind_nats`
-/// is NaN).
+/// behind, so more restarts could not make it the choice. A run that failed
+/// ([`super::FAILED_COST`] or not finite) has no end. `None` otherwise (or when `behind_nats` is
+/// NaN).
 pub(crate) fn hopelessly_behind(ends: &[f64], behind_nats: f64) -> Option<(f64, f64)> {
     let (lo, hi) = ends
         .iter()
-        .filter(|c| c.is_finite())
+        .filter(|c| c.is_finite() && **c < super::FAILED_COST)
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &c| {
             (lo.min(c), hi.max(c))
         });
@@ -2237,9 +2238,9 @@ mod tests {
     #[test]
     fn a_search_is_hopelessly_behind_only_beyond_the_spread_of_its_finite_ends() {
         // Shaped like a head-only recording's blade2dof+shoulder (calibration cal_091): the smaller
-        // model's search end, a warm point that could not be simulated, two local polish ends,
-        // and the candidate 2533.7 nats behind head1dof.
-        let ends = [2914.0, f64::INFINITY, 2602.67, 2750.0];
+        // model's search end, a warm point that could not be simulated, a polish that failed, two
+        // local polish ends, and the candidate 2533.7 nats behind head1dof.
+        let ends = [2914.0, f64::INFINITY, super::super::FAILED_COST, 2602.67, 2750.0];
         assert_eq!(hopelessly_behind(&ends, 2533.7), Some((2602.67, 2914.0)));
         let edge = 2914.0 - 2602.67 + DEFERRED_CONFIRM_MARGIN_NATS;
         assert!(hopelessly_behind(&ends, 0.999 * edge).is_none());
