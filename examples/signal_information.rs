@@ -19,8 +19,8 @@
 //! The sandwich's `V` is the variance of the score over noise replicates of the truth's signals,
 //! as the fit's sandwich draws them.
 //!
-//! Prints, per configuration, each parameter's 1σ from `F⁻¹` (normalised units, and relative to
-//! the truth's value), and the ratio of the first signal's 1σ to the joint one.
+//! Prints, per configuration, each parameter's 1σ from `F⁻¹` and from the sandwich (normalised
+//! units, and relative to the truth's value), and how much narrower than the first signal's alone.
 //!
 //! ```sh
 //! cargo run --release --example signal_information -- JOB.toml --model blade2dof+shoulder \
@@ -35,7 +35,7 @@ use wiperlab::likelihood::covariance::sample_covariance;
 use wiperlab::likelihood::multivariate::MultivariateWhittle;
 use wiperlab::likelihood::{interior_bin, tracking_noise_sigma};
 use wiperlab::search::evidence::{FISHER_STEP_U, NOISE_REPLICATES, NOISE_SEED};
-use wiperlab::search::problem_for;
+use wiperlab::search::{SpectralProblem, problem_for};
 use wiperlab::spectrum::features::SignalKind;
 use wiperlab::spectrum::welch::{CrossSpectra, WelchConfig, WelchPlan};
 use wiperlab::trace::Role;
@@ -96,7 +96,8 @@ fn main() -> Fallible<()> {
         // A truth on the edge of contact loss may not simulate at a displaced point.
         if let Err(e) = information(&args, path) {
             let e = e.to_string();
-            println!("{}: skipped: {}", path.display(), &e[..e.len().min(300)]);
+            let short: String = e.chars().take(300).collect();
+            println!("{}: skipped: {short}", path.display());
         }
     }
     Ok(())
@@ -151,50 +152,9 @@ fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
                 .ok_or(format!("no truth for {}", f.name))
         })
         .collect::<Result<_, _>>()?;
-    // The recording: each tracked coordinate's own white-noise σ̂, and where each signal is
-    // missing.
-    let rec = job
-        .job
-        .recording
-        .as_ref()
-        .ok_or("a job without a recording")?;
-    let trace = wiperlab::import::read_trace(&job.recording_path, &rec.import)?;
-    let (head, tip) = (
-        trace.role(Role::Head).ok_or("no head point")?,
-        trace.role(Role::Tip).ok_or("no tip point")?,
-    );
-    let sigma: Vec<f64> = [&head.x_m, &head.y_m, &tip.x_m, &tip.y_m]
-        .iter()
-        .map(|c| tracking_noise_sigma(c))
-        .collect::<Result<_, _>>()?;
-    let missing: Vec<Vec<bool>> = kinds
-        .iter()
-        .map(|k| Ok(k.extract(&trace)?.iter().map(|v| !v.is_finite()).collect()))
-        .collect::<Fallible<_>>()?;
-    let p = kinds.len();
-    // White noise's cross-spectral density, one-sided: 2·Cov/fs (row-major p × p).
-    let noise: Vec<Complex<f64>> = (0..p * p)
-        .map(|ab| {
-            let (ca, cb) = (coordinates(kinds[ab / p]), coordinates(kinds[ab % p]));
-            let cov: f64 = (0..4).map(|c| ca[c] * cb[c] * sigma[c] * sigma[c]).sum();
-            Complex::new(2.0 * cov / problem.fs_hz, 0.0)
-        })
-        .collect();
-    // Per band: its settings and its interior bins in range.
-    let bands: Vec<(WelchConfig, Vec<usize>)> = problem
-        .bands
-        .iter()
-        .map(|b| {
-            let cfg = b.welch_config()?;
-            let bins = (0..cfg.n_freqs())
-                .filter(|&k| {
-                    let f = k as f64 * problem.fs_hz / cfg.nfft as f64;
-                    f >= b.range_hz[0] && f <= b.range_hz[1] && interior_bin(f, problem.fs_hz, &cfg)
-                })
-                .collect();
-            Ok((cfg, bins))
-        })
-        .collect::<Fallible<_>>()?;
+    let (sigma, missing) = recording_noise(&job, &kinds)?;
+    let noise = noise_matrix(&kinds, &sigma, problem.fs_hz);
+    let bands = band_bins(&problem)?;
     let signals_at = |u: &[f64]| -> Fallible<Vec<Vec<f64>>> {
         let trace = problem.simulate(&problem.params_at(u))?.to_trace();
         Ok(kinds
@@ -202,44 +162,26 @@ fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
             .map(|k| k.extract(&trace))
             .collect::<Result<_, _>>()?)
     };
-    // The signals' cross-spectra with the recording's missing samples missing.
-    let spectra_of = |signals: &[Vec<f64>]| -> Fallible<Vec<CrossSpectra>> {
-        let masked: Vec<Vec<f64>> = signals
-            .iter()
-            .zip(&missing)
-            .map(|(x, m)| {
-                x.iter()
-                    .zip(m)
-                    .map(|(v, m)| if *m { f64::NAN } else { *v })
-                    .collect()
-            })
-            .collect();
-        let refs: Vec<&[f64]> = masked.iter().map(Vec::as_slice).collect();
-        bands
-            .iter()
-            .map(|(cfg, bins)| {
-                Ok(WelchPlan::new(*cfg)?.cross_spectra_gappy(
-                    &refs,
-                    problem.fs_hz,
-                    bins,
-                    problem.max_fill,
-                )?)
-            })
-            .collect()
+    let spectra_of = |signals: &[Vec<f64>]| {
+        cross_spectra(signals, &missing, &bands, problem.fs_hz, problem.max_fill)
     };
-    let k = truth.len();
+    let p = kinds.len();
     let clean = signals_at(&truth)?;
-    let centre = spectra_of(&clean)?;
+    let spectra = Spectra {
+        centre: spectra_of(&clean)?,
+        derivs: derivatives(&truth, |u| spectra_of(&signals_at(u)?))?,
+        // The truth's signals plus fresh white noise on each tracked coordinate, as the fit's
+        // sandwich draws them.
+        replicates: (0..args.replicates)
+            .map(|r| spectra_of(&with_noise(&clean, &kinds, &sigma, r as u64)))
+            .collect::<Fallible<_>>()?,
+        noise,
+        p,
+    };
     // Every band must hold enough segments for the signals together (else no row is written).
-    for (c, (cfg, bins)) in centre.iter().zip(&bands) {
+    for (c, (cfg, bins)) in spectra.centre.iter().zip(&bands) {
         MultivariateWhittle::new(cfg, c.n_segments, bins.len(), p)?;
     }
-    let derivs = derivatives(&truth, |u| spectra_of(&signals_at(u)?))?;
-    // The noise replicates' cross-spectra: the truth's signals plus fresh white noise on each
-    // tracked coordinate, as the fit's sandwich draws them.
-    let replicates: Vec<Vec<CrossSpectra>> = (0..args.replicates)
-        .map(|r| spectra_of(&with_noise(&clean, &kinds, &sigma, r as u64)))
-        .collect::<Fallible<_>>()?;
     println!(
         "{}: candidate {candidate}, σ̂ of head x, head y, tip x, tip y {:.2e}, {:.2e}, {:.2e}, \
          {:.2e} m, signals {}",
@@ -254,38 +196,11 @@ fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
     if p > 1 {
         configs.push((0..p).collect());
     }
-    let mut first: Option<Vec<f64>> = None;
-    let mut first_sandwich: Option<Vec<f64>> = None;
+    let k = truth.len();
+    let (mut first, mut first_sandwich) = (None, None);
     let mut single: Vec<(DMatrix<f64>, Vec<Vec<f64>>)> = Vec::new();
     for sel in configs {
-        // The entries of the selected signals, row-major.
-        let pick = |m: &[Complex<f64>]| -> Vec<Complex<f64>> {
-            sel.iter()
-                .flat_map(|&a| sel.iter().map(move |&b| m[a * p + b]))
-                .collect()
-        };
-        let mut f = DMatrix::<f64>::zeros(k, k);
-        let mut scores = vec![vec![0.0; k]; replicates.len()];
-        for (band, (c, (cfg, bins))) in centre.iter().zip(&bands).enumerate() {
-            let model: Vec<Vec<Complex<f64>>> = c
-                .matrices
-                .iter()
-                .map(|m| pick(&m.iter().zip(&noise).map(|(s, n)| s + n).collect::<Vec<_>>()))
-                .collect();
-            let d: Vec<Vec<Vec<Complex<f64>>>> = derivs
-                .iter()
-                .map(|di| di[band].iter().map(|m| pick(m)).collect())
-                .collect();
-            let w = MultivariateWhittle::new(cfg, c.n_segments, bins.len(), sel.len())?;
-            f += w.fisher(&model, &d)?;
-            for (score, rep) in scores.iter_mut().zip(&replicates) {
-                let measured: Vec<Vec<Complex<f64>>> =
-                    rep[band].matrices.iter().map(|m| pick(m)).collect();
-                for (s, g) in score.iter_mut().zip(w.score(&measured, &model, &d)?) {
-                    *s += g;
-                }
-            }
-        }
+        let (f, scores) = spectra.information_of(&sel, &bands, k)?;
         let label: Vec<&str> = sel.iter().map(|&i| args.signals[i].as_str()).collect();
         let mut rows = vec![(label.join(" + "), f.clone(), scores.clone())];
         if sel.len() == 1 {
@@ -295,7 +210,7 @@ fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
             let f_sum = single
                 .iter()
                 .fold(DMatrix::<f64>::zeros(k, k), |a, b| a + &b.0);
-            let s_sum: Vec<Vec<f64>> = (0..replicates.len())
+            let s_sum: Vec<Vec<f64>> = (0..spectra.replicates.len())
                 .map(|r| {
                     (0..k)
                         .map(|i| single.iter().map(|s| s.1[r][i]).sum())
@@ -340,6 +255,150 @@ fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
         }
     }
     Ok(())
+}
+
+/// Each tracked coordinate's white-noise σ̂ in the job's recording (head x, head y, tip x, tip y;
+/// [`tracking_noise_sigma`], m) and where each of the signals `kinds` is missing.
+fn recording_noise(job: &LoadedJob, kinds: &[SignalKind]) -> Fallible<(Vec<f64>, Vec<Vec<bool>>)> {
+    let rec = job
+        .job
+        .recording
+        .as_ref()
+        .ok_or("a job without a recording")?;
+    let trace = wiperlab::import::read_trace(&job.recording_path, &rec.import)?;
+    let (head, tip) = (
+        trace.role(Role::Head).ok_or("no head point")?,
+        trace.role(Role::Tip).ok_or("no tip point")?,
+    );
+    let sigma: Vec<f64> = [&head.x_m, &head.y_m, &tip.x_m, &tip.y_m]
+        .iter()
+        .map(|c| tracking_noise_sigma(c))
+        .collect::<Result<_, _>>()?;
+    let missing = kinds
+        .iter()
+        .map(|k| Ok(k.extract(&trace)?.iter().map(|v| !v.is_finite()).collect()))
+        .collect::<Fallible<_>>()?;
+    Ok((sigma, missing))
+}
+
+/// The one-sided cross-spectral density of white tracking noise of `sigma` (per coordinate) in
+/// the signals `kinds` sampled at `fs_hz`: `2·Cov/fs`, row-major `p × p`.
+fn noise_matrix(kinds: &[SignalKind], sigma: &[f64], fs_hz: f64) -> Vec<Complex<f64>> {
+    let p = kinds.len();
+    (0..p * p)
+        .map(|ab| {
+            let (ca, cb) = (coordinates(kinds[ab / p]), coordinates(kinds[ab % p]));
+            let cov: f64 = (0..4).map(|c| ca[c] * cb[c] * sigma[c] * sigma[c]).sum();
+            Complex::new(2.0 * cov / fs_hz, 0.0)
+        })
+        .collect()
+}
+
+/// Each band's Welch settings and its interior bins inside its range (indices of the FFT bins).
+fn band_bins(problem: &SpectralProblem) -> Fallible<Vec<(WelchConfig, Vec<usize>)>> {
+    problem
+        .bands
+        .iter()
+        .map(|b| {
+            let cfg = b.welch_config()?;
+            let bins = (0..cfg.n_freqs())
+                .filter(|&k| {
+                    let f = k as f64 * problem.fs_hz / cfg.nfft as f64;
+                    f >= b.range_hz[0] && f <= b.range_hz[1] && interior_bin(f, problem.fs_hz, &cfg)
+                })
+                .collect();
+            Ok((cfg, bins))
+        })
+        .collect()
+}
+
+/// Every band's cross-spectra of `signals` with the samples `missing` (per signal) missing, short
+/// gaps filled as the fit fills them.
+fn cross_spectra(
+    signals: &[Vec<f64>],
+    missing: &[Vec<bool>],
+    bands: &[(WelchConfig, Vec<usize>)],
+    fs_hz: f64,
+    max_fill: usize,
+) -> Fallible<Vec<CrossSpectra>> {
+    let masked: Vec<Vec<f64>> = signals
+        .iter()
+        .zip(missing)
+        .map(|(x, m)| {
+            x.iter()
+                .zip(m)
+                .map(|(v, m)| if *m { f64::NAN } else { *v })
+                .collect()
+        })
+        .collect();
+    let refs: Vec<&[f64]> = masked.iter().map(Vec::as_slice).collect();
+    bands
+        .iter()
+        .map(|(cfg, bins)| {
+            Ok(WelchPlan::new(*cfg)?.cross_spectra_gappy(&refs, fs_hz, bins, max_fill)?)
+        })
+        .collect()
+}
+
+/// The truth's cross-spectra of all `p` signals, their derivatives, the noise replicates' and the
+/// noise's own.
+struct Spectra {
+    centre: Vec<CrossSpectra>,
+    /// `[parameter][band]`.
+    derivs: Vec<Vec<BandMatrices>>,
+    /// `[replicate][band]`.
+    replicates: Vec<Vec<CrossSpectra>>,
+    noise: Vec<Complex<f64>>,
+    p: usize,
+}
+
+impl Spectra {
+    /// The Fisher information (`k × k`) of the signals `sel` read together, and the score of each
+    /// noise replicate.
+    fn information_of(
+        &self,
+        sel: &[usize],
+        bands: &[(WelchConfig, Vec<usize>)],
+        k: usize,
+    ) -> Fallible<(DMatrix<f64>, Vec<Vec<f64>>)> {
+        let p = self.p;
+        // The entries of the selected signals, row-major.
+        let pick = |m: &[Complex<f64>]| -> Vec<Complex<f64>> {
+            sel.iter()
+                .flat_map(|&a| sel.iter().map(move |&b| m[a * p + b]))
+                .collect()
+        };
+        let mut f = DMatrix::<f64>::zeros(k, k);
+        let mut scores = vec![vec![0.0; k]; self.replicates.len()];
+        for (band, (c, (cfg, bins))) in self.centre.iter().zip(bands).enumerate() {
+            let model: BandMatrices = c
+                .matrices
+                .iter()
+                .map(|m| {
+                    pick(
+                        &m.iter()
+                            .zip(&self.noise)
+                            .map(|(s, n)| s + n)
+                            .collect::<Vec<_>>(),
+                    )
+                })
+                .collect();
+            let d: Vec<BandMatrices> = self
+                .derivs
+                .iter()
+                .map(|di| di[band].iter().map(|m| pick(m)).collect())
+                .collect();
+            let w = MultivariateWhittle::new(cfg, c.n_segments, bins.len(), sel.len())?;
+            f += w.fisher(&model, &d)?;
+            for (score, rep) in scores.iter_mut().zip(&self.replicates) {
+                let measured: BandMatrices = rep[band].matrices.iter().map(|m| pick(m)).collect();
+                for (s, g) in score.iter_mut().zip(w.score(&measured, &model, &d)?) {
+                    *s += g;
+                }
+            }
+        }
+        Ok((f, scores))
+    }
 }
 
 /// The central differences, step [`FISHER_STEP_U`] (one-sided at a bound), of the cross-spectral

@@ -2240,7 +2240,13 @@ mod tests {
         // Shaped like a head-only recording's blade2dof+shoulder (calibration cal_091): the smaller
         // model's search end, a warm point that could not be simulated, a polish that failed, two
         // local polish ends, and the candidate 2533.7 nats behind head1dof.
-        let ends = [2914.0, f64::INFINITY, super::super::FAILED_COST, 2602.67, 2750.0];
+        let ends = [
+            2914.0,
+            f64::INFINITY,
+            super::super::FAILED_COST,
+            2602.67,
+            2750.0,
+        ];
         assert_eq!(hopelessly_behind(&ends, 2533.7), Some((2602.67, 2914.0)));
         let edge = 2914.0 - 2602.67 + DEFERRED_CONFIRM_MARGIN_NATS;
         assert!(hopelessly_behind(&ends, 0.999 * edge).is_none());
