@@ -85,7 +85,9 @@ pub(crate) fn scan_reason(
 }
 
 /// Scans every `+shoulder` candidate of `fits` whose model without shoulder was fitted too, when the
-/// job bounds the shoulder in `[fit.shoulder]`. `why` goes into each scanned candidate's search
+/// job bounds the shoulder in `[fit.shoulder]`, unless the deferred confirmation found more
+/// restarts of it futile (it trails the chosen model by more than its ends' spread + 5 nats:
+/// [`CandidateFit::more_restarts_futile`]). `why` goes into each scanned candidate's search
 /// note. Returns whether any candidate moved.
 pub(crate) fn scan_contact_angle(
     job: &LoadedJob,
@@ -108,6 +110,13 @@ pub(crate) fn scan_contact_angle(
         };
         if interrupt::stop_requested() {
             break;
+        }
+        if fits[i].more_restarts_futile {
+            add_note(
+                &mut fits[i].search_note,
+                "no contact-angle scan: no more restarts could make it the choice".into(),
+            );
+            continue;
         }
         let Some((lo, hi)) = scan_range(&fits[s], &fits[i]) else {
             continue;

@@ -259,6 +259,10 @@ pub(crate) struct CandidateFit {
     pub(crate) search_note: Option<String>,
     /// The deferred confirmation of an unconfirmed best end, until [`confirm_deferred`].
     pub(crate) unconfirmed: Option<Unconfirmed>,
+    /// Whether [`confirm_deferred`] left the candidate's second batch of restarts out because no
+    /// end it could reach would make it the choice ([`confirmation_skipped`]); a contact-angle
+    /// scan, more restarts in slices, is then left out too.
+    pub(crate) more_restarts_futile: bool,
     /// The profile walk at the optimum ([`crate::uncertainty::climb::climb_chosen`]), kept for its intervals.
     pub(crate) profile_walk: Option<ProfileWalk>,
 }
@@ -1004,6 +1008,7 @@ fn finish(
         search_note: None,
         unconfirmed: None,
         profile_walk: None,
+        more_restarts_futile: false,
     })
 }
 
@@ -1086,6 +1091,7 @@ pub(crate) fn confirm_deferred(
         }
         if let Some(note) = confirmation_skipped(&unconfirmed.ends, gap) {
             add_note(&mut f.search_note, note);
+            f.more_restarts_futile = true;
             continue;
         }
         let started = std::time::Instant::now();
