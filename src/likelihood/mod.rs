@@ -160,6 +160,16 @@ pub enum LikelihoodError {
         "Whittle likelihood: the Welch estimate averaged {n_segments} segments; expected at least {min}"
     )]
     TooFewSegments { n_segments: usize, min: usize },
+    /// A Welch estimate of several signals whose equivalent degrees of freedom cannot carry their
+    /// cross-spectral matrix (`ν/2` below the number of signals: the matrix is then near singular).
+    #[error(
+        "multivariate Whittle likelihood: {n_segments} segments give ν/2 = {half_dof:.2} equivalent degrees of freedom for {signals} signals; expected at least one per signal (more segments: a longer record or a shorter nperseg)"
+    )]
+    TooFewSegmentsForSignals {
+        n_segments: usize,
+        half_dof: f64,
+        signals: usize,
+    },
     /// A band without a bin.
     #[error("Whittle likelihood: the band has no frequency bin")]
     EmptyBand,
@@ -186,7 +196,9 @@ impl LikelihoodError {
     pub fn is_setting(&self) -> bool {
         matches!(
             self,
-            LikelihoodError::UnsupportedAverage { .. } | LikelihoodError::TooFewSegments { .. }
+            LikelihoodError::UnsupportedAverage { .. }
+                | LikelihoodError::TooFewSegments { .. }
+                | LikelihoodError::TooFewSegmentsForSignals { .. }
         )
     }
 

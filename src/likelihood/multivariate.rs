@@ -41,8 +41,9 @@ impl MultivariateWhittle {
     /// `cfg` over `n_segments` segments.
     ///
     /// # Errors
-    /// Those of [`WelchLikelihood::new`], and [`LikelihoodError::TooFewSegments`] when `ν/2` is
-    /// below `signals` (the Welch matrix is then singular: fewer segments than signals).
+    /// Those of [`WelchLikelihood::new`], and [`LikelihoodError::TooFewSegmentsForSignals`] when
+    /// `ν/2` is below `signals` (or there is no signal): the complex Wishart law then has no
+    /// density, the Welch matrix being (near) singular.
     pub fn new(
         cfg: &WelchConfig,
         n_segments: usize,
@@ -52,9 +53,10 @@ impl MultivariateWhittle {
         let welch = WelchLikelihood::new(cfg, n_segments, n_bins)?;
         let n = welch.dof / 2.0;
         if signals == 0 || n < signals as f64 {
-            return Err(LikelihoodError::TooFewSegments {
+            return Err(LikelihoodError::TooFewSegmentsForSignals {
                 n_segments,
-                min: signals.max(1),
+                half_dof: n,
+                signals,
             });
         }
         let p = signals as f64;
@@ -243,6 +245,15 @@ mod tests {
         let s: Vec<Vec<Complex<f64>>> = model.iter().map(|&x| real(&[x])).collect();
         let b = multi.nll(&m, &s).unwrap();
         assert!((a - b).abs() < 1e-9 * a.abs().max(1.0), "{a} against {b}");
+        // Two segments at 50 % overlap give ν/2 ≈ 1.95: too few for two signals.
+        assert!(matches!(
+            MultivariateWhittle::new(&cfg, 2, 3, 2),
+            Err(LikelihoodError::TooFewSegmentsForSignals {
+                n_segments: 2,
+                signals: 2,
+                ..
+            })
+        ));
     }
 
     #[test]
