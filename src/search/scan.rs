@@ -18,8 +18,8 @@
 
 use super::interrupt;
 use super::strategy::{
-    CandidateFit, Confirmation, NESTED_WARM_POINTS, Optimised, Reporting, VALLEY_GAIN_NATS,
-    add_note, fit_candidate, polish_budget, settle_anew, sorted_abs_theta,
+    CandidateFit, Confirming, NESTED_WARM_POINTS, Optimised, Reporting, VALLEY_GAIN_NATS, add_note,
+    fit_candidate, polish_budget, settle_anew, sorted_abs_theta,
 };
 use crate::Result;
 use crate::job::Candidate;
@@ -183,14 +183,7 @@ fn search_slices(
             let n = smaller.free.len() + 2;
             pb.inc_length(NESTED_WARM_POINTS * polish_budget(&job.job.fit, n));
         }
-        let f = fit_candidate(
-            &sliced,
-            meas,
-            candidate,
-            pb,
-            Some(smaller),
-            (Confirmation::Now, None),
-        )?;
+        let f = fit_candidate(&sliced, meas, candidate, pb, Some(smaller), Confirming::NOW)?;
         found.evaluations += f.problem.evaluations.load(Ordering::Relaxed);
         found.failures += f.problem.failures.load(Ordering::Relaxed);
         found.swarm_iters += f.swarm_iters;

@@ -397,12 +397,16 @@ pub(crate) fn fit_candidates(
     for (i, c) in candidates.iter().enumerate() {
         let nested = fits.iter().find(|f| c.extends(&f.candidate));
         let base_of_later = candidates[i + 1..].iter().any(|l| l.extends(c));
-        let confirmation = if candidates.len() > 1 && !base_of_later {
+        let when = if candidates.len() > 1 && !base_of_later {
             Confirmation::Deferred
         } else {
             Confirmation::Now
         };
-        let fitted = fit_candidate(job, meas, *c, pb, nested, (confirmation, leader(&fits)))?;
+        let confirming = Confirming {
+            when,
+            leader: leader(&fits),
+        };
+        let fitted = fit_candidate(job, meas, *c, pb, nested, confirming)?;
         fits.push(fitted);
         if interrupt::stop_requested() {
             break;
@@ -566,16 +570,15 @@ pub fn problem_for(job: &LoadedJob, candidate: Candidate) -> Result<SpectralProb
 /// nested models assumes. Without the warm particle a swarm can leave the larger candidate above
 /// the optimum of the model it contains.
 ///
-/// `leader`: the lowest cost of the candidates fitted before ([`leader`]). A search that ends
-/// hopelessly behind it ([`hopelessly_behind`]) leaves its confirmation, or a nested candidate's
-/// global search, to [`confirm_deferred`], which runs it only where it could change the choice.
+/// `confirming`: when an unconfirmed end is confirmed, and the lowest cost of the candidates
+/// fitted before ([`Confirming`]).
 pub(crate) fn fit_candidate(
     job: &LoadedJob,
     meas: &Measurement,
     candidate: Candidate,
     pb: &Option<indicatif::ProgressBar>,
     nested: Option<&CandidateFit>,
-    (confirmation, leader): (Confirmation, Option<f64>),
+    confirming: Confirming,
 ) -> Result<CandidateFit> {
     let started = std::time::Instant::now();
     let reporting = Reporting::new(pb, candidate);
@@ -591,7 +594,7 @@ pub(crate) fn fit_candidate(
         nested.map(|s| (s.search_cost, candidate.nested_phrase(&s.candidate))),
         &warm,
         &reporting,
-        (confirmation, leader),
+        confirming,
     )?;
     let unconfirmed = found.unconfirmed_ends.clone().map(|ends| Unconfirmed {
         ends,
@@ -1141,7 +1144,7 @@ fn search(
     nested: Option<(f64, String)>,
     warm: &[Vec<f64>],
     reporting: &Reporting,
-    (confirmation, leader): (Confirmation, Option<f64>),
+    confirming: Confirming,
 ) -> Result<(Optimised, Option<String>)> {
     let fit = &job.job.fit;
     if fit.search.method == job::SearchMethod::Cmaes {
@@ -1153,14 +1156,7 @@ fn search(
         && fit.objective == job::Objective::Likelihood
         && job.job.targets.is_none();
     if configured && problem.cost_is_nll() {
-        return nested_search(
-            problem,
-            fit,
-            warm,
-            nested,
-            reporting,
-            (confirmation, leader),
-        );
+        return nested_search(problem, fit, warm, nested, reporting, confirming);
     }
     if configured && let Some(pb) = &reporting.progress {
         // The bar counted an adaptive search, but this problem has no likelihood to gauge it.
@@ -1169,11 +1165,7 @@ fn search(
             restarts_budget(fit, n).saturating_sub(NESTED_WARM_POINTS * polish_budget(fit, n)),
         );
     }
-    let confirmation = match (confirmation, leader) {
-        (Confirmation::Now, Some(l)) => Confirmation::NowUnlessBehind(l),
-        (c, _) => c,
-    };
-    let found = optimise(problem, fit, fit.seed, warm, Some(reporting), confirmation)?;
+    let found = optimise(problem, fit, fit.seed, warm, Some(reporting), confirming)?;
     Ok((found, None))
 }
 
@@ -1201,7 +1193,7 @@ fn nested_search(
     warm: &[Vec<f64>],
     smaller: Option<(f64, String)>,
     reporting: &Reporting,
-    (confirmation, leader): (Confirmation, Option<f64>),
+    confirming: Confirming,
 ) -> Result<(Optimised, Option<String>)> {
     use rayon::prelude::*;
     reporting.stage(format_args!("local search"));
@@ -1245,10 +1237,11 @@ fn nested_search(
     }
     let (u, cost) = local.ok_or(FitError::NoNestedStart)?;
     let gain = base - cost;
-    let behind = match (confirmation, leader) {
-        (Confirmation::Deferred, Some(l)) if gain > NESTED_GLOBAL_GAIN_NATS => {
-            hopelessly_behind(&ends, cost - l).map(|_| cost - l)
-        }
+    let behind = match confirming {
+        Confirming {
+            when: Confirmation::Deferred,
+            leader: Some(l),
+        } if gain > NESTED_GLOBAL_GAIN_NATS => hopelessly_behind(&ends, cost - l).map(|_| cost - l),
         _ => None,
     };
     if let Some(behind_nats) = behind {
@@ -1286,7 +1279,12 @@ fn nested_search(
     if let Some(pb) = &reporting.progress {
         pb.inc_length(restarts_budget(fit, problem.free.len()));
     }
-    let mut global = optimise(problem, fit, fit.seed, warm, Some(reporting), confirmation)?;
+    // The leader was read above, for the decision to search globally at all.
+    let own = Confirming {
+        leader: None,
+        ..confirming
+    };
+    let mut global = optimise(problem, fit, fit.seed, warm, Some(reporting), own)?;
     let note = format!(
         "global search: the local search ended {gain:.3} nats below {smaller}'s search (> \
          {NESTED_GLOBAL_GAIN_NATS})"
@@ -1442,7 +1440,7 @@ pub(crate) fn optimise(
     seed: u64,
     warm: &[Vec<f64>],
     log: Option<&Reporting>,
-    confirmation: Confirmation,
+    confirming: Confirming,
 ) -> Result<Optimised> {
     if fit.search.method == job::SearchMethod::Cmaes {
         return Ok(cmaes_search(problem, fit, seed, log)?.0);
@@ -1467,15 +1465,7 @@ pub(crate) fn optimise(
     );
     let unconfirmed =
         restarts > 1 && problem.cost_is_nll() && !confirmed(&ends) && !interrupt::stop_requested();
-    let deferred = unconfirmed
-        && match confirmation {
-            Confirmation::Now => false,
-            Confirmation::Deferred => true,
-            Confirmation::NowUnlessBehind(leader) => {
-                let best = ends.iter().copied().fold(f64::INFINITY, f64::min);
-                hopelessly_behind(&ends, best - leader).is_some()
-            }
-        };
+    let deferred = unconfirmed && confirming.defers(&ends);
     if unconfirmed && !deferred {
         // No second restart reached the best one's basin: one more batch of restarts.
         runs.extend(more_restarts(problem, fit, seed, log));
@@ -1628,13 +1618,42 @@ fn more_restarts(
 /// second batch of restarts at once (`Now`: the candidate's optimum is needed before the next
 /// candidate starts, or it is the only one), or leaves it to [`confirm_deferred`] once every
 /// candidate is fitted (`Deferred`), which runs it only where it could change the model choice.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Confirmation {
     Now,
     Deferred,
-    /// At once, unless the best end trails the lowest cost of the candidates fitted before (nats)
-    /// hopelessly ([`hopelessly_behind`]): then deferred, as no restart could make it the choice.
-    NowUnlessBehind(f64),
+}
+
+/// How a candidate's search treats an unconfirmed best end: `when` ([`Confirmation`]), and
+/// `leader`, the lowest cost (nats) of the candidates fitted before it ([`leader`]). A search
+/// that ends hopelessly behind the leader ([`hopelessly_behind`]) defers its second batch even
+/// when `Now`, and a nested candidate searched with `Deferred` its global search, to
+/// [`confirm_deferred`], which runs them only where they could change the choice.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Confirming {
+    pub(crate) when: Confirmation,
+    pub(crate) leader: Option<f64>,
+}
+
+impl Confirming {
+    /// At once, measured against no other candidate (a single search).
+    pub(crate) const NOW: Confirming = Confirming {
+        when: Confirmation::Now,
+        leader: None,
+    };
+
+    /// Whether the second batch of restarts of a search whose unconfirmed ends are `ends` (nats)
+    /// is left to [`confirm_deferred`].
+    fn defers(&self, ends: &[f64]) -> bool {
+        match (self.when, self.leader) {
+            (Confirmation::Deferred, _) => true,
+            (Confirmation::Now, None) => false,
+            (Confirmation::Now, Some(leader)) => {
+                let best = ends.iter().copied().fold(f64::INFINITY, f64::min);
+                hopelessly_behind(ends, best - leader).is_some()
+            }
+        }
+    }
 }
 
 /// What [`optimise`] found.

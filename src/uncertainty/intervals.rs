@@ -9,7 +9,7 @@ use crate::posterior::PosteriorSummary;
 use crate::search::evidence::RecordingLikelihood;
 use crate::search::problem::SpectralProblem;
 use crate::search::strategy::{
-    CandidateFit, Confirmation, POLISH_STEP_U, ProgressObserver, Reporting, optimise, polish,
+    CandidateFit, Confirming, POLISH_STEP_U, ProgressObserver, Reporting, optimise, polish,
     polish_pinned,
 };
 use crate::simulate::blade::BladeSimulation;
@@ -1009,7 +1009,7 @@ pub fn bootstrap_intervals(
             let rep = Arc::new(rep);
             let (u, cost) = if settings.full_refit {
                 let seed = fit.seed.wrapping_add(1 + r as u64);
-                let found = optimise(&rep, fit, seed, &[], None, Confirmation::Now)?;
+                let found = optimise(&rep, fit, seed, &[], None, Confirming::NOW)?;
                 (found.u, found.cost)
             } else {
                 let (u, _, cost) = polish(
