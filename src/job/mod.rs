@@ -280,7 +280,7 @@ pub struct FitSection {
 }
 
 /// Which terms the recording's likelihood has (docs/likelihood.md, "Likelihood").
-#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq, Default)]
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq, Default)]
 #[serde(deny_unknown_fields, default)]
 pub struct LikelihoodSection {
     /// Add the Gaussian likelihood of the signal's time-domain residuals to the Welch spectra's.
@@ -290,6 +290,13 @@ pub struct LikelihoodSection {
     pub block_s: Option<f64>,
     /// The tracking noise's spectrum ([`NoiseSpectrum`]).
     pub noise: NoiseSpectrum,
+    /// Further tracked signals read together with `[spectrum] signal` through their Welch
+    /// cross-spectra (the multivariate Whittle likelihood,
+    /// [`crate::likelihood::multivariate`]); none reads the one signal alone. Each signal's
+    /// tracking noise is its own (`noise`, estimated per signal); the signals may share no
+    /// tracked coordinate, so that their noises are independent.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub joint_signals: Vec<crate::spectrum::features::SignalKind>,
 }
 
 crate::names::named_enum! {
@@ -1257,6 +1264,7 @@ impl Check<'_> {
             "[fit] swarm_rtol",
             fit.swarm_rtol,
         )?;
+        self.joint_signals(fit)?;
         if let Some(b) = fit.likelihood.block_s {
             let at = [
                 Key::Name("fit"),
@@ -1276,6 +1284,50 @@ impl Check<'_> {
                     format!("[fit.likelihood] block_s must be a duration > 0 s (got {b})"),
                 ));
             }
+        }
+        Ok(())
+    }
+
+    /// `[fit.likelihood] joint_signals`: none is the fit's own signal or shares a tracked
+    /// coordinate with another signal read, and the intervals' method refits no replicate of the
+    /// one signal alone (`bootstrap`).
+    fn joint_signals(&self, fit: &FitSection) -> Result<()> {
+        let joint = &fit.likelihood.joint_signals;
+        if joint.is_empty() {
+            return Ok(());
+        }
+        let at = [
+            Key::Name("fit"),
+            Key::Name("likelihood"),
+            Key::Name("joint_signals"),
+        ];
+        let main = self.job.spectrum.signal;
+        let all: Vec<_> = std::iter::once(main).chain(joint.iter().copied()).collect();
+        for (i, a) in all.iter().enumerate() {
+            for b in &all[..i] {
+                if a.shares_coordinate(*b) {
+                    return Err(self.error(
+                        &at,
+                        format!(
+                            "[fit.likelihood] joint_signals: \"{a}\" shares a tracked coordinate \
+                             with \"{b}\" ({}); expected signals of separate coordinates, e.g. \
+                             [\"head_y\"] beside signal = \"tip_rel_x\"",
+                            if i == 1 || *b == main {
+                                "the fit's [spectrum] signal"
+                            } else {
+                                "another joint signal"
+                            }
+                        ),
+                    ));
+                }
+            }
+        }
+        if fit.uncertainty.method() == UncertaintyMethod::Bootstrap {
+            return Err(self.error(
+                &at,
+                "[fit.likelihood] joint_signals: the bootstrap refits replicates of the one signal; \
+                 use [fit.uncertainty] method = \"laplace\", \"profile\", \"mcmc\" or \"auto\"",
+            ));
         }
         Ok(())
     }

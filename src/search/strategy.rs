@@ -544,6 +544,7 @@ fn problem_of(
                         .map(|b| (b * p.fs_hz).round() as usize),
                 )
             })
+            .and_then(|l| l.with_joint(&p, &m.trace, &fit.likelihood.joint_signals))
             .map(Arc::new)
             .map_err(|e| super::NoLikelihood::Recording(Arc::new(e)))
     };

@@ -137,6 +137,27 @@ impl SignalKind {
         })
     }
 
+    /// The signal's coefficients on the tracked coordinates `[head x, head y, tip x, tip y]`: the
+    /// signal is their weighted sum, so two signals share tracking noise where both weigh one
+    /// coordinate.
+    pub fn coordinates(self) -> [f64; 4] {
+        match self {
+            SignalKind::TipRelX => [-1.0, 0.0, 1.0, 0.0],
+            SignalKind::TipRelY => [0.0, -1.0, 0.0, 1.0],
+            SignalKind::HeadY => [0.0, 1.0, 0.0, 0.0],
+            SignalKind::TipX => [0.0, 0.0, 1.0, 0.0],
+        }
+    }
+
+    /// Whether `self` and `other` read a tracked coordinate in common (their tracking noises are
+    /// then correlated).
+    pub fn shares_coordinate(self, other: SignalKind) -> bool {
+        self.coordinates()
+            .iter()
+            .zip(other.coordinates())
+            .any(|(a, b)| *a != 0.0 && b != 0.0)
+    }
+
     /// Label with unit for figures.
     pub fn label(self) -> &'static str {
         match self {

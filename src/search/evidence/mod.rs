@@ -23,6 +23,8 @@
 //! with `V` the variance of the NLL's gradient over replicates of the recording's tracking noise:
 //! the Whittle-type likelihood's own `F⁻¹` overstates it for a deterministic motion plus noise.
 
+mod joint;
+
 use super::problem::SpectralProblem;
 use crate::Result;
 use crate::job::NoiseSpectrum;
@@ -136,6 +138,9 @@ pub struct RecordingLikelihood {
     /// The bands' NLL of the saturated model (every expected ordinate equal to the measured one),
     /// nats: the lowest value each band's term can take.
     saturated_spectral_nats: f64,
+    /// Further signals read together with the measured one through their cross-spectra
+    /// (`[fit.likelihood] joint_signals`; [`joint`]): the spectral term is then theirs.
+    joint: Option<joint::JointSignals>,
 }
 
 /// The time-domain term at one simulation.
@@ -221,7 +226,42 @@ impl RecordingLikelihood {
             time_domain,
             block_len: None,
             saturated_spectral_nats,
+            joint: None,
         })
+    }
+
+    /// The same likelihood with the spectral term of the measured signal and the signals `others`
+    /// of the recording `trace` read together through their cross-spectra ([`joint`]); none keeps
+    /// the one signal's. Build it after [`RecordingLikelihood::with_noise`]: each signal's noise
+    /// follows the likelihood's noise spectrum.
+    ///
+    /// # Errors
+    /// A signal the trace lacks, a band whose segments cannot carry the signals' cross-spectral
+    /// matrix ([`likelihood::LikelihoodError::TooFewSegmentsForSignals`]), a signal whose noise
+    /// cannot be estimated.
+    pub fn with_joint(
+        mut self,
+        problem: &SpectralProblem,
+        trace: &crate::trace::Trace,
+        others: &[crate::spectrum::features::SignalKind],
+    ) -> Result<Self> {
+        if others.is_empty() {
+            return Ok(self);
+        }
+        let kinds = std::iter::once(problem.signal)
+            .chain(others.iter().copied())
+            .collect();
+        self.joint = Some(joint::JointSignals::new(&self, problem, trace, kinds)?);
+        Ok(self)
+    }
+
+    /// The signals the spectral term reads together, the measured one first (only it without
+    /// joint signals).
+    pub fn signals(&self, problem: &SpectralProblem) -> Vec<crate::spectrum::features::SignalKind> {
+        match &self.joint {
+            Some(j) => j.kinds.clone(),
+            None => vec![problem.signal],
+        }
     }
 
     /// The same likelihood with the tracking noise's spectrum `noise`.
@@ -426,16 +466,42 @@ impl RecordingLikelihood {
         Ok(excess)
     }
 
-    /// The bands' Whittle NLL above the saturated model's, nats: the spectral part of
-    /// [`RecordingLikelihood::excess_nll`] and the statistic of
-    /// [`RecordingLikelihood::goodness_of_fit`].
+    /// The spectral part of [`RecordingLikelihood::excess_nll`], nats: the bands' NLL above the
+    /// saturated model's, of the measured signal or of the joint signals' cross-spectra.
     fn spectral_excess_nll(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<f64> {
-        let (spectral_nats, _) = self.spectral_terms(problem, sim)?;
+        match &self.joint {
+            Some(j) => {
+                let nats = j.nll(&j.model(self, problem, sim)?)?;
+                Ok(nats.iter().sum::<f64>() - j.saturated_nats())
+            }
+            None => self.signal_excess_nll(problem, sim),
+        }
+    }
+
+    /// The measured signal's Whittle NLL above the saturated model's, nats: the statistic of
+    /// [`RecordingLikelihood::goodness_of_fit`] (the one signal's, also when the fit reads joint
+    /// signals).
+    fn signal_excess_nll(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<f64> {
+        let (spectral_nats, _) = self.signal_terms(problem, sim)?;
         Ok(spectral_nats.iter().sum::<f64>() - self.saturated_spectral_nats)
     }
 
-    /// The Whittle NLL of every band, nats, and the bands' effectively independent bins.
+    /// The spectral NLL of every band, nats (the joint signals' when read), and the bands'
+    /// effectively independent bins.
     fn spectral_terms(
+        &self,
+        problem: &SpectralProblem,
+        sim: &BladeSimulation,
+    ) -> Result<(Vec<f64>, f64)> {
+        match &self.joint {
+            Some(j) => Ok((j.nll(&j.model(self, problem, sim)?)?, j.effective_bins())),
+            None => self.signal_terms(problem, sim),
+        }
+    }
+
+    /// The measured signal's Whittle NLL of every band, nats, and the bands' effectively
+    /// independent bins.
+    fn signal_terms(
         &self,
         problem: &SpectralProblem,
         sim: &BladeSimulation,
@@ -473,13 +539,18 @@ impl RecordingLikelihood {
 
     /// What one simulation contributes to the Gauss–Newton Fisher information: the log expected
     /// ordinates of every band and the de-meaned model signal (over the samples both sides have).
+    /// With joint signals the spectral part is the expected matrices' entries
+    /// ([`joint::JointSignals::entries`]), whitened at the fit by [`RecordingLikelihood::jacobian`].
     fn response(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<Vec<f64>> {
-        let mut r: Vec<f64> = self
-            .model_psd(problem, sim)?
-            .into_iter()
-            .flatten()
-            .map(f64::ln)
-            .collect();
+        let mut r: Vec<f64> = match &self.joint {
+            Some(j) => j.entries(&j.model(self, problem, sim)?),
+            None => self
+                .model_psd(problem, sim)?
+                .into_iter()
+                .flatten()
+                .map(f64::ln)
+                .collect(),
+        };
         if self.time_domain
             && let Some(len) = self.block_len
         {
@@ -503,11 +574,16 @@ impl RecordingLikelihood {
     /// are the NLL terms at the fit.
     fn weights(&self, parts: &NllParts, n_time: usize) -> Vec<f64> {
         let mut w = Vec::new();
-        for b in &self.bands {
-            w.extend(std::iter::repeat_n(
-                b.lik.dof / 2.0 / b.lik.bin_factor,
-                b.measured.len(),
-            ));
+        match &self.joint {
+            Some(j) => w.extend(j.weights()),
+            None => {
+                for b in &self.bands {
+                    w.extend(std::iter::repeat_n(
+                        b.lik.dof / 2.0 / b.lik.bin_factor,
+                        b.measured.len(),
+                    ));
+                }
+            }
         }
         if self.time_domain
             && let Some(b) = parts.block_rms_m
@@ -556,14 +632,47 @@ impl RecordingLikelihood {
         parts: &NllParts,
         h: f64,
     ) -> Result<DMatrix<f64>> {
-        let j = self.jacobian(problem, u, h)?;
+        let metric = self.metric_at(problem, &problem.simulate(&problem.params_at(u))?)?;
+        let j = self.jacobian(problem, u, h, metric.as_ref())?;
         Ok(j.fisher(&self.weights(parts, j.n_time(self))))
+    }
+
+    /// The whitening of the joint signals' matrices at the simulation `sim` (the fit's), which
+    /// the response's derivatives and the replicates' residuals are read in; `None` for one
+    /// signal.
+    ///
+    /// # Errors
+    /// The model's matrices' errors, and a matrix that is not positive definite.
+    fn metric_at(
+        &self,
+        problem: &SpectralProblem,
+        sim: &BladeSimulation,
+    ) -> Result<Option<joint::Metric>> {
+        self.joint
+            .as_ref()
+            .map(|j| j.metric(&j.model(self, problem, sim)?))
+            .transpose()
+    }
+
+    /// Components of the response that belong to the spectral term.
+    fn spectral_len(&self) -> usize {
+        match &self.joint {
+            Some(j) => j.response_len(),
+            None => self.bands.iter().map(|b| b.measured.len()).sum(),
+        }
     }
 
     /// The response's derivatives at `u` by central differences of step `h` (one-sided at a bound
     /// of the box, or where a displaced simulation fails: [`difference_column`]): `2k` simulations,
-    /// and one more at `u` when a side fails.
-    fn jacobian(&self, problem: &SpectralProblem, u: &[f64], h: f64) -> Result<Jacobian> {
+    /// and one more at `u` when a side fails. The joint signals' part is whitened by `metric`
+    /// ([`RecordingLikelihood::metric_at`]).
+    fn jacobian(
+        &self,
+        problem: &SpectralProblem,
+        u: &[f64],
+        h: f64,
+        metric: Option<&joint::Metric>,
+    ) -> Result<Jacobian> {
         use rayon::prelude::*;
         let response_at = |p: &[f64]| -> Result<Vec<f64>> {
             self.response(problem, &problem.simulate(&problem.params_at(p))?)
@@ -581,7 +690,15 @@ impl RecordingLikelihood {
                 difference_column(at, center, u[i], h)
             })
             .collect::<Result<_>>()?;
-        Ok(Jacobian { columns })
+        let mut j = Jacobian { columns };
+        if let (Some(joint), Some(metric)) = (&self.joint, metric) {
+            let n = self.spectral_len();
+            for c in &mut j.columns {
+                let white = joint.whiten(metric, &c[..n]);
+                c[..n].copy_from_slice(&white);
+            }
+        }
+        Ok(j)
     }
 
     /// The response's linearisation over the central part of the likelihood's bowl: the mean of
@@ -604,6 +721,7 @@ impl RecordingLikelihood {
         u: &[f64],
         j: Jacobian,
         w: &[f64],
+        metric: Option<&joint::Metric>,
     ) -> Result<(Jacobian, usize)> {
         let k = u.len();
         let (sigma, corr) = covariance(&j.fisher(w));
@@ -617,7 +735,7 @@ impl RecordingLikelihood {
                     .map(|a| (u[a] + sign * SANDWICH_SPAN_SIGMA * l[(a, i)]).clamp(0.0, 1.0))
                     .collect();
                 sims += 2 * k;
-                let Ok(ji) = self.jacobian(problem, &at, FISHER_STEP_U) else {
+                let Ok(ji) = self.jacobian(problem, &at, FISHER_STEP_U, metric) else {
                     continue;
                 };
                 if ji.columns[0].len() != sum[0].len() {
@@ -655,16 +773,14 @@ impl RecordingLikelihood {
         sim: &BladeSimulation,
         parts: &NllParts,
         j: &Jacobian,
+        metric: Option<&joint::Metric>,
     ) -> Result<DMatrix<f64>> {
         use rayon::prelude::*;
         let base = self.replicate_base(problem, sim)?;
         let w = self.weights(parts, j.n_time(self));
         let scores: Vec<Vec<f64>> = (0..NOISE_REPLICATES)
             .into_par_iter()
-            .map(|r| {
-                let x = base.signal(r);
-                Ok(j.score(&w, &self.replicate_residuals(problem, &x, &base)?))
-            })
+            .map(|r| Ok(j.score(&w, &self.replicate_residuals(problem, r, &base, metric)?)))
             .collect::<Result<_>>()?;
         Ok(sample_covariance(&scores))
     }
@@ -689,10 +805,23 @@ impl RecordingLikelihood {
             }
             .into());
         }
+        let joint = match &self.joint {
+            Some(j) => {
+                let signals = j.model_signals(sim)?;
+                let sim = j.sim_matrices(problem, sim)?;
+                Some(JointBase {
+                    noises: j.recording_noises(self, &sim),
+                    signals,
+                    sim,
+                })
+            }
+            None => None,
+        };
         Ok(ReplicateBase {
             m: self.model_x(problem, sim)?,
             sim_psd,
             noise,
+            joint,
         })
     }
 
@@ -728,11 +857,34 @@ impl RecordingLikelihood {
         Ok((measured, ordinates))
     }
 
-    /// One noise replicate's residuals in the response's order: per spectral ordinate
+    /// Noise replicate `r`'s residuals in the response's order: per spectral ordinate
     /// `1 − P̂_k/S_k` with `S_k` the simulation's ordinate `sim_psd` plus the noise density of the
-    /// replicate's own `σ̂`; per time-domain sample or block mean the negated noise, de-meaned.
-    /// `x`: the replicate's signal, drawn around `base`.
+    /// replicate's own `σ̂` (with joint signals, the whitened `S − P̂` of their matrices,
+    /// [`joint::JointSignals::replicate_residuals`]); per time-domain sample or block mean the
+    /// negated noise, de-meaned. The replicate is drawn around `base`.
     fn replicate_residuals(
+        &self,
+        problem: &SpectralProblem,
+        r: usize,
+        base: &ReplicateBase,
+        metric: Option<&joint::Metric>,
+    ) -> Result<Vec<f64>> {
+        let x = base.signal(r);
+        let mut res = match (&self.joint, &base.joint, metric) {
+            (Some(j), Some(b), Some(metric)) => {
+                j.replicate_residuals(self, problem, &b.sim, &b.replicate(r), metric)?
+            }
+            _ => self.signal_residuals(problem, &x, base)?,
+        };
+        if self.time_domain {
+            res.extend(self.time_residuals(&x, &base.m)?.into_iter().map(|e| -e));
+        }
+        Ok(res)
+    }
+
+    /// The measured signal's spectral residuals of a replicate `x` drawn around `base`: per
+    /// ordinate `1 − P̂_k/S_k` ([`RecordingLikelihood::replicate_residuals`]).
+    fn signal_residuals(
         &self,
         problem: &SpectralProblem,
         x: &[f64],
@@ -755,9 +907,6 @@ impl RecordingLikelihood {
                     .map(|((p, s), n)| 1.0 - p / (s + n)),
             );
         }
-        if self.time_domain {
-            res.extend(self.time_residuals(x, &base.m)?.into_iter().map(|e| -e));
-        }
         Ok(res)
     }
 
@@ -775,7 +924,7 @@ impl RecordingLikelihood {
         problem: &SpectralProblem,
         sim: &BladeSimulation,
     ) -> Result<likelihood::GoodnessOfFit> {
-        let observed = self.spectral_excess_nll(problem, sim)?;
+        let observed = self.signal_excess_nll(problem, sim)?;
         let replicates = self.replicate_excess_nll(problem, sim, GOODNESS_OF_FIT_REPLICATES)?;
         Ok(likelihood::GoodnessOfFit::of(observed, &replicates)?)
     }
@@ -864,6 +1013,39 @@ struct ReplicateBase {
     m: Vec<f64>,
     sim_psd: Vec<Vec<f64>>,
     noise: TrackingNoise,
+    joint: Option<JointBase>,
+}
+
+/// What noise replicates of the joint signals are drawn around: the simulation's signals (NaN
+/// where the recording's are), their matrices, and each signal's noise at the fit.
+struct JointBase {
+    signals: Vec<Vec<f64>>,
+    sim: Vec<joint::Matrices>,
+    noises: Vec<TrackingNoise>,
+}
+
+impl JointBase {
+    /// Replicate `r`'s signals: each simulated signal plus its own noise. The measured signal's
+    /// noise is drawn from seed [`NOISE_SEED`]` + r` as [`ReplicateBase::signal`]'s, signal `a`'s
+    /// from that seed plus `a·2³²`.
+    fn replicate(&self, r: usize) -> Vec<Vec<f64>> {
+        use rand::SeedableRng;
+        self.signals
+            .iter()
+            .zip(&self.noises)
+            .enumerate()
+            .map(|(a, (m, noise))| {
+                let seed = NOISE_SEED
+                    .wrapping_add(r as u64)
+                    .wrapping_add((a as u64) << 32);
+                let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+                m.iter()
+                    .zip(noise.sample(m.len(), &mut rng))
+                    .map(|(v, e)| v + e)
+                    .collect()
+            })
+            .collect()
+    }
 }
 
 impl ReplicateBase {
@@ -995,7 +1177,7 @@ struct Jacobian {
 impl Jacobian {
     /// Components of the response that belong to the time-domain term.
     fn n_time(&self, lik: &RecordingLikelihood) -> usize {
-        self.columns[0].len() - lik.bands.iter().map(|b| b.measured.len()).sum::<usize>()
+        self.columns[0].len() - lik.spectral_len()
     }
 
     /// `Jᵀ W J` for per-component weights `w`.
@@ -1135,12 +1317,13 @@ fn information(
             .map_err(|why| super::FitError::NoLikelihood { why: why.clone() })?;
         let sim = p.simulate(&p.params_at(u))?;
         let parts = lik.nll(p, &sim)?;
-        let j = lik.jacobian(p, u, FISHER_STEP_U)?;
+        let metric = lik.metric_at(p, &sim)?;
+        let j = lik.jacobian(p, u, FISHER_STEP_U, metric.as_ref())?;
         let w = lik.weights(&parts, j.n_time(lik));
         let mut sims = 1 + 2 * u.len();
         let j = match spread {
             Spread::Smoothed => {
-                let (j, more) = lik.smoothed_jacobian(p, u, j, &w)?;
+                let (j, more) = lik.smoothed_jacobian(p, u, j, &w, metric.as_ref())?;
                 sims += more;
                 j
             }
@@ -1148,7 +1331,7 @@ fn information(
         };
         info += j.fisher(&w);
         if spread != Spread::CurvatureOnly {
-            var += lik.variability(p, &sim, &parts, &j)?;
+            var += lik.variability(p, &sim, &parts, &j, metric.as_ref())?;
         }
         problem
             .evaluations
@@ -1461,6 +1644,7 @@ mod tests {
             time_domain: false,
             block_len: None,
             saturated_spectral_nats: 0.0,
+            joint: None,
         };
         (lik, zeros)
     }
