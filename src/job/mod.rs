@@ -1312,7 +1312,7 @@ impl Check<'_> {
                             "[fit.likelihood] joint_signals: \"{a}\" shares a tracked coordinate \
                              with \"{b}\" ({}); expected signals of separate coordinates, e.g. \
                              [\"head_y\"] beside signal = \"tip_rel_x\"",
-                            if i == 1 || *b == main {
+                            if *b == main {
                                 "the fit's [spectrum] signal"
                             } else {
                                 "another joint signal"

@@ -917,6 +917,37 @@ fn fit_cases() -> Vec<Case> {
             &["$D/job.toml:", "local", "no swarm"],
         ),
         case(
+            "fit: a joint signal that shares the fit's signal's tracked coordinate",
+            j(&[(
+                "[fit.uncertainty]",
+                "[fit.likelihood]\njoint_signals = [\"tip_x\"]\n\n[fit.uncertainty]",
+            )]),
+            fit,
+            &[
+                "$D/job.toml:",
+                "joint_signals",
+                "\"tip_x\" shares a tracked coordinate with \"tip_rel_x\"",
+            ],
+        ),
+        case(
+            "fit: an unknown joint signal",
+            j(&[(
+                "[fit.uncertainty]",
+                "[fit.likelihood]\njoint_signals = [\"head_z\"]\n\n[fit.uncertainty]",
+            )]),
+            fit,
+            &["$D/job.toml:", "head_z", "head_y"],
+        ),
+        case(
+            "fit: joint signals beside the bootstrap",
+            j(&[(
+                "method = \"profile\"",
+                "method = \"bootstrap\"\nbootstrap = 8\n\n[fit.likelihood]\njoint_signals = [\"head_y\"]",
+            )]),
+            fit,
+            &["$D/job.toml:", "joint_signals", "bootstrap", "laplace"],
+        ),
+        case(
             "fit: a local stage's tolerance of zero",
             j(&[("local_rtol = 1e-7", "local_rtol = 0.0")]),
             fit,

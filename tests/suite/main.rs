@@ -30,6 +30,7 @@ mod init;
 mod instfreq;
 mod interval_coverage;
 mod joint_fit;
+mod joint_signals;
 mod likelihood;
 mod model;
 mod model_choice;
