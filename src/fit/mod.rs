@@ -321,10 +321,21 @@ fn goodness_of_fit(cf: &CandidateFit, sim: &BladeSimulation) -> GoodnessOutcome 
 fn tracking_noise(cf: &CandidateFit, sim: &BladeSimulation) -> Option<result::NoiseEstimate> {
     let lik = cf.problem.likelihood.as_ref().ok()?;
     let n = lik.noise_at(&cf.problem, sim).ok()?;
+    let joint = lik
+        .joint_noises_at(&cf.problem, sim)
+        .ok()?
+        .into_iter()
+        .map(|(signal, n)| result::SignalNoise {
+            signal,
+            sigma_m: n.sigma_m,
+            rho: n.rho,
+        })
+        .collect();
     Some(result::NoiseEstimate {
         spectrum: lik.noise_spectrum,
         sigma_m: n.sigma_m,
         rho: n.rho,
+        joint,
     })
 }
 

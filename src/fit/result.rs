@@ -293,10 +293,25 @@ impl FitResult {
 /// The tracking noise of the measured signal as the likelihood reads it
 /// ([`crate::spectrum::noise::TrackingNoise`]): white of the second-difference σ, or the AR(1)
 /// profile's σ and ρ at the fit.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct NoiseEstimate {
     /// The noise spectrum of the job (`white` or `ar1`).
     pub spectrum: crate::job::NoiseSpectrum,
+    /// Marginal standard deviation, m.
+    pub sigma_m: f64,
+    /// Lag-one autocorrelation (0 for white noise).
+    pub rho: f64,
+    /// The noise of each further signal the likelihood reads with the measured one
+    /// (`[fit.likelihood] joint_signals`), estimated the same way from that signal.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub joint: Vec<SignalNoise>,
+}
+
+/// One joint signal's tracking noise at the fit.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SignalNoise {
+    /// The signal.
+    pub signal: crate::spectrum::features::SignalKind,
     /// Marginal standard deviation, m.
     pub sigma_m: f64,
     /// Lag-one autocorrelation (0 for white noise).

@@ -1123,6 +1123,15 @@ pub fn fit_summary(r: &FitResult) -> String {
             "  tracking noise ({}): σ {:.3e} m, lag-one correlation ρ {:.2}",
             n.spectrum, n.sigma_m, n.rho
         );
+        for j in &n.joint {
+            let _ = writeln!(
+                s,
+                "  joint signal {} (read through the cross-spectra): tracking noise σ {:.3e} m, ρ {:.2}",
+                j.signal,
+                j.sigma_m,
+                j.rho
+            );
+        }
     }
     s.push_str(&truth_line(r));
     s.push_str(&prior_lines(r));

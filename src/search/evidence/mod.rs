@@ -414,6 +414,23 @@ impl RecordingLikelihood {
         Ok(self.noise_for(&sim_psd, &measured, self.sigma_m))
     }
 
+    /// Each joint signal's tracking noise at the simulation `sim` (the measured signal's is
+    /// [`RecordingLikelihood::noise_at`]'s); empty without joint signals.
+    ///
+    /// # Errors
+    /// The simulation's cross-spectra's errors.
+    pub fn joint_noises_at(
+        &self,
+        problem: &SpectralProblem,
+        sim: &BladeSimulation,
+    ) -> Result<Vec<(crate::spectrum::features::SignalKind, TrackingNoise)>> {
+        let Some(j) = &self.joint else {
+            return Ok(Vec::new());
+        };
+        let noises = j.recording_noises(self, &j.sim_matrices(problem, sim)?);
+        Ok(j.kinds.iter().copied().zip(noises).skip(1).collect())
+    }
+
     /// The model's signal at the recording's samples, NaN where the measurement is.
     fn model_x(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<Vec<f64>> {
         let mut x = problem.signal.extract(&sim.to_trace())?;
