@@ -1127,9 +1127,7 @@ pub fn fit_summary(r: &FitResult) -> String {
             let _ = writeln!(
                 s,
                 "  joint signal {} (read through the cross-spectra): tracking noise σ {:.3e} m, ρ {:.2}",
-                j.signal,
-                j.sigma_m,
-                j.rho
+                j.signal, j.sigma_m, j.rho
             );
         }
     }

@@ -76,7 +76,7 @@ impl JointSignals {
     ) -> Result<Self> {
         let mut x: Vec<Vec<f64>> = kinds
             .iter()
-            .map(|k| Ok(k.extract(trace)?))
+            .map(|k| k.extract(trace))
             .collect::<Result<_>>()?;
         let missing: Vec<bool> = (0..x[0].len())
             .map(|t| {
@@ -507,7 +507,7 @@ mod tests {
     #[test]
     fn one_signal_whitens_to_the_relative_change_and_a_singular_matrix_is_refused() {
         // p = 1: L⁻¹ X L⁻ᴴ = X/S₀, the derivative of ln S at S₀ (the one-signal response).
-        let s0 = vec![vec![Complex::new(4.0, 0.0)]];
+        let s0 = [vec![Complex::new(4.0, 0.0)]];
         let m = metric(1, s0.iter()).unwrap();
         assert_eq!(whiten(1, &m, &[2.0]), vec![0.5]);
         // A rank-one 2 × 2 matrix has no Cholesky factor: a typed error, no NaN.
