@@ -76,16 +76,6 @@ type Fallible<T> = Result<T, Box<dyn std::error::Error>>;
 /// One band's cross-spectral matrices, one per bin (row-major entries).
 type BandMatrices = Vec<Vec<Complex<f64>>>;
 
-/// Coefficients of a signal on the tracked coordinates (head x, head y, tip x, tip y).
-fn coordinates(s: SignalKind) -> [f64; 4] {
-    match s {
-        SignalKind::TipRelX => [-1.0, 0.0, 1.0, 0.0],
-        SignalKind::TipRelY => [0.0, -1.0, 0.0, 1.0],
-        SignalKind::HeadY => [0.0, 1.0, 0.0, 0.0],
-        SignalKind::TipX => [0.0, 0.0, 1.0, 0.0],
-    }
-}
-
 fn main() -> Fallible<()> {
     let args = Args::parse();
     let mut jobs = args.jobs.clone();
@@ -287,7 +277,7 @@ fn noise_matrix(kinds: &[SignalKind], sigma: &[f64], fs_hz: f64) -> Vec<Complex<
     let p = kinds.len();
     (0..p * p)
         .map(|ab| {
-            let (ca, cb) = (coordinates(kinds[ab / p]), coordinates(kinds[ab % p]));
+            let (ca, cb) = (kinds[ab / p].coordinates(), kinds[ab % p].coordinates());
             let cov: f64 = (0..4).map(|c| ca[c] * cb[c] * sigma[c] * sigma[c]).sum();
             Complex::new(2.0 * cov / fs_hz, 0.0)
         })
@@ -456,7 +446,7 @@ fn with_noise(clean: &[Vec<f64>], kinds: &[SignalKind], sigma_m: &[f64], r: u64)
         .iter()
         .zip(kinds)
         .map(|(x, &kind)| {
-            let c = coordinates(kind);
+            let c = kind.coordinates();
             x.iter()
                 .enumerate()
                 .map(|(t, v)| v + (0..4).map(|j| c[j] * coords[j][t]).sum::<f64>())
