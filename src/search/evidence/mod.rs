@@ -9,7 +9,10 @@
 //! - **time-domain term**: the Gaussian NLL of the de-meaned residuals `d − m` at the tracking noise
 //!   `σ`, weighed by the residuals' AR(1) effective sample size ([`likelihood::gaussian_nll`]);
 //! - `σ` is the recording's own tracking noise, `1.4826·MAD(Δ²d)/√6`
-//!   ([`likelihood::tracking_noise_sigma`]), the same for every candidate.
+//!   ([`likelihood::tracking_noise_sigma`]), the same for every candidate;
+//! - with `[fit.likelihood] joint_signals`, the spectral term is the multivariate Whittle NLL of
+//!   the signals' Welch cross-spectral matrices, and the Fisher information and the sandwich read
+//!   their whitened entries ([`joint`]).
 //!
 //! The **Fisher information** at a fit is the Gauss–Newton form of the same likelihood, positive
 //! semi-definite by construction: per band `(α/φ)·Σ_k ∇ln S_k ∇ln S_kᵀ` (α = ν/2 the Gamma shape, φ
