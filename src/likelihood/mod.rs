@@ -163,7 +163,7 @@ pub enum LikelihoodError {
     /// A Welch estimate of several signals whose equivalent degrees of freedom cannot carry their
     /// cross-spectral matrix (`ν/2` below the number of signals: the matrix is then near singular).
     #[error(
-        "multivariate Whittle likelihood: {n_segments} segments give ν/2 = {half_dof:.2} equivalent degrees of freedom for {signals} signals; expected at least one per signal (more segments: a longer record or a shorter nperseg)"
+        "multivariate Whittle likelihood: {n_segments} segments give ν/2 = {half_dof:.2} equivalent degrees of freedom for {signals} signals; expected at least one per signal (more segments: a longer record or a shorter nperseg; or fewer signals, [fit.likelihood] joint_signals)"
     )]
     TooFewSegmentsForSignals {
         n_segments: usize,
