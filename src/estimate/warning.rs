@@ -233,6 +233,14 @@ pub enum FitWarning {
     },
     /// The blade's modes at the fitted parameters could not be computed.
     NoBladeModes { reason: String },
+    /// `[fit.likelihood] joint_signals` could not be read: a band's segments give `half_dof`
+    /// (`ν/2`) equivalent degrees of freedom, fewer than the `signals` signals' matrix needs, so
+    /// the fit read its own signal alone.
+    JointSignalsDropped {
+        n_segments: usize,
+        half_dof: f64,
+        signals: usize,
+    },
     /// A parameter fitted beyond [`crate::likelihood::prior::PRIOR_CONFLICT_Z`] standard
     /// deviations of its `[fit.priors]` prior.
     PriorConflict(ParamConflict),
@@ -318,6 +326,7 @@ impl FitWarning {
             | ChosenOnMisfit { .. }
             | PriorConflict(_)
             | RigCurveConflict(_)
+            | JointSignalsDropped { .. }
             | Text { .. } => Severity::Attention,
         }
     }
@@ -354,6 +363,7 @@ impl FitWarning {
             ChosenOnMisfit { .. } => "chosen_on_misfit",
             FailedEvaluations { .. } => "failed_evaluations",
             NoBladeModes { .. } => "no_blade_modes",
+            JointSignalsDropped { .. } => "joint_signals_dropped",
             PriorConflict(_) => "prior_conflict",
             RigCurveConflict(_) => "rig_curve_conflict",
             Text { .. } => "text",

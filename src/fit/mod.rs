@@ -133,6 +133,13 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let tol = tolerance_check.as_ref();
     let truth = optimum_checks(job, (&cf, &fits), &best, tol, interrupted, &mut warnings);
     warnings.extend(failure_warning(&cf.problem));
+    warnings.extend(
+        cf.problem
+            .likelihood
+            .as_ref()
+            .ok()
+            .and_then(|l| l.joint_dropped.clone()),
+    );
     // The chosen model's counts include its bootstrap replicates and the tolerance check's
     // simulations (they share its counters).
     let chosen = &mut selection.trials[selection.chosen];

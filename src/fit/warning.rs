@@ -170,6 +170,17 @@ impl fmt::Display for FitWarning {
             NoBladeModes { reason } => {
                 write!(f, "no blade modes at the fitted parameters: {reason}")
             }
+            JointSignalsDropped {
+                n_segments,
+                half_dof,
+                signals,
+            } => write!(
+                f,
+                "[fit.likelihood] joint_signals were not read: a band's {n_segments} segments between \
+                 lost frames give ν/2 = {half_dof:.2} degrees of freedom, fewer than the {signals} \
+                 signals' cross-spectral matrix needs, so the fit reads its own signal alone \
+                 (docs/likelihood.md, \"Several signals\")"
+            ),
             PriorConflict(c) => c.fmt(f),
             RigCurveConflict(c) => c.fmt(f),
             Text { text } => f.write_str(text),

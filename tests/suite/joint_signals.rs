@@ -67,3 +67,27 @@ fn head_y_read_with_the_signal_narrows_every_curvature_interval_at_the_truth() {
         l2.excess_nll(&two, &sim).unwrap()
     );
 }
+
+#[test]
+fn a_band_too_short_for_the_cross_spectra_falls_back_to_the_one_signal_and_says_so() {
+    // The low band at nperseg 16384 keeps one segment of the recording's 18,869 frames: ν = 2
+    // (Percival & Walden 1993, §6.17: one Hann segment has 2 degrees of freedom), ν/2 = 1, fewer
+    // than the 2 × 2 cross-spectral matrix of two signals needs (complex Wishart with n ≥ p).
+    let mut job = LoadedJob::load(&common::root().join("fits/reversal.toml")).expect("job");
+    job.job.spectrum.bands[0].nperseg = 16384;
+    job.job.fit.likelihood.joint_signals = vec![SignalKind::HeadY];
+    let p = problem_for(&job, "blade2dof".parse::<Candidate>().unwrap()).expect("problem");
+    let lik = p.likelihood.as_ref().expect("the one signal's likelihood");
+    assert_eq!(lik.signals(&p), vec![SignalKind::TipRelX]);
+    match &lik.joint_dropped {
+        Some(wiperlab::estimate::warning::FitWarning::JointSignalsDropped {
+            n_segments,
+            half_dof,
+            signals,
+        }) => {
+            assert_eq!((*n_segments, *signals), (1, 2));
+            assert!((half_dof - 1.0).abs() < 1e-12, "ν/2 = {half_dof}");
+        }
+        other => panic!("expected joint_signals_dropped, got {other:?}"),
+    }
+}

@@ -144,6 +144,9 @@ pub struct RecordingLikelihood {
     /// Further signals read together with the measured one through their cross-spectra
     /// (`[fit.likelihood] joint_signals`; [`joint`]): the spectral term is then theirs.
     joint: Option<joint::JointSignals>,
+    /// Why the job's joint signals are not read: a band too short for their matrix
+    /// ([`RecordingLikelihood::with_joint`]).
+    pub joint_dropped: Option<crate::estimate::warning::FitWarning>,
 }
 
 /// The time-domain term at one simulation.
@@ -230,18 +233,20 @@ impl RecordingLikelihood {
             block_len: None,
             saturated_spectral_nats,
             joint: None,
+            joint_dropped: None,
         })
     }
 
     /// The same likelihood with the spectral term of the measured signal and the signals `others`
     /// of the recording `trace` read together through their cross-spectra ([`joint`]); none keeps
     /// the one signal's. Build it after [`RecordingLikelihood::with_noise`]: each signal's noise
-    /// follows the likelihood's noise spectrum.
+    /// follows the likelihood's noise spectrum. Where a band's segments between lost frames cannot
+    /// carry the signals' cross-spectral matrix
+    /// ([`likelihood::LikelihoodError::TooFewSegmentsForSignals`]), the likelihood keeps the one
+    /// signal and says why in [`RecordingLikelihood::joint_dropped`].
     ///
     /// # Errors
-    /// A signal the trace lacks, a band whose segments cannot carry the signals' cross-spectral
-    /// matrix ([`likelihood::LikelihoodError::TooFewSegmentsForSignals`]), a signal whose noise
-    /// cannot be estimated.
+    /// A signal the trace lacks, a signal whose noise cannot be estimated.
     pub fn with_joint(
         mut self,
         problem: &SpectralProblem,
@@ -254,7 +259,24 @@ impl RecordingLikelihood {
         let kinds = std::iter::once(problem.signal)
             .chain(others.iter().copied())
             .collect();
-        self.joint = Some(joint::JointSignals::new(&self, problem, trace, kinds)?);
+        match joint::JointSignals::new(&self, problem, trace, kinds) {
+            Ok(j) => self.joint = Some(j),
+            Err(e) => match likelihood::LikelihoodError::of(&e) {
+                Some(&likelihood::LikelihoodError::TooFewSegmentsForSignals {
+                    n_segments,
+                    half_dof,
+                    signals,
+                }) => {
+                    self.joint_dropped =
+                        Some(crate::estimate::warning::FitWarning::JointSignalsDropped {
+                            n_segments,
+                            half_dof,
+                            signals,
+                        })
+                }
+                _ => return Err(e),
+            },
+        }
         Ok(self)
     }
 
@@ -1665,6 +1687,7 @@ mod tests {
             block_len: None,
             saturated_spectral_nats: 0.0,
             joint: None,
+            joint_dropped: None,
         };
         (lik, zeros)
     }
