@@ -328,9 +328,10 @@ fn goodness_of_fit(cf: &CandidateFit, sim: &BladeSimulation) -> GoodnessOutcome 
 fn tracking_noise(cf: &CandidateFit, sim: &BladeSimulation) -> Option<result::NoiseEstimate> {
     let lik = cf.problem.likelihood.as_ref().ok()?;
     let n = lik.noise_at(&cf.problem, sim).ok()?;
+    // A joint signal's noise that cannot be read leaves the measured signal's in the result.
     let joint = lik
         .joint_noises_at(&cf.problem, sim)
-        .ok()?
+        .unwrap_or_default()
         .into_iter()
         .map(|(signal, n)| result::SignalNoise {
             signal,
