@@ -258,7 +258,7 @@ impl JointSignals {
         sim: &BladeSimulation,
     ) -> Result<Vec<Matrices>> {
         let s = self.sim_matrices(problem, sim)?;
-        let noises = self.noises(lik, &s, &self.diag, &self.sigma_m);
+        let noises = self.recording_noises(lik, &s);
         Ok(self.expected(lik, &s, &noises))
     }
 

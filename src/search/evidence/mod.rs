@@ -345,9 +345,15 @@ impl RecordingLikelihood {
     /// ([`RecordingLikelihood::noise_for`]).
     fn model_psd(&self, problem: &SpectralProblem, sim: &BladeSimulation) -> Result<Vec<Vec<f64>>> {
         let sim_psd = self.sim_psd(problem, sim)?;
-        let measured: Vec<&[f64]> = self.bands.iter().map(|b| b.measured.as_slice()).collect();
-        let noise = self.noise_for(&sim_psd, &measured, self.sigma_m);
+        let noise = self.recording_noise(&sim_psd);
         Ok(self.expected(&sim_psd, &noise))
+    }
+
+    /// The measured signal's tracking noise beside the simulation's ordinates `sim_psd`: the
+    /// recording's own ordinates and σ̂ through [`RecordingLikelihood::noise_for`].
+    fn recording_noise(&self, sim_psd: &[Vec<f64>]) -> TrackingNoise {
+        let measured: Vec<&[f64]> = self.bands.iter().map(|b| b.measured.as_slice()).collect();
+        self.noise_for(sim_psd, &measured, self.sigma_m)
     }
 
     /// The simulation's Welch ordinates of every band.
@@ -434,9 +440,7 @@ impl RecordingLikelihood {
         problem: &SpectralProblem,
         sim: &BladeSimulation,
     ) -> Result<TrackingNoise> {
-        let sim_psd = self.sim_psd(problem, sim)?;
-        let measured: Vec<&[f64]> = self.bands.iter().map(|b| b.measured.as_slice()).collect();
-        Ok(self.noise_for(&sim_psd, &measured, self.sigma_m))
+        Ok(self.recording_noise(&self.sim_psd(problem, sim)?))
     }
 
     /// Each joint signal's tracking noise at the simulation `sim` (the measured signal's is
@@ -674,7 +678,10 @@ impl RecordingLikelihood {
         parts: &NllParts,
         h: f64,
     ) -> Result<DMatrix<f64>> {
-        let metric = self.metric_at(problem, &problem.simulate(&problem.params_at(u))?)?;
+        let metric = match self.joint {
+            Some(_) => self.metric_at(problem, &problem.simulate(&problem.params_at(u))?)?,
+            None => None,
+        };
         let j = self.jacobian(problem, u, h, metric.as_ref())?;
         Ok(j.fisher(&self.weights(parts, j.n_time(self))))
     }
@@ -839,8 +846,7 @@ impl RecordingLikelihood {
         sim: &BladeSimulation,
     ) -> Result<ReplicateBase> {
         let sim_psd = self.sim_psd(problem, sim)?;
-        let measured: Vec<&[f64]> = self.bands.iter().map(|b| b.measured.as_slice()).collect();
-        let noise = self.noise_for(&sim_psd, &measured, self.sigma_m);
+        let noise = self.recording_noise(&sim_psd);
         if !(noise.sigma_m.is_finite() && noise.sigma_m > 0.0) {
             return Err(likelihood::LikelihoodError::InvalidSigma {
                 sigma: noise.sigma_m,
@@ -1071,7 +1077,6 @@ impl JointBase {
     /// noise is drawn from seed [`NOISE_SEED`]` + r` as [`ReplicateBase::signal`]'s, signal `a`'s
     /// from that seed plus `a·2³²`.
     fn replicate(&self, r: usize) -> Vec<Vec<f64>> {
-        use rand::SeedableRng;
         self.signals
             .iter()
             .zip(&self.noises)
@@ -1080,26 +1085,26 @@ impl JointBase {
                 let seed = NOISE_SEED
                     .wrapping_add(r as u64)
                     .wrapping_add((a as u64) << 32);
-                let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-                m.iter()
-                    .zip(noise.sample(m.len(), &mut rng))
-                    .map(|(v, e)| v + e)
-                    .collect()
+                with_noise(m, noise, seed)
             })
             .collect()
     }
 }
 
+/// `m` plus `noise` drawn from `seed`.
+fn with_noise(m: &[f64], noise: &TrackingNoise, seed: u64) -> Vec<f64> {
+    use rand::SeedableRng;
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    m.iter()
+        .zip(noise.sample(m.len(), &mut rng))
+        .map(|(v, e)| v + e)
+        .collect()
+}
+
 impl ReplicateBase {
     /// Replicate `r`'s signal: `m` plus the noise drawn from seed [`NOISE_SEED`]` + r`.
     fn signal(&self, r: usize) -> Vec<f64> {
-        use rand::SeedableRng;
-        let mut rng = rand::rngs::StdRng::seed_from_u64(NOISE_SEED + r as u64);
-        self.m
-            .iter()
-            .zip(self.noise.sample(self.m.len(), &mut rng))
-            .map(|(v, e)| v + e)
-            .collect()
+        with_noise(&self.m, &self.noise, NOISE_SEED + r as u64)
     }
 }
 
