@@ -233,14 +233,8 @@ pub enum FitWarning {
     },
     /// The blade's modes at the fitted parameters could not be computed.
     NoBladeModes { reason: String },
-    /// `[fit.likelihood] joint_signals` could not be read: a band's segments give `half_dof`
-    /// (`ν/2`) equivalent degrees of freedom, fewer than the `signals` signals' matrix needs, so
-    /// the fit read its own signal alone.
-    JointSignalsDropped {
-        n_segments: usize,
-        half_dof: f64,
-        signals: usize,
-    },
+    /// `[fit.likelihood] joint_signals` could not be read, so the fit read its own signal alone.
+    JointSignalsDropped(JointDropped),
     /// A parameter fitted beyond [`crate::likelihood::prior::PRIOR_CONFLICT_Z`] standard
     /// deviations of its `[fit.priors]` prior.
     PriorConflict(ParamConflict),
@@ -248,6 +242,16 @@ pub enum FitWarning {
     RigCurveConflict(RigConflict),
     /// A warning read from a result written before warnings had kinds: its sentence only.
     Text { text: String },
+}
+
+/// Why `[fit.likelihood] joint_signals` were not read: a band's `n_segments` segments give
+/// `half_dof` (`ν/2`) equivalent degrees of freedom, fewer than the cross-spectral matrix of
+/// `signals` signals needs.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct JointDropped {
+    pub n_segments: usize,
+    pub half_dof: f64,
+    pub signals: usize,
 }
 
 /// The cost of one simulation of the optimum at one tolerance.
@@ -326,7 +330,7 @@ impl FitWarning {
             | ChosenOnMisfit { .. }
             | PriorConflict(_)
             | RigCurveConflict(_)
-            | JointSignalsDropped { .. }
+            | JointSignalsDropped(_)
             | Text { .. } => Severity::Attention,
         }
     }
@@ -363,7 +367,7 @@ impl FitWarning {
             ChosenOnMisfit { .. } => "chosen_on_misfit",
             FailedEvaluations { .. } => "failed_evaluations",
             NoBladeModes { .. } => "no_blade_modes",
-            JointSignalsDropped { .. } => "joint_signals_dropped",
+            JointSignalsDropped(_) => "joint_signals_dropped",
             PriorConflict(_) => "prior_conflict",
             RigCurveConflict(_) => "rig_curve_conflict",
             Text { .. } => "text",

@@ -133,24 +133,13 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let tol = tolerance_check.as_ref();
     let truth = optimum_checks(job, (&cf, &fits), &best, tol, interrupted, &mut warnings);
     warnings.extend(failure_warning(&cf.problem));
-    warnings.extend(
-        cf.problem
-            .likelihood
-            .as_ref()
-            .ok()
-            .and_then(|l| l.joint_dropped.clone()),
-    );
+    warnings.extend(joint_dropped_warning(&cf.problem));
     // The chosen model's counts include its bootstrap replicates and the tolerance check's
     // simulations (they share its counters).
     let chosen = &mut selection.trials[selection.chosen];
     chosen.model_evaluations = cf.problem.evaluations.load(Ordering::Relaxed);
     chosen.failed_evaluations = failures(&cf.problem).0;
-    let modes = blade_modes(&best.params).unwrap_or_else(|e| {
-        warnings.push(FitWarning::NoBladeModes {
-            reason: e.to_string(),
-        });
-        Vec::new()
-    });
+    let modes = modes_or_warning(&best.params, &mut warnings);
     let result = assemble_result(
         job,
         &cf,
@@ -186,6 +175,26 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         best_sim: best.sim,
         best_params: best.params,
     })
+}
+
+/// The blade's modes at the fitted parameters, or none and a warning saying why.
+fn modes_or_warning(
+    params: &BladeParams,
+    warnings: &mut Vec<FitWarning>,
+) -> Vec<crate::model::modes::BladeMode> {
+    blade_modes(params).unwrap_or_else(|e| {
+        warnings.push(FitWarning::NoBladeModes {
+            reason: e.to_string(),
+        });
+        Vec::new()
+    })
+}
+
+/// The warning that the likelihood read the measured signal alone, its joint signals' bands too
+/// short ([`crate::search::evidence::RecordingLikelihood::joint_dropped`]).
+fn joint_dropped_warning(problem: &SpectralProblem) -> Option<FitWarning> {
+    let d = problem.likelihood.as_ref().ok()?.joint_dropped?;
+    Some(FitWarning::JointSignalsDropped(d))
 }
 
 /// The fitted law over the slip speeds of the chosen optimum's simulation, its band from the

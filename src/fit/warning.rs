@@ -18,8 +18,8 @@
 use super::select::INDISTINGUISHABLE_TIC;
 use super::tolerance::{SPREAD_WARN_NATS, TolerancePoint};
 pub use crate::estimate::warning::{
-    End, FAILED_ATTENTION_FRACTION, FAILED_WARN_FRACTION, FitWarning, LineSource, SampledReason,
-    Severity,
+    End, FAILED_ATTENTION_FRACTION, FAILED_WARN_FRACTION, FitWarning, JointDropped, LineSource,
+    SampledReason, Severity,
 };
 use crate::job::Candidate;
 use crate::job::UncertaintyMethod;
@@ -170,17 +170,7 @@ impl fmt::Display for FitWarning {
             NoBladeModes { reason } => {
                 write!(f, "no blade modes at the fitted parameters: {reason}")
             }
-            JointSignalsDropped {
-                n_segments,
-                half_dof,
-                signals,
-            } => write!(
-                f,
-                "[fit.likelihood] joint_signals were not read: a band's {n_segments} segments between \
-                 lost frames give ν/2 = {half_dof:.2} degrees of freedom, fewer than the {signals} \
-                 signals' cross-spectral matrix needs, so the fit reads its own signal alone \
-                 (docs/likelihood.md, \"Several signals\")"
-            ),
+            JointSignalsDropped(d) => d.fmt(f),
             PriorConflict(c) => c.fmt(f),
             RigCurveConflict(c) => c.fmt(f),
             Text { text } => f.write_str(text),
@@ -494,6 +484,19 @@ fn posterior_spans_bounds(
         interval[1],
         100.0 * span_fraction
     )
+}
+
+impl fmt::Display for JointDropped {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "[fit.likelihood] joint_signals were not read: a band's {} segments between lost \
+             frames give ν/2 = {:.2} degrees of freedom, fewer than the {} signals' cross-spectral \
+             matrix needs, so the fit reads its own signal alone (docs/likelihood.md, \"Several \
+             signals\")",
+            self.n_segments, self.half_dof, self.signals
+        )
+    }
 }
 
 /// [`FitWarning::ChosenOnMisfit`]'s sentence.

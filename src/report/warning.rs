@@ -298,11 +298,7 @@ fn fit_headline(w: &FitWarning) -> String {
         NoBladeModes { .. } => {
             "The blade's modes could not be computed at the fitted parameters.".into()
         }
-        JointSignalsDropped { half_dof, .. } => format!(
-            "Head y and the job's other joint signals were not read: a band keeps too few \
-             segments between lost frames for their cross-spectra (ν/2 = {half_dof:.2}), so the fit \
-             reads its own signal alone."
-        ),
+        JointSignalsDropped(d) => joint_dropped_headline(d.half_dof),
         PriorConflict(c) => prior_conflict_headline(c.parameter, c.z),
         RigCurveConflict(c) => rig_curve_conflict_headline(c.rms_z, c.points),
         Text { text } => text.clone(),
@@ -579,4 +575,13 @@ fn line_headline(source: LineSource, band: &str, o: &LineOrigin, same: bool) -> 
         ),
         (None, _) => subject,
     }
+}
+
+/// [`FitWarning::JointSignalsDropped`]'s headline.
+fn joint_dropped_headline(half_dof: f64) -> String {
+    format!(
+        "Head y and the job's other joint signals were not read: a band keeps too few segments \
+         between lost frames for their cross-spectra (ν/2 = {half_dof:.2}), so the fit reads its \
+         own signal alone."
+    )
 }

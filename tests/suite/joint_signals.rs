@@ -80,7 +80,7 @@ fn a_band_too_short_for_the_cross_spectra_falls_back_to_the_one_signal_and_says_
     let lik = p.likelihood.as_ref().expect("the one signal's likelihood");
     assert_eq!(lik.signals(&p), vec![SignalKind::TipRelX]);
     match &lik.joint_dropped {
-        Some(wiperlab::estimate::warning::FitWarning::JointSignalsDropped {
+        Some(wiperlab::estimate::warning::JointDropped {
             n_segments,
             half_dof,
             signals,

@@ -146,7 +146,7 @@ pub struct RecordingLikelihood {
     joint: Option<joint::JointSignals>,
     /// Why the job's joint signals are not read: a band too short for their matrix
     /// ([`RecordingLikelihood::with_joint`]).
-    pub joint_dropped: Option<crate::estimate::warning::FitWarning>,
+    pub joint_dropped: Option<crate::estimate::warning::JointDropped>,
 }
 
 /// The time-domain term at one simulation.
@@ -267,12 +267,11 @@ impl RecordingLikelihood {
                     half_dof,
                     signals,
                 }) => {
-                    self.joint_dropped =
-                        Some(crate::estimate::warning::FitWarning::JointSignalsDropped {
-                            n_segments,
-                            half_dof,
-                            signals,
-                        })
+                    self.joint_dropped = Some(crate::estimate::warning::JointDropped {
+                        n_segments,
+                        half_dof,
+                        signals,
+                    })
                 }
                 _ => return Err(e),
             },
