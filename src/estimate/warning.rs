@@ -235,6 +235,9 @@ pub enum FitWarning {
     NoBladeModes { reason: String },
     /// `[fit.likelihood] joint_signals` could not be read, so the fit read its own signal alone.
     JointSignalsDropped(JointDropped),
+    /// The cost at the optimum jitters under rounding-level steps by more than a profile's rise
+    /// limit ([`crate::search::jitter`]).
+    CostJitter(Jitter),
     /// A parameter fitted beyond [`crate::likelihood::prior::PRIOR_CONFLICT_Z`] standard
     /// deviations of its `[fit.priors]` prior.
     PriorConflict(ParamConflict),
@@ -252,6 +255,16 @@ pub struct JointDropped {
     pub n_segments: usize,
     pub half_dof: f64,
     pub signals: usize,
+}
+
+/// The cost's jitter at the optimum: its standard deviation `sd_nats` over steps of `step_u`
+/// (normalised units) either way along each coordinate, against the smallest profile rise limit
+/// `rise_limit_nats` of the fit's parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Jitter {
+    pub sd_nats: f64,
+    pub step_u: f64,
+    pub rise_limit_nats: f64,
 }
 
 /// The cost of one simulation of the optimum at one tolerance.
@@ -331,6 +344,7 @@ impl FitWarning {
             | PriorConflict(_)
             | RigCurveConflict(_)
             | JointSignalsDropped(_)
+            | CostJitter(_)
             | Text { .. } => Severity::Attention,
         }
     }
@@ -368,6 +382,7 @@ impl FitWarning {
             FailedEvaluations { .. } => "failed_evaluations",
             NoBladeModes { .. } => "no_blade_modes",
             JointSignalsDropped(_) => "joint_signals_dropped",
+            CostJitter(_) => "cost_jitter",
             PriorConflict(_) => "prior_conflict",
             RigCurveConflict(_) => "rig_curve_conflict",
             Text { .. } => "text",

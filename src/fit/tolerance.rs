@@ -16,6 +16,7 @@ use super::FitWarning;
 pub use crate::estimate::TolerancePoint;
 use crate::model::BladeParams;
 use crate::search::FAILED_COST;
+use crate::search::jitter::RoundingJitter;
 use crate::search::strategy::CandidateFit;
 use crate::search::{SpectralProblem, interrupt};
 use serde::{Deserialize, Serialize};
@@ -58,6 +59,10 @@ pub struct ToleranceCheck {
     /// Probes whose simulation failed, and why.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub failed: Vec<String>,
+    /// The cost's jitter at the job's tolerance under rounding-level steps
+    /// ([`crate::search::jitter`]): set for the chosen optimum.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub jitter: Option<RoundingJitter>,
 }
 
 impl ToleranceCheck {
@@ -119,6 +124,7 @@ impl ToleranceCheck {
             points,
             spread_nats,
             failed,
+            jitter: None,
         }
     }
 

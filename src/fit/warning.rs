@@ -18,8 +18,8 @@
 use super::select::INDISTINGUISHABLE_TIC;
 use super::tolerance::{SPREAD_WARN_NATS, TolerancePoint};
 pub use crate::estimate::warning::{
-    End, FAILED_ATTENTION_FRACTION, FAILED_WARN_FRACTION, FitWarning, JointDropped, LineSource,
-    SampledReason, Severity,
+    End, FAILED_ATTENTION_FRACTION, FAILED_WARN_FRACTION, FitWarning, Jitter, JointDropped,
+    LineSource, SampledReason, Severity,
 };
 use crate::job::Candidate;
 use crate::job::UncertaintyMethod;
@@ -171,6 +171,7 @@ impl fmt::Display for FitWarning {
                 write!(f, "no blade modes at the fitted parameters: {reason}")
             }
             JointSignalsDropped(d) => d.fmt(f),
+            CostJitter(j) => j.fmt(f),
             PriorConflict(c) => c.fmt(f),
             RigCurveConflict(c) => c.fmt(f),
             Text { text } => f.write_str(text),
@@ -495,6 +496,20 @@ impl fmt::Display for JointDropped {
              matrix needs, so the fit reads its own signal alone (docs/likelihood.md, \"Several \
              signals\")",
             self.n_segments, self.half_dof, self.signals
+        )
+    }
+}
+
+impl fmt::Display for Jitter {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "the cost at the optimum jitters by {:.2} nats (standard deviation) under steps of \
+             {:e} in the normalised coordinates, more than the profile's smallest rise limit of \
+             {:.2} nats: the slip grows an oscillation out of the integrator's rounding, whose \
+             timing the spectra see, so profile ends and cost differences within that jitter are \
+             read through it (docs/likelihood.md, \"Jitter\")",
+            self.sd_nats, self.step_u, self.rise_limit_nats
         )
     }
 }

@@ -1116,6 +1116,13 @@ pub fn fit_summary(r: &FitResult) -> String {
                 Verdict::Unresolved => "not resolved, see the warning",
             }
         );
+        if let Some(j) = &t.jitter {
+            let _ = writeln!(
+                s,
+                "  cost jitter: {:.3} nats (standard deviation) under steps of {:e} at rtol {:e}",
+                j.sd_nats, j.step_u, t.points[0].rtol
+            );
+        }
     }
     if let Some(n) = &r.tracking_noise {
         let _ = writeln!(

@@ -442,8 +442,16 @@ fn tolerance_check_words(t: &crate::fit::tolerance::ToleranceCheck) -> String {
             "the integrator does not resolve the likelihood at the optimum: the cost surface is rough at that depth and the intervals understate the uncertainty"
         }
     };
+    let jitter = t.jitter.as_ref().map_or(String::new(), |j| {
+        format!(
+            " Under steps of {:e} in the normalised coordinates it jitters by {} nats (standard \
+             deviation): cost differences within that do not tell parameter sets apart.",
+            j.step_u,
+            num(j.sd_nats, 2)
+        )
+    });
     format!(
-        "Tolerance check: the optimum's cost is {} ({} nats apart): {verdict}.",
+        "Tolerance check: the optimum's cost is {} ({} nats apart): {verdict}.{jitter}",
         crate::names::join(&at, ", "),
         num(t.spread_nats, 2),
     )

@@ -299,6 +299,11 @@ fn fit_headline(w: &FitWarning) -> String {
             "The blade's modes could not be computed at the fitted parameters.".into()
         }
         JointSignalsDropped(d) => joint_dropped_headline(d.half_dof),
+        CostJitter(j) => format!(
+            "The cost jitters by {} nats at the optimum under rounding-level steps: profile ends \
+             and cost differences within that are read through it.",
+            num(j.sd_nats, 2)
+        ),
         PriorConflict(c) => prior_conflict_headline(c.parameter, c.z),
         RigCurveConflict(c) => rig_curve_conflict_headline(c.rms_z, c.points),
         Text { text } => text.clone(),

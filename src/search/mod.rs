@@ -8,6 +8,7 @@
 //!   their ends, Nelder–Mead polishes, nested and warm starts) into a
 //!   [`strategy::CandidateFit`], with its history and progress reported through argmin observers.
 //! * [`ipop`]: CMA-ES with restarts of increasing population over the unit box.
+//! * [`jitter`]: how much the cost moves under steps far below any physical scale.
 //! * [`scan`]: the contact-angle scan of a shoulder candidate.
 //! * [`history`]: the stages of the optimiser and the best cost after each iteration.
 //! * [`interrupt`]: SIGINT/SIGTERM stop a running search, which keeps its best point.
@@ -27,6 +28,7 @@ pub mod evidence;
 pub mod history;
 pub mod interrupt;
 pub mod ipop;
+pub mod jitter;
 pub mod problem;
 pub mod scan;
 pub mod strategy;

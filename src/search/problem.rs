@@ -394,6 +394,12 @@ impl SpectralProblem {
         }
     }
 
+    /// [`SpectralProblem::cost_at`] without keeping the point among the near-best ones (a
+    /// probe of the cost, not a step of a search).
+    pub(crate) fn unrecorded_cost_at(&self, u: &[f64]) -> f64 {
+        self.unrecorded_cost_at_stage(u, SearchStage::Polish)
+    }
+
     /// [`SpectralProblem::cost_at_stage`] without keeping the point (a joint fit's other
     /// recordings, whose cost is a part of the whole).
     fn unrecorded_cost_at_stage(&self, u: &[f64], stage: SearchStage) -> f64 {

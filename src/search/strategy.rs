@@ -1954,13 +1954,15 @@ fn polish_sd(problem: &SpectralProblem) -> f64 {
 }
 
 /// [`polish`] of every coordinate but `index`, which is held at `u_held`: the minimum of the cost
-/// over the others from `start` (full coordinates; its `index` entry is replaced). Returns the full
-/// coordinates of the best point and its cost.
+/// over the others from `start` (full coordinates; its `index` entry is replaced), stopping when
+/// the simplex's costs spread by less than [`polish`]'s limit or `jitter_nats`, whichever is
+/// larger (a simplex cannot settle below the cost's own jitter, [`super::jitter`]). Returns the
+/// full coordinates of the best point and its cost.
 pub(crate) fn polish_pinned(
     problem: &Arc<SpectralProblem>,
     start: &[f64],
     (index, u_held): (usize, f64),
-    step: f64,
+    (step, jitter_nats): (f64, f64),
     iterations: u64,
     progress: Option<ProgressObserver>,
 ) -> Result<(Vec<f64>, f64)> {
@@ -1974,7 +1976,7 @@ pub(crate) fn polish_pinned(
         index,
         u: u_held,
     };
-    let sd = polish_sd(problem);
+    let sd = polish_sd(problem).max(jitter_nats);
     let (best, _, cost) = nelder_mead(pinned.clone(), &others, step, sd, iterations, progress)?;
     Ok((pinned.full(&best), cost))
 }

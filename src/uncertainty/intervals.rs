@@ -1,12 +1,13 @@
 //! Uncertainty stage: bootstrap intervals and identifiability warnings for the chosen model.
 
 use crate::Result;
-use crate::estimate::warning::{End, FitWarning, SampledReason};
+use crate::estimate::warning::{End, FitWarning, Jitter, SampledReason};
 use crate::estimate::{FittedParam, Interval, IntervalMethod};
 use crate::job::FreeParam;
 use crate::job::{self, NoiseSpectrum, UncertaintyMethod};
 use crate::posterior::PosteriorSummary;
 use crate::search::evidence::RecordingLikelihood;
+use crate::search::jitter::RoundingJitter;
 use crate::search::problem::SpectralProblem;
 use crate::search::strategy::{
     CandidateFit, Confirming, POLISH_STEP_U, ProgressObserver, Reporting, optimise, polish,
@@ -627,6 +628,8 @@ fn profile_with(
     use rayon::prelude::*;
     let n = at.u.len();
     let limit = |i: usize| profile_rise_limit(at.sigma_u[i], at.fisher_sigma_u[i]);
+    let jitter = RoundingJitter::at(problem, at.u);
+    let jitter_nats = jitter.as_ref().map_or(0.0, |j| j.sd_nats);
     let walk = |(i, side): (usize, f64)| -> Result<ProfileEnd> {
         let first = at.sigma_u[i].clamp(PROFILE_MIN_STEP_U, PROFILE_MAX_STEP_U);
         let first = if first.is_nan() {
@@ -645,7 +648,7 @@ fn profile_with(
                 problem,
                 &from,
                 (i, x),
-                POLISH_STEP_U,
+                (POLISH_STEP_U, jitter_nats),
                 polish_iterations,
                 observer,
             ) {
@@ -666,7 +669,18 @@ fn profile_with(
     };
     let sides: Vec<(usize, f64)> = (0..n).flat_map(|i| [(i, -1.0), (i, 1.0)]).collect();
     let ends: Vec<ProfileEnd> = sides.par_iter().map(|s| walk(*s)).collect::<Result<_>>()?;
-    let mut warnings = Vec::new();
+    let smallest_limit = (0..n).map(limit).fold(f64::INFINITY, f64::min);
+    let mut warnings: Vec<FitWarning> = jitter
+        .filter(|j| j.sd_nats > smallest_limit)
+        .map(|j| {
+            FitWarning::CostJitter(Jitter {
+                sd_nats: j.sd_nats,
+                step_u: j.step_u,
+                rise_limit_nats: smallest_limit,
+            })
+        })
+        .into_iter()
+        .collect();
     let mut intervals = Vec::with_capacity(n);
     for (i, fp) in problem.free.iter().enumerate() {
         let (lo, hi) = (ends[2 * i], ends[2 * i + 1]);

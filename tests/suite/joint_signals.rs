@@ -91,3 +91,48 @@ fn a_band_too_short_for_the_cross_spectra_falls_back_to_the_one_signal_and_says_
         other => panic!("expected joint_signals_dropped, got {other:?}"),
     }
 }
+
+#[test]
+fn the_slow_slip_before_the_reversal_grows_a_rounding_level_step_and_head_y_sees_it() {
+    // A step of 1e-13 in A's normalised coordinate changes nothing the integrator can see until
+    // the slip slows towards the reversal; there an oscillation grows out of the difference until
+    // the neck angles of the two runs part by milliradians (measured on this recording's truth:
+    // below 2e-13 rad for the first 8,000 frames, 6e-3 rad by frame 9,035 of 18,869). The cost of
+    // tip − head x hardly sees it (a few hundredths of a nat); head y's low band, which sees the
+    // squared angle's envelope, does (most of a nat): docs/likelihood.md, "Jitter".
+    use wiperlab::search::jitter::RoundingJitter;
+    let (one, u) = problem(&[]);
+    let (two, _) = problem(&[SignalKind::HeadY]);
+    let mut stepped = u.clone();
+    stepped[0] += 1e-13;
+    let a = one
+        .simulate(&one.params_at(&u))
+        .expect("the truth simulates");
+    let b = one
+        .simulate(&one.params_at(&stepped))
+        .expect("the stepped truth simulates");
+    let parted = |range: std::ops::Range<usize>| {
+        range
+            .map(|j| (a.theta_rad[j] - b.theta_rad[j]).abs())
+            .fold(0.0_f64, f64::max)
+    };
+    let n = a.theta_rad.len();
+    let (early, late) = (parted(0..n / 3), parted(n / 3..n));
+    println!("neck angles part by {early:.2e} rad in the first third, {late:.2e} rad later");
+    assert!(early < 1e-10, "{early:.2e} rad in the first third");
+    assert!(late > 1e-4, "{late:.2e} rad after the first third");
+    let j1 = RoundingJitter::at(&one, &u).expect("one signal's jitter");
+    let j2 = RoundingJitter::at(&two, &u).expect("two signals' jitter");
+    println!(
+        "jitter {:.3} nats alone, {:.3} with head y",
+        j1.sd_nats, j2.sd_nats
+    );
+    assert_eq!(j1.costs_nats.len(), 2 * u.len() + 1);
+    assert!(j1.sd_nats < 0.1, "one signal: {} nats", j1.sd_nats);
+    assert!(
+        j2.sd_nats > 5.0 * j1.sd_nats,
+        "{} against {}",
+        j2.sd_nats,
+        j1.sd_nats
+    );
+}
