@@ -28,6 +28,9 @@
 //! ```
 
 use clap::Parser;
+#[path = "common/campaign.rs"]
+mod campaign;
+use campaign::campaign_jobs;
 use nalgebra::{Complex, DMatrix};
 use std::path::PathBuf;
 use wiperlab::job::{Candidate, LoadedJob};
@@ -91,29 +94,6 @@ fn main() -> Fallible<()> {
         }
     }
     Ok(())
-}
-
-/// Writes the job and blade file of every recording of the campaign at `path` (output directory
-/// `out_dir`, else the campaign's own) and returns the jobs' paths.
-fn campaign_jobs(
-    path: &std::path::Path,
-    out_dir: Option<&std::path::Path>,
-) -> Fallible<Vec<PathBuf>> {
-    use wiperlab::campaign::{
-        Campaign,
-        run::{EntryPaths, generate},
-    };
-    let campaign = Campaign::load(path)?.with_out_dir(out_dir)?;
-    let mut jobs = Vec::new();
-    for entry in &campaign.entries {
-        let paths = EntryPaths::new(&campaign.out_dir(), entry);
-        let g = generate(&campaign, entry, &paths)?;
-        std::fs::create_dir_all(paths.job.parent().unwrap_or(std::path::Path::new(".")))?;
-        wiperlab::io::write_atomic(&paths.blade, g.blade_text.as_bytes())?;
-        wiperlab::io::write_atomic(&paths.job, g.job_text.as_bytes())?;
-        jobs.push(paths.job);
-    }
-    Ok(jobs)
 }
 
 /// The information table of one job (see the module docs).

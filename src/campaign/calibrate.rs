@@ -212,6 +212,9 @@ pub struct RecordingScore {
     /// tighter ones, nats ([`FitResult::truth_tolerance`]), when the shortfall is priced and the
     /// result has the check.
     pub truth_spread_nats: Option<f64>,
+    /// How much the truth's own cost jitters under rounding-level steps, nats (standard
+    /// deviation; [`crate::search::jitter`]), when the result has it.
+    pub truth_jitter_nats: Option<f64>,
     pub wall_time_s: f64,
     /// The scored parameters (empty when the chosen model does not contain the truth's).
     pub params: Vec<Scored>,
@@ -370,6 +373,18 @@ impl Calibration {
         (spreads.len(), wider)
     }
 
+    /// Of the fits above [`SHORTFALL_TOLERANCE_NATS`]: (those whose truth's cost jitter was
+    /// measured, of them those whose shortfall lies within two standard deviations of that
+    /// jitter: the truth's cost is not known more closely than that).
+    pub fn shortfall_jittered(&self) -> (usize, usize) {
+        let jitters: Vec<(f64, f64)> = (self.done())
+            .filter_map(|r| Some((r.shortfall_nats?, r.truth_jitter_nats?)))
+            .filter(|(s, _)| *s > SHORTFALL_TOLERANCE_NATS)
+            .collect();
+        let over = jitters.iter().filter(|(s, j)| *s <= 2.0 * j).count();
+        (jitters.len(), over)
+    }
+
     /// Fits whose truth was priced at tighter tolerances, and of them those whose truth's cost
     /// spreads by more than [`SPREAD_WARN_NATS`]: a truth the integrator does not resolve.
     pub fn unresolved_truths(&self) -> (usize, usize) {
@@ -489,6 +504,7 @@ pub fn calibrate(campaign: &Campaign) -> Result<Option<Calibration>> {
             shortfall_nats: None,
             ridge_nats: None,
             truth_spread_nats: None,
+            truth_jitter_nats: None,
             wall_time_s: f64::NAN,
             params: Vec::new(),
             departure,
@@ -571,6 +587,9 @@ fn score(r: &mut RecordingScore, result: &FitResult) {
     r.truth_spread_nats = (result.truth_tolerance.as_ref())
         .filter(|t| r.shortfall_nats.is_some() && t.probed())
         .map(|t| t.spread_nats);
+    r.truth_jitter_nats = (result.truth_tolerance.as_ref())
+        .and_then(|t| t.jitter.as_ref())
+        .map(|j| j.sd_nats);
     r.law = super::law::LawScore::of(result);
     r.gof_p = result.goodness_of_fit.as_ref().map(|g| g.p_value);
     if !r.model_contains_truth() {
@@ -759,6 +778,18 @@ fn shortfall_unresolved_paragraph(md: &mut String, c: &Calibration) {
             "\nOf the {checked} short fits whose truth was priced at tighter tolerances too, \
              {wider} have a truth whose cost moves by more than the shortfall between them: \
              there the integrator, not the search, may have put the fit above the truth."
+        );
+    }
+    let (jittered, over) = c.shortfall_jittered();
+    if jittered > 0 {
+        let _ = writeln!(
+            md,
+            "\nOf the {jittered} short fits whose truth's cost jitter was measured, {over} have a \
+             shortfall within two standard deviations of their truth's cost jitter under \
+             rounding-level steps (`truth_jitter_nats` in calibration_recordings.csv): their slip grows an \
+             oscillation out of the integrator's error, whose timing sets the cost \
+             (docs/likelihood.md, \"Jitter\"), so the truth's cost is known only to within that \
+             jitter."
         );
     }
 }
@@ -1054,6 +1085,7 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
         "shortfall_nats",
         "ridge_nats",
         "truth_spread_nats",
+        "truth_jitter_nats",
         "wall_time_s",
         "departure",
         "law_rms_rel_diff",
@@ -1086,6 +1118,7 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
             r.shortfall_nats.map(csv_num).unwrap_or_default(),
             r.ridge_nats.map(csv_num).unwrap_or_default(),
             r.truth_spread_nats.map(csv_num).unwrap_or_default(),
+            r.truth_jitter_nats.map(csv_num).unwrap_or_default(),
             csv_num(r.wall_time_s),
             r.departure.clone().unwrap_or_default(),
             r.law.map(|l| csv_num(l.rms_rel_diff)).unwrap_or_default(),
@@ -1306,6 +1339,7 @@ mod tests {
             shortfall_nats: Some(0.0),
             ridge_nats: None,
             truth_spread_nats: None,
+            truth_jitter_nats: None,
             wall_time_s: 1.0,
             params: z
                 .iter()
@@ -1325,6 +1359,32 @@ mod tests {
             true_model_delta_tic: None,
             true_model_k_tr: None,
         }
+    }
+
+    /// Four fits: short by 2 nats with a truth jittering by 1.5 (within two standard deviations)
+    /// and by 0.5 (beyond), one within the tolerance, one short without a measured jitter: one of
+    /// the two measured short fits lies within its truth's jitter.
+    #[test]
+    fn short_fits_within_their_truths_jitter_are_counted() {
+        let fit = |short: f64, jitter: Option<f64>| {
+            let mut r = recording(&[]);
+            r.shortfall_nats = Some(short);
+            r.truth_jitter_nats = jitter;
+            r
+        };
+        let c = Calibration {
+            name: "t".into(),
+            campaign: PathBuf::from("t.toml"),
+            recordings: vec![
+                fit(2.0, Some(1.5)),
+                fit(2.0, Some(0.5)),
+                fit(0.05, Some(1.0)),
+                fit(3.0, None),
+            ],
+            overall: Vec::new(),
+            by_model: Vec::new(),
+        };
+        assert_eq!(c.shortfall_jittered(), (2, 1));
     }
 
     /// Four fits: two short (by 2 and by 0.3 nats) whose truths' costs spread by 5 and by 0.2 nats

@@ -14,6 +14,7 @@
 use super::tolerance::ToleranceCheck;
 use super::warning::FitWarning;
 use crate::job::{Candidate, LoadedJob};
+use crate::search::jitter::RoundingJitter;
 use crate::search::strategy::CandidateFit;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -92,8 +93,9 @@ pub(super) fn truth_fit<'a>(
 /// The truth's cost and segment for the fit `cf` of cost `fit_cost`, at the fit's solver; `None`
 /// without a truth for every freed parameter or when the truth cannot be simulated. The segment is
 /// left out where a true value lies outside the search box; the truth's [`ToleranceCheck`] beside
-/// them. `1 + 9 + 2` simulations: the segment's 9 and the tolerance check's 2 are counted as
-/// `cf`'s evaluations, the truth's own is not (a truth the model cannot simulate adds no failure
+/// them, with the truth's cost jitter ([`RoundingJitter`]) where it lies inside the box.
+/// `1 + 9 + 2 + (2k + 1)` simulations: the segment's 9, the tolerance check's 2 and the
+/// jitter's `2k + 1` are counted as `cf`'s evaluations, the truth's own is not (a truth the model cannot simulate adds no failure
 /// to the fit's record); none of them enters the intervals (already computed) or the search's
 /// record of near-best points. `model` is the true model when `cf` is not the chosen fit.
 pub(super) fn check(
@@ -115,7 +117,12 @@ pub(super) fn check(
     let sim = p.simulate(&params).ok()?;
     let cost_nats = p.total_cost(&sim).ok()? + p.prior.nats(&params);
     let segment = inside.then(|| segment(cf, &u_true, fit_cost, cost_nats));
-    let tolerance = ToleranceCheck::run(p, &params, (cost_nats, sim.transitions.len()));
+    let tolerance = ToleranceCheck::run(p, &params, (cost_nats, sim.transitions.len())).map(|c| {
+        ToleranceCheck {
+            jitter: inside.then(|| RoundingJitter::at(p, &u_true)).flatten(),
+            ..c
+        }
+    });
     Some(TruthCheck {
         cost_nats,
         segment,

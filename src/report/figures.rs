@@ -657,8 +657,19 @@ fn truth_tolerance_words(r: &FitResult, short: f64) -> String {
     } else {
         ""
     };
+    let jitter = tc.jitter.as_ref().map_or(String::new(), |j| {
+        let wider = if j.sd_nats > short.abs() {
+            ", more than the gap"
+        } else {
+            ""
+        };
+        format!(
+            "; it jitters by {:.2} nats under steps of {:e}{wider}",
+            j.sd_nats, j.step_u
+        )
+    });
     format!(
-        " (the truth costs {costs} nats at rtol {rtols}, {:.2} apart{verdict})",
+        " (the truth costs {costs} nats at rtol {rtols}, {:.2} apart{verdict}{jitter})",
         tc.spread_nats
     )
 }

@@ -1,0 +1,117 @@
+//! How much each recording's cost jitters at its truth under rounding-level steps
+//! ([`wiperlab::search::jitter::RoundingJitter`], docs/likelihood.md, "Jitter"), read with the
+//! fit's own signal alone and with each further signal beside it (`[fit.likelihood]
+//! joint_signals`).
+//!
+//! The jitter bounds what a cost difference can say: a search's shortfall, a likelihood ratio at
+//! the truth or a profile's rise smaller than it are read through it. The truth's parameters are
+//! the job's `[truth]`, in its true model (`[truth] model`, or `--model`).
+//!
+//! ```sh
+//! cargo run --release --example cost_jitter -- \
+//!     --campaign campaigns/calibration_development.toml --out-dir /tmp/jitter --joint head_y
+//! ```
+
+use clap::Parser;
+#[path = "common/campaign.rs"]
+mod campaign;
+use campaign::campaign_jobs;
+use std::path::{Path, PathBuf};
+use wiperlab::job::{Candidate, LoadedJob};
+use wiperlab::search::jitter::RoundingJitter;
+use wiperlab::search::problem_for;
+use wiperlab::spectrum::features::SignalKind;
+
+#[derive(Parser)]
+struct Args {
+    /// Fit jobs (each with `[truth]` for every freed parameter of the candidate).
+    jobs: Vec<PathBuf>,
+    /// Also every recording of this campaign, its jobs written into `--out-dir` as `wiperlab
+    /// campaign` writes them.
+    #[arg(long)]
+    campaign: Option<PathBuf>,
+    /// The campaign's output directory (as `wiperlab campaign --out-dir`).
+    #[arg(long)]
+    out_dir: Option<PathBuf>,
+    /// The candidate model; default: each job's true model (`[truth] model`).
+    #[arg(long)]
+    model: Option<String>,
+    /// Signals read beside the fit's own, one configuration each (the fit's own alone always).
+    #[arg(long, value_delimiter = ',', default_value = "head_y")]
+    joint: Vec<String>,
+}
+
+type Fallible<T> = Result<T, Box<dyn std::error::Error>>;
+
+fn main() -> Fallible<()> {
+    let args = Args::parse();
+    let mut jobs = args.jobs.clone();
+    if let Some(path) = &args.campaign {
+        jobs.extend(campaign_jobs(path, args.out_dir.as_deref())?);
+    }
+    let joint: Vec<SignalKind> = args
+        .joint
+        .iter()
+        .map(|s| s.parse::<SignalKind>())
+        .collect::<Result<_, _>>()?;
+    println!("job,model,signals,jitter_sd_nats,costs");
+    for path in &jobs {
+        if let Err(e) = jitters(&args, &joint, path) {
+            let e: String = e.to_string().chars().take(300).collect();
+            println!("# {}: skipped: {e}", path.display());
+        }
+    }
+    Ok(())
+}
+
+/// One CSV row per configuration of the job at `path`: its own signal alone, then with each of
+/// `joint` beside it.
+fn jitters(args: &Args, joint: &[SignalKind], path: &Path) -> Fallible<()> {
+    let mut job = LoadedJob::load(path)?;
+    let candidate: Candidate = match (&args.model, job.truth_model) {
+        (Some(m), _) => m.parse()?,
+        (None, Some(m)) => m,
+        (None, None) => return Err("no --model and no [truth] model".into()),
+    };
+    let name = path
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let own = job.job.spectrum.signal;
+    let configs: Vec<Vec<SignalKind>> = std::iter::once(Vec::new())
+        .chain(joint.iter().map(|s| vec![*s]))
+        .collect();
+    for extra in configs {
+        job.job.fit.likelihood.joint_signals = extra.clone();
+        let problem = problem_for(&job, candidate)?;
+        let u: Vec<f64> = problem
+            .free
+            .iter()
+            .map(|f| {
+                job.truth
+                    .get(&f.name)
+                    .map(|t| f.u_of(*t))
+                    .ok_or(format!("no truth for {}", f.name))
+            })
+            .collect::<Result<_, _>>()?;
+        let signals: Vec<String> = std::iter::once(own)
+            .chain(extra)
+            .map(|s| s.to_string())
+            .collect();
+        match RoundingJitter::at(&problem, &u) {
+            Some(j) => {
+                let costs: Vec<String> = j.costs_nats.iter().map(|c| format!("{c:.3}")).collect();
+                println!(
+                    "{name},{candidate},{},{:.4},{}",
+                    signals.join("+"),
+                    j.sd_nats,
+                    costs.join(" ")
+                );
+            }
+            None => println!(
+                "{name},{candidate},{},,fewer than three runs simulated",
+                signals.join("+")
+            ),
+        }
+    }
+    Ok(())
+}
