@@ -39,6 +39,10 @@ struct Args {
     /// Signals read beside the fit's own, one configuration each (the fit's own alone always).
     #[arg(long, value_delimiter = ',', default_value = "head_y")]
     joint: Vec<String>,
+    /// Scale true values before the check, `NAME=FACTOR` (e.g. `B=2`: the Stribeck slope `−A·B`
+    /// at zero slip speed doubled), to see which of them the jitter follows.
+    #[arg(long, value_delimiter = ',')]
+    scale: Vec<String>,
 }
 
 type Fallible<T> = Result<T, Box<dyn std::error::Error>>;
@@ -68,6 +72,16 @@ fn main() -> Fallible<()> {
 /// `joint` beside it.
 fn jitters(args: &Args, joint: &[SignalKind], path: &Path) -> Fallible<()> {
     let mut job = LoadedJob::load(path)?;
+    for pair in &args.scale {
+        let (name, factor) = pair
+            .split_once('=')
+            .ok_or(format!("--scale {pair}: expected NAME=FACTOR"))?;
+        let factor: f64 = factor.parse().map_err(|e| format!("--scale {pair}: {e}"))?;
+        let truth = (job.truth.iter_mut())
+            .find(|(n, _)| n.to_string() == name)
+            .ok_or(format!("--scale {pair}: no truth named {name}"))?;
+        *truth.1 *= factor;
+    }
     let candidate: Candidate = match (&args.model, job.truth_model) {
         (Some(m), _) => m.parse()?,
         (None, Some(m)) => m,
