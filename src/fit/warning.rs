@@ -167,9 +167,7 @@ impl fmt::Display for FitWarning {
                 first,
                 ..
             } => failed_evaluations(f, *failed, *evaluations, first.as_deref()),
-            NoBladeModes { reason } => {
-                write!(f, "no blade modes at the fitted parameters: {reason}")
-            }
+            NoBladeModes { reason } => no_blade_modes(f, reason),
             JointSignalsDropped(d) => d.fmt(f),
             CostJitter(j) => j.fmt(f),
             PriorConflict(c) => c.fmt(f),
@@ -498,6 +496,11 @@ impl fmt::Display for JointDropped {
             self.n_segments, self.half_dof, self.signals
         )
     }
+}
+
+/// [`FitWarning::NoBladeModes`]'s sentence.
+fn no_blade_modes(f: &mut fmt::Formatter<'_>, reason: &str) -> fmt::Result {
+    write!(f, "no blade modes at the fitted parameters: {reason}")
 }
 
 impl fmt::Display for Jitter {

@@ -299,11 +299,7 @@ fn fit_headline(w: &FitWarning) -> String {
             "The blade's modes could not be computed at the fitted parameters.".into()
         }
         JointSignalsDropped(d) => joint_dropped_headline(d.half_dof),
-        CostJitter(j) => format!(
-            "The cost jitters by {} nats at the optimum under rounding-level steps: profile ends \
-             and cost differences within that are read through it.",
-            num(j.sd_nats, 2)
-        ),
+        CostJitter(j) => cost_jitter_headline(j.sd_nats),
         PriorConflict(c) => prior_conflict_headline(c.parameter, c.z),
         RigCurveConflict(c) => rig_curve_conflict_headline(c.rms_z, c.points),
         Text { text } => text.clone(),
@@ -580,6 +576,15 @@ fn line_headline(source: LineSource, band: &str, o: &LineOrigin, same: bool) -> 
         ),
         (None, _) => subject,
     }
+}
+
+/// [`FitWarning::CostJitter`]'s headline.
+fn cost_jitter_headline(sd_nats: f64) -> String {
+    format!(
+        "The cost jitters by {} nats at the optimum under rounding-level steps: profile ends and \
+         cost differences within that are read through it.",
+        num(sd_nats, 2)
+    )
 }
 
 /// [`FitWarning::JointSignalsDropped`]'s headline.
