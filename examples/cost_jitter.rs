@@ -15,27 +15,17 @@
 use clap::Parser;
 #[path = "common/campaign.rs"]
 mod campaign;
-use campaign::campaign_jobs;
-use std::path::{Path, PathBuf};
-use wiperlab::job::{Candidate, LoadedJob};
+use campaign::{JobSource, truth_u};
+use std::path::Path;
+use wiperlab::job::LoadedJob;
 use wiperlab::search::jitter::RoundingJitter;
 use wiperlab::search::problem_for;
 use wiperlab::spectrum::features::SignalKind;
 
 #[derive(Parser)]
 struct Args {
-    /// Fit jobs (each with `[truth]` for every freed parameter of the candidate).
-    jobs: Vec<PathBuf>,
-    /// Also every recording of this campaign, its jobs written into `--out-dir` as `wiperlab
-    /// campaign` writes them.
-    #[arg(long)]
-    campaign: Option<PathBuf>,
-    /// The campaign's output directory (as `wiperlab campaign --out-dir`).
-    #[arg(long)]
-    out_dir: Option<PathBuf>,
-    /// The candidate model; default: each job's true model (`[truth] model`).
-    #[arg(long)]
-    model: Option<String>,
+    #[command(flatten)]
+    source: JobSource,
     /// Signals read beside the fit's own, one configuration each (the fit's own alone always).
     #[arg(long, value_delimiter = ',', default_value = "head_y")]
     joint: Vec<String>,
@@ -49,10 +39,7 @@ type Fallible<T> = Result<T, Box<dyn std::error::Error>>;
 
 fn main() -> Fallible<()> {
     let args = Args::parse();
-    let mut jobs = args.jobs.clone();
-    if let Some(path) = &args.campaign {
-        jobs.extend(campaign_jobs(path, args.out_dir.as_deref())?);
-    }
+    let jobs = args.source.paths()?;
     let joint: Vec<SignalKind> = args
         .joint
         .iter()
@@ -82,11 +69,7 @@ fn jitters(args: &Args, joint: &[SignalKind], path: &Path) -> Fallible<()> {
             .ok_or(format!("--scale {pair}: no truth named {name}"))?;
         *truth.1 *= factor;
     }
-    let candidate: Candidate = match (&args.model, job.truth_model) {
-        (Some(m), _) => m.parse()?,
-        (None, Some(m)) => m,
-        (None, None) => return Err("no --model and no [truth] model".into()),
-    };
+    let candidate = args.source.candidate(&job, path)?;
     let name = path
         .file_stem()
         .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
@@ -97,16 +80,7 @@ fn jitters(args: &Args, joint: &[SignalKind], path: &Path) -> Fallible<()> {
     for extra in configs {
         job.job.fit.likelihood.joint_signals = extra.clone();
         let problem = problem_for(&job, candidate)?;
-        let u: Vec<f64> = problem
-            .free
-            .iter()
-            .map(|f| {
-                job.truth
-                    .get(&f.name)
-                    .map(|t| f.u_of(*t))
-                    .ok_or(format!("no truth for {}", f.name))
-            })
-            .collect::<Result<_, _>>()?;
+        let u = truth_u(&job, &problem)?;
         let signals: Vec<String> = std::iter::once(own)
             .chain(extra)
             .map(|s| s.to_string())

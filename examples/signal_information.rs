@@ -30,7 +30,7 @@
 use clap::Parser;
 #[path = "common/campaign.rs"]
 mod campaign;
-use campaign::campaign_jobs;
+use campaign::{JobSource, truth_u};
 use nalgebra::{Complex, DMatrix};
 use std::path::PathBuf;
 use wiperlab::job::{Candidate, LoadedJob};
@@ -45,19 +45,8 @@ use wiperlab::trace::Role;
 
 #[derive(Parser)]
 struct Args {
-    /// Fit jobs (each with `[truth]` for every freed parameter of the candidate).
-    jobs: Vec<PathBuf>,
-    /// Also every recording of this campaign: its jobs are generated as `wiperlab campaign`
-    /// generates them, into `<--out-dir>/jobs/`.
-    #[arg(long)]
-    campaign: Option<PathBuf>,
-    /// The campaign's output directory (as `wiperlab campaign --out-dir`).
-    #[arg(long)]
-    out_dir: Option<PathBuf>,
-    /// The candidate model (`blade2dof`, `head1dof`, `blade2dof+shoulder`, ...); default: each
-    /// job's true model (`[truth] model`).
-    #[arg(long)]
-    model: Option<String>,
+    #[command(flatten)]
+    source: JobSource,
     /// The signals, the fit's own first.
     #[arg(
         long,
@@ -81,10 +70,7 @@ type BandMatrices = Vec<Vec<Complex<f64>>>;
 
 fn main() -> Fallible<()> {
     let args = Args::parse();
-    let mut jobs = args.jobs.clone();
-    if let Some(path) = &args.campaign {
-        jobs.extend(campaign_jobs(path, args.out_dir.as_deref())?);
-    }
+    let jobs = args.source.paths()?;
     for path in &jobs {
         // A truth on the edge of contact loss may not simulate at a displaced point.
         if let Err(e) = information(&args, path) {
@@ -99,29 +85,14 @@ fn main() -> Fallible<()> {
 /// The information table of one job (see the module docs).
 fn information(args: &Args, path: &std::path::Path) -> Fallible<()> {
     let job = LoadedJob::load(path)?;
-    let candidate: Candidate = match (&args.model, job.truth_model) {
-        (Some(m), _) => m.parse()?,
-        (None, Some(m)) => m,
-        (None, None) => {
-            return Err(format!("{}: no --model and no [truth] model", path.display()).into());
-        }
-    };
+    let candidate = args.source.candidate(&job, path)?;
     let problem = problem_for(&job, candidate)?;
     let kinds: Vec<SignalKind> = args
         .signals
         .iter()
         .map(|s| s.parse::<SignalKind>())
         .collect::<Result<_, _>>()?;
-    let truth: Vec<f64> = problem
-        .free
-        .iter()
-        .map(|f| {
-            job.truth
-                .get(&f.name)
-                .map(|t| f.u_of(*t))
-                .ok_or(format!("no truth for {}", f.name))
-        })
-        .collect::<Result<_, _>>()?;
+    let truth = truth_u(&job, &problem)?;
     let (sigma, missing) = recording_noise(&job, &kinds)?;
     let noise = noise_matrix(&kinds, &sigma, problem.fs_hz);
     let bands = band_bins(&problem)?;
