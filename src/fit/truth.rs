@@ -94,10 +94,11 @@ pub(super) fn truth_fit<'a>(
 /// without a truth for every freed parameter or when the truth cannot be simulated. The segment is
 /// left out where a true value lies outside the search box; the truth's [`ToleranceCheck`] beside
 /// them, with the truth's cost jitter ([`RoundingJitter`]) where it lies inside the box.
-/// `1 + 9 + 2 + (2k + 1)` simulations: the segment's 9, the tolerance check's 2 and the
-/// jitter's `2k + 1` are counted as `cf`'s evaluations, the truth's own is not (a truth the model cannot simulate adds no failure
-/// to the fit's record); none of them enters the intervals (already computed) or the search's
-/// record of near-best points. `model` is the true model when `cf` is not the chosen fit.
+/// `1 + 9 + 2 + (2k + 1)` simulations: the segment's 9, the tolerance check's 2 and the jitter's
+/// `2k + 1` are counted as `cf`'s evaluations, the truth's own is not (a truth the model cannot
+/// simulate adds no failure to the fit's record); none of them enters the intervals (already
+/// computed) or the search's record of near-best points. `model` is the true model when `cf` is
+/// not the chosen fit.
 pub(super) fn check(
     job: &LoadedJob,
     cf: &CandidateFit,

@@ -9,9 +9,9 @@
 //! 47:7; Hoffmann & Gaul 2003, *ZAMM* 83:8). In a simulation that perturbation is the
 //! integrator's own error, so when the oscillation grows out of it and where it saturates into
 //! stick–slip is set by rounding: on the shipped recording's truth a step of 1e-13 in one
-//! normalised coordinate changes the neck angle by 6e-3 rad within 30 ms of the onset, and doubling B
-//! (the slope at zero slip speed) raises the jitter from 0.05 to 134 nats (docs/validation.md,
-//! "Jitter"). The cost
+//! normalised coordinate changes the neck angle by 6e-3 rad within 30 ms of the onset, and
+//! doubling B (the slope at zero slip speed) raises the jitter from 0.05 to 134 nats
+//! (docs/validation.md, "Jitter"). The cost
 //! inherits that jitter wherever a spectrum sees the growing oscillation's timing: tip − head x
 //! hardly (a few hundredths of a nat), head y's low band, which sees the squared angle's envelope,
 //! by most of a nat (docs/likelihood.md, "Jitter").
