@@ -689,6 +689,42 @@ fn reached_section(md: &mut String, c: &Calibration) {
     }
 }
 
+/// Coverage split by the truth's cost jitter ([`RecordingScore::truth_jitter_nats`]): the fits
+/// whose chosen model contains the true one, with a truth whose cost jitters by at most
+/// [`SHORTFALL_TOLERANCE_NATS`] (the resolution the table reads costs at) and by more. Nothing
+/// when no result has the jitter.
+fn jitter_section(md: &mut String, c: &Calibration) {
+    let with = |rough: bool| {
+        c.done().filter(move |r| {
+            r.model_contains_truth()
+                && r.truth_jitter_nats
+                    .is_some_and(|j| (j > SHORTFALL_TOLERANCE_NATS) == rough)
+        })
+    };
+    let (smooth, rough) = (with(false).count(), with(true).count());
+    if smooth + rough == 0 {
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "\n### By the truth's cost jitter\n\n\
+         The fits above whose result measured their truth's cost jitter under rounding-level steps \
+         (`truth_jitter_nats`; docs/likelihood.md, \"Jitter\"), split at \
+         {SHORTFALL_TOLERANCE_NATS} nats: {smooth} truths whose cost does not jitter beyond it, \
+         then {rough} whose slip grows an oscillation out of the integrator's error.\n"
+    );
+    for (rough, n) in [(false, smooth), (true, rough)] {
+        if n > 0 {
+            let side = if rough { "above" } else { "at most" };
+            let _ = writeln!(
+                md,
+                "**Truth's cost jitter {side} {SHORTFALL_TOLERANCE_NATS} nats** (fits: {n}):\n"
+            );
+            stats_table(md, &param_stats(with(rough)));
+        }
+    }
+}
+
 /// One parameter's coverage by three intervals over a set of recordings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct VariantCoverage {
@@ -932,6 +968,7 @@ pub fn to_markdown(c: &Calibration, notes: Option<&str>, command: &str) -> Strin
         stats_table(&mut md, stats);
     }
     reached_section(&mut md, c);
+    jitter_section(&mut md, c);
     let (known, over, max) = c.shortfalls();
     let _ = writeln!(
         md,
@@ -1359,6 +1396,38 @@ mod tests {
             true_model_delta_tic: None,
             true_model_k_tr: None,
         }
+    }
+
+    /// Three fits with A's z of 0.5, 2 and 3: the first two truths' costs do not jitter beyond
+    /// the shortfall tolerance, the third's does; a fourth has no jitter measured and is left out
+    /// of the split.
+    #[test]
+    fn the_table_splits_coverage_by_the_truths_cost_jitter() {
+        let fit = |z: f64, jitter: Option<f64>| {
+            let mut r = recording(&[z]);
+            r.truth_jitter_nats = jitter;
+            r
+        };
+        let recordings = vec![
+            fit(0.5, Some(0.0)),
+            fit(2.0, Some(0.05)),
+            fit(3.0, Some(4.0)),
+            fit(0.1, None),
+        ];
+        let cal = Calibration {
+            name: "t".into(),
+            campaign: PathBuf::from("t.toml"),
+            overall: param_stats(recordings.iter()),
+            by_model: Vec::new(),
+            recordings,
+        };
+        let md = to_markdown(&cal, None, "collect");
+        let section = &md[md
+            .find("### By the truth's cost jitter")
+            .expect("the section")..];
+        assert!(section.contains("2 truths whose cost does not jitter beyond it, then 1"));
+        assert!(section.contains("**Truth's cost jitter at most 0.1 nats** (fits: 2)"));
+        assert!(section.contains("**Truth's cost jitter above 0.1 nats** (fits: 1)"));
     }
 
     /// Four fits: short by 2 nats with a truth jittering by 1.5 (within two standard deviations)
