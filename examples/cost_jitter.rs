@@ -3,6 +3,9 @@
 //! fit's own signal alone and with each further signal beside it (`[fit.likelihood]
 //! joint_signals`).
 //!
+//! With `--fisher` it also prints the Fisher information's 1σ at the truth and at steps of
+//! 1e-12: where the cost jitters, whether the information's finite differences move with it.
+//!
 //! The jitter bounds what a cost difference can say: a search's shortfall, a likelihood ratio at
 //! the truth or a profile's rise smaller than it are read through it. The truth's parameters are
 //! the job's `[truth]`, in its true model (`[truth] model`, or `--model`).
@@ -18,6 +21,7 @@ mod campaign;
 use campaign::{JobSource, truth_u};
 use std::path::Path;
 use wiperlab::job::LoadedJob;
+use wiperlab::search::evidence::curvature_at;
 use wiperlab::search::jitter::RoundingJitter;
 use wiperlab::search::problem_for;
 use wiperlab::spectrum::features::SignalKind;
@@ -26,13 +30,19 @@ use wiperlab::spectrum::features::SignalKind;
 struct Args {
     #[command(flatten)]
     source: JobSource,
-    /// Signals read beside the fit's own, one configuration each (the fit's own alone always).
+    /// Signals read beside the fit's own, one configuration each (the fit's own alone always;
+    /// `--joint ''` for that alone).
     #[arg(long, value_delimiter = ',', default_value = "head_y")]
     joint: Vec<String>,
     /// Scale true values before the check, `NAME=FACTOR` (e.g. `B=2`: the Stribeck slope `−A·B`
     /// at zero slip speed doubled), to see which of them the jitter follows.
     #[arg(long, value_delimiter = ',')]
     scale: Vec<String>,
+    /// Also the Fisher information's 1σ (`curvature_at`, normalised units) at the truth and at
+    /// steps of +1e-12, +2e-12 and −1e-12 along the first coordinate: where the cost jitters, how
+    /// far the finite differences of the information move with it (a `#`-line per job).
+    #[arg(long)]
+    fisher: bool,
 }
 
 type Fallible<T> = Result<T, Box<dyn std::error::Error>>;
@@ -43,6 +53,7 @@ fn main() -> Fallible<()> {
     let joint: Vec<SignalKind> = args
         .joint
         .iter()
+        .filter(|s| !s.is_empty())
         .map(|s| s.parse::<SignalKind>())
         .collect::<Result<_, _>>()?;
     println!("job,model,signals,jitter_sd_nats,costs");
@@ -100,6 +111,33 @@ fn jitters(args: &Args, joint: &[SignalKind], path: &Path) -> Fallible<()> {
                 signals.join("+")
             ),
         }
+        if args.fisher {
+            println!(
+                "# {name} {}: {}",
+                signals.join("+"),
+                fisher_sigmas(&problem, &u)
+            );
+        }
     }
     Ok(())
+}
+
+/// The Fisher 1σ of each coordinate at `u` and at rounding-level steps along the first one, each
+/// set in brackets.
+fn fisher_sigmas(problem: &wiperlab::search::SpectralProblem, u: &[f64]) -> String {
+    [0.0, 1e-12, 2e-12, -1e-12]
+        .iter()
+        .map(|d| {
+            let mut v = u.to_vec();
+            v[0] += d;
+            match curvature_at(problem, &v) {
+                Ok((sigma, _)) => {
+                    let s: Vec<String> = sigma.iter().map(|x| format!("{x:.2e}")).collect();
+                    format!("[{}]", s.join(" "))
+                }
+                Err(e) => format!("[{e}]"),
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
 }
