@@ -235,8 +235,8 @@ pub enum FitWarning {
     NoBladeModes { reason: String },
     /// `[fit.likelihood] joint_signals` could not be read, so the fit read its own signal alone.
     JointSignalsDropped(JointDropped),
-    /// The cost at the optimum jitters under rounding-level steps by more than a profile's rise
-    /// limit ([`crate::search::jitter`]).
+    /// The cost at the optimum jitters under rounding-level steps by more than the likelihood's
+    /// rise at an interval's edge ([`crate::search::jitter`]).
     CostJitter(Jitter),
     /// A parameter fitted beyond [`crate::likelihood::prior::PRIOR_CONFLICT_Z`] standard
     /// deviations of its `[fit.priors]` prior.
@@ -258,8 +258,9 @@ pub struct JointDropped {
 }
 
 /// The cost's jitter at the optimum: its standard deviation `sd_nats` over steps of `step_u`
-/// (normalised units) either way along each coordinate, against the smallest profile rise limit
-/// `rise_limit_nats` of the fit's parameters.
+/// (normalised units) either way along each coordinate, against the likelihood's rise
+/// `rise_limit_nats` at an interval's edge (a profile's smallest rise limit, or 0.5 nats, a
+/// quadratic likelihood's rise at 1σ, for the other interval methods).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Jitter {
     pub sd_nats: f64,

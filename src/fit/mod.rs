@@ -308,6 +308,9 @@ fn optimum_checks(
     warnings: &mut Vec<FitWarning>,
 ) -> Option<truth::TruthCheck> {
     warnings.extend(tolerance_check.and_then(|t| t.warning()));
+    if job.job.fit.uncertainty.method() != job::UncertaintyMethod::Profile {
+        warnings.extend(tolerance_check.and_then(|t| t.jitter_warning()));
+    }
     if interrupted {
         return None;
     }

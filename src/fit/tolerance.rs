@@ -14,6 +14,7 @@
 
 use super::FitWarning;
 pub use crate::estimate::TolerancePoint;
+use crate::estimate::warning::Jitter;
 use crate::model::BladeParams;
 use crate::search::FAILED_COST;
 use crate::search::jitter::RoundingJitter;
@@ -149,6 +150,20 @@ impl ToleranceCheck {
         self.verdict() == Verdict::Resolved
     }
 
+    /// The `cost_jitter` warning of intervals that are not a profile's (a profile warns at its own
+    /// rise limits): the optimum's cost jitters by more than
+    /// [`crate::uncertainty::intervals::PROFILE_68_NATS`], the rise at a quadratic likelihood's
+    /// 1σ, so the curvature those intervals read is drawn from the jitter.
+    pub fn jitter_warning(&self) -> Option<FitWarning> {
+        use crate::uncertainty::intervals::PROFILE_68_NATS;
+        let j = self.jitter.as_ref()?;
+        (j.sd_nats > PROFILE_68_NATS).then_some(FitWarning::CostJitter(Jitter {
+            sd_nats: j.sd_nats,
+            step_u: j.step_u,
+            rise_limit_nats: PROFILE_68_NATS,
+        }))
+    }
+
     /// The warning of an optimum the integrator does not resolve, or whose probes all failed;
     /// `None` when it is resolved.
     pub fn warning(&self) -> Option<FitWarning> {
@@ -205,6 +220,24 @@ pub(super) fn checks_for_choice(
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn a_jitter_beyond_half_a_nat_warns_for_intervals_read_from_the_curvature() {
+        // 0.5 nats: a quadratic likelihood's rise at 1σ (PROFILE_68_NATS).
+        let with = |sd: Option<f64>| ToleranceCheck {
+            jitter: sd.and_then(|sd| RoundingJitter::of(vec![10.0 - sd, 10.0, 10.0 + sd])),
+            ..ToleranceCheck::of(Vec::new(), Vec::new())
+        };
+        match with(Some(0.7)).jitter_warning() {
+            Some(FitWarning::CostJitter(j)) => {
+                assert!((j.sd_nats - 0.7).abs() < 1e-12, "{}", j.sd_nats);
+                assert_eq!(j.rise_limit_nats, 0.5);
+            }
+            other => panic!("expected cost_jitter, got {other:?}"),
+        }
+        assert_eq!(with(Some(0.3)).jitter_warning(), None);
+        assert_eq!(with(None).jitter_warning(), None);
+    }
     use super::*;
 
     fn point(rtol: f64, cost_nats: f64, transitions: usize) -> TolerancePoint {
