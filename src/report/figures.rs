@@ -1127,11 +1127,11 @@ pub fn fit_summary(r: &FitResult) -> String {
                 Verdict::Unresolved => "not resolved, see the warning",
             }
         );
-        if let Some(j) = &t.jitter {
+        if let (Some(j), Some(at)) = (&t.jitter, t.points.first()) {
             let _ = writeln!(
                 s,
                 "  cost jitter: {:.3} nats (standard deviation) under steps of {:e} at rtol {:e}",
-                j.sd_nats, j.step_u, t.points[0].rtol
+                j.sd_nats, j.step_u, at.rtol
             );
         }
     }
