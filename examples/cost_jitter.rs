@@ -12,7 +12,7 @@
 //!
 //! ```sh
 //! cargo run --release --example cost_jitter -- \
-//!     --campaign campaigns/calibration_development.toml --out-dir /tmp/jitter --joint head_y
+//!     --campaign campaigns/calibration_development.toml --out-dir target/jitter --joint head_y
 //! ```
 
 use clap::Parser;
