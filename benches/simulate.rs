@@ -129,6 +129,7 @@ fn cost(c: &mut Criterion) {
         failure_causes: Default::default(),
         first_failure: Mutex::new(None),
         near_best: Mutex::new(Default::default()),
+        last_jitter: Mutex::new(None),
         prior: Default::default(),
     };
     problem.likelihood = Ok(Arc::new(

@@ -21,6 +21,7 @@ mod campaign;
 use campaign::{JobSource, truth_u};
 use std::path::Path;
 use wiperlab::job::LoadedJob;
+use wiperlab::model::ParamId;
 use wiperlab::search::evidence::curvature_at;
 use wiperlab::search::jitter::RoundingJitter;
 use wiperlab::search::problem_for;
@@ -75,10 +76,10 @@ fn jitters(args: &Args, joint: &[SignalKind], path: &Path) -> Fallible<()> {
             .split_once('=')
             .ok_or(format!("--scale {pair}: expected NAME=FACTOR"))?;
         let factor: f64 = factor.parse().map_err(|e| format!("--scale {pair}: {e}"))?;
-        let truth = (job.truth.iter_mut())
-            .find(|(n, _)| n.to_string() == name)
-            .ok_or(format!("--scale {pair}: no truth named {name}"))?;
-        *truth.1 *= factor;
+        let id: ParamId = name.parse()?;
+        *job.truth
+            .get_mut(&id)
+            .ok_or(format!("--scale {pair}: the job has no truth for {name}"))? *= factor;
     }
     let candidate = args.source.candidate(&job, path)?;
     let name = path

@@ -365,24 +365,32 @@ impl Calibration {
     /// tolerances too, of them those whose truth's cost spreads by more than the shortfall: the
     /// integrator, not the search, may have put the truth below the fit).
     pub fn shortfall_unresolved(&self) -> (usize, usize) {
-        let spreads: Vec<(f64, f64)> = (self.done())
-            .filter_map(|r| Some((r.shortfall_nats?, r.truth_spread_nats?)))
-            .filter(|(s, _)| *s > SHORTFALL_TOLERANCE_NATS)
-            .collect();
-        let wider = spreads.iter().filter(|(s, w)| w > s).count();
-        (spreads.len(), wider)
+        self.short_beside(|r| r.truth_spread_nats, |short, spread| spread > short)
     }
 
     /// Of the fits above [`SHORTFALL_TOLERANCE_NATS`]: (those whose truth's cost jitter was
     /// measured, of them those whose shortfall lies within two standard deviations of that
     /// jitter: the truth's cost is not known more closely than that).
     pub fn shortfall_jittered(&self) -> (usize, usize) {
-        let jitters: Vec<(f64, f64)> = (self.done())
-            .filter_map(|r| Some((r.shortfall_nats?, r.truth_jitter_nats?)))
+        self.short_beside(
+            |r| r.truth_jitter_nats,
+            |short, jitter| short <= 2.0 * jitter,
+        )
+    }
+
+    /// Of the fits above [`SHORTFALL_TOLERANCE_NATS`]: (those with a measure `of` their truth's
+    /// cost, of them those whose shortfall and measure are `within`).
+    fn short_beside(
+        &self,
+        of: impl Fn(&RecordingScore) -> Option<f64>,
+        within: impl Fn(f64, f64) -> bool,
+    ) -> (usize, usize) {
+        let pairs: Vec<(f64, f64)> = (self.done())
+            .filter_map(|r| Some((r.shortfall_nats?, of(r)?)))
             .filter(|(s, _)| *s > SHORTFALL_TOLERANCE_NATS)
             .collect();
-        let over = jitters.iter().filter(|(s, j)| *s <= 2.0 * j).count();
-        (jitters.len(), over)
+        let n = pairs.iter().filter(|(s, m)| within(*s, *m)).count();
+        (pairs.len(), n)
     }
 
     /// Fits whose truth was priced at tighter tolerances, and of them those whose truth's cost
@@ -822,8 +830,8 @@ fn shortfall_unresolved_paragraph(md: &mut String, c: &Calibration) {
             md,
             "\nOf the {jittered} short fits whose truth's cost jitter was measured, {over} have a \
              shortfall within two standard deviations of their truth's cost jitter under \
-             rounding-level steps (`truth_jitter_nats` in calibration_recordings.csv): their slip grows an \
-             oscillation out of the integrator's error, whose timing sets the cost \
+             rounding-level steps (`truth_jitter_nats` in calibration_recordings.csv): their slip \
+             grows an oscillation out of the integrator's error, whose timing sets the cost \
              (docs/likelihood.md, \"Jitter\"), so the truth's cost is known only to within that \
              jitter."
         );

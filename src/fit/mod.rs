@@ -28,7 +28,6 @@ use crate::job::{self, LoadedJob};
 use crate::likelihood;
 use crate::likelihood::measure::measure;
 use crate::model::BladeParams;
-use crate::search::jitter::RoundingJitter;
 use crate::search::strategy::{
     self as search, CandidateFit, confirm_deferred, descend_chosen, fit_candidates, progress_bar,
 };
@@ -273,12 +272,8 @@ fn choose_at_resolution(
     let cf = &fits[selection.chosen];
     let at_job = (best.cost, best.sim.transitions.len());
     let check =
-        tolerance::ToleranceCheck::run(&cf.problem, &cf.problem.params_at(&cf.best_u), at_job).map(
-            |c| tolerance::ToleranceCheck {
-                jitter: RoundingJitter::at(&cf.problem, &cf.best_u),
-                ..c
-            },
-        );
+        tolerance::ToleranceCheck::run(&cf.problem, &cf.problem.params_at(&cf.best_u), at_job)
+            .map(|c| c.with_jitter(&cf.problem, Some(&cf.best_u)));
     let mut checks = tolerance::checks_for_choice(fits, selection.chosen, check);
     let spreads: Vec<f64> = checks
         .iter()

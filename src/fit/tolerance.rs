@@ -14,7 +14,6 @@
 
 use super::FitWarning;
 pub use crate::estimate::TolerancePoint;
-use crate::estimate::warning::Jitter;
 use crate::model::BladeParams;
 use crate::search::FAILED_COST;
 use crate::search::jitter::RoundingJitter;
@@ -156,12 +155,16 @@ impl ToleranceCheck {
     /// 1σ, so the curvature those intervals read is drawn from the jitter.
     pub fn jitter_warning(&self) -> Option<FitWarning> {
         use crate::uncertainty::intervals::PROFILE_68_NATS;
-        let j = self.jitter.as_ref()?;
-        (j.sd_nats > PROFILE_68_NATS).then_some(FitWarning::CostJitter(Jitter {
-            sd_nats: j.sd_nats,
-            step_u: j.step_u,
-            rise_limit_nats: PROFILE_68_NATS,
-        }))
+        self.jitter.as_ref()?.warning_above(PROFILE_68_NATS)
+    }
+
+    /// The check with the cost's jitter at `u` (`problem`'s normalised coordinates of the point it
+    /// checks; none where that point lies outside the search box).
+    pub fn with_jitter(self, problem: &SpectralProblem, u: Option<&[f64]>) -> ToleranceCheck {
+        ToleranceCheck {
+            jitter: u.and_then(|u| RoundingJitter::at(problem, u)),
+            ..self
+        }
     }
 
     /// The warning of an optimum the integrator does not resolve, or whose probes all failed;

@@ -14,7 +14,6 @@
 use super::tolerance::ToleranceCheck;
 use super::warning::FitWarning;
 use crate::job::{Candidate, LoadedJob};
-use crate::search::jitter::RoundingJitter;
 use crate::search::strategy::CandidateFit;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -93,7 +92,7 @@ pub(super) fn truth_fit<'a>(
 /// The truth's cost and segment for the fit `cf` of cost `fit_cost`, at the fit's solver; `None`
 /// without a truth for every freed parameter or when the truth cannot be simulated. The segment is
 /// left out where a true value lies outside the search box; the truth's [`ToleranceCheck`] beside
-/// them, with the truth's cost jitter ([`RoundingJitter`]) where it lies inside the box.
+/// them, with the truth's cost jitter ([`ToleranceCheck::with_jitter`]) where it lies inside the box.
 /// `1 + 9 + 2 + (2k + 1)` simulations: the segment's 9, the tolerance check's 2 and the jitter's
 /// `2k + 1` are counted as `cf`'s evaluations, the truth's own is not (a truth the model cannot
 /// simulate adds no failure to the fit's record); none of them enters the intervals (already
@@ -118,12 +117,8 @@ pub(super) fn check(
     let sim = p.simulate(&params).ok()?;
     let cost_nats = p.total_cost(&sim).ok()? + p.prior.nats(&params);
     let segment = inside.then(|| segment(cf, &u_true, fit_cost, cost_nats));
-    let tolerance = ToleranceCheck::run(p, &params, (cost_nats, sim.transitions.len())).map(|c| {
-        ToleranceCheck {
-            jitter: inside.then(|| RoundingJitter::at(p, &u_true)).flatten(),
-            ..c
-        }
-    });
+    let tolerance = ToleranceCheck::run(p, &params, (cost_nats, sim.transitions.len()))
+        .map(|c| c.with_jitter(p, inside.then_some(u_true.as_slice())));
     Some(TruthCheck {
         cost_nats,
         segment,

@@ -21,6 +21,7 @@
 
 use super::SpectralProblem;
 use super::problem::FAILED_COST;
+use crate::estimate::warning::{FitWarning, Jitter};
 use serde::{Deserialize, Serialize};
 
 /// The step of the jitter check, normalised units: four orders above the coordinates' rounding
@@ -42,8 +43,35 @@ pub struct RoundingJitter {
 impl RoundingJitter {
     /// The check at `u` (normalised coordinates) of `problem`'s cost; `None` when fewer than
     /// three of its simulations succeed. The probes count as evaluations of `problem` but are not
-    /// kept among the points near the best (they are not steps of a search).
+    /// kept among the points near the best (they are not steps of a search). A second check at
+    /// the same point reads the first's.
     pub fn at(problem: &SpectralProblem, u: &[f64]) -> Option<RoundingJitter> {
+        let last = || {
+            problem
+                .last_jitter
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+        };
+        if let Some((_, j)) = last().as_ref().filter(|(at, _)| at.as_slice() == u) {
+            return j.clone();
+        }
+        let j = Self::measure(problem, u);
+        *last() = Some((u.to_vec(), j.clone()));
+        j
+    }
+
+    /// The `cost_jitter` warning when the jitter exceeds `rise_limit_nats`, the likelihood's rise
+    /// at the edge of the intervals it is read against.
+    pub fn warning_above(&self, rise_limit_nats: f64) -> Option<FitWarning> {
+        (self.sd_nats > rise_limit_nats).then_some(FitWarning::CostJitter(Jitter {
+            sd_nats: self.sd_nats,
+            step_u: self.step_u,
+            rise_limit_nats,
+        }))
+    }
+
+    /// [`RoundingJitter::at`]'s simulations.
+    fn measure(problem: &SpectralProblem, u: &[f64]) -> Option<RoundingJitter> {
         use rayon::prelude::*;
         let mut points = vec![u.to_vec()];
         for i in 0..u.len() {

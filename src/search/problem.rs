@@ -75,6 +75,10 @@ pub struct SpectralProblem {
     /// The polish-stage evaluations found about as likely as the best one
     /// ([`EvaluatedNearBest`]), which the intervals read.
     pub near_best: Mutex<EvaluatedNearBest>,
+    /// The last cost-jitter check and the point it was made at
+    /// ([`super::jitter::RoundingJitter::at`]): the tolerance check and the profile walk read the
+    /// same optimum's.
+    pub last_jitter: Mutex<Option<(Vec<f64>, Option<super::jitter::RoundingJitter>)>>,
     /// `[fit.priors]`' terms that read this candidate's freed parameters (empty: flat; a joint
     /// fit's other recordings have none, the main one carries them once).
     pub prior: Arc<crate::likelihood::prior::Prior>,

@@ -531,6 +531,7 @@ fn problem_of(
         failure_causes: Default::default(),
         first_failure: Mutex::new(None),
         near_best: Mutex::new(Default::default()),
+        last_jitter: Mutex::new(None),
         prior: Default::default(),
     };
     p.likelihood = if p.targets.is_some() {

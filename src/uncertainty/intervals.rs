@@ -1,7 +1,7 @@
 //! Uncertainty stage: bootstrap intervals and identifiability warnings for the chosen model.
 
 use crate::Result;
-use crate::estimate::warning::{End, FitWarning, Jitter, SampledReason};
+use crate::estimate::warning::{End, FitWarning, SampledReason};
 use crate::estimate::{FittedParam, Interval, IntervalMethod};
 use crate::job::FreeParam;
 use crate::job::{self, NoiseSpectrum, UncertaintyMethod};
@@ -670,15 +670,8 @@ fn profile_with(
     let sides: Vec<(usize, f64)> = (0..n).flat_map(|i| [(i, -1.0), (i, 1.0)]).collect();
     let ends: Vec<ProfileEnd> = sides.par_iter().map(|s| walk(*s)).collect::<Result<_>>()?;
     let smallest_limit = (0..n).map(limit).fold(f64::INFINITY, f64::min);
-    let mut warnings: Vec<FitWarning> = jitter
-        .filter(|j| j.sd_nats > smallest_limit)
-        .map(|j| {
-            FitWarning::CostJitter(Jitter {
-                sd_nats: j.sd_nats,
-                step_u: j.step_u,
-                rise_limit_nats: smallest_limit,
-            })
-        })
+    let mut warnings: Vec<FitWarning> = (jitter.as_ref())
+        .and_then(|j| j.warning_above(smallest_limit))
         .into_iter()
         .collect();
     let mut intervals = Vec::with_capacity(n);
@@ -1155,6 +1148,7 @@ impl ReplicateSource {
             failure_causes: problem.failure_causes.clone(),
             first_failure: Mutex::new(None),
             near_best: Mutex::new(Default::default()),
+            last_jitter: Mutex::new(None),
             prior: problem.prior.clone(),
         })
         .map(|mut rep| {
