@@ -8,13 +8,10 @@
 //! negative-slope mechanisms of friction-induced vibration: Ibrahim 1994, *Appl. Mech. Rev.*
 //! 47:7; Hoffmann & Gaul 2003, *ZAMM* 83:8). In a simulation that perturbation is the
 //! integrator's own error, so when the oscillation grows out of it and where it saturates into
-//! stick–slip is set by rounding: on the shipped recording's truth a step of 1e-13 in one
-//! normalised coordinate changes the neck angle by 6e-3 rad within 30 ms of the onset, and
-//! doubling B (the slope at zero slip speed) raises the jitter from 0.05 to 134 nats
-//! (docs/validation.md, "Jitter"). The cost
-//! inherits that jitter wherever a spectrum sees the growing oscillation's timing: tip − head x
-//! hardly (a few hundredths of a nat), head y's low band, which sees the squared angle's envelope,
-//! by most of a nat (docs/likelihood.md, "Jitter").
+//! stick–slip is set by rounding, and the jitter grows with the law's slope at zero slip speed
+//! (docs/validation.md, "Jitter"). The cost inherits that jitter wherever a spectrum sees the
+//! growing oscillation's timing: tip − head x hardly, head y's low band, which sees the squared
+//! angles' envelope, much more (docs/likelihood.md, "Jitter").
 //!
 //! The check costs `2k + 1` simulations at the job's tolerance: the optimum and a step of
 //! [`JITTER_STEP_U`] either way along each coordinate.
