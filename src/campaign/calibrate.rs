@@ -1306,6 +1306,7 @@ mod tests {
             upper: bounds[1],
             std_error: f64::NAN,
             fisher_std_error: None,
+            rounding_widening: None,
             determined: true,
             true_value: None,
             rel_error: None,

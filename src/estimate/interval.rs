@@ -184,6 +184,11 @@ pub struct FittedParam {
     /// `F⁻¹ V F⁻¹` (docs/uncertainty.md, "Uncertainty").
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fisher_std_error: Option<f64>,
+    /// `std_error` over the sandwich's 1σ with the tracking noise's variability alone: how much
+    /// the trajectory's sensitivity to rounding widens the spread (1 where the motion does not
+    /// depend on rounding; docs/uncertainty.md, "Jitter").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rounding_widening: Option<f64>,
     /// False when the data do not pin the parameter down (1σ wider than 10 % of its search range,
     /// or no positive curvature).
     pub determined: bool,

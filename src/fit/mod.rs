@@ -510,6 +510,7 @@ fn fitted_parameters(job: &LoadedJob, cf: &CandidateFit) -> Vec<FittedParam> {
                 upper: fp.upper,
                 std_error: su * fp.slope(*u),
                 fisher_std_error: cf.fisher_sigma_u.as_ref().map(|f| f[i] * fp.slope(*u)),
+                rounding_widening: cf.rounding_widening.as_ref().map(|w| w[i]),
                 determined: su.is_finite() && *su < 0.1,
                 true_value: truth,
                 rel_error: truth.map(|t| (value - t) / t),

@@ -685,6 +685,27 @@ fn tolerance_lists(t: &crate::fit::tolerance::ToleranceCheck) -> (String, String
 
 /// The summary's line on `[fit.priors]`: the prior's share of the cost and how far the fit lies
 /// from each prior, in the prior's standard deviations (empty without priors).
+/// Widening factors below this are not worth a summary line: the rounding's share of the 1σ is
+/// then within the spread's own sampling error over the noise replicates.
+const WIDENING_WORTH_SAYING: f64 = 1.05;
+
+/// The summary's line on how much the rounding's draws widen each parameter's 1σ
+/// (`rounding_widening`), when any does by [`WIDENING_WORTH_SAYING`] or more.
+fn rounding_widening_words(params: &[crate::estimate::FittedParam]) -> Option<String> {
+    let wide: Vec<String> = params
+        .iter()
+        .filter_map(|p| Some((p.name, p.rounding_widening?)))
+        .filter(|(_, w)| *w >= WIDENING_WORTH_SAYING)
+        .map(|(name, w)| format!("{name} ×{w:.2}"))
+        .collect();
+    (!wide.is_empty()).then(|| {
+        format!(
+            "the rounding's draws of the slip's onset widen the 1σ: {} (docs/uncertainty.md, \"Jitter\")",
+            wide.join(", ")
+        )
+    })
+}
+
 fn prior_lines(r: &FitResult) -> String {
     let Some(p) = &r.priors else {
         return String::new();
@@ -1135,6 +1156,9 @@ pub fn fit_summary(r: &FitResult) -> String {
             );
         }
     }
+    if let Some(w) = rounding_widening_words(&r.parameters) {
+        let _ = writeln!(s, "  {w}");
+    }
     if let Some(n) = &r.tracking_noise {
         let _ = writeln!(
             s,
@@ -1184,6 +1208,35 @@ mod tests {
     /// it exists and names the measured range, the band's method, the extrapolation, the truth
     /// with its rms difference, the axes, and the dashed legend sample; without a fitted
     /// coefficient the title says there is no band.
+    #[test]
+    fn the_rounding_line_names_the_parameters_it_widens_and_only_those() {
+        use crate::estimate::FittedParam;
+        use crate::model::ParamId;
+        let param = |name, w| FittedParam {
+            name,
+            value: 1.0,
+            lower: 0.0,
+            upper: 2.0,
+            std_error: 0.1,
+            fisher_std_error: None,
+            rounding_widening: w,
+            determined: true,
+            true_value: None,
+            rel_error: None,
+            interval: None,
+        };
+        let calm = [param(ParamId::A, Some(1.01)), param(ParamId::B, None)];
+        assert_eq!(super::rounding_widening_words(&calm), None);
+        let rough = [
+            param(ParamId::A, Some(2.5)),
+            param(ParamId::B, Some(1.0)),
+            param(ParamId::C, Some(1.05)),
+        ];
+        let line = super::rounding_widening_words(&rough).expect("two parameters widen");
+        assert!(line.contains("A ×2.50, C ×1.05"), "{line}");
+        assert!(!line.contains('B'), "{line}");
+    }
+
     #[test]
     fn the_friction_figure_draws_the_measured_range_band_extrapolation_and_truth() {
         let dir = tempfile::tempdir().unwrap();

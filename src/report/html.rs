@@ -1187,6 +1187,7 @@ pub(super) mod tests {
             upper: 0.15,
             std_error: if determined { 0.001 } else { 0.2 },
             fisher_std_error: None,
+            rounding_widening: None,
             determined,
             true_value: Some(0.029),
             rel_error: Some(0.03 / 0.029 - 1.0),

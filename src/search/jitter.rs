@@ -26,6 +26,25 @@ use serde::{Deserialize, Serialize};
 /// bowl moves the cost by nothing measurable and any change is the trajectory's sensitivity.
 pub const JITTER_STEP_U: f64 = 1e-12;
 
+/// `u` and the `2k` points [`JITTER_STEP_U`] away from it either way along each coordinate (a
+/// step that would leave the unit box goes the other way: outside it the box's penalty, not the
+/// jitter, would move the cost).
+pub fn rounding_points(u: &[f64]) -> Vec<Vec<f64>> {
+    let mut points = vec![u.to_vec()];
+    for i in 0..u.len() {
+        for side in [1.0, -1.0] {
+            let mut p = u.to_vec();
+            p[i] = if (0.0..=1.0).contains(&(p[i] + side * JITTER_STEP_U)) {
+                p[i] + side * JITTER_STEP_U
+            } else {
+                p[i] - side * JITTER_STEP_U
+            };
+            points.push(p);
+        }
+    }
+    points
+}
+
 /// The cost at a point and at [`JITTER_STEP_U`] steps around it, at the job's tolerance.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RoundingJitter {
@@ -70,20 +89,7 @@ impl RoundingJitter {
     /// [`RoundingJitter::at`]'s simulations.
     fn measure(problem: &SpectralProblem, u: &[f64]) -> Option<RoundingJitter> {
         use rayon::prelude::*;
-        let mut points = vec![u.to_vec()];
-        for i in 0..u.len() {
-            for side in [1.0, -1.0] {
-                let mut p = u.to_vec();
-                // Inside the box: a step out of it would add the box penalty, not jitter.
-                p[i] = if (0.0..=1.0).contains(&(p[i] + side * JITTER_STEP_U)) {
-                    p[i] + side * JITTER_STEP_U
-                } else {
-                    p[i] - side * JITTER_STEP_U
-                };
-                points.push(p);
-            }
-        }
-        let costs_nats: Vec<f64> = points
+        let costs_nats: Vec<f64> = rounding_points(u)
             .par_iter()
             .map(|p| problem.unrecorded_cost_at(p))
             .collect::<Vec<_>>()

@@ -243,6 +243,9 @@ pub(crate) struct CandidateFit {
     pub(crate) fisher_sigma_u: Option<Vec<f64>>,
     /// The correlations of `F⁻¹`, with `fisher_sigma_u`.
     pub(crate) fisher_corr: Option<Vec<Vec<f64>>>,
+    /// How much the rounding's draws widen each coordinate's 1σ
+    /// ([`super::evidence::LocalFit::rounding_widening`]), once the smoothed spread is in.
+    pub(crate) rounding_widening: Option<Vec<f64>>,
     /// The recording's NLL at the optimum (`sigma_u` and `corr` then come from its sandwich
     /// covariance, [`super::evidence::at_fit`]), or why there is none (then from the cost's
     /// curvature).
@@ -289,6 +292,7 @@ impl CandidateFit {
             self.corr = l.corr;
             self.fisher_sigma_u = Some(l.curvature_sigma_u);
             self.fisher_corr = Some(l.curvature_corr);
+            self.rounding_widening = Some(l.rounding_widening);
             self.evidence = Ok(l.nll);
         }
         self
@@ -1003,6 +1007,7 @@ fn finish(
         corr,
         fisher_sigma_u,
         fisher_corr,
+        rounding_widening: None,
         evidence,
         swarm_iters,
         polish_iters,

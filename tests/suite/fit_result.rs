@@ -13,6 +13,7 @@ fn sample_parameter() -> FittedParam {
         upper: 0.15,
         std_error: 0.001,
         fisher_std_error: None,
+        rounding_widening: None,
         determined: true,
         true_value: Some(0.029),
         rel_error: Some(0.03 / 0.029 - 1.0),

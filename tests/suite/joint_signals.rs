@@ -136,3 +136,38 @@ fn the_slow_slip_before_the_reversal_grows_a_rounding_level_step_and_head_y_sees
         j1.sd_nats
     );
 }
+
+#[test]
+fn the_rounding_widens_the_spread_where_the_slip_is_unstable_and_nowhere_else() {
+    // The sandwich's V carries the rounding's draws of the growing oscillation's onset
+    // (docs/uncertainty.md, "Jitter"). At this recording's truth tip − head x hardly jitters, so
+    // its spread is the tracking noise's; with the Stribeck slope −A·B doubled (B × 2) the cost
+    // jitters by about a hundred nats (docs/validation.md, "Jitter"), and the draws widen the
+    // spread of some coordinate by more than half again. Factors as measured here: 1.00 and
+    // more than 2.
+    use wiperlab::search::evidence::at_fit_smoothed;
+    let (one, u) = problem(&[]);
+    let calm = at_fit_smoothed(&one, &u).expect("the spread at the truth");
+    println!("widening at the truth: {:?}", calm.rounding_widening);
+    assert!(
+        calm.rounding_widening
+            .iter()
+            .all(|w| (1.0..1.05).contains(w)),
+        "{:?}",
+        calm.rounding_widening
+    );
+    let b = one
+        .free
+        .iter()
+        .position(|f| f.name == wiperlab::model::ParamId::B)
+        .expect("B is freed");
+    let mut steep = u.clone();
+    steep[b] = one.free[b].u_of(2.0 * one.free[b].value(u[b]));
+    let jittery = at_fit_smoothed(&one, &steep).expect("the spread with B doubled");
+    println!("widening with B doubled: {:?}", jittery.rounding_widening);
+    assert!(
+        jittery.rounding_widening.iter().any(|w| *w > 1.5),
+        "{:?}",
+        jittery.rounding_widening
+    );
+}

@@ -833,6 +833,64 @@ impl RecordingLikelihood {
         Ok(sample_covariance(&scores))
     }
 
+    /// The variability the trajectory's sensitivity to rounding adds to `V`
+    /// ([`RecordingLikelihood::variability`]), normalised coordinates (`k × k`, positive
+    /// semi-definite): twice the sample covariance of the scores `Jᵀ W (ρ_r − ρ̄)` of the responses
+    /// `ρ_r` simulated at `u` and at [`crate::search::jitter::JITTER_STEP_U`] either way along each coordinate
+    /// (`2k + 1` simulations, returned with the matrix).
+    ///
+    /// Why: where the slip near the reversal is unstable, the growing oscillation's onset is seeded
+    /// by the integrator's error ([`crate::search::jitter`]), so the model's spectra at one
+    /// parameter point are one draw among many that differ by far more than the parameters' effect
+    /// over that step. The recording carries a draw of its own and the model at the fit another,
+    /// independent of it and of the tracking noise: each adds the draws' covariance to the score's
+    /// variance, hence the factor 2. Zero where the motion does not depend on rounding. What it
+    /// leaves out: the search picks, among nearby draws, the ones that suit the recording, which
+    /// moves the estimate further than one draw does (docs/uncertainty.md, "Jitter").
+    ///
+    /// # Errors
+    /// A failed simulation, or responses of different lengths.
+    fn rounding_variability(
+        &self,
+        problem: &SpectralProblem,
+        u: &[f64],
+        j: &Jacobian,
+        w: &[f64],
+        metric: Option<&joint::Metric>,
+    ) -> Result<(DMatrix<f64>, usize)> {
+        use rayon::prelude::*;
+        let points = super::jitter::rounding_points(u);
+        let responses: Vec<Vec<f64>> = points
+            .par_iter()
+            .map(|p| self.response(problem, &problem.simulate(&problem.params_at(p))?))
+            .collect::<Result<_>>()?;
+        let len = responses[0].len();
+        if let Some(r) = responses.iter().find(|r| r.len() != len) {
+            return Err(likelihood::LikelihoodError::LengthMismatch {
+                measured: len,
+                model: r.len(),
+            }
+            .into());
+        }
+        let n = responses.len() as f64;
+        let mean: Vec<f64> = (0..len)
+            .map(|c| responses.iter().map(|r| r[c]).sum::<f64>() / n)
+            .collect();
+        let scores: Vec<Vec<f64>> = responses
+            .iter()
+            .map(|r| {
+                let mut d: Vec<f64> = r.iter().zip(&mean).map(|(a, b)| a - b).collect();
+                if let (Some(joint), Some(metric)) = (&self.joint, metric) {
+                    let n = self.spectral_len();
+                    let white = joint.whiten(metric, &d[..n]);
+                    d[..n].copy_from_slice(&white);
+                }
+                j.score(w, &d)
+            })
+            .collect();
+        Ok((sample_covariance(&scores) * 2.0, points.len()))
+    }
+
     /// What the noise replicates of the simulation `sim` are drawn around
     /// ([`ReplicateBase`]).
     ///
@@ -1271,6 +1329,10 @@ pub struct LocalFit {
     pub curvature_sigma_u: Vec<f64>,
     /// Correlations of `F⁻¹`.
     pub curvature_corr: Vec<Vec<f64>>,
+    /// Per coordinate, `sigma_u` over the sandwich's 1σ with the tracking noise's `V` alone: how
+    /// much the rounding's draws widen the spread ([`at_fit_smoothed`]; 1 for [`at_fit`], NaN
+    /// where either 1σ is not finite and positive).
+    pub rounding_widening: Vec<f64>,
 }
 
 /// The likelihood of `problem`'s recording (and of a joint fit's further recordings, whose NLLs,
@@ -1302,8 +1364,12 @@ pub fn at_fit(problem: &SpectralProblem, u: &[f64]) -> Result<LocalFit> {
 }
 
 /// [`at_fit`] with `F` and `V` from the response's Jacobian averaged over the central part of the
-/// likelihood's bowl ([`RecordingLikelihood::smoothed_jacobian`]): the spread the chosen model's
-/// intervals report. Costs `2k` more Jacobians (`4k²` simulations) per recording.
+/// likelihood's bowl ([`RecordingLikelihood::smoothed_jacobian`]), and with the variability the
+/// trajectory's sensitivity to rounding adds to `V`
+/// ([`RecordingLikelihood::rounding_variability`]): the spread the chosen model's intervals
+/// report. Costs `2k` more Jacobians and `2k + 1` rounding steps (`4k² + 2k + 1` simulations)
+/// per recording. The effective number of parameters ([`NllParts::effective_parameters`]) reads
+/// the tracking noise's `V` alone, as [`at_fit`]'s does.
 ///
 /// # Errors
 /// As [`at_fit`].
@@ -1314,21 +1380,30 @@ pub fn at_fit_smoothed(problem: &SpectralProblem, u: &[f64]) -> Result<LocalFit>
 /// [`at_fit`] and [`at_fit_smoothed`].
 fn local_fit(problem: &SpectralProblem, u: &[f64], spread: Spread) -> Result<LocalFit> {
     let (mut nll, mut info, var) = information(problem, u, spread)?;
-    let mut var = var.expect("asked for");
-    // Model choice reads the likelihood's own penalty; the prior's information then adds to both
-    // sides of the sandwich as a pseudo-observation's (docs/priors.md, "Priors").
+    let (mut var, rounding) = var.expect("asked for");
+    // Model choice reads the likelihood's own penalty, whose V is the tracking noise's; the
+    // rounding's draws then widen the spread, and the prior's information adds to both sides of
+    // the sandwich as a pseudo-observation's (docs/priors.md, "Priors").
     nll.effective_parameters = Some(effective_parameters(&info, &var));
     let prior = problem.prior.information_u(&problem.free, &problem.base, u);
     info += &prior;
     var += prior;
+    let (noise_sigma_u, _) = sandwich_covariance(&info, &var);
+    var += rounding;
     let (sigma_u, corr) = sandwich_covariance(&info, &var);
     let (curvature_sigma_u, curvature_corr) = covariance(&info);
+    let rounding_widening = sigma_u
+        .iter()
+        .zip(&noise_sigma_u)
+        .map(|(with, without)| with / without)
+        .collect();
     Ok(LocalFit {
         nll,
         sigma_u,
         corr,
         curvature_sigma_u,
         curvature_corr,
+        rounding_widening,
     })
 }
 
@@ -1352,10 +1427,11 @@ fn information(
     problem: &SpectralProblem,
     u: &[f64],
     spread: Spread,
-) -> Result<(NllParts, DMatrix<f64>, Option<DMatrix<f64>>)> {
+) -> Result<(NllParts, DMatrix<f64>, Option<Variability>)> {
     let mut nll: Option<NllParts> = None;
     let mut info = DMatrix::<f64>::zeros(u.len(), u.len());
     let mut var = DMatrix::<f64>::zeros(u.len(), u.len());
+    let mut rounding = DMatrix::<f64>::zeros(u.len(), u.len());
     for p in std::iter::once(problem).chain(&problem.others) {
         let lik = p
             .likelihood
@@ -1370,7 +1446,9 @@ fn information(
         let j = match spread {
             Spread::Smoothed => {
                 let (j, more) = lik.smoothed_jacobian(p, u, j, &w, metric.as_ref())?;
-                sims += more;
+                let (r, rounding_sims) = lik.rounding_variability(p, u, &j, &w, metric.as_ref())?;
+                rounding += r;
+                sims += more + rounding_sims;
                 j
             }
             Spread::CurvatureOnly | Spread::AtPoint => j,
@@ -1400,9 +1478,14 @@ fn information(
     Ok((
         nll.expect("the main recording is always there"),
         info,
-        (spread != Spread::CurvatureOnly).then_some(var),
+        (spread != Spread::CurvatureOnly).then_some((var, rounding)),
     ))
 }
+
+/// The variability `V` of [`information`]: the tracking noise's
+/// ([`RecordingLikelihood::variability`]) and the rounding's
+/// ([`RecordingLikelihood::rounding_variability`], zero unless [`Spread::Smoothed`]).
+type Variability = (DMatrix<f64>, DMatrix<f64>);
 
 /// What [`information`] linearises the response with, and whether it estimates the variability.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -1412,7 +1495,8 @@ enum Spread {
     /// `F` and `V` from the Jacobian at the point.
     AtPoint,
     /// `F` and `V` from the Jacobian averaged over the bowl's centre
-    /// ([`RecordingLikelihood::smoothed_jacobian`]).
+    /// ([`RecordingLikelihood::smoothed_jacobian`]), and the rounding's variability
+    /// ([`RecordingLikelihood::rounding_variability`]).
     Smoothed,
 }
 
