@@ -215,6 +215,9 @@ pub struct RecordingScore {
     /// How much the truth's own cost jitters under rounding-level steps, nats (standard
     /// deviation; [`crate::search::jitter`]), when the result has it.
     pub truth_jitter_nats: Option<f64>,
+    /// The largest of the chosen model's parameters' `rounding_widening`
+    /// ([`crate::estimate::FittedParam::rounding_widening`]), when the result has them.
+    pub rounding_widening_max: Option<f64>,
     pub wall_time_s: f64,
     /// The scored parameters (empty when the chosen model does not contain the truth's).
     pub params: Vec<Scored>,
@@ -513,6 +516,7 @@ pub fn calibrate(campaign: &Campaign) -> Result<Option<Calibration>> {
             ridge_nats: None,
             truth_spread_nats: None,
             truth_jitter_nats: None,
+            rounding_widening_max: None,
             wall_time_s: f64::NAN,
             params: Vec::new(),
             departure,
@@ -598,6 +602,9 @@ fn score(r: &mut RecordingScore, result: &FitResult) {
     r.truth_jitter_nats = (result.truth_tolerance.as_ref())
         .and_then(|t| t.jitter.as_ref())
         .map(|j| j.sd_nats);
+    r.rounding_widening_max = (result.parameters.iter())
+        .filter_map(|p| p.rounding_widening)
+        .reduce(f64::max);
     r.law = super::law::LawScore::of(result);
     r.gof_p = result.goodness_of_fit.as_ref().map(|g| g.p_value);
     if !r.model_contains_truth() {
@@ -1131,6 +1138,7 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
         "ridge_nats",
         "truth_spread_nats",
         "truth_jitter_nats",
+        "rounding_widening_max",
         "wall_time_s",
         "departure",
         "law_rms_rel_diff",
@@ -1164,6 +1172,7 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
             r.ridge_nats.map(csv_num).unwrap_or_default(),
             r.truth_spread_nats.map(csv_num).unwrap_or_default(),
             r.truth_jitter_nats.map(csv_num).unwrap_or_default(),
+            r.rounding_widening_max.map(csv_num).unwrap_or_default(),
             csv_num(r.wall_time_s),
             r.departure.clone().unwrap_or_default(),
             r.law.map(|l| csv_num(l.rms_rel_diff)).unwrap_or_default(),
@@ -1386,6 +1395,7 @@ mod tests {
             ridge_nats: None,
             truth_spread_nats: None,
             truth_jitter_nats: None,
+            rounding_widening_max: None,
             wall_time_s: 1.0,
             params: z
                 .iter()
