@@ -691,7 +691,7 @@ const WIDENING_WORTH_SAYING: f64 = 1.05;
 
 /// The summary's line on how much the rounding's draws widen each parameter's 1σ
 /// (`rounding_widening`), when any does by [`WIDENING_WORTH_SAYING`] or more.
-fn rounding_widening_words(params: &[crate::estimate::FittedParam]) -> Option<String> {
+pub(super) fn rounding_widening_words(params: &[crate::estimate::FittedParam]) -> Option<String> {
     let wide: Vec<String> = params
         .iter()
         .filter_map(|p| Some((p.name, p.rounding_widening?)))

@@ -893,7 +893,11 @@ fn page_view<'a>(
         peaks: peak_rows(r),
         trials: trial_rows(r),
         goodness_of_fit: r.goodness_of_fit.as_ref().map(goodness_of_fit_words),
-        tolerance_check: r.tolerance_check.as_ref().map(tolerance_check_words),
+        tolerance_check: r.tolerance_check.as_ref().map(|t| {
+            let widening = super::figures::rounding_widening_words(&r.parameters)
+                .map_or(String::new(), |w| format!(" In the intervals, {w}."));
+            tolerance_check_words(t) + &widening
+        }),
         modes: mode_rows(r),
         correlation: if pd { correlation_rows(r) } else { Vec::new() },
         summary: super::summary::summary(r, warnings),
@@ -1426,6 +1430,42 @@ pub(super) mod tests {
                 "<td>[0.02800, 0.03200] (68 %)<sup>1</sup><br><span class=\"note\">widened from \
                  [0.02900, 0.03100]</span></td>"
             ),
+            "{html}"
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn the_tolerance_sentence_names_what_the_rounding_widens() {
+        use crate::estimate::TolerancePoint;
+        let dir = std::env::temp_dir().join(format!("wiperlab_html_round_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut r = result();
+        let point = |rtol: f64, cost_nats| TolerancePoint {
+            rtol,
+            atol: rtol * 1e-2,
+            cost_nats,
+            transitions: 100,
+        };
+        r.tolerance_check = Some(crate::fit::tolerance::ToleranceCheck {
+            points: vec![point(1e-8, 70.0), point(1e-9, 70.1)],
+            spread_nats: 0.1,
+            failed: Vec::new(),
+            jitter: None,
+        });
+        r.parameters[0].rounding_widening = Some(2.5);
+        let paths = ReportPaths {
+            job: dir.join("job.toml"),
+            result: dir.join("unit.result.toml"),
+            recording: dir.join("rec.csv"),
+            dir: dir.clone(),
+        };
+        let html = std::fs::read_to_string(write_report(&r, &paths).unwrap().path).unwrap();
+        let name = r.parameters[0].name;
+        assert!(
+            html.contains("In the intervals, the rounding")
+                && html.contains(&format!("{name} ×2.50")),
             "{html}"
         );
         std::fs::remove_dir_all(&dir).ok();
