@@ -1409,22 +1409,30 @@ pub(super) mod tests {
         std::fs::remove_dir_all(paths.dir.parent().unwrap()).ok();
     }
 
-    #[test]
-    fn a_widened_interval_shows_the_methods_own_ends() {
-        let dir = std::env::temp_dir().join(format!("wiperlab_html_wide_{}", std::process::id()));
+    /// The page of `r` written into a fresh directory named after `tag`, read back; the
+    /// directory is removed.
+    fn page_html(r: &FitResult, tag: &str) -> String {
+        let dir = std::env::temp_dir().join(format!("wiperlab_html_{tag}_{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
-        let mut r = result();
-        if let Some(iv) = r.parameters[0].interval.as_mut() {
-            iv.widened_from = Some([0.029, 0.031]);
-        }
         let paths = ReportPaths {
             job: dir.join("job.toml"),
             result: dir.join("unit.result.toml"),
             recording: dir.join("rec.csv"),
             dir: dir.clone(),
         };
-        let html = std::fs::read_to_string(write_report(&r, &paths).unwrap().path).unwrap();
+        let html = std::fs::read_to_string(write_report(r, &paths).unwrap().path).unwrap();
+        std::fs::remove_dir_all(&dir).ok();
+        html
+    }
+
+    #[test]
+    fn a_widened_interval_shows_the_methods_own_ends() {
+        let mut r = result();
+        if let Some(iv) = r.parameters[0].interval.as_mut() {
+            iv.widened_from = Some([0.029, 0.031]);
+        }
+        let html = page_html(&r, "wide");
         assert!(
             html.contains(
                 "<td>[0.02800, 0.03200] (68 %)<sup>1</sup><br><span class=\"note\">widened from \
@@ -1432,15 +1440,11 @@ pub(super) mod tests {
             ),
             "{html}"
         );
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
     fn the_tolerance_sentence_names_what_the_rounding_widens() {
         use crate::estimate::TolerancePoint;
-        let dir = std::env::temp_dir().join(format!("wiperlab_html_round_{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
         let mut r = result();
         let point = |rtol: f64, cost_nats| TolerancePoint {
             rtol,
@@ -1455,20 +1459,13 @@ pub(super) mod tests {
             jitter: None,
         });
         r.parameters[0].rounding_widening = Some(2.5);
-        let paths = ReportPaths {
-            job: dir.join("job.toml"),
-            result: dir.join("unit.result.toml"),
-            recording: dir.join("rec.csv"),
-            dir: dir.clone(),
-        };
-        let html = std::fs::read_to_string(write_report(&r, &paths).unwrap().path).unwrap();
+        let html = page_html(&r, "round");
         let name = r.parameters[0].name;
         assert!(
             html.contains("In the intervals, the rounding")
                 && html.contains(&format!("{name} ×2.50")),
             "{html}"
         );
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     /// A result with priors shows each prior beside the fitted value and interval, and the rig
