@@ -837,7 +837,9 @@ impl RecordingLikelihood {
     /// ([`RecordingLikelihood::variability`]), normalised coordinates (`k × k`, positive
     /// semi-definite): twice the sample covariance of the scores `Jᵀ W (ρ_r − ρ̄)` of the responses
     /// `ρ_r` simulated at `u` and at [`crate::search::jitter::JITTER_STEP_U`] either way along each coordinate
-    /// (`2k + 1` simulations, returned with the matrix).
+    /// (`2k + 1` simulations, returned with the matrix). A step whose simulation fails or whose
+    /// response differs in length from the Jacobian's is left out; with fewer than three left the
+    /// matrix is zero (the draws cannot be told from the steps).
     ///
     /// Why: where the slip near the reversal is unstable, the growing oscillation's onset is seeded
     /// by the integrator's error ([`crate::search::jitter`]), so the model's spectra at one
@@ -847,9 +849,6 @@ impl RecordingLikelihood {
     /// variance, hence the factor 2. Zero where the motion does not depend on rounding. What it
     /// leaves out: the search picks, among nearby draws, the ones that suit the recording, which
     /// moves the estimate further than one draw does (docs/uncertainty.md, "Jitter").
-    ///
-    /// # Errors
-    /// A failed simulation, or responses of different lengths.
     fn rounding_variability(
         &self,
         problem: &SpectralProblem,
@@ -857,20 +856,20 @@ impl RecordingLikelihood {
         j: &Jacobian,
         w: &[f64],
         metric: Option<&joint::Metric>,
-    ) -> Result<(DMatrix<f64>, usize)> {
+    ) -> (DMatrix<f64>, usize) {
         use rayon::prelude::*;
         let points = super::jitter::rounding_points(u);
+        let len = j.columns[0].len();
         let responses: Vec<Vec<f64>> = points
             .par_iter()
-            .map(|p| self.response(problem, &problem.simulate(&problem.params_at(p))?))
-            .collect::<Result<_>>()?;
-        let len = responses[0].len();
-        if let Some(r) = responses.iter().find(|r| r.len() != len) {
-            return Err(likelihood::LikelihoodError::LengthMismatch {
-                measured: len,
-                model: r.len(),
-            }
-            .into());
+            .filter_map(|p| {
+                let sim = problem.simulate(&problem.params_at(p)).ok()?;
+                self.response(problem, &sim).ok()
+            })
+            .filter(|r| r.len() == len)
+            .collect();
+        if responses.len() < 3 {
+            return (DMatrix::zeros(u.len(), u.len()), points.len());
         }
         let n = responses.len() as f64;
         let mean: Vec<f64> = (0..len)
@@ -888,7 +887,7 @@ impl RecordingLikelihood {
                 j.score(w, &d)
             })
             .collect();
-        Ok((sample_covariance(&scores) * 2.0, points.len()))
+        (sample_covariance(&scores) * 2.0, points.len())
     }
 
     /// What the noise replicates of the simulation `sim` are drawn around
@@ -1446,7 +1445,7 @@ fn information(
         let j = match spread {
             Spread::Smoothed => {
                 let (j, more) = lik.smoothed_jacobian(p, u, j, &w, metric.as_ref())?;
-                let (r, rounding_sims) = lik.rounding_variability(p, u, &j, &w, metric.as_ref())?;
+                let (r, rounding_sims) = lik.rounding_variability(p, u, &j, &w, metric.as_ref());
                 rounding += r;
                 sims += more + rounding_sims;
                 j
