@@ -20,7 +20,8 @@ use clap::Parser;
 mod campaign;
 use campaign::{JobSource, truth_u};
 use std::path::Path;
-use wiperlab::job::LoadedJob;
+
+use wiperlab::job::{Candidate, LoadedJob};
 use wiperlab::model::ParamId;
 use wiperlab::search::evidence::curvature_at;
 use wiperlab::search::jitter::RoundingJitter;
@@ -44,6 +45,12 @@ struct Args {
     /// far the finite differences of the information move with it (a `#`-line per job).
     #[arg(long)]
     fisher: bool,
+    /// Read each job's fit from `<DIR>/<job stem>.result.toml` (a campaign's `results/`) and
+    /// check there instead of at the truth: whether the search's optimum is a draw that suits the
+    /// recording (its cost below the mean of its neighbours' draws). A job whose result chose
+    /// another model than the candidate is skipped.
+    #[arg(long, value_name = "DIR")]
+    fitted: Option<std::path::PathBuf>,
 }
 
 type Fallible<T> = Result<T, Box<dyn std::error::Error>>;
@@ -57,7 +64,7 @@ fn main() -> Fallible<()> {
         .filter(|s| !s.is_empty())
         .map(|s| s.parse::<SignalKind>())
         .collect::<Result<_, _>>()?;
-    println!("job,model,signals,jitter_sd_nats,costs");
+    println!("job,model,at,signals,jitter_sd_nats,mean_nats,costs");
     for path in &jobs {
         if let Err(e) = jitters(&args, &joint, path) {
             let e: String = e.to_string().chars().take(300).collect();
@@ -85,6 +92,17 @@ fn jitters(args: &Args, joint: &[SignalKind], path: &Path) -> Fallible<()> {
     let name = path
         .file_stem()
         .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let at = match &args.fitted {
+        Some(dir) => {
+            put_fit(
+                &mut job,
+                &dir.join(format!("{name}.result.toml")),
+                candidate,
+            )?;
+            "fit"
+        }
+        None => "truth",
+    };
     let own = job.job.spectrum.signal;
     let configs: Vec<Vec<SignalKind>> = std::iter::once(Vec::new())
         .chain(joint.iter().map(|s| vec![*s]))
@@ -100,15 +118,16 @@ fn jitters(args: &Args, joint: &[SignalKind], path: &Path) -> Fallible<()> {
         match RoundingJitter::at(&problem, &u) {
             Some(j) => {
                 let costs: Vec<String> = j.costs_nats.iter().map(|c| format!("{c:.3}")).collect();
+                let mean = j.costs_nats.iter().sum::<f64>() / j.costs_nats.len() as f64;
                 println!(
-                    "{name},{candidate},{},{:.4},{}",
+                    "{name},{candidate},{at},{},{:.4},{mean:.3},{}",
                     signals.join("+"),
                     j.sd_nats,
                     costs.join(" ")
                 );
             }
             None => println!(
-                "{name},{candidate},{},,fewer than three runs simulated",
+                "{name},{candidate},{at},{},,,fewer than three runs simulated",
                 signals.join("+")
             ),
         }
@@ -119,6 +138,21 @@ fn jitters(args: &Args, joint: &[SignalKind], path: &Path) -> Fallible<()> {
                 fisher_sigmas(&problem, &u)
             );
         }
+    }
+    Ok(())
+}
+
+/// Puts the fitted values of the result at `path` in the job's truth, so that the checks read the
+/// fit; an error when the result chose another model than `candidate`.
+fn put_fit(job: &mut LoadedJob, path: &Path, candidate: Candidate) -> Fallible<()> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let result: wiperlab::fit::FitResult =
+        toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    if result.model != candidate {
+        return Err(format!("{}: the fit chose {}", path.display(), result.model).into());
+    }
+    for p in &result.parameters {
+        job.truth.insert(p.name, p.value);
     }
     Ok(())
 }
