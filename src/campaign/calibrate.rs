@@ -218,6 +218,9 @@ pub struct RecordingScore {
     /// The largest of the chosen model's parameters' `rounding_widening`
     /// ([`crate::estimate::FittedParam::rounding_widening`]), when the result has them.
     pub rounding_widening_max: Option<f64>,
+    /// The shortfall with each side's cost averaged over its rounding draws
+    /// ([`FitResult::averaged_shortfall_nats`]), when the result has both jitter checks.
+    pub averaged_shortfall_nats: Option<f64>,
     pub wall_time_s: f64,
     /// The scored parameters (empty when the chosen model does not contain the truth's).
     pub params: Vec<Scored>,
@@ -381,6 +384,26 @@ impl Calibration {
         )
     }
 
+    /// Of the fits whose truth's cost jitters by more than [`SHORTFALL_TOLERANCE_NATS`] and whose
+    /// averaged shortfall is known ([`RecordingScore::averaged_shortfall_nats`]): (those, of them
+    /// those short by the averaged cost, of those the ones not short by the optimum's own cost).
+    pub fn averaged_shortfalls(&self) -> (usize, usize, usize) {
+        let rows: Vec<(f64, Option<f64>)> = (self.done())
+            .filter(|r| {
+                r.truth_jitter_nats
+                    .is_some_and(|j| j > SHORTFALL_TOLERANCE_NATS)
+            })
+            .filter_map(|r| Some((r.averaged_shortfall_nats?, r.shortfall_nats)))
+            .collect();
+        let short: Vec<&(f64, Option<f64>)> = (rows.iter())
+            .filter(|(a, _)| *a > SHORTFALL_TOLERANCE_NATS)
+            .collect();
+        let hidden = (short.iter())
+            .filter(|(_, s)| s.is_some_and(|s| s <= SHORTFALL_TOLERANCE_NATS))
+            .count();
+        (rows.len(), short.len(), hidden)
+    }
+
     /// Of the fits above [`SHORTFALL_TOLERANCE_NATS`]: (those with a measure `of` their truth's
     /// cost, of them those whose shortfall and measure are `within`).
     fn short_beside(
@@ -517,6 +540,7 @@ pub fn calibrate(campaign: &Campaign) -> Result<Option<Calibration>> {
             truth_spread_nats: None,
             truth_jitter_nats: None,
             rounding_widening_max: None,
+            averaged_shortfall_nats: None,
             wall_time_s: f64::NAN,
             params: Vec::new(),
             departure,
@@ -605,6 +629,7 @@ fn score(r: &mut RecordingScore, result: &FitResult) {
     r.rounding_widening_max = (result.parameters.iter())
         .filter_map(|p| p.rounding_widening)
         .reduce(f64::max);
+    r.averaged_shortfall_nats = result.averaged_shortfall_nats();
     r.law = super::law::LawScore::of(result);
     r.gof_p = result.goodness_of_fit.as_ref().map(|g| g.p_value);
     if !r.model_contains_truth() {
@@ -841,6 +866,16 @@ fn shortfall_unresolved_paragraph(md: &mut String, c: &Calibration) {
              grows an oscillation out of the integrator's error, whose timing sets the cost \
              (docs/likelihood.md, \"Jitter\"), so the truth's cost is known only to within that \
              jitter."
+        );
+    }
+    let (rough, short, hidden) = c.averaged_shortfalls();
+    if rough > 0 {
+        let _ = writeln!(
+            md,
+            "\nOf the {rough} fits whose truth's cost jitters by more than \
+             {SHORTFALL_TOLERANCE_NATS} nats, {short} are short when each side's cost is averaged \
+             over its rounding draws (`averaged_shortfall_nats`), {hidden} of them not short by \
+             the optimum's own cost: their search ended on a draw that suits the recording."
         );
     }
 }
@@ -1139,6 +1174,7 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
         "truth_spread_nats",
         "truth_jitter_nats",
         "rounding_widening_max",
+        "averaged_shortfall_nats",
         "wall_time_s",
         "departure",
         "law_rms_rel_diff",
@@ -1173,6 +1209,7 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
             r.truth_spread_nats.map(csv_num).unwrap_or_default(),
             r.truth_jitter_nats.map(csv_num).unwrap_or_default(),
             r.rounding_widening_max.map(csv_num).unwrap_or_default(),
+            r.averaged_shortfall_nats.map(csv_num).unwrap_or_default(),
             csv_num(r.wall_time_s),
             r.departure.clone().unwrap_or_default(),
             r.law.map(|l| csv_num(l.rms_rel_diff)).unwrap_or_default(),
@@ -1396,6 +1433,7 @@ mod tests {
             truth_spread_nats: None,
             truth_jitter_nats: None,
             rounding_widening_max: None,
+            averaged_shortfall_nats: None,
             wall_time_s: 1.0,
             params: z
                 .iter()
@@ -1473,6 +1511,35 @@ mod tests {
             by_model: Vec::new(),
         };
         assert_eq!(c.shortfall_jittered(), (2, 1));
+    }
+
+    /// Four fits on jittery truths and one on a calm truth: short by the averaged cost by 15 nats
+    /// while 0.8 nats more likely than the truth by the optimum's own cost (a lucky draw), short
+    /// by both, not short by the averaged cost, and one without the averaged cost. The calm
+    /// truth's fit is left out even though short.
+    #[test]
+    fn fits_short_by_the_draw_averaged_cost_are_counted() {
+        let fit = |jitter: f64, averaged: Option<f64>, short: f64| {
+            let mut r = recording(&[]);
+            r.truth_jitter_nats = Some(jitter);
+            r.averaged_shortfall_nats = averaged;
+            r.shortfall_nats = Some(short);
+            r
+        };
+        let c = Calibration {
+            name: "t".into(),
+            campaign: PathBuf::from("t.toml"),
+            recordings: vec![
+                fit(3.7, Some(15.0), -0.8),
+                fit(9.8, Some(6.0), 4.0),
+                fit(0.3, Some(-1.0), -1.3),
+                fit(2.0, None, 0.5),
+                fit(0.01, Some(5.0), 5.0),
+            ],
+            overall: Vec::new(),
+            by_model: Vec::new(),
+        };
+        assert_eq!(c.averaged_shortfalls(), (3, 2, 1));
     }
 
     /// Four fits: two short (by 2 and by 0.3 nats) whose truths' costs spread by 5 and by 0.2 nats

@@ -288,6 +288,23 @@ impl FitResult {
         let fit = self.truth_model_cost.unwrap_or(self.cost);
         self.truth_cost.map(|t| fit - t)
     }
+
+    /// [`FitResult::shortfall_nats`] with each side's cost averaged over its rounding draws (the
+    /// mean of the jitter check's costs at the optimum, `[tolerance_check.jitter]`, and at the
+    /// truth, `[truth_tolerance.jitter]`): where the cost jitters, whether the search's optimum is
+    /// a draw that suits the recording rather than the likelihood's optimum (docs/likelihood.md,
+    /// "Jitter"). `None` without both checks, or when the truth is read in another model than
+    /// the chosen one (the optimum's check is the chosen model's).
+    pub fn averaged_shortfall_nats(&self) -> Option<f64> {
+        if self.truth_model.is_some_and(|m| m != self.model) {
+            return None;
+        }
+        let mean = |t: &Option<crate::fit::tolerance::ToleranceCheck>| {
+            let j = t.as_ref()?.jitter.as_ref()?;
+            Some(j.costs_nats.iter().sum::<f64>() / j.costs_nats.len() as f64)
+        };
+        Some(mean(&self.tolerance_check)? - mean(&self.truth_tolerance)?)
+    }
 }
 
 /// The tracking noise of the measured signal as the likelihood reads it

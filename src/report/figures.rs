@@ -637,10 +637,37 @@ fn truth_line(r: &FitResult) -> String {
         None => (String::new(), ""),
     };
     format!(
-        "  truth's own cost{whose} {t:.2} nats: the fit{fit} is {:.2} nats {} likely than the truth{}\n",
+        "  truth's own cost{whose} {t:.2} nats: the fit{fit} is {:.2} nats {} likely than the truth{}{}\n",
         short.abs(),
         if short > 0.0 { "less" } else { "more" },
-        truth_tolerance_words(r, short)
+        truth_tolerance_words(r, short),
+        averaged_shortfall_words(r)
+    )
+}
+
+/// Where either side's cost jitters by more than [`crate::fit::SHORTFALL_TOLERANCE_NATS`], the
+/// fit's distance from the truth with each cost averaged over its rounding draws
+/// ([`FitResult::averaged_shortfall_nats`]); empty otherwise.
+fn averaged_shortfall_words(r: &FitResult) -> String {
+    let rough = |t: &Option<crate::fit::tolerance::ToleranceCheck>| {
+        (t.as_ref().and_then(|t| t.jitter.as_ref()))
+            .is_some_and(|j| j.sd_nats > crate::fit::SHORTFALL_TOLERANCE_NATS)
+    };
+    let Some(short) = r.averaged_shortfall_nats() else {
+        return String::new();
+    };
+    if !(rough(&r.tolerance_check) || rough(&r.truth_tolerance)) {
+        return String::new();
+    }
+    let verdict = if short > crate::fit::SHORTFALL_TOLERANCE_NATS {
+        ": by the averaged cost the search stopped short, on a draw that suits the recording"
+    } else {
+        ""
+    };
+    format!(
+        "; averaged over their rounding draws the fit is {:.2} nats {} likely than the truth{verdict}",
+        short.abs(),
+        if short > 0.0 { "less" } else { "more" },
     )
 }
 
@@ -683,8 +710,6 @@ fn tolerance_lists(t: &crate::fit::tolerance::ToleranceCheck) -> (String, String
     (costs.join(", "), rtols.join(", "))
 }
 
-/// The summary's line on `[fit.priors]`: the prior's share of the cost and how far the fit lies
-/// from each prior, in the prior's standard deviations (empty without priors).
 /// Widening factors below this are not worth a summary line: the rounding's share of the 1σ is
 /// then within the spread's own sampling error over the noise replicates.
 const WIDENING_WORTH_SAYING: f64 = 1.05;
@@ -706,6 +731,8 @@ pub(super) fn rounding_widening_words(params: &[crate::estimate::FittedParam]) -
     })
 }
 
+/// The summary's line on `[fit.priors]`: the prior's share of the cost and how far the fit lies
+/// from each prior, in the prior's standard deviations (empty without priors).
 fn prior_lines(r: &FitResult) -> String {
     let Some(p) = &r.priors else {
         return String::new();
@@ -1235,6 +1262,44 @@ mod tests {
         let line = super::rounding_widening_words(&rough).expect("two parameters widen");
         assert!(line.contains("A ×2.50, C ×1.05"), "{line}");
         assert!(!line.contains('B'), "{line}");
+    }
+
+    #[test]
+    fn a_fit_on_a_lucky_rounding_draw_is_short_by_the_averaged_cost() {
+        use crate::fit::tolerance::ToleranceCheck;
+        use crate::search::jitter::RoundingJitter;
+        // Costs as cal_003's (docs/validation.md, "Jitter"): the optimum's own cost below the
+        // truth's, its draws' mean far above the truth's.
+        let check = |costs: Vec<f64>| ToleranceCheck {
+            points: Vec::new(),
+            spread_nats: 0.0,
+            failed: Vec::new(),
+            jitter: RoundingJitter::of(costs),
+        };
+        let mut r = crate::report::html::tests::result();
+        r.cost = 43.0;
+        r.truth_cost = Some(43.5);
+        r.tolerance_check = Some(check(vec![43.0, 60.0, 62.0]));
+        r.truth_tolerance = Some(check(vec![43.5, 45.0, 46.0]));
+        // Means 55 and 44.83: 10.17 nats short by the averaged cost.
+        let short = r.averaged_shortfall_nats().unwrap();
+        assert!((short - (55.0 - 134.5 / 3.0)).abs() < 1e-12, "{short}");
+        let line = super::truth_line(&r);
+        assert!(
+            line.contains("the fit is 0.50 nats more likely than the truth"),
+            "{line}"
+        );
+        assert!(
+            line.contains("averaged over their rounding draws the fit is 10.17 nats less likely than the truth: by the averaged cost the search stopped short"),
+            "{line}"
+        );
+        // Where neither side jitters, the line says nothing of the draws.
+        r.tolerance_check = Some(check(vec![43.0, 43.0, 43.0]));
+        r.truth_tolerance = Some(check(vec![43.5, 43.5, 43.5]));
+        assert!(!super::truth_line(&r).contains("averaged"));
+        // Nor where the truth is read in another model than the chosen one.
+        r.truth_model = "head1dof".parse().ok();
+        assert_eq!(r.averaged_shortfall_nats(), None);
     }
 
     #[test]
