@@ -1,0 +1,149 @@
+//! Where a Nelder–Mead polish on the cost averaged over rounding draws ends, started from a
+//! campaign's fits: whether a search on that cost would leave the draws that suit the recording
+//! (docs/validation.md, "Jitter").
+//!
+//! The averaged cost at a point is the mean of the cost at it and at steps of 1e-12 either way
+//! along each coordinate (`2k + 1` simulations, [`wiperlab::search::jitter::rounding_points`]).
+//! For each job the example prints the averaged cost at the fit, at the polish's end and at the
+//! truth, and each parameter's relative error at the fit and at the polish's end.
+//!
+//! ```sh
+//! cargo run --release --example averaged_polish -- JOBS --fitted DIR
+//! ```
+
+use argmin::core::{CostFunction, Executor};
+use argmin::solver::neldermead::NelderMead;
+use clap::Parser;
+#[path = "common/campaign.rs"]
+mod campaign;
+use campaign::{JobSource, truth_u};
+use std::path::{Path, PathBuf};
+use wiperlab::job::LoadedJob;
+use wiperlab::search::jitter::rounding_points;
+use wiperlab::search::{SpectralProblem, problem_for};
+
+#[derive(Parser)]
+struct Args {
+    #[command(flatten)]
+    source: JobSource,
+    /// The campaign's results (`<DIR>/<job stem>.result.toml`), whose fits the polish starts from.
+    #[arg(long, value_name = "DIR")]
+    fitted: PathBuf,
+    /// The polish's iterations at the most.
+    #[arg(long, default_value_t = 60)]
+    iterations: u64,
+    /// The initial simplex's edge, normalised units.
+    #[arg(long, default_value_t = 0.02)]
+    step: f64,
+}
+
+type Fallible<T> = Result<T, Box<dyn std::error::Error>>;
+
+/// The cost averaged over the rounding draws at a point.
+struct Averaged<'a>(&'a SpectralProblem);
+
+impl Averaged<'_> {
+    fn at(&self, u: &[f64]) -> f64 {
+        use rayon::prelude::*;
+        let costs: Vec<f64> = rounding_points(u)
+            .par_iter()
+            .map(|p| self.0.cost_at(p))
+            .collect();
+        costs.iter().sum::<f64>() / costs.len() as f64
+    }
+}
+
+impl CostFunction for Averaged<'_> {
+    type Param = Vec<f64>;
+    type Output = f64;
+    fn cost(&self, u: &Vec<f64>) -> Result<f64, argmin::core::Error> {
+        Ok(self.at(u))
+    }
+}
+
+fn main() -> Fallible<()> {
+    let args = Args::parse();
+    println!("job,at_fit,polished,at_truth,evaluations,rel_err_fit,rel_err_polished");
+    for path in args.source.paths()? {
+        if let Err(e) = one(&args, &path) {
+            println!("# {}: skipped: {e}", path.display());
+        }
+    }
+    Ok(())
+}
+
+fn one(args: &Args, path: &Path) -> Fallible<()> {
+    let job = LoadedJob::load(path)?;
+    let candidate = args.source.candidate(&job, path)?;
+    let name = path
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let file = args.fitted.join(format!("{name}.result.toml"));
+    let result: wiperlab::fit::FitResult = toml::from_str(&std::fs::read_to_string(&file)?)?;
+    if result.model != candidate {
+        return Err(format!("the fit chose {}", result.model).into());
+    }
+    let problem = problem_for(&job, candidate)?;
+    let ut = truth_u(&job, &problem)?;
+    let uf: Vec<f64> = (problem.free.iter())
+        .map(|f| {
+            let p = result.parameters.iter().find(|p| p.name == f.name);
+            p.map(|p| f.u_of(p.value))
+                .ok_or(format!("no fitted {}", f.name))
+        })
+        .collect::<Result<_, _>>()?;
+    let avg = Averaged(&problem);
+    let simplex: Vec<Vec<f64>> = std::iter::once(uf.clone())
+        .chain((0..uf.len()).map(|i| {
+            let mut v = uf.clone();
+            v[i] = if v[i] + args.step <= 1.0 {
+                v[i] + args.step
+            } else {
+                v[i] - args.step
+            };
+            v
+        }))
+        .collect();
+    let before = problem
+        .evaluations
+        .load(std::sync::atomic::Ordering::Relaxed);
+    let res = Executor::new(
+        Averaged(&problem),
+        NelderMead::new(simplex).with_sd_tolerance(0.1)?,
+    )
+    .configure(|s| s.max_iters(args.iterations))
+    .run()?;
+    let up: Vec<f64> = res
+        .state()
+        .best_param
+        .clone()
+        .unwrap_or(uf.clone())
+        .iter()
+        .map(|x| x.clamp(0.0, 1.0))
+        .collect();
+    let evaluations = problem
+        .evaluations
+        .load(std::sync::atomic::Ordering::Relaxed)
+        - before;
+    let rel = |u: &[f64]| {
+        (problem.free.iter().zip(u).zip(&ut))
+            .map(|((f, a), t)| {
+                format!(
+                    "{}{:+.1}%",
+                    f.name,
+                    100.0 * (f.value(*a) / f.value(*t) - 1.0)
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    println!(
+        "{name},{:.2},{:.2},{:.2},{evaluations},{},{}",
+        avg.at(&uf),
+        avg.at(&up),
+        avg.at(&ut),
+        rel(&uf),
+        rel(&up)
+    );
+    Ok(())
+}
