@@ -1268,8 +1268,8 @@ mod tests {
     fn a_fit_on_a_lucky_rounding_draw_is_short_by_the_averaged_cost() {
         use crate::fit::tolerance::ToleranceCheck;
         use crate::search::jitter::RoundingJitter;
-        // Costs as cal_003's (docs/validation.md, "Jitter"): the optimum's own cost below the
-        // truth's, its draws' mean far above the truth's.
+        // A lucky draw: the optimum's own cost below the truth's, its draws' mean far above
+        // (docs/validation.md, "Jitter", has searches that ended on such draws).
         let check = |costs: Vec<f64>| ToleranceCheck {
             points: Vec::new(),
             spread_nats: 0.0,
