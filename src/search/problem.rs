@@ -66,12 +66,6 @@ pub struct SpectralProblem {
     /// for a target job or a recording it cannot be computed for.
     pub likelihood:
         std::result::Result<Arc<super::evidence::RecordingLikelihood>, super::NoLikelihood>,
-    /// The measured signal's own likelihood when `likelihood` also reads further signals
-    /// (`[fit.likelihood] joint_signals`): the local CMA-ES stage's cost. Reading the further
-    /// signals sharpens the likelihood's basins until a local search from the swarm's best misses
-    /// the one around the truth, which the signal's own wider basin leads it into
-    /// (docs/fit.md, "The local CMA-ES stage"); the polish and all that follows read `likelihood`.
-    pub signal_likelihood: Option<Arc<super::evidence::RecordingLikelihood>>,
     pub evaluations: Arc<AtomicUsize>,
     /// Failed evaluations, shared like `evaluations` with the bootstrap's replicate problems.
     pub failures: Arc<AtomicUsize>,
@@ -301,10 +295,6 @@ impl SpectralProblem {
                 .likelihood
                 .as_ref()
                 .map_err(|why| super::FitError::LikelihoodObjective { why: why.clone() })?;
-            let lik = match (&self.signal_likelihood, stage) {
-                (Some(own), SearchStage::Local) => own,
-                _ => lik,
-            };
             return lik.excess_nll(self, sim);
         }
         let spectral = self.cost_of(&self.model_features(sim)?);
@@ -385,9 +375,7 @@ impl SpectralProblem {
     pub(crate) fn cost_at_stage(&self, u: &[f64], stage: SearchStage) -> f64 {
         let c = self.unrecorded_cost_at_stage(u, stage);
         let inside = u.iter().all(|x| (0.0..=1.0).contains(x));
-        let own_signal = stage == SearchStage::Local && self.signal_likelihood.is_some();
         if stage != SearchStage::Swarm
-            && !own_signal
             && *self.solver_of(stage) == self.solver
             && inside
             && c < FAILED_COST

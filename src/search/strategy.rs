@@ -530,7 +530,6 @@ fn problem_of(
         objective: fit.objective,
         weights: fit.weights,
         likelihood: Err(super::NoLikelihood::NotBuilt),
-        signal_likelihood: None,
         evaluations,
         failures: Arc::new(AtomicUsize::new(0)),
         failure_causes: Default::default(),
@@ -539,26 +538,21 @@ fn problem_of(
         last_jitter: Mutex::new(None),
         prior: Default::default(),
     };
-    let own = |p: &SpectralProblem| {
-        RecordingLikelihood::new(p, &m.x, fit.likelihood.time_domain).map(|l| {
-            l.with_noise(fit.likelihood.noise).with_blocks(
-                fit.likelihood
-                    .block_s
-                    .map(|b| (b * p.fs_hz).round() as usize),
-            )
-        })
-    };
     p.likelihood = if p.targets.is_some() {
         Err(super::NoLikelihood::TargetJob)
     } else {
-        own(&p)
+        RecordingLikelihood::new(&p, &m.x, fit.likelihood.time_domain)
+            .map(|l| {
+                l.with_noise(fit.likelihood.noise).with_blocks(
+                    fit.likelihood
+                        .block_s
+                        .map(|b| (b * p.fs_hz).round() as usize),
+                )
+            })
             .and_then(|l| l.with_joint(&p, &m.trace, &fit.likelihood.joint_signals))
             .map(Arc::new)
             .map_err(|e| super::NoLikelihood::Recording(Arc::new(e)))
     };
-    if !fit.likelihood.joint_signals.is_empty() && p.likelihood.is_ok() {
-        p.signal_likelihood = own(&p).ok().map(Arc::new);
-    }
     Ok(p)
 }
 

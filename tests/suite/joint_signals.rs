@@ -171,32 +171,3 @@ fn the_rounding_widens_the_spread_where_the_slip_is_unstable_and_nowhere_else() 
         jittery.rounding_widening
     );
 }
-
-#[test]
-fn a_joint_problem_keeps_the_signals_own_likelihood_for_its_local_stage() {
-    // The local CMA-ES stage of a joint fit reads the measured signal's own likelihood
-    // (docs/fit.md, "The local CMA-ES stage"): a problem reading head y carries it, one reading
-    // the signal alone needs none. The two likelihoods differ at the truth by head y's own terms.
-    let (one, u) = problem(&[]);
-    let (two, _) = problem(&[SignalKind::HeadY]);
-    assert!(one.signal_likelihood.is_none());
-    let own = two
-        .signal_likelihood
-        .as_ref()
-        .expect("the signal's own likelihood");
-    let sim = two
-        .simulate(&two.params_at(&u))
-        .expect("the truth simulates");
-    let alone = one.likelihood.as_ref().expect("one signal's likelihood");
-    let (a, b) = (
-        own.excess_nll(&two, &sim).expect("own"),
-        alone.excess_nll(&one, &sim).expect("alone"),
-    );
-    // Same recording, same signal, same noise model: the same NLL.
-    assert!((a - b).abs() < 1e-9 * b.abs().max(1.0), "{a} against {b}");
-    let joint = two.cost_at(&u);
-    assert!(
-        joint - a > 10.0,
-        "joint {joint} against the signal's own {a}"
-    );
-}
