@@ -118,7 +118,7 @@ fn jitters(args: &Args, joint: &[SignalKind], path: &Path) -> Fallible<()> {
         match RoundingJitter::at(&problem, &u) {
             Some(j) => {
                 let costs: Vec<String> = j.costs_nats.iter().map(|c| format!("{c:.3}")).collect();
-                let mean = j.costs_nats.iter().sum::<f64>() / j.costs_nats.len() as f64;
+                let mean = j.mean_nats();
                 println!(
                     "{name},{candidate},{at},{},{:.4},{mean:.3},{}",
                     signals.join("+"),

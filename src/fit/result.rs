@@ -300,8 +300,7 @@ impl FitResult {
             return None;
         }
         let mean = |t: &Option<crate::fit::tolerance::ToleranceCheck>| {
-            let j = t.as_ref()?.jitter.as_ref()?;
-            Some(j.costs_nats.iter().sum::<f64>() / j.costs_nats.len() as f64)
+            Some(t.as_ref()?.jitter.as_ref()?.mean_nats())
         };
         Some(mean(&self.tolerance_check)? - mean(&self.truth_tolerance)?)
     }

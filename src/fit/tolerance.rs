@@ -223,6 +223,7 @@ pub(super) fn checks_for_choice(
 
 #[cfg(test)]
 mod tests {
+    use super::*;
 
     #[test]
     fn a_jitter_beyond_half_a_nat_warns_for_intervals_read_from_the_curvature() {
@@ -241,7 +242,6 @@ mod tests {
         assert_eq!(with(Some(0.3)).jitter_warning(), None);
         assert_eq!(with(None).jitter_warning(), None);
     }
-    use super::*;
 
     fn point(rtol: f64, cost_nats: f64, transitions: usize) -> TolerancePoint {
         TolerancePoint {

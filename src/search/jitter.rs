@@ -86,6 +86,11 @@ impl RoundingJitter {
         }))
     }
 
+    /// The mean of the costs, nats: the cost averaged over the point's rounding draws.
+    pub fn mean_nats(&self) -> f64 {
+        self.costs_nats.iter().sum::<f64>() / self.costs_nats.len() as f64
+    }
+
     /// [`RoundingJitter::at`]'s simulations.
     fn measure(problem: &SpectralProblem, u: &[f64]) -> Option<RoundingJitter> {
         use rayon::prelude::*;
