@@ -843,6 +843,8 @@ fn cost_figure(
             Some(SearchStage::Swarm),
             Some(SearchStage::Local),
             Some(SearchStage::Polish),
+            Some(SearchStage::SignalLocal),
+            Some(SearchStage::SignalPolish),
             Some(SearchStage::Cmaes),
         ]
     } else {
@@ -861,6 +863,8 @@ fn cost_figure(
                 Some(SearchStage::Swarm) => "swarm, nats",
                 Some(SearchStage::Local) => "local CMA-ES, nats",
                 Some(SearchStage::Polish) => "Nelder–Mead, nats",
+                Some(SearchStage::SignalLocal) => "local CMA-ES on the signal alone, nats",
+                Some(SearchStage::SignalPolish) => "Nelder–Mead after it, nats",
                 Some(SearchStage::Cmaes) => "CMA-ES",
                 None => "search",
             };

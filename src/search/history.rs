@@ -19,6 +19,12 @@ named_enum! {
         /// The local CMA-ES run from a swarm's best particle (`[fit.search] local = "cmaes"`),
         /// before its Nelder–Mead polish.
         Local => "local",
+        /// In a fit that reads further signals (`[fit.likelihood] joint_signals`), the second
+        /// local CMA-ES run from the same particle as `Local`, on the measured signal's own
+        /// likelihood: its basins are wider than the joint likelihood's.
+        SignalLocal => "signal_local",
+        /// The Nelder–Mead polish, on the joint likelihood, from the end of `SignalLocal`.
+        SignalPolish => "signal_polish",
     }
 }
 

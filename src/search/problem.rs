@@ -66,6 +66,10 @@ pub struct SpectralProblem {
     /// for a target job or a recording it cannot be computed for.
     pub likelihood:
         std::result::Result<Arc<super::evidence::RecordingLikelihood>, super::NoLikelihood>,
+    /// The measured signal's own likelihood when `likelihood` also reads further signals
+    /// (`[fit.likelihood] joint_signals`): the cost of [`SearchStage::SignalLocal`], a second
+    /// local run beside the joint one (docs/fit.md, "The local CMA-ES stage").
+    pub signal_likelihood: Option<Arc<super::evidence::RecordingLikelihood>>,
     pub evaluations: Arc<AtomicUsize>,
     /// Failed evaluations, shared like `evaluations` with the bootstrap's replicate problems.
     pub failures: Arc<AtomicUsize>,
@@ -295,6 +299,10 @@ impl SpectralProblem {
                 .likelihood
                 .as_ref()
                 .map_err(|why| super::FitError::LikelihoodObjective { why: why.clone() })?;
+            let lik = match (&self.signal_likelihood, stage) {
+                (Some(own), SearchStage::SignalLocal) => own,
+                _ => lik,
+            };
             return lik.excess_nll(self, sim);
         }
         let spectral = self.cost_of(&self.model_features(sim)?);
@@ -370,12 +378,13 @@ impl SpectralProblem {
     /// [`SpectralProblem::cost_at`] with the simulations of `stage` (the swarm's may be coarser).
     ///
     /// With the likelihood as the cost, an evaluation inside the box at the job's own tolerance
-    /// (not the swarm's, nor a looser local stage's, whose costs are not comparable) is kept in
+    /// (not the swarm's, nor a looser local stage's, nor the signal's own likelihood's, whose costs
+    /// are not comparable) is kept in
     /// [`SpectralProblem::near_best`] when it is near the lowest seen.
     pub(crate) fn cost_at_stage(&self, u: &[f64], stage: SearchStage) -> f64 {
         let c = self.unrecorded_cost_at_stage(u, stage);
         let inside = u.iter().all(|x| (0.0..=1.0).contains(x));
-        if stage != SearchStage::Swarm
+        if !matches!(stage, SearchStage::Swarm | SearchStage::SignalLocal)
             && *self.solver_of(stage) == self.solver
             && inside
             && c < FAILED_COST
@@ -393,8 +402,8 @@ impl SpectralProblem {
     fn solver_of(&self, stage: SearchStage) -> &SolverOptions {
         match stage {
             SearchStage::Swarm => &self.swarm_solver,
-            SearchStage::Local => &self.local_solver,
-            SearchStage::Polish | SearchStage::Cmaes => &self.solver,
+            SearchStage::Local | SearchStage::SignalLocal => &self.local_solver,
+            SearchStage::Polish | SearchStage::SignalPolish | SearchStage::Cmaes => &self.solver,
         }
     }
 

@@ -530,6 +530,7 @@ fn problem_of(
         objective: fit.objective,
         weights: fit.weights,
         likelihood: Err(super::NoLikelihood::NotBuilt),
+        signal_likelihood: None,
         evaluations,
         failures: Arc::new(AtomicUsize::new(0)),
         failure_causes: Default::default(),
@@ -538,21 +539,26 @@ fn problem_of(
         last_jitter: Mutex::new(None),
         prior: Default::default(),
     };
+    let own = |p: &SpectralProblem| {
+        RecordingLikelihood::new(p, &m.x, fit.likelihood.time_domain).map(|l| {
+            l.with_noise(fit.likelihood.noise).with_blocks(
+                fit.likelihood
+                    .block_s
+                    .map(|b| (b * p.fs_hz).round() as usize),
+            )
+        })
+    };
     p.likelihood = if p.targets.is_some() {
         Err(super::NoLikelihood::TargetJob)
     } else {
-        RecordingLikelihood::new(&p, &m.x, fit.likelihood.time_domain)
-            .map(|l| {
-                l.with_noise(fit.likelihood.noise).with_blocks(
-                    fit.likelihood
-                        .block_s
-                        .map(|b| (b * p.fs_hz).round() as usize),
-                )
-            })
+        own(&p)
             .and_then(|l| l.with_joint(&p, &m.trace, &fit.likelihood.joint_signals))
             .map(Arc::new)
             .map_err(|e| super::NoLikelihood::Recording(Arc::new(e)))
     };
+    if !fit.likelihood.joint_signals.is_empty() && p.likelihood.is_ok() {
+        p.signal_likelihood = own(&p).ok().map(Arc::new);
+    }
     Ok(p)
 }
 
@@ -1756,27 +1762,21 @@ fn restart(
         .map(|p| p.position.clone())
         .ok_or(FitError::NoParticle)?;
     let swarm_iters = res.state().get_iter();
-    let swarm_best = match fit.search.local {
-        job::LocalSearch::NelderMead => swarm_best,
-        job::LocalSearch::Cmaes => {
-            match local_cmaes(problem, fit, &swarm_best, (run_seed, r, &run_evals), log) {
-                Some(u) => u,
-                None if interrupt::stop_requested() => return Ok(None),
-                None => swarm_best,
-            }
+    let run = (run_seed, r, &run_evals);
+    let Some((mut u, mut polish_iters, mut cost)) =
+        local_route(problem, fit, &swarm_best, run, Route::Joint, log)?
+    else {
+        return Ok(None);
+    };
+    if fit.search.local == job::LocalSearch::Cmaes && problem.signal_likelihood.is_some() {
+        let Some(second) = local_route(problem, fit, &swarm_best, run, Route::Signal, log)? else {
+            return Ok(None);
+        };
+        polish_iters += second.1;
+        if second.2 < cost {
+            (u, cost) = (second.0, second.2);
         }
-    };
-    let (u, polish_iters, cost) = match polish(
-        problem,
-        &swarm_best,
-        POLISH_STEP_U,
-        fit.polish_iterations,
-        observer(SearchStage::Polish),
-    ) {
-        Ok(p) => p,
-        Err(_) if interrupt::stop_requested() => return Ok(None),
-        Err(e) => return Err(e),
-    };
+    }
     Ok(Some(Run {
         u,
         cost,
@@ -1785,25 +1785,85 @@ fn restart(
     }))
 }
 
+/// Which likelihood a restart's local CMA-ES run reads ([`local_route`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Route {
+    /// The polish's own cost.
+    Joint,
+    /// In a fit that reads further signals, the measured signal's own likelihood
+    /// ([`SpectralProblem::signal_likelihood`]).
+    Signal,
+}
+
+/// One local route of restart `r` from its swarm's best particle `start`: the local CMA-ES run
+/// (`[fit.search] local = "cmaes"`) on the likelihood `route` names, then the Nelder–Mead polish
+/// on the job's cost: its end, the polish's iterations and its cost, `None` when interrupted.
+///
+/// A fit that reads further signals runs both routes and keeps the lower end: the further
+/// signals sharpen the likelihood until its basin around the truth can be too narrow for a local
+/// run from the swarm's best to find, while the signal's own, wider basins lead there; on other
+/// recordings the signal's own basins lead away from it (docs/fit.md, "The local CMA-ES stage").
+fn local_route(
+    problem: &Arc<SpectralProblem>,
+    fit: &job::FitSection,
+    start: &[f64],
+    run: (u64, usize, &Arc<AtomicUsize>),
+    route: Route,
+    log: Option<&Reporting>,
+) -> Result<Option<(Vec<f64>, u64, f64)>> {
+    let (local, polishing) = match route {
+        Route::Joint => (SearchStage::Local, SearchStage::Polish),
+        Route::Signal => (SearchStage::SignalLocal, SearchStage::SignalPolish),
+    };
+    let from = match fit.search.local {
+        job::LocalSearch::NelderMead => start.to_vec(),
+        job::LocalSearch::Cmaes => match local_cmaes(problem, fit, start, run, local, log) {
+            Some(u) => u,
+            None if interrupt::stop_requested() => return Ok(None),
+            None => start.to_vec(),
+        },
+    };
+    let observer = log.map(|reporting| SearchObserver {
+        stage: polishing,
+        restart: run.1,
+        reporting: reporting.clone(),
+        evals: problem.evaluations.clone(),
+        run_evals: run.2.clone(),
+    });
+    match polish(
+        problem,
+        &from,
+        POLISH_STEP_U,
+        fit.polish_iterations,
+        observer,
+    ) {
+        Ok(p) => Ok(Some(p)),
+        Err(_) if interrupt::stop_requested() => Ok(None),
+        Err(e) => Err(e),
+    }
+}
+
 /// The local CMA-ES run of restart `r` from its swarm's best particle `start`
-/// (`[fit.search] local = "cmaes"`, [`super::ipop::local`]) on the polish's cost, its generations
-/// in the history as [`SearchStage::Local`]: the run's lowest point, `None` when no generation
-/// finished (interrupted). The Nelder–Mead polish then goes on from it. `run`: the run's seed,
-/// the restart and its evaluation counter.
+/// (`[fit.search] local = "cmaes"`, [`super::ipop::local`]) on the cost of `stage`
+/// ([`SearchStage::Local`] or [`SearchStage::SignalLocal`]), its generations in the history
+/// under that stage: the run's lowest point, `None` when no generation finished (interrupted).
+/// The Nelder–Mead polish then goes on from it. `run`: the run's seed, the restart and its
+/// evaluation counter.
 fn local_cmaes(
     problem: &Arc<SpectralProblem>,
     fit: &job::FitSection,
     start: &[f64],
     (seed, r, run_evals): (u64, usize, &Arc<AtomicUsize>),
+    stage: SearchStage,
     log: Option<&Reporting>,
 ) -> Option<Vec<f64>> {
     let cost = |u: &[f64]| {
         run_evals.fetch_add(1, Ordering::Relaxed);
-        problem.cost_at_stage(u, SearchStage::Local)
+        problem.cost_at_stage(u, stage)
     };
     let mut observe = |g: super::ipop::Generation| {
         if let Some(reporting) = log {
-            reporting.generation(SearchStage::Local, r, &g, run_evals.load(Ordering::Relaxed));
+            reporting.generation(stage, r, &g, run_evals.load(Ordering::Relaxed));
             reporting.advance(problem.evaluations.load(Ordering::Relaxed));
         }
         !interrupt::stop_requested()
@@ -2193,6 +2253,47 @@ mod tests {
         assert_eq!(near(&problem), 1, "the polish's point not kept");
         assert!(local.is_finite() && polish.is_finite());
         assert_ne!(local, polish, "rtol 1e-7 and 1e-8 gave the same cost");
+    }
+
+    /// A fit that reads head y beside tip − head x keeps the signal's own likelihood for its
+    /// second local route ([`local_route`]): at the shipped recording's truth
+    /// (`data/reversal/truth.json`) that stage's cost is the one-signal problem's local-stage cost
+    /// (same signal, noise model and tolerance), below the joint one by head y's own terms, and
+    /// none of its points enters the near-best points, whose costs are the joint likelihood's.
+    #[test]
+    fn the_signal_route_reads_the_signals_own_likelihood_and_keeps_no_near_best_point() {
+        let (mut job, candidate, one) = main_job_problem();
+        assert!(
+            one.signal_likelihood.is_none(),
+            "one signal needs no second"
+        );
+        job.job.fit.likelihood.joint_signals = vec![crate::spectrum::features::SignalKind::HeadY];
+        let joint = problem_for(&job, candidate).expect("joint problem");
+        assert!(joint.signal_likelihood.is_some());
+        let truth: serde_json::Value =
+            serde_json::from_str(&repository_file("data/reversal/truth.json")).expect("truth json");
+        let u = coordinates(&joint, |name| {
+            truth["params"][name].as_f64().expect("true value")
+        });
+        let own = joint.cost_at_stage(&u, SearchStage::SignalLocal);
+        let alone = one.cost_at_stage(&u, SearchStage::Local);
+        assert!(
+            (own - alone).abs() <= 1e-9 * alone.abs().max(1.0),
+            "{own} against {alone}"
+        );
+        let near = |p: &SpectralProblem| p.near_best.lock().unwrap().at_most(f64::INFINITY).count();
+        assert_eq!(
+            near(&joint),
+            0,
+            "a signal-route point kept among the near-best"
+        );
+        let both = joint.cost_at_stage(&u, SearchStage::Local);
+        assert!(
+            both - own > 10.0,
+            "joint {both} against the signal's own {own}"
+        );
+        joint.cost_at_stage(&u, SearchStage::SignalPolish);
+        assert_eq!(near(&joint), 1, "the signal route's polish point not kept");
     }
 
     /// A polish cut short (10 iterations) from A ×0.9 and B ×0.85 of the truth

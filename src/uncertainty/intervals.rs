@@ -1143,6 +1143,7 @@ impl ReplicateSource {
             objective: problem.objective,
             weights: problem.weights,
             likelihood: Err(crate::search::NoLikelihood::NotBuilt),
+            signal_likelihood: None,
             evaluations: problem.evaluations.clone(),
             failures: problem.failures.clone(),
             failure_causes: problem.failure_causes.clone(),
