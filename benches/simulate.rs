@@ -124,6 +124,7 @@ fn cost(c: &mut Criterion) {
         objective: Objective::Likelihood,
         weights: Weights::default(),
         likelihood: Err(wiperlab::search::NoLikelihood::NotBuilt),
+        signal_likelihood: None,
         evaluations: Arc::new(AtomicUsize::new(0)),
         failures: std::sync::Arc::new(AtomicUsize::new(0)),
         failure_causes: Default::default(),

@@ -45,6 +45,11 @@ struct Args {
     /// far the finite differences of the information move with it (a `#`-line per job).
     #[arg(long)]
     fisher: bool,
+    /// Also the Fisher information's 1σ with central differences of steps 1e-3, 3e-3, 1e-2,
+    /// 3e-2 and 1e-1 (normalised units; the fits' own is 3e-3): where the response jitters, the
+    /// differences read the jitter over the step, and the 1σ grows with it.
+    #[arg(long)]
+    fisher_steps: bool,
     /// Read each job's fit from `<DIR>/<job stem>.result.toml` (a campaign's `results/`) and
     /// check there instead of at the truth: whether the search's optimum is a draw that suits the
     /// recording (its cost below the mean of its neighbours' draws). A job whose result chose
@@ -131,6 +136,13 @@ fn jitters(args: &Args, joint: &[SignalKind], path: &Path) -> Fallible<()> {
                 signals.join("+")
             ),
         }
+        if args.fisher_steps {
+            println!(
+                "# steps {name} {}: {}",
+                signals.join("+"),
+                fisher_by_step(&problem, &u)
+            );
+        }
         if args.fisher {
             println!(
                 "# {name} {}: {}",
@@ -172,6 +184,33 @@ fn fisher_sigmas(problem: &wiperlab::search::SpectralProblem, u: &[f64]) -> Stri
                 }
                 Err(e) => format!("[{e}]"),
             }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// The Fisher 1σ of each coordinate at `u` with central differences of several steps, each set
+/// in brackets after its step.
+fn fisher_by_step(problem: &wiperlab::search::SpectralProblem, u: &[f64]) -> String {
+    let Ok(lik) = problem.likelihood.as_ref() else {
+        return "no likelihood".into();
+    };
+    let parts = match problem
+        .simulate(&problem.params_at(u))
+        .and_then(|sim| lik.nll(problem, &sim))
+    {
+        Ok(p) => p,
+        Err(e) => return format!("{e}"),
+    };
+    [1e-3, 3e-3, 1e-2, 3e-2, 1e-1]
+        .iter()
+        .map(|h| match lik.fisher_with_step(problem, u, &parts, *h) {
+            Ok(f) => {
+                let (sigma, _) = wiperlab::likelihood::covariance::covariance(&f);
+                let s: Vec<String> = sigma.iter().map(|x| format!("{x:.2e}")).collect();
+                format!("{h:e} [{}]", s.join(" "))
+            }
+            Err(e) => format!("{h:e} [{e}]"),
         })
         .collect::<Vec<_>>()
         .join(" ")

@@ -171,3 +171,61 @@ fn the_rounding_widens_the_spread_where_the_slip_is_unstable_and_nowhere_else() 
         jittery.rounding_widening
     );
 }
+
+#[test]
+fn where_the_response_jitters_the_fisher_steps_grow_until_the_information_is_the_bowls() {
+    // A central difference of step h over a response that carries the rounding's draws (variance
+    // ε² per component) carries noise of variance ε²/(2h²), which JᵀWJ reads as information
+    // (Moré & Wild 2011, ACM TOMS 38:19). With B × 2 (the cost jitters by about a hundred nats
+    // at this truth, docs/validation.md, "Jitter") the Fisher 1σ at the fits' own step 3e-3
+    // is that noise's: it grows with the step. The sandwich's steps then grow until the noise
+    // makes up at most a tenth of each column's information, and the 1σ there is the one the
+    // larger step reads. At the truth itself, where tip − head x hardly jitters, no step grows.
+    use wiperlab::likelihood::covariance::covariance;
+    use wiperlab::search::evidence::{FISHER_STEP_U, at_fit_smoothed};
+    let (one, u) = problem(&[]);
+    let calm = at_fit_smoothed(&one, &u).expect("the spread at the truth");
+    assert!(
+        calm.fisher_steps_u.iter().all(|h| *h == FISHER_STEP_U),
+        "{:?}",
+        calm.fisher_steps_u
+    );
+    let b = one
+        .free
+        .iter()
+        .position(|f| f.name == wiperlab::model::ParamId::B)
+        .expect("B is freed");
+    let mut steep = u.clone();
+    steep[b] = one.free[b].u_of(2.0 * one.free[b].value(u[b]));
+    let jittery = at_fit_smoothed(&one, &steep).expect("the spread with B doubled");
+    let lik = one.likelihood.as_ref().expect("a likelihood");
+    let parts = lik
+        .nll(
+            &one,
+            &one.simulate(&one.params_at(&steep)).expect("simulates"),
+        )
+        .expect("the NLL");
+    let sigma_at =
+        |h: f64| covariance(&lik.fisher_with_step(&one, &steep, &parts, h).expect("F")).0;
+    let (own, wide) = (sigma_at(FISHER_STEP_U), sigma_at(10.0 * FISHER_STEP_U));
+    println!(
+        "steps {:?}; Fisher 1σ at 3e-3 {own:?}, at 3e-2 {wide:?}, adapted {:?}",
+        jittery.fisher_steps_u, jittery.curvature_sigma_u
+    );
+    // The noise's signature: a ten-fold step widens some coordinate's 1σ more than three-fold.
+    assert!(own.iter().zip(&wide).any(|(a, b)| *b > 3.0 * a));
+    assert!(jittery.fisher_steps_u.iter().any(|h| *h > FISHER_STEP_U));
+    for (i, (adapted, fixed)) in jittery.curvature_sigma_u.iter().zip(&own).enumerate() {
+        assert!(
+            *adapted >= *fixed,
+            "coordinate {i}: adapted 1σ {adapted:.2e} below the fixed step's {fixed:.2e}"
+        );
+    }
+    assert!(
+        jittery
+            .curvature_sigma_u
+            .iter()
+            .zip(&own)
+            .any(|(a, f)| *a > 2.0 * f)
+    );
+}

@@ -48,6 +48,15 @@ use serde::{Deserialize, Serialize};
 /// stick–slip comb's jumps enter the differences and the intervals move.
 pub const FISHER_STEP_U: f64 = 3e-3;
 
+/// The largest step the central differences of a coordinate grow to where the response jitters
+/// ([`RecordingLikelihood::noise_adapted`]), normalised units: a tenth of the box.
+pub const MAX_FISHER_STEP_U: f64 = 0.1;
+
+/// The share of a Jacobian column's information `Σ w J²` that the rounding's noise in its
+/// differences may make up before the step grows ([`RecordingLikelihood::noise_adapted`]): at
+/// 0.1 the noise inflates that coordinate's information by at most about 10 %, its 1σ by 5 %.
+pub const FISHER_NOISE_SHARE: f64 = 0.1;
+
 /// Half-span, in the whitened coordinates of `F⁻¹` (1 = the bowl's 1σ along an axis), of the
 /// points whose Jacobians the sandwich averages ([`RecordingLikelihood::smoothed_jacobian`]).
 pub const SANDWICH_SPAN_SIGMA: f64 = 0.5;
@@ -721,14 +730,44 @@ impl RecordingLikelihood {
         h: f64,
         metric: Option<&joint::Metric>,
     ) -> Result<Jacobian> {
+        let steps: Vec<(usize, f64)> = (0..u.len()).map(|i| (i, h)).collect();
+        Ok(Jacobian {
+            columns: self.difference_columns(problem, u, &steps, metric)?,
+        })
+    }
+
+    /// [`RecordingLikelihood::jacobian`] with a step of its own for each coordinate.
+    fn jacobian_with_steps(
+        &self,
+        problem: &SpectralProblem,
+        u: &[f64],
+        steps: &[f64],
+        metric: Option<&joint::Metric>,
+    ) -> Result<Jacobian> {
+        let steps: Vec<(usize, f64)> = steps.iter().copied().enumerate().collect();
+        Ok(Jacobian {
+            columns: self.difference_columns(problem, u, &steps, metric)?,
+        })
+    }
+
+    /// The response's derivatives at `u` along the coordinates `steps` names, each by central
+    /// differences of its own step ([`difference_column`]), in parallel, the joint signals' part
+    /// whitened by `metric`.
+    fn difference_columns(
+        &self,
+        problem: &SpectralProblem,
+        u: &[f64],
+        steps: &[(usize, f64)],
+        metric: Option<&joint::Metric>,
+    ) -> Result<Vec<Vec<f64>>> {
         use rayon::prelude::*;
         let response_at = |p: &[f64]| -> Result<Vec<f64>> {
             self.response(problem, &problem.simulate(&problem.params_at(p))?)
         };
         let center = std::sync::OnceLock::<Option<Vec<f64>>>::new();
-        let columns: Vec<Vec<f64>> = (0..u.len())
-            .into_par_iter()
-            .map(|i| {
+        let mut columns: Vec<Vec<f64>> = steps
+            .par_iter()
+            .map(|&(i, h)| {
                 let at = |v: f64| {
                     let mut p = u.to_vec();
                     p[i] = v;
@@ -738,19 +777,76 @@ impl RecordingLikelihood {
                 difference_column(at, center, u[i], h)
             })
             .collect::<Result<_>>()?;
-        let mut j = Jacobian { columns };
         if let (Some(joint), Some(metric)) = (&self.joint, metric) {
             let n = self.spectral_len();
-            for c in &mut j.columns {
+            for c in &mut columns {
                 let white = joint.whiten(metric, &c[..n]);
                 c[..n].copy_from_slice(&white);
             }
         }
-        Ok(j)
+        Ok(columns)
+    }
+
+    /// The Jacobian `j` (central differences of [`FISHER_STEP_U`] at `u`) with each column's step
+    /// grown, three-fold at a time up to [`MAX_FISHER_STEP_U`], until the rounding's noise makes
+    /// up no more than [`FISHER_NOISE_SHARE`] of the column's information. `draws`: the
+    /// responses' deviations at the rounding points ([`RecordingLikelihood::rounding_draws`]);
+    /// `w`: the weights `W`. Returns the Jacobian, each coordinate's step and the simulations
+    /// it took (2 per column recomputed). No draws, or draws that do not differ: `j` as it is.
+    ///
+    /// Why: where the slip is unstable each simulation carries a draw of the onset's noise of
+    /// variance `ε²` per response component ([`RecordingLikelihood::rounding_variability`]), so
+    /// a central difference of step `h` carries noise of variance `ε²/(2h²)`, which `JᵀWJ` reads
+    /// as information: with the fits' own step the information of such a recording is the
+    /// noise's, and the 1σ grows in proportion to the step (docs/validation.md, "Jitter").
+    /// Choosing the step against the function's noise is the standard remedy for differences
+    /// of a noisy simulation (Moré & Wild 2011, "Estimating derivatives of noisy simulations",
+    /// *ACM TOMS* 38:19). Where the response does not jitter the step stays [`FISHER_STEP_U`].
+    fn noise_adapted(
+        &self,
+        problem: &SpectralProblem,
+        u: &[f64],
+        mut j: Jacobian,
+        w: &[f64],
+        draws: &[Vec<f64>],
+        metric: Option<&joint::Metric>,
+    ) -> Result<(Jacobian, Vec<f64>, usize)> {
+        let mut steps = vec![FISHER_STEP_U; u.len()];
+        let Some(noise) = noise_information(draws, w) else {
+            return Ok((j, steps, 0));
+        };
+        let mut sims = 0;
+        loop {
+            let grow: Vec<(usize, f64)> = j
+                .columns
+                .iter()
+                .enumerate()
+                .filter(|(i, c)| {
+                    let info: f64 = c.iter().zip(w).map(|(a, wk)| wk * a * a).sum();
+                    let h = steps[*i];
+                    h < MAX_FISHER_STEP_U && noise / (2.0 * h * h) > FISHER_NOISE_SHARE * info
+                })
+                .map(|(i, _)| (i, (3.0 * steps[i]).min(MAX_FISHER_STEP_U)))
+                .collect();
+            if grow.is_empty() {
+                return Ok((j, steps, sims));
+            }
+            sims += 2 * grow.len();
+            let columns = self.difference_columns(problem, u, &grow, metric)?;
+            for (&(i, h), c) in grow.iter().zip(columns) {
+                if c.len() != j.columns[i].len() {
+                    steps[i] = MAX_FISHER_STEP_U;
+                    continue;
+                }
+                steps[i] = h;
+                j.columns[i] = c;
+            }
+        }
     }
 
     /// The response's linearisation over the central part of the likelihood's bowl: the mean of
-    /// the Jacobian `j` at `u` and of the Jacobians at `u ± r·L eᵢ`, with `r` =
+    /// the Jacobian `j` at `u` (each coordinate differenced with its step of `steps`) and of the
+    /// Jacobians with the same steps at `u ± r·L eᵢ`, with `r` =
     /// [`SANDWICH_SPAN_SIGMA`], `L` the Cholesky factor of `F⁻¹ = (jᵀWj)⁻¹` (`w`: the weights
     /// `W`) and `eᵢ` the axes; points outside the box are moved onto it, and a displaced Jacobian
     /// whose response lost samples is left out. `j` itself where `F` is singular. Returns the mean
@@ -767,7 +863,7 @@ impl RecordingLikelihood {
         &self,
         problem: &SpectralProblem,
         u: &[f64],
-        j: Jacobian,
+        (j, steps): (Jacobian, &[f64]),
         w: &[f64],
         metric: Option<&joint::Metric>,
     ) -> Result<(Jacobian, usize)> {
@@ -783,7 +879,7 @@ impl RecordingLikelihood {
                     .map(|a| (u[a] + sign * SANDWICH_SPAN_SIGMA * l[(a, i)]).clamp(0.0, 1.0))
                     .collect();
                 sims += 2 * k;
-                let Ok(ji) = self.jacobian(problem, &at, FISHER_STEP_U, metric) else {
+                let Ok(ji) = self.jacobian_with_steps(problem, &at, steps, metric) else {
                     continue;
                 };
                 if ji.columns[0].len() != sum[0].len() {
@@ -833,33 +929,21 @@ impl RecordingLikelihood {
         Ok(sample_covariance(&scores))
     }
 
-    /// The variability the trajectory's sensitivity to rounding adds to `V`
-    /// ([`RecordingLikelihood::variability`]), normalised coordinates (`k × k`, positive
-    /// semi-definite): twice the sample covariance of the scores `Jᵀ W (ρ_r − ρ̄)` of the responses
-    /// `ρ_r` simulated at `u` and at [`crate::search::jitter::JITTER_STEP_U`] either way along each coordinate
-    /// (`2k + 1` simulations, returned with the matrix). A step whose simulation fails or whose
-    /// response differs in length from the Jacobian's is left out; with fewer than three left the
-    /// matrix is zero (the draws cannot be told from the steps).
-    ///
-    /// Why: where the slip near the reversal is unstable, the growing oscillation's onset is seeded
-    /// by the integrator's error ([`crate::search::jitter`]), so the model's spectra at one
-    /// parameter point are one draw among many that differ by far more than the parameters' effect
-    /// over that step. The recording carries a draw of its own and the model at the fit another,
-    /// independent of it and of the tracking noise: each adds the draws' covariance to the score's
-    /// variance, hence the factor 2. Zero where the motion does not depend on rounding. What it
-    /// leaves out: the search picks, among nearby draws, the ones that suit the recording, which
-    /// moves the estimate further than one draw does (docs/uncertainty.md, "Jitter").
-    fn rounding_variability(
+    /// The responses simulated at `u` and at [`crate::search::jitter::JITTER_STEP_U`] either way
+    /// along each coordinate ([`crate::search::jitter::rounding_points`]), as deviations from
+    /// their mean, the joint signals' part whitened by `metric`; and the simulations made
+    /// (`2k + 1`). A step whose simulation fails or whose response differs in length from `len`
+    /// (the Jacobian's) is left out; with fewer than three left there are no draws (they cannot
+    /// be told from the steps).
+    fn rounding_draws(
         &self,
         problem: &SpectralProblem,
         u: &[f64],
-        j: &Jacobian,
-        w: &[f64],
+        len: usize,
         metric: Option<&joint::Metric>,
-    ) -> (DMatrix<f64>, usize) {
+    ) -> (Vec<Vec<f64>>, usize) {
         use rayon::prelude::*;
         let points = super::jitter::rounding_points(u);
-        let len = j.columns[0].len();
         let responses: Vec<Vec<f64>> = points
             .par_iter()
             .filter_map(|p| {
@@ -869,13 +953,13 @@ impl RecordingLikelihood {
             .filter(|r| r.len() == len)
             .collect();
         if responses.len() < 3 {
-            return (DMatrix::zeros(u.len(), u.len()), points.len());
+            return (Vec::new(), points.len());
         }
         let n = responses.len() as f64;
         let mean: Vec<f64> = (0..len)
             .map(|c| responses.iter().map(|r| r[c]).sum::<f64>() / n)
             .collect();
-        let scores: Vec<Vec<f64>> = responses
+        let draws = responses
             .iter()
             .map(|r| {
                 let mut d: Vec<f64> = r.iter().zip(&mean).map(|(a, b)| a - b).collect();
@@ -884,10 +968,32 @@ impl RecordingLikelihood {
                     let white = joint.whiten(metric, &d[..n]);
                     d[..n].copy_from_slice(&white);
                 }
-                j.score(w, &d)
+                d
             })
             .collect();
-        (sample_covariance(&scores) * 2.0, points.len())
+        (draws, points.len())
+    }
+
+    /// The variability the trajectory's sensitivity to rounding adds to `V`
+    /// ([`RecordingLikelihood::variability`]), normalised coordinates (`k × k`, positive
+    /// semi-definite): twice the sample covariance of the scores `Jᵀ W (ρ_r − ρ̄)` of the
+    /// rounding's draws ([`RecordingLikelihood::rounding_draws`]); zero without draws.
+    ///
+    /// Why: where the slip near the reversal is unstable, the growing oscillation's onset is seeded
+    /// by the integrator's error ([`crate::search::jitter`]), so the model's spectra at one
+    /// parameter point are one draw among many that differ by far more than the parameters' effect
+    /// over that step. The recording carries a draw of its own and the model at the fit another,
+    /// independent of it and of the tracking noise: each adds the draws' covariance to the score's
+    /// variance, hence the factor 2. Zero where the motion does not depend on rounding. What it
+    /// leaves out: the search picks, among nearby draws, the ones that suit the recording, which
+    /// moves the estimate further than one draw does (docs/uncertainty.md, "Jitter").
+    fn rounding_variability(&self, j: &Jacobian, w: &[f64], draws: &[Vec<f64>]) -> DMatrix<f64> {
+        let k = j.columns.len();
+        if draws.len() < 3 {
+            return DMatrix::zeros(k, k);
+        }
+        let scores: Vec<Vec<f64>> = draws.iter().map(|d| j.score(w, d)).collect();
+        sample_covariance(&scores) * 2.0
     }
 
     /// What the noise replicates of the simulation `sim` are drawn around
@@ -1264,6 +1370,22 @@ fn difference_column(
     Err(first_error.expect("two steps were tried"))
 }
 
+/// `Σ_c w_c ε_c²`: the rounding's noise variance `ε_c²` of each response component (the sample
+/// variance over `draws`, deviations from their mean) weighted by `w`; `None` without three
+/// draws or where the draws do not differ.
+fn noise_information(draws: &[Vec<f64>], w: &[f64]) -> Option<f64> {
+    if draws.len() < 3 {
+        return None;
+    }
+    let n = draws.len() as f64;
+    let total: f64 = w
+        .iter()
+        .enumerate()
+        .map(|(c, wc)| wc * draws.iter().map(|d| d[c] * d[c]).sum::<f64>() / (n - 1.0))
+        .sum();
+    (total > 0.0 && total.is_finite()).then_some(total)
+}
+
 /// `(r1 − r0)/(v1 − v0)` component by component.
 fn slope(r0: &[f64], v0: f64, r1: &[f64], v1: f64) -> Vec<f64> {
     r1.iter()
@@ -1332,6 +1454,10 @@ pub struct LocalFit {
     /// much the rounding's draws widen the spread ([`at_fit_smoothed`]; 1 for [`at_fit`], NaN
     /// where either 1σ is not finite and positive).
     pub rounding_widening: Vec<f64>,
+    /// The step of each coordinate's central differences in `F` and `V` (normalised units):
+    /// [`FISHER_STEP_U`], grown where the rounding's noise would make up the information
+    /// ([`at_fit_smoothed`]; the main recording's in a joint fit).
+    pub fisher_steps_u: Vec<f64>,
 }
 
 /// The likelihood of `problem`'s recording (and of a joint fit's further recordings, whose NLLs,
@@ -1379,7 +1505,7 @@ pub fn at_fit_smoothed(problem: &SpectralProblem, u: &[f64]) -> Result<LocalFit>
 /// [`at_fit`] and [`at_fit_smoothed`].
 fn local_fit(problem: &SpectralProblem, u: &[f64], spread: Spread) -> Result<LocalFit> {
     let (mut nll, mut info, var) = information(problem, u, spread)?;
-    let (mut var, rounding) = var.expect("asked for");
+    let (mut var, rounding, fisher_steps_u) = var.expect("asked for");
     // Model choice reads the likelihood's own penalty, whose V is the tracking noise's; the
     // rounding's draws then widen the spread, and the prior's information adds to both sides of
     // the sandwich as a pseudo-observation's (docs/priors.md, "Priors").
@@ -1403,6 +1529,7 @@ fn local_fit(problem: &SpectralProblem, u: &[f64], spread: Spread) -> Result<Loc
         curvature_sigma_u,
         curvature_corr,
         rounding_widening,
+        fisher_steps_u,
     })
 }
 
@@ -1431,6 +1558,7 @@ fn information(
     let mut info = DMatrix::<f64>::zeros(u.len(), u.len());
     let mut var = DMatrix::<f64>::zeros(u.len(), u.len());
     let mut rounding = DMatrix::<f64>::zeros(u.len(), u.len());
+    let mut main_steps: Option<Vec<f64>> = None;
     for p in std::iter::once(problem).chain(&problem.others) {
         let lik = p
             .likelihood
@@ -1444,10 +1572,13 @@ fn information(
         let mut sims = 1 + 2 * u.len();
         let j = match spread {
             Spread::Smoothed => {
-                let (j, more) = lik.smoothed_jacobian(p, u, j, &w, metric.as_ref())?;
-                let (r, rounding_sims) = lik.rounding_variability(p, u, &j, &w, metric.as_ref());
-                rounding += r;
-                sims += more + rounding_sims;
+                let len = j.columns[0].len();
+                let (draws, rounding_sims) = lik.rounding_draws(p, u, len, metric.as_ref());
+                let (j, steps, grown) = lik.noise_adapted(p, u, j, &w, &draws, metric.as_ref())?;
+                main_steps.get_or_insert_with(|| steps.clone());
+                let (j, more) = lik.smoothed_jacobian(p, u, (j, &steps), &w, metric.as_ref())?;
+                rounding += lik.rounding_variability(&j, &w, &draws);
+                sims += rounding_sims + grown + more;
                 j
             }
             Spread::CurvatureOnly | Spread::AtPoint => j,
@@ -1477,14 +1608,18 @@ fn information(
     Ok((
         nll.expect("the main recording is always there"),
         info,
-        (spread != Spread::CurvatureOnly).then_some((var, rounding)),
+        (spread != Spread::CurvatureOnly).then(|| {
+            let steps = main_steps.unwrap_or_else(|| vec![FISHER_STEP_U; u.len()]);
+            (var, rounding, steps)
+        }),
     ))
 }
 
 /// The variability `V` of [`information`]: the tracking noise's
 /// ([`RecordingLikelihood::variability`]) and the rounding's
-/// ([`RecordingLikelihood::rounding_variability`], zero unless [`Spread::Smoothed`]).
-type Variability = (DMatrix<f64>, DMatrix<f64>);
+/// ([`RecordingLikelihood::rounding_variability`], zero unless [`Spread::Smoothed`]), and the
+/// main recording's steps of the differences ([`LocalFit::fisher_steps_u`]).
+type Variability = (DMatrix<f64>, DMatrix<f64>, Vec<f64>);
 
 /// What [`information`] linearises the response with, and whether it estimates the variability.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
