@@ -229,3 +229,48 @@ fn where_the_response_jitters_the_fisher_steps_grow_until_the_information_is_the
             .any(|(a, f)| *a > 2.0 * f)
     );
 }
+
+#[test]
+fn a_profile_that_rises_by_less_than_the_jitter_is_not_walked_and_the_sandwich_stands_in() {
+    // docs/likelihood.md, "Jitter": with B × 2 the cost at this truth jitters by about a hundred
+    // nats under rounding-level steps (docs/validation.md, "Jitter"), more than any rise limit
+    // 0.5·σ²_sandwich/σ²_Fisher, so no parameter's profile is walked: each interval is the
+    // sandwich's ±1σ (`laplace_intervals`), and the fit warns `cost_jitter`.
+    use std::sync::Arc;
+    use wiperlab::estimate::IntervalMethod;
+    use wiperlab::search::evidence::at_fit_smoothed;
+    use wiperlab::uncertainty::{ProfileStart, laplace_intervals, profile_intervals_at};
+    let (one, u) = problem(&[]);
+    let b = one
+        .free
+        .iter()
+        .position(|f| f.name == wiperlab::model::ParamId::B)
+        .expect("B is freed");
+    let mut steep = u.clone();
+    steep[b] = one.free[b].u_of(2.0 * one.free[b].value(u[b]));
+    let one = Arc::new(one);
+    let local = at_fit_smoothed(&one, &steep).expect("the spread with B doubled");
+    let start = ProfileStart {
+        u: &steep,
+        cost_nats: one.cost_at(&steep),
+        sigma_u: &local.sigma_u,
+        fisher_sigma_u: &local.curvature_sigma_u,
+        fisher_corr: Some(&local.curvature_corr),
+    };
+    let before = one.evaluations.load(std::sync::atomic::Ordering::Relaxed);
+    let (intervals, warnings) = profile_intervals_at(&one, start, 30).expect("intervals");
+    let walked = one.evaluations.load(std::sync::atomic::Ordering::Relaxed) - before;
+    let laplace = laplace_intervals(&one.free, &steep, &local.sigma_u);
+    assert_eq!(intervals, laplace);
+    assert!(
+        warnings.iter().any(|w| w.kind() == "cost_jitter"),
+        "{warnings:?}"
+    );
+    // Only the jitter check's 2k + 1 simulations: no polish ran.
+    assert_eq!(walked, 2 * steep.len() + 1);
+    assert!(
+        intervals
+            .iter()
+            .all(|i| matches!(i.method, IntervalMethod::Laplace { .. }))
+    );
+}
