@@ -16,11 +16,12 @@ use argmin::solver::neldermead::NelderMead;
 use clap::Parser;
 #[path = "common/campaign.rs"]
 mod campaign;
-use campaign::{JobSource, truth_u};
+#[path = "common/fitted.rs"]
+mod fitted;
+use campaign::JobSource;
 use std::path::{Path, PathBuf};
-use wiperlab::job::LoadedJob;
+use wiperlab::search::SpectralProblem;
 use wiperlab::search::jitter::rounding_points;
-use wiperlab::search::{SpectralProblem, problem_for};
 
 #[derive(Parser)]
 struct Args {
@@ -73,25 +74,12 @@ fn main() -> Fallible<()> {
 }
 
 fn one(args: &Args, path: &Path) -> Fallible<()> {
-    let job = LoadedJob::load(path)?;
-    let candidate = args.source.candidate(&job, path)?;
-    let name = path
-        .file_stem()
-        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-    let file = args.fitted.join(format!("{name}.result.toml"));
-    let result: wiperlab::fit::FitResult = toml::from_str(&std::fs::read_to_string(&file)?)?;
-    if result.model != candidate {
-        return Err(format!("the fit chose {}", result.model).into());
-    }
-    let problem = problem_for(&job, candidate)?;
-    let ut = truth_u(&job, &problem)?;
-    let uf: Vec<f64> = (problem.free.iter())
-        .map(|f| {
-            let p = result.parameters.iter().find(|p| p.name == f.name);
-            p.map(|p| f.u_of(p.value))
-                .ok_or(format!("no fitted {}", f.name))
-        })
-        .collect::<Result<_, _>>()?;
+    let fitted::Fitted {
+        name,
+        problem,
+        fit_u: uf,
+        truth_u: ut,
+    } = fitted::read(&args.source, &args.fitted, path)?;
     let avg = Averaged(&problem);
     let simplex: Vec<Vec<f64>> = std::iter::once(uf.clone())
         .chain((0..uf.len()).map(|i| {

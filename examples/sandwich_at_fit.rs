@@ -12,13 +12,11 @@
 use clap::Parser;
 #[path = "common/campaign.rs"]
 mod campaign;
-use campaign::{JobSource, truth_u};
+#[path = "common/fitted.rs"]
+mod fitted;
+use campaign::JobSource;
 use std::path::{Path, PathBuf};
-
-use wiperlab::fit::FitResult;
-use wiperlab::job::LoadedJob;
 use wiperlab::search::evidence::at_fit_smoothed;
-use wiperlab::search::problem_for;
 
 #[derive(Parser)]
 struct Args {
@@ -46,40 +44,16 @@ fn main() -> Fallible<()> {
 /// One row per parameter of the fit of the job at `path`, when it chose the candidate (the true
 /// model unless `--model`).
 fn spread(args: &Args, path: &Path) -> Fallible<()> {
-    let job = LoadedJob::load(path)?;
-    let candidate = args.source.candidate(&job, path)?;
-    let stem = path
-        .file_stem()
-        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-    let result_path = args.fitted.join(format!("{stem}.result.toml"));
-    let text = std::fs::read_to_string(&result_path)
-        .map_err(|e| format!("{}: {e}", result_path.display()))?;
-    let result: FitResult = toml::from_str(&text)?;
-    if result.model != candidate {
-        return Err(format!("the fit chose {}", result.model).into());
-    }
-    let problem = problem_for(&job, result.model)?;
-    let truth = truth_u(&job, &problem)?;
-    let fit: Vec<f64> = problem
-        .free
-        .iter()
-        .map(|f| {
-            result
-                .parameters
-                .iter()
-                .find(|p| p.name == f.name)
-                .map(|p| f.u_of(p.value))
-                .ok_or(format!("the result has no {}", f.name))
-        })
-        .collect::<Result<_, _>>()?;
-    let local = at_fit_smoothed(&problem, &fit)?;
-    for (i, f) in problem.free.iter().enumerate() {
+    let f = fitted::read(&args.source, &args.fitted, path)?;
+    let local = at_fit_smoothed(&f.problem, &f.fit_u)?;
+    for (i, p) in f.problem.free.iter().enumerate() {
         let s = local.sigma_u[i];
         println!(
-            "{stem},{},{},{s:.3e},{:.2},{:.2}",
-            result.model,
+            "{},{},{},{s:.3e},{:.2},{:.2}",
             f.name,
-            (truth[i] - fit[i]) / s,
+            f.problem.model,
+            p.name,
+            (f.truth_u[i] - f.fit_u[i]) / s,
             local.rounding_widening[i]
         );
     }

@@ -32,6 +32,19 @@ fn problem(joint: &[SignalKind]) -> (wiperlab::search::SpectralProblem, Vec<f64>
     (p, u)
 }
 
+/// `u` with B doubled: the Stribeck slope −A·B at zero slip speed twice the truth's, where the
+/// cost jitters by about a hundred nats (docs/validation.md, "Jitter").
+fn b_doubled(p: &wiperlab::search::SpectralProblem, u: &[f64]) -> Vec<f64> {
+    let b = p
+        .free
+        .iter()
+        .position(|f| f.name == wiperlab::model::ParamId::B)
+        .expect("B is freed");
+    let mut steep = u.to_vec();
+    steep[b] = p.free[b].u_of(2.0 * p.free[b].value(u[b]));
+    steep
+}
+
 #[test]
 fn head_y_read_with_the_signal_narrows_every_curvature_interval_at_the_truth() {
     let (one, u) = problem(&[]);
@@ -156,13 +169,7 @@ fn the_rounding_widens_the_spread_where_the_slip_is_unstable_and_nowhere_else() 
         "{:?}",
         calm.rounding_widening
     );
-    let b = one
-        .free
-        .iter()
-        .position(|f| f.name == wiperlab::model::ParamId::B)
-        .expect("B is freed");
-    let mut steep = u.clone();
-    steep[b] = one.free[b].u_of(2.0 * one.free[b].value(u[b]));
+    let steep = b_doubled(&one, &u);
     let jittery = at_fit_smoothed(&one, &steep).expect("the spread with B doubled");
     println!("widening with B doubled: {:?}", jittery.rounding_widening);
     assert!(
@@ -190,13 +197,7 @@ fn where_the_response_jitters_the_fisher_steps_grow_until_the_information_is_the
         "{:?}",
         calm.fisher_steps_u
     );
-    let b = one
-        .free
-        .iter()
-        .position(|f| f.name == wiperlab::model::ParamId::B)
-        .expect("B is freed");
-    let mut steep = u.clone();
-    steep[b] = one.free[b].u_of(2.0 * one.free[b].value(u[b]));
+    let steep = b_doubled(&one, &u);
     let jittery = at_fit_smoothed(&one, &steep).expect("the spread with B doubled");
     let lik = one.likelihood.as_ref().expect("a likelihood");
     let parts = lik
@@ -241,13 +242,7 @@ fn a_profile_that_rises_by_less_than_the_jitter_is_not_walked_and_the_sandwich_s
     use wiperlab::search::evidence::at_fit_smoothed;
     use wiperlab::uncertainty::{ProfileStart, laplace_intervals, profile_intervals_at};
     let (one, u) = problem(&[]);
-    let b = one
-        .free
-        .iter()
-        .position(|f| f.name == wiperlab::model::ParamId::B)
-        .expect("B is freed");
-    let mut steep = u.clone();
-    steep[b] = one.free[b].u_of(2.0 * one.free[b].value(u[b]));
+    let steep = b_doubled(&one, &u);
     let one = Arc::new(one);
     let local = at_fit_smoothed(&one, &steep).expect("the spread with B doubled");
     let start = ProfileStart {
