@@ -246,6 +246,9 @@ pub(crate) struct CandidateFit {
     /// How much the rounding's draws widen each coordinate's 1σ
     /// ([`super::evidence::LocalFit::rounding_widening`]), once the smoothed spread is in.
     pub(crate) rounding_widening: Option<Vec<f64>>,
+    /// The step of each coordinate's differences in that spread
+    /// ([`super::evidence::LocalFit::fisher_steps_u`]).
+    pub(crate) fisher_steps_u: Option<Vec<f64>>,
     /// The recording's NLL at the optimum (`sigma_u` and `corr` then come from its sandwich
     /// covariance, [`super::evidence::at_fit`]), or why there is none (then from the cost's
     /// curvature).
@@ -293,6 +296,7 @@ impl CandidateFit {
             self.fisher_sigma_u = Some(l.curvature_sigma_u);
             self.fisher_corr = Some(l.curvature_corr);
             self.rounding_widening = Some(l.rounding_widening);
+            self.fisher_steps_u = Some(l.fisher_steps_u);
             self.evidence = Ok(l.nll);
         }
         self
@@ -1014,6 +1018,7 @@ fn finish(
         fisher_sigma_u,
         fisher_corr,
         rounding_widening: None,
+        fisher_steps_u: None,
         evidence,
         swarm_iters,
         polish_iters,

@@ -91,7 +91,12 @@ fn auto_intervals(
     if let Err(why) = &cf.evidence {
         return Ok((None, vec![no_intervals(UncertaintyMethod::Auto, why)], None));
     }
-    let laplace = laplace_intervals(&cf.free, &cf.best_u, &cf.sigma_u);
+    let laplace = laplace_intervals(
+        &cf.free,
+        &cf.best_u,
+        &cf.sigma_u,
+        cf.fisher_steps_u.as_deref(),
+    );
     let mut reached = laplace.clone();
     along_contact_ridge(cf, &mut reached);
     near_best_of(cf, &mut reached);
@@ -186,7 +191,12 @@ fn other_intervals(
     match fit.uncertainty.method() {
         UncertaintyMethod::Laplace => match &cf.evidence {
             Ok(_) => {
-                let mut intervals = laplace_intervals(&cf.free, &cf.best_u, &cf.sigma_u);
+                let mut intervals = laplace_intervals(
+                    &cf.free,
+                    &cf.best_u,
+                    &cf.sigma_u,
+                    cf.fisher_steps_u.as_deref(),
+                );
                 let mut warnings = secant_check(cf);
                 warnings.extend(along_contact_ridge(cf, &mut intervals));
                 warnings.extend(near_best_of(cf, &mut intervals));
@@ -354,7 +364,8 @@ pub(super) fn mcmc_intervals(
 
 /// Laplace intervals (68.27 %): `[θ(u − σ_u), θ(u + σ_u)]` for each freed parameter, with `σ_u`
 /// the 1σ of its normalised coordinate from the sandwich covariance `F⁻¹ V F⁻¹` of the recording's
-/// likelihood at the fit ([`crate::search::evidence::at_fit`]); through the search's coordinates, so a parameter
+/// likelihood at the fit ([`crate::search::evidence::at_fit`]), whose differences took the steps
+/// `steps_u` (default [`crate::search::evidence::FISHER_STEP_U`]); through the search's coordinates, so a parameter
 /// searched on a log scale gets an interval symmetric in `ln θ`. Every interval contains its
 /// estimate. A parameter the likelihood does not inform (`σ_u = ∞`) gets its search range.
 ///
@@ -362,11 +373,17 @@ pub(super) fn mcmc_intervals(
 /// the likelihood's maximiser (White 1982, *Econometrica* 50:1, Theorem 3.2, for a likelihood
 /// whose law is not exactly the data's), which the fit's estimate is with the default `[fit]
 /// objective = "likelihood"`; its coverage is measured in docs/validation.md, "Intervals".
-pub fn laplace_intervals(free: &[FreeParam], best_u: &[f64], sigma_u: &[f64]) -> Vec<Interval> {
+pub fn laplace_intervals(
+    free: &[FreeParam],
+    best_u: &[f64],
+    sigma_u: &[f64],
+    steps_u: Option<&[f64]>,
+) -> Vec<Interval> {
     free.iter()
         .zip(best_u)
         .zip(sigma_u)
-        .map(|((fp, u), s)| {
+        .enumerate()
+        .map(|(i, ((fp, u), s))| {
             let (lo, hi) = if s.is_finite() {
                 (fp.value_unclamped(u - s), fp.value_unclamped(u + s))
             } else {
@@ -377,7 +394,9 @@ pub fn laplace_intervals(free: &[FreeParam], best_u: &[f64], sigma_u: &[f64]) ->
                 hi,
                 level: 0.6827,
                 method: IntervalMethod::Laplace {
-                    fisher_step_u: crate::search::evidence::FISHER_STEP_U,
+                    fisher_step_u: steps_u
+                        .and_then(|h| h.get(i).copied())
+                        .unwrap_or(crate::search::evidence::FISHER_STEP_U),
                     noise_replicates: crate::search::evidence::NOISE_REPLICATES,
                     span_sigma: crate::search::evidence::SANDWICH_SPAN_SIGMA,
                 },
@@ -538,6 +557,10 @@ pub struct ProfileStart<'a> {
     /// which each step's polish is also started ([`valley_start`]); `None`: every polish starts
     /// where the previous one ended.
     pub fisher_corr: Option<&'a [Vec<f64>]>,
+    /// The step of each coordinate's differences in `sigma_u`
+    /// ([`crate::search::evidence::LocalFit::fisher_steps_u`]); `None`:
+    /// [`crate::search::evidence::FISHER_STEP_U`].
+    pub fisher_steps_u: Option<&'a [f64]>,
 }
 
 impl<'a> ProfileStart<'a> {
@@ -554,6 +577,7 @@ impl<'a> ProfileStart<'a> {
             sigma_u: &cf.sigma_u,
             fisher_sigma_u,
             fisher_corr: Some(fisher_corr),
+            fisher_steps_u: cf.fisher_steps_u.as_deref(),
         }
     }
 }
@@ -696,6 +720,7 @@ fn profile_with(
                 std::slice::from_ref(fp),
                 &at.u[i..=i],
                 &at.sigma_u[i..=i],
+                at.fisher_steps_u.map(|h| &h[i..=i]),
             ));
             continue;
         };
@@ -1450,7 +1475,7 @@ mod tests {
             .zip(&free)
             .map(|(v, f)| f.u_of(*v))
             .collect();
-        let iv = laplace_intervals(&free, &u, &[0.01, 0.01, 0.01]);
+        let iv = laplace_intervals(&free, &u, &[0.01, 0.01, 0.01], None);
         (free, u, iv)
     }
 
@@ -1587,13 +1612,14 @@ mod tests {
             sigma_u: &sigma,
             fisher_sigma_u: &sigma,
             fisher_corr: None,
+            fisher_steps_u: None,
         };
         // Closed form: on the quadratic bowl of 1σ = 0.01 in each coordinate, a point within
         // 0.5 nats has |Δu| ≤ 0.01 in each, so the Laplace intervals already hold every one.
         let bowl = |u: &[f64]| {
             ((u[0] - u0[0]) / sigma[0]).powi(2) / 2.0 + ((u[1] - u0[1]) / sigma[1]).powi(2) / 2.0
         };
-        let iv0 = laplace_intervals(&free, &u0, &sigma);
+        let iv0 = laplace_intervals(&free, &u0, &sigma, None);
         let mut iv = iv0.clone();
         let near = evaluated_grid(&u0, 0.05, bowl);
         let w = widen_to_near_best(&free, at, &near, &mut iv);

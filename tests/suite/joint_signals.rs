@@ -251,11 +251,17 @@ fn a_profile_that_rises_by_less_than_the_jitter_is_not_walked_and_the_sandwich_s
         sigma_u: &local.sigma_u,
         fisher_sigma_u: &local.curvature_sigma_u,
         fisher_corr: Some(&local.curvature_corr),
+        fisher_steps_u: Some(&local.fisher_steps_u),
     };
     let before = one.evaluations.load(std::sync::atomic::Ordering::Relaxed);
     let (intervals, warnings) = profile_intervals_at(&one, start, 30).expect("intervals");
     let walked = one.evaluations.load(std::sync::atomic::Ordering::Relaxed) - before;
-    let laplace = laplace_intervals(&one.free, &steep, &local.sigma_u);
+    let laplace = laplace_intervals(
+        &one.free,
+        &steep,
+        &local.sigma_u,
+        Some(&local.fisher_steps_u),
+    );
     assert_eq!(intervals, laplace);
     assert!(
         warnings.iter().any(|w| w.kind() == "cost_jitter"),
