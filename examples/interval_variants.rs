@@ -95,7 +95,6 @@ fn main() -> Fallible<()> {
             sigma_u: &lf.sigma_u,
             fisher_sigma_u: &fisher,
             fisher_corr: valley.then_some(lf.curvature_corr.as_slice()),
-            fisher_steps_u: Some(&lf.fisher_steps_u),
         };
         let (intervals, _) = profile_intervals_at(&p, at, job.job.fit.polish_iterations)?;
         let cells: Vec<String> = p

@@ -510,9 +510,8 @@ impl fmt::Display for Jitter {
             "the cost at the optimum jitters by {:.2} nats (standard deviation) under steps of \
              {:e} in the normalised coordinates, more than the {:.2} nats the likelihood rises by \
              at an interval's edge: the slip grows an oscillation out of the integrator's \
-             rounding, whose timing the spectra see, so a parameter whose profile rises by less \
-             than the jitter at its edge gets the sandwich's ±1σ instead, and cost differences \
-             within that jitter are read through it (docs/likelihood.md, \"Jitter\")",
+             rounding, whose timing the spectra see, so the intervals and cost differences within \
+             that jitter are read through it (docs/likelihood.md, \"Jitter\")",
             self.sd_nats, self.step_u, self.rise_limit_nats
         )
     }

@@ -581,9 +581,8 @@ fn line_headline(source: LineSource, band: &str, o: &LineOrigin, same: bool) -> 
 /// [`FitWarning::CostJitter`]'s headline.
 fn cost_jitter_headline(sd_nats: f64) -> String {
     format!(
-        "The cost jitters by {} nats at the optimum under rounding-level steps: a profile that \
-         rises by less is replaced by the sandwich's ±1σ, and cost differences within that are \
-         read through it.",
+        "The cost jitters by {} nats at the optimum under rounding-level steps: profile ends and \
+         cost differences within that are read through it.",
         num(sd_nats, 2)
     )
 }

@@ -125,7 +125,6 @@ fn walk(
         sigma_u: &spread.sigma_u,
         fisher_sigma_u: &spread.curvature_sigma_u,
         fisher_corr: Some(&spread.curvature_corr),
-        fisher_steps_u: Some(&spread.fisher_steps_u),
     };
     let (intervals, warnings) = profile_walk(f, at, polish_iterations, pb)?;
     Ok(Some(ProfileWalk {

@@ -557,10 +557,6 @@ pub struct ProfileStart<'a> {
     /// which each step's polish is also started ([`valley_start`]); `None`: every polish starts
     /// where the previous one ended.
     pub fisher_corr: Option<&'a [Vec<f64>]>,
-    /// The step of each coordinate's differences in `sigma_u`
-    /// ([`crate::search::evidence::LocalFit::fisher_steps_u`]); `None`:
-    /// [`crate::search::evidence::FISHER_STEP_U`].
-    pub fisher_steps_u: Option<&'a [f64]>,
 }
 
 impl<'a> ProfileStart<'a> {
@@ -577,7 +573,6 @@ impl<'a> ProfileStart<'a> {
             sigma_u: &cf.sigma_u,
             fisher_sigma_u,
             fisher_corr: Some(fisher_corr),
-            fisher_steps_u: cf.fisher_steps_u.as_deref(),
         }
     }
 }
@@ -624,11 +619,7 @@ pub fn valley_start(
 /// with `at.fisher_corr`), and the limit [`profile_rise_limit`] from the parameter's sandwich and
 /// Fisher 1σ. Where the likelihood is quadratic this gives the Laplace interval; where it is flat
 /// or bent (a ridge, a valley) the interval follows the likelihood instead of its curvature at the
-/// fit. A parameter whose rise limit lies below the cost's jitter at the fit
-/// ([`RoundingJitter`]) is not walked: each step's cost would be read through a fresh draw of the
-/// rounding, against the draw the search kept for being low, so its interval is the Laplace one
-/// ([`laplace_intervals`], the sandwich's ±1σ, whose differences and `V` carry the draws). The
-/// 2k walks run in parallel; each costs one polish per step, typically two or three. A
+/// fit. The 2k walks run in parallel; each costs one polish per step, typically two or three. A
 /// failed simulation counts as an infinite rise. Warnings name a parameter whose profile reaches
 /// its search bound or runs out of steps below the limit, and a walk that met a point more likely
 /// than the fit by more than
@@ -695,19 +686,8 @@ fn profile_with(
             _ => Ok(end),
         }
     };
-    // A rise the cost's own jitter exceeds cannot be walked to: every step's cost is read
-    // through a fresh draw, and the fit's is the draw the search kept for being low.
-    let walked = |i: usize| jitter_nats <= limit(i);
-    let sides: Vec<(usize, f64)> = (0..n)
-        .filter(|i| walked(*i))
-        .flat_map(|i| [(i, -1.0), (i, 1.0)])
-        .collect();
-    let walks: Vec<ProfileEnd> = sides.par_iter().map(|s| walk(*s)).collect::<Result<_>>()?;
-    let ends: std::collections::HashMap<(usize, bool), ProfileEnd> = sides
-        .iter()
-        .zip(walks)
-        .map(|(&(i, side), e)| ((i, side > 0.0), e))
-        .collect();
+    let sides: Vec<(usize, f64)> = (0..n).flat_map(|i| [(i, -1.0), (i, 1.0)]).collect();
+    let ends: Vec<ProfileEnd> = sides.par_iter().map(|s| walk(*s)).collect::<Result<_>>()?;
     let smallest_limit = (0..n).map(limit).fold(f64::INFINITY, f64::min);
     let mut warnings: Vec<FitWarning> = (jitter.as_ref())
         .and_then(|j| j.warning_above(smallest_limit))
@@ -715,15 +695,7 @@ fn profile_with(
         .collect();
     let mut intervals = Vec::with_capacity(n);
     for (i, fp) in problem.free.iter().enumerate() {
-        let (Some(&lo), Some(&hi)) = (ends.get(&(i, false)), ends.get(&(i, true))) else {
-            intervals.extend(laplace_intervals(
-                std::slice::from_ref(fp),
-                &at.u[i..=i],
-                &at.sigma_u[i..=i],
-                at.fisher_steps_u.map(|h| &h[i..=i]),
-            ));
-            continue;
-        };
+        let (lo, hi) = (ends[2 * i], ends[2 * i + 1]);
         intervals.push(Interval {
             lo: fp.value(lo.u),
             hi: fp.value(hi.u),
@@ -1612,7 +1584,6 @@ mod tests {
             sigma_u: &sigma,
             fisher_sigma_u: &sigma,
             fisher_corr: None,
-            fisher_steps_u: None,
         };
         // Closed form: on the quadratic bowl of 1σ = 0.01 in each coordinate, a point within
         // 0.5 nats has |Δu| ≤ 0.01 in each, so the Laplace intervals already hold every one.
