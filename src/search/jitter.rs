@@ -76,6 +76,12 @@ impl RoundingJitter {
         j
     }
 
+    /// The check at `u` without reading or keeping the problem's last check: for probes at many
+    /// points, such as a profile's steps ([`crate::uncertainty::profile_intervals_at`]).
+    pub fn probe(problem: &SpectralProblem, u: &[f64]) -> Option<RoundingJitter> {
+        Self::measure(problem, u)
+    }
+
     /// The `cost_jitter` warning when the jitter exceeds `rise_limit_nats`, the likelihood's rise
     /// at the edge of the intervals it is read against.
     pub fn warning_above(&self, rise_limit_nats: f64) -> Option<FitWarning> {

@@ -619,7 +619,11 @@ pub fn valley_start(
 /// with `at.fisher_corr`), and the limit [`profile_rise_limit`] from the parameter's sandwich and
 /// Fisher 1σ. Where the likelihood is quadratic this gives the Laplace interval; where it is flat
 /// or bent (a ridge, a valley) the interval follows the likelihood instead of its curvature at the
-/// fit. The 2k walks run in parallel; each costs one polish per step, typically two or three. A
+/// fit. Where the cost's jitter at the fit ([`RoundingJitter`]) exceeds the smallest rise limit,
+/// every rise is read between costs averaged over each point's `2k + 1` rounding draws
+/// ([`RoundingJitter::probe`], `2k + 1` more simulations per step): the fit's own draw is the one
+/// the search kept for being low, and a step's polish ends on a low draw too. The 2k walks run in
+/// parallel; each costs one polish per step, typically two or three. A
 /// failed simulation counts as an infinite rise. Warnings name a parameter whose profile reaches
 /// its search bound or runs out of steps below the limit, and a walk that met a point more likely
 /// than the fit by more than
@@ -649,6 +653,13 @@ fn profile_with(
     let limit = |i: usize| profile_rise_limit(at.sigma_u[i], at.fisher_sigma_u[i]);
     let jitter = RoundingJitter::at(problem, at.u);
     let jitter_nats = jitter.as_ref().map_or(0.0, |j| j.sd_nats);
+    let smallest_limit = (0..n).map(limit).fold(f64::INFINITY, f64::min);
+    // Where the cost jitters by more than a rise limit, each rise is read between draw-averaged
+    // costs: the fit's own draw is the one the search kept for being low.
+    let averaged_fit = jitter
+        .as_ref()
+        .filter(|j| j.sd_nats > smallest_limit)
+        .map(RoundingJitter::mean_nats);
     let walk = |(i, side): (usize, f64)| -> Result<ProfileEnd> {
         let first = at.sigma_u[i].clamp(PROFILE_MIN_STEP_U, PROFILE_MAX_STEP_U);
         let first = if first.is_nan() {
@@ -672,8 +683,13 @@ fn profile_with(
                 observer,
             ) {
                 Ok((u, cost)) => {
+                    let rise = match averaged_fit {
+                        Some(fit) => RoundingJitter::probe(problem, &u)
+                            .map_or(cost - at.cost_nats, |j| j.mean_nats() - fit),
+                        None => cost - at.cost_nats,
+                    };
                     start = u;
-                    cost - at.cost_nats
+                    rise
                 }
                 Err(e) => {
                     failure.get_or_insert(e);
@@ -688,7 +704,6 @@ fn profile_with(
     };
     let sides: Vec<(usize, f64)> = (0..n).flat_map(|i| [(i, -1.0), (i, 1.0)]).collect();
     let ends: Vec<ProfileEnd> = sides.par_iter().map(|s| walk(*s)).collect::<Result<_>>()?;
-    let smallest_limit = (0..n).map(limit).fold(f64::INFINITY, f64::min);
     let mut warnings: Vec<FitWarning> = (jitter.as_ref())
         .and_then(|j| j.warning_above(smallest_limit))
         .into_iter()

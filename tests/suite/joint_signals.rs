@@ -230,3 +230,30 @@ fn where_the_response_jitters_the_fisher_steps_grow_until_the_information_is_the
             .any(|(a, f)| *a > 2.0 * f)
     );
 }
+
+#[test]
+fn a_probe_of_the_jitter_measures_as_the_check_does_and_leaves_its_cache_alone() {
+    // The profile reads each step's draw-averaged cost with `RoundingJitter::probe` where the
+    // optimum jitters by more than a rise limit (docs/likelihood.md, "Jitter"); the tolerance
+    // check and the walk's start read the optimum's check from the problem's cache, which the
+    // probes at the steps must not replace. The simulations are deterministic, so a probe and a
+    // check at one point give the same costs.
+    use std::sync::atomic::Ordering;
+    use wiperlab::search::jitter::RoundingJitter;
+    let (one, u) = problem(&[]);
+    let steep = b_doubled(&one, &u);
+    let checked = RoundingJitter::at(&one, &u).expect("the check at the truth");
+    let probed = RoundingJitter::probe(&one, &steep).expect("a probe with B doubled");
+    let again = RoundingJitter::at(&one, &steep).expect("the check with B doubled");
+    assert_eq!(probed, again);
+    assert!(probed.sd_nats > 1.0, "{} nats", probed.sd_nats);
+    let before = one.evaluations.load(Ordering::Relaxed);
+    let _ = RoundingJitter::probe(&one, &u);
+    assert_eq!(RoundingJitter::at(&one, &steep), Some(again));
+    assert_eq!(
+        one.evaluations.load(Ordering::Relaxed) - before,
+        2 * u.len() + 1,
+        "the probe simulated, the cached check did not"
+    );
+    assert!(checked.sd_nats < 0.1);
+}
