@@ -18,18 +18,15 @@ use clap::Parser;
 mod campaign;
 #[path = "common/fitted.rs"]
 mod fitted;
-use campaign::JobSource;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use wiperlab::search::SpectralProblem;
 use wiperlab::search::jitter::rounding_points;
 
 #[derive(Parser)]
 struct Args {
+    /// The jobs and the campaign results whose fits the polish starts from.
     #[command(flatten)]
-    source: JobSource,
-    /// The campaign's results (`<DIR>/<job stem>.result.toml`), whose fits the polish starts from.
-    #[arg(long, value_name = "DIR")]
-    fitted: PathBuf,
+    fits: fitted::FittedSource,
     /// The polish's iterations at the most.
     #[arg(long, default_value_t = 60)]
     iterations: u64,
@@ -65,7 +62,7 @@ impl CostFunction for Averaged<'_> {
 fn main() -> Fallible<()> {
     let args = Args::parse();
     println!("job,at_fit,polished,at_truth,evaluations,rel_err_fit,rel_err_polished");
-    for path in args.source.paths()? {
+    for path in args.fits.source.paths()? {
         if let Err(e) = one(&args, &path) {
             println!("# {}: skipped: {e}", path.display());
         }
@@ -79,7 +76,7 @@ fn one(args: &Args, path: &Path) -> Fallible<()> {
         problem,
         fit_u: uf,
         truth_u: ut,
-    } = fitted::read(&args.source, &args.fitted, path)?;
+    } = fitted::read(&args.fits, path)?;
     let avg = Averaged(&problem);
     let simplex: Vec<Vec<f64>> = std::iter::once(uf.clone())
         .chain((0..uf.len()).map(|i| {

@@ -14,17 +14,13 @@ use clap::Parser;
 mod campaign;
 #[path = "common/fitted.rs"]
 mod fitted;
-use campaign::JobSource;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use wiperlab::search::evidence::at_fit_smoothed;
 
 #[derive(Parser)]
 struct Args {
     #[command(flatten)]
-    source: JobSource,
-    /// The campaign's `results/` directory: each job's fit is `<DIR>/<job stem>.result.toml`.
-    #[arg(long, value_name = "DIR")]
-    fitted: PathBuf,
+    fits: fitted::FittedSource,
 }
 
 type Fallible<T> = Result<T, Box<dyn std::error::Error>>;
@@ -32,7 +28,7 @@ type Fallible<T> = Result<T, Box<dyn std::error::Error>>;
 fn main() -> Fallible<()> {
     let args = Args::parse();
     println!("job,model,param,sigma_u,z,rounding_widening");
-    for path in args.source.paths()? {
+    for path in args.fits.source.paths()? {
         if let Err(e) = spread(&args, &path) {
             let e: String = e.to_string().chars().take(300).collect();
             println!("# {}: skipped: {e}", path.display());
@@ -44,7 +40,7 @@ fn main() -> Fallible<()> {
 /// One row per parameter of the fit of the job at `path`, when it chose the candidate (the true
 /// model unless `--model`).
 fn spread(args: &Args, path: &Path) -> Fallible<()> {
-    let f = fitted::read(&args.source, &args.fitted, path)?;
+    let f = fitted::read(&args.fits, path)?;
     let local = at_fit_smoothed(&f.problem, &f.fit_u)?;
     for (i, p) in f.problem.free.iter().enumerate() {
         let s = local.sigma_u[i];
