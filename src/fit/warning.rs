@@ -511,7 +511,8 @@ impl fmt::Display for Jitter {
              {:e} in the normalised coordinates, more than the {:.2} nats the likelihood rises by \
              at an interval's edge: the slip grows an oscillation out of the integrator's \
              rounding, whose timing the spectra see, so the intervals and cost differences within \
-             that jitter are read through it (docs/likelihood.md, \"Jitter\")",
+             that jitter are read through it (a profile reads its rises between costs averaged \
+             over each point's rounding draws; docs/likelihood.md, \"Jitter\")",
             self.sd_nats, self.step_u, self.rise_limit_nats
         )
     }

@@ -581,8 +581,9 @@ fn line_headline(source: LineSource, band: &str, o: &LineOrigin, same: bool) -> 
 /// [`FitWarning::CostJitter`]'s headline.
 fn cost_jitter_headline(sd_nats: f64) -> String {
     format!(
-        "The cost jitters by {} nats at the optimum under rounding-level steps: profile ends and \
-         cost differences within that are read through it.",
+        "The cost jitters by {} nats at the optimum under rounding-level steps: intervals and cost \
+         differences within that are read through it (a profile reads its rises between \
+         draw-averaged costs).",
         num(sd_nats, 2)
     )
 }
