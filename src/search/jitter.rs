@@ -71,15 +71,9 @@ impl RoundingJitter {
         if let Some((_, j)) = last().as_ref().filter(|(at, _)| at.as_slice() == u) {
             return j.clone();
         }
-        let j = Self::measure(problem, u);
+        let j = Self::probe(problem, u);
         *last() = Some((u.to_vec(), j.clone()));
         j
-    }
-
-    /// The check at `u` without reading or keeping the problem's last check: for probes at many
-    /// points, such as a profile's steps ([`crate::uncertainty::profile_intervals_at`]).
-    pub fn probe(problem: &SpectralProblem, u: &[f64]) -> Option<RoundingJitter> {
-        Self::measure(problem, u)
     }
 
     /// The `cost_jitter` warning when the jitter exceeds `rise_limit_nats`, the likelihood's rise
@@ -97,8 +91,10 @@ impl RoundingJitter {
         self.costs_nats.iter().sum::<f64>() / self.costs_nats.len() as f64
     }
 
-    /// [`RoundingJitter::at`]'s simulations.
-    fn measure(problem: &SpectralProblem, u: &[f64]) -> Option<RoundingJitter> {
+    /// The check at `u` without reading or keeping the problem's last check ([`RoundingJitter::at`]
+    /// caches through it): for probes at many points, such as a profile's steps
+    /// ([`crate::uncertainty::profile_intervals_at`]).
+    pub fn probe(problem: &SpectralProblem, u: &[f64]) -> Option<RoundingJitter> {
         use rayon::prelude::*;
         let costs_nats: Vec<f64> = rounding_points(u)
             .par_iter()

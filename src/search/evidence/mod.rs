@@ -730,10 +730,7 @@ impl RecordingLikelihood {
         h: f64,
         metric: Option<&joint::Metric>,
     ) -> Result<Jacobian> {
-        let steps: Vec<(usize, f64)> = (0..u.len()).map(|i| (i, h)).collect();
-        Ok(Jacobian {
-            columns: self.difference_columns(problem, u, &steps, metric)?,
-        })
+        self.jacobian_with_steps(problem, u, &vec![h; u.len()], metric)
     }
 
     /// [`RecordingLikelihood::jacobian`] with a step of its own for each coordinate.
@@ -815,16 +812,17 @@ impl RecordingLikelihood {
         let Some(noise) = noise_information(draws, w) else {
             return Ok((j, steps, 0));
         };
+        // A column whose larger step lost response samples keeps the step it has.
+        let mut kept = vec![false; u.len()];
         let mut sims = 0;
         loop {
-            let grow: Vec<(usize, f64)> = j
-                .columns
-                .iter()
-                .enumerate()
+            let grow: Vec<(usize, f64)> = (j.columns.iter().enumerate())
                 .filter(|(i, c)| {
                     let info: f64 = c.iter().zip(w).map(|(a, wk)| wk * a * a).sum();
                     let h = steps[*i];
-                    h < MAX_FISHER_STEP_U && noise / (2.0 * h * h) > FISHER_NOISE_SHARE * info
+                    !kept[*i]
+                        && h < MAX_FISHER_STEP_U
+                        && noise / (2.0 * h * h) > FISHER_NOISE_SHARE * info
                 })
                 .map(|(i, _)| (i, (3.0 * steps[i]).min(MAX_FISHER_STEP_U)))
                 .collect();
@@ -834,12 +832,12 @@ impl RecordingLikelihood {
             sims += 2 * grow.len();
             let columns = self.difference_columns(problem, u, &grow, metric)?;
             for (&(i, h), c) in grow.iter().zip(columns) {
-                if c.len() != j.columns[i].len() {
-                    steps[i] = MAX_FISHER_STEP_U;
-                    continue;
+                if c.len() == j.columns[i].len() {
+                    steps[i] = h;
+                    j.columns[i] = c;
+                } else {
+                    kept[i] = true;
                 }
-                steps[i] = h;
-                j.columns[i] = c;
             }
         }
     }
