@@ -161,7 +161,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         },
     );
     let result = FitResult {
-        friction_curve: friction_curve(job, &result, &best, &cf),
+        friction_curve: friction_curve(job, &result, &best, (&cf, &fits)),
         posterior,
         ..result
     };
@@ -200,55 +200,111 @@ fn joint_dropped_warning(problem: &SpectralProblem) -> Option<FitWarning> {
 /// The fitted law over the slip speeds of the chosen optimum's simulation, its band from the
 /// result's 1σ and correlations widened, as Laplace and profile intervals are, to the points the
 /// search evaluated within each speed's profile rise limit ([`uncertainty::mu_d_rise_limits`]),
-/// the envelope of the laws the recording does not distinguish from it, and the job's true law
+/// the envelope of the bands of the candidates the recording does not distinguish from it
+/// (`others`, the fits beside the chosen `cf`), and the job's true law
 /// ([`LoadedJob::true_friction_law`]).
 fn friction_curve(
     job: &LoadedJob,
     r: &FitResult,
     best: &BestModel,
-    cf: &CandidateFit,
+    (cf, others): (&CandidateFit, &[CandidateFit]),
 ) -> Option<crate::model::friction_curve::FrictionCurve> {
-    use crate::model::friction_curve::{FrictionCurve, Spread};
-    let ids: Vec<crate::model::ParamId> = r.parameters.iter().map(|p| p.name).collect();
-    let sigma: Vec<f64> = r.parameters.iter().map(|p| p.std_error).collect();
-    let fisher_sigma: Vec<f64> = (r.parameters.iter())
-        .map(|p| p.fisher_std_error.unwrap_or(f64::NAN))
-        .collect();
-    let spread = Spread {
-        ids: &ids,
-        sigma: &sigma,
-        corr: &r.correlation,
-    };
-    let fisher = cf.fisher_corr.as_ref().map(|corr| Spread {
-        ids: &ids,
-        sigma: &fisher_sigma,
-        corr,
-    });
-    let law = best.params.friction;
-    let curve = FrictionCurve::new(
-        law,
-        &best.sim.slip_speeds(),
-        Some(spread),
-        job.true_friction_law(),
-    )?;
-    let limits = uncertainty::mu_d_rise_limits(&law, &curve.speed_m_per_s, spread, fisher);
     let widens = (r.parameters.iter())
         .filter_map(|p| p.interval.as_ref())
         .any(|iv| iv.method.widens_to_near_best());
-    let near = if widens {
-        uncertainty::near_best_laws(cf, &limits)
-    } else {
-        Vec::new()
-    };
-    let others: Vec<_> = (r.model_trials.iter())
+    let law = best.params.friction;
+    let chosen = CandidateSpread::of_result(r, cf);
+    let curve = crate::model::friction_curve::FrictionCurve::new(
+        law,
+        &best.sim.slip_speeds(),
+        Some(chosen.spread()),
+        job.true_friction_law(),
+    )?;
+    let (limits, near) = chosen.near_best(&curve.speed_m_per_s, &law, widens, cf);
+    let curve = curve.with_near_best(&near, &limits);
+    let alternatives: Vec<_> = (r.model_trials.iter())
         .filter(|t| t.not_distinguishable)
-        .filter_map(|t| t.friction)
+        .filter_map(|t| {
+            let law = t.friction?;
+            let Some(o) = others.iter().find(|f| f.candidate == t.model) else {
+                return Some(curve.alternative(law, None, &[], &[]));
+            };
+            let s = CandidateSpread::of_fit(job, o);
+            let (limits, near) = s.near_best(&curve.speed_m_per_s, &law, widens, o);
+            Some(curve.alternative(law, Some(s.spread()), &near, &limits))
+        })
         .collect();
-    Some(
-        curve
-            .with_near_best(&near, &limits)
-            .with_alternatives(&others),
-    )
+    Some(curve.with_alternatives(&alternatives))
+}
+
+/// A candidate's parameters' 1σ and correlations (sandwich, and Fisher's where there is a
+/// likelihood), for its friction law's band.
+struct CandidateSpread {
+    ids: Vec<crate::model::ParamId>,
+    sigma: Vec<f64>,
+    corr: Vec<Vec<f64>>,
+    fisher: Option<(Vec<f64>, Vec<Vec<f64>>)>,
+}
+
+impl CandidateSpread {
+    /// The chosen fit's, as the result reports them.
+    fn of_result(r: &FitResult, cf: &CandidateFit) -> Self {
+        let fisher_sigma = (r.parameters.iter())
+            .map(|p| p.fisher_std_error.unwrap_or(f64::NAN))
+            .collect();
+        CandidateSpread {
+            ids: r.parameters.iter().map(|p| p.name).collect(),
+            sigma: r.parameters.iter().map(|p| p.std_error).collect(),
+            corr: r.correlation.clone(),
+            fisher: cf.fisher_corr.clone().map(|c| (fisher_sigma, c)),
+        }
+    }
+
+    /// Another candidate's, from its fit.
+    fn of_fit(job: &LoadedJob, cf: &CandidateFit) -> Self {
+        let params = fitted_parameters(job, cf);
+        let fisher_sigma = (params.iter())
+            .map(|p| p.fisher_std_error.unwrap_or(f64::NAN))
+            .collect();
+        CandidateSpread {
+            ids: params.iter().map(|p| p.name).collect(),
+            sigma: params.iter().map(|p| p.std_error).collect(),
+            corr: cf.corr.clone(),
+            fisher: cf.fisher_corr.clone().map(|c| (fisher_sigma, c)),
+        }
+    }
+
+    fn spread(&self) -> crate::model::friction_curve::Spread<'_> {
+        crate::model::friction_curve::Spread {
+            ids: &self.ids,
+            sigma: &self.sigma,
+            corr: &self.corr,
+        }
+    }
+
+    /// μ_d's profile rise limit at each of `speeds` for `law`, and (when the intervals widen,
+    /// `widens`) the points `cf`'s search evaluated within the largest of them.
+    fn near_best(
+        &self,
+        speeds: &[f64],
+        law: &crate::model::FrictionLaw,
+        widens: bool,
+        cf: &CandidateFit,
+    ) -> (Vec<f64>, Vec<(f64, crate::model::FrictionLaw)>) {
+        let fisher =
+            (self.fisher.as_ref()).map(|(sigma, corr)| crate::model::friction_curve::Spread {
+                ids: &self.ids,
+                sigma,
+                corr,
+            });
+        let limits = uncertainty::mu_d_rise_limits(law, speeds, self.spread(), fisher);
+        let near = if widens {
+            uncertainty::near_best_laws(cf, &limits)
+        } else {
+            Vec::new()
+        };
+        (limits, near)
+    }
 }
 
 /// The chosen optimum's tolerance check ([`tolerance::ToleranceCheck`]) and, where an optimum the

@@ -56,7 +56,7 @@ pub struct FrictionCurve {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub truth_within_band: Option<f64>,
     /// The models the recording does not distinguish from the chosen one, on the grid: the
-    /// lowest and the highest of the fitted μ_d ± 1σ and each such candidate's own μ_d
+    /// lowest and the highest of the fitted band and each such candidate's own band
     /// ([`FrictionCurve::with_alternatives`]). Empty when every other candidate is distinguished
     /// (or there is none): then the band alone says what the recording leaves open.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -204,51 +204,58 @@ impl FrictionCurve {
         points: &[(f64, FrictionLaw)],
         rise_limit_nats: &[f64],
     ) -> Self {
-        if rise_limit_nats.len() != self.speed_m_per_s.len() {
-            return self;
-        }
-        let ranges: Option<Vec<[f64; 2]>> = (self.speed_m_per_s.iter().zip(rise_limit_nats))
-            .map(|(&v, &limit)| {
-                (points.iter())
-                    .filter(|(rise, _)| *rise <= limit)
-                    .map(|(_, law)| law.mu_slip(v))
-                    .filter(|m| m.is_finite())
-                    .fold(None, |r: Option<[f64; 2]>, m| {
-                        Some(r.map_or([m, m], |[lo, hi]| [lo.min(m), hi.max(m)]))
-                    })
-            })
-            .collect();
-        if let Some(ranges) = ranges {
+        if let Some(ranges) = near_best_ranges(&self.speed_m_per_s, points, rise_limit_nats) {
             self.mu_d_near_best = ranges;
             self = self.with_truth_in_band();
         }
         self
     }
 
-    /// The curve with the envelope of `laws`, the friction laws of the candidates the recording
-    /// does not distinguish from the chosen one (docs/model-choice.md): on every grid point the
-    /// lowest and highest of μ_d ± 1σ (μ_d alone without a band) and of each law's μ_d. Model
-    /// choice reports the simplest of those candidates (Burnham & Anderson 2002, §2.6), so its
-    /// band alone is conditional on a choice the recording did not make; the envelope is what the
-    /// recording leaves open among the candidates. Unchanged when `laws` is empty.
-    pub fn with_alternatives(mut self, laws: &[FrictionLaw]) -> FrictionCurve {
-        if laws.is_empty() {
+    /// Another candidate's `law` on this curve's grid, with its band made as this curve's is: ±1σ
+    /// by the delta method from `spread`, widened to the candidate's own evaluated `points` within
+    /// `rise_limit_nats` ([`FrictionCurve::with_near_best`]). Without a spread or such points the
+    /// band is the law's μ_d alone.
+    pub fn alternative(
+        &self,
+        law: FrictionLaw,
+        spread: Option<Spread<'_>>,
+        points: &[(f64, FrictionLaw)],
+        rise_limit_nats: &[f64],
+    ) -> Alternative {
+        let speeds = &self.speed_m_per_s;
+        let mu: Vec<f64> = speeds.iter().map(|&v| law.mu_slip(v)).collect();
+        let sigma: Vec<f64> = spread
+            .and_then(|s| speeds.iter().map(|&v| s.mu_sigma(&law, v)).collect())
+            .unwrap_or_default();
+        let near = near_best_ranges(speeds, points, rise_limit_nats).unwrap_or_default();
+        let band = band_edges(&mu, &sigma, &near).unwrap_or_else(|| [mu.clone(), mu]);
+        Alternative { law, band }
+    }
+
+    /// The curve with the envelope of `others`, the candidates the recording does not distinguish
+    /// from the chosen one (docs/model-choice.md), each on this curve's grid
+    /// ([`FrictionCurve::alternative`]): on every grid point the lowest and highest of this
+    /// curve's band (μ_d alone without one) and of each candidate's band. Model choice reports the
+    /// simplest of those candidates (Burnham & Anderson 2002, §2.6), so its band alone is
+    /// conditional on a choice the recording did not make; each candidate's band is what the
+    /// recording leaves open within it, and the envelope is their union. Unchanged when `others`
+    /// is empty or a band does not match the grid.
+    pub fn with_alternatives(mut self, others: &[Alternative]) -> FrictionCurve {
+        let n = self.speed_m_per_s.len();
+        if others.is_empty() || others.iter().any(|a| a.band.iter().any(|e| e.len() != n)) {
             return self;
         }
         let [band_lo, band_hi] = self
             .band_edges()
             .unwrap_or_else(|| [self.mu_d.clone(), self.mu_d.clone()]);
-        self.mu_d_envelope = (0..self.speed_m_per_s.len())
+        self.mu_d_envelope = (0..n)
             .map(|i| {
-                let v = self.speed_m_per_s[i];
-                laws.iter()
-                    .map(|l| l.mu_slip(v))
-                    .fold([band_lo[i], band_hi[i]], |[lo, hi], m| {
-                        [lo.min(m), hi.max(m)]
-                    })
+                (others.iter()).fold([band_lo[i], band_hi[i]], |[lo, hi], a| {
+                    [lo.min(a.band[0][i]), hi.max(a.band[1][i])]
+                })
             })
             .collect();
-        self.alternative_laws = laws.to_vec();
+        self.alternative_laws = others.iter().map(|a| a.law).collect();
         self.truth_within_envelope = (!self.mu_d_true.is_empty()).then(|| {
             let [lo, hi] = self.envelope_edges().unwrap_or_default();
             share_within(&lo, &hi, &self.mu_d_true)
@@ -259,23 +266,7 @@ impl FrictionCurve {
     /// The band's lower and upper edges on the grid: μ_d ∓ σ, widened to
     /// [`FrictionCurve::mu_d_near_best`] where that reaches further; `None` without either.
     pub fn band_edges(&self) -> Option<[Vec<f64>; 2]> {
-        if self.mu_d_sigma.is_empty() && self.mu_d_near_best.is_empty() {
-            return None;
-        }
-        let edge = |sign: f64| -> Vec<f64> {
-            (0..self.mu_d.len())
-                .map(|i| {
-                    let m = self.mu_d[i];
-                    let s = self.mu_d_sigma.get(i).map_or(m, |s| m + sign * s);
-                    match self.mu_d_near_best.get(i) {
-                        Some([lo, _]) if sign < 0.0 => s.min(*lo),
-                        Some([_, hi]) => s.max(*hi),
-                        None => s,
-                    }
-                })
-                .collect()
-        };
-        Some([edge(-1.0), edge(1.0)])
+        band_edges(&self.mu_d, &self.mu_d_sigma, &self.mu_d_near_best)
     }
 
     /// Whether the points the search evaluated reach beyond μ_d ± 1σ at some grid point by more
@@ -303,6 +294,62 @@ impl FrictionCurve {
         let [lo, hi] = self.measured_range_m_per_s;
         (lo..=hi).contains(&speed_m_per_s)
     }
+}
+
+/// A candidate the recording does not distinguish from the chosen one, on the chosen curve's
+/// grid ([`FrictionCurve::alternative`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Alternative {
+    /// The candidate's law at its own optimum.
+    pub law: FrictionLaw,
+    /// Its band's lower and upper edges on the grid.
+    pub band: [Vec<f64>; 2],
+}
+
+/// On each of `speeds`, the lowest and highest μ_d of the `points` (cost above the fit's, nats;
+/// law) whose rise is within that speed's `rise_limit_nats`; `None` when the limits do not match
+/// the speeds or a speed has no such point.
+fn near_best_ranges(
+    speeds: &[f64],
+    points: &[(f64, FrictionLaw)],
+    rise_limit_nats: &[f64],
+) -> Option<Vec<[f64; 2]>> {
+    if rise_limit_nats.len() != speeds.len() {
+        return None;
+    }
+    (speeds.iter().zip(rise_limit_nats))
+        .map(|(&v, &limit)| {
+            (points.iter())
+                .filter(|(rise, _)| *rise <= limit)
+                .map(|(_, law)| law.mu_slip(v))
+                .filter(|m| m.is_finite())
+                .fold(None, |r: Option<[f64; 2]>, m| {
+                    Some(r.map_or([m, m], |[lo, hi]| [lo.min(m), hi.max(m)]))
+                })
+        })
+        .collect()
+}
+
+/// A band's lower and upper edges: `mu` ∓ `sigma`, widened to `near` where that reaches further
+/// (either may be empty); `None` when both are.
+fn band_edges(mu: &[f64], sigma: &[f64], near: &[[f64; 2]]) -> Option<[Vec<f64>; 2]> {
+    if sigma.is_empty() && near.is_empty() {
+        return None;
+    }
+    let edge = |sign: f64| -> Vec<f64> {
+        (0..mu.len())
+            .map(|i| {
+                let m = mu[i];
+                let s = sigma.get(i).map_or(m, |s| m + sign * s);
+                match near.get(i) {
+                    Some([lo, _]) if sign < 0.0 => s.min(*lo),
+                    Some([_, hi]) => s.max(*hi),
+                    None => s,
+                }
+            })
+            .collect()
+    };
+    Some([edge(-1.0), edge(1.0)])
 }
 
 /// The share of `truth`'s points that lie within `[lo, hi]` point by point.
@@ -452,7 +499,8 @@ mod tests {
         let c = FrictionCurve::new(LAW, &speeds, Some(spread), Some(scaled(1.05))).unwrap();
         assert_eq!(c.truth_within_band, Some(0.0));
         assert!(c.clone().with_alternatives(&[]) == c && c.mu_d_envelope.is_empty());
-        let c = c.with_alternatives(&[scaled(1.1), scaled(0.9)]);
+        let others = [scaled(1.1), scaled(0.9)].map(|l| c.alternative(l, None, &[], &[]));
+        let c = c.with_alternatives(&others);
         for (i, [lo, hi]) in c.mu_d_envelope.iter().enumerate() {
             assert!((lo - 0.9 * c.mu_d[i]).abs() < 1e-15 && (hi - 1.1 * c.mu_d[i]).abs() < 1e-15);
         }
@@ -464,6 +512,51 @@ mod tests {
         assert!(lo[7] == c.mu_d[7] - 0.002 && hi[7] == c.mu_d[7] + 0.002);
         let text = toml::to_string_pretty(&c).unwrap();
         assert_eq!(toml::from_str::<FrictionCurve>(&text).unwrap(), c);
+    }
+
+    /// An alternative's own band against closed forms: a law 10 % below the fitted one with
+    /// σ_C = 0.004 and an evaluated point 20 % below it, 0.2 nats above that candidate's fit
+    /// within a 0.3-nat limit, gives a band from 0.8·μ_d up to 0.9·μ_d + 0.004. The envelope with
+    /// the fitted ±0.002 band then runs from 0.8·μ_d to μ_d + 0.002 (μ_d ≥ 0.49 here), and holds
+    /// a truth 15 % below the fit that a point-only alternative at 0.9·μ_d would leave out. A band
+    /// off the grid leaves the curve as it was.
+    #[test]
+    fn an_alternatives_envelope_holds_its_own_band() {
+        let speeds: Vec<f64> = (0..=100).map(|i| i as f64 * 0.001).collect();
+        let spread = Spread {
+            ids: &[ParamId::C],
+            sigma: &[0.002],
+            corr: &[vec![1.0]],
+        };
+        let c = FrictionCurve::new(LAW, &speeds, Some(spread), Some(scaled(0.85))).unwrap();
+        let wide = Spread {
+            sigma: &[0.004],
+            ..spread
+        };
+        let limits = [0.3; CURVE_POINTS];
+        let points = [(0.2, scaled(0.8))];
+        let alt = c.alternative(scaled(0.9), Some(wide), &points, &limits);
+        for i in 0..CURVE_POINTS {
+            let m = c.mu_d[i];
+            assert!((alt.band[0][i] - 0.8 * m).abs() < 1e-15, "{i}");
+            assert!((alt.band[1][i] - (0.9 * m + 0.004)).abs() < 1e-15, "{i}");
+        }
+        let point_only = c.alternative(scaled(0.9), None, &[], &[]);
+        assert_eq!(point_only.band[0], point_only.band[1]);
+        assert_eq!(
+            (c.clone().with_alternatives(&[point_only])).truth_within_envelope,
+            Some(0.0)
+        );
+        let e = c.clone().with_alternatives(std::slice::from_ref(&alt));
+        assert_eq!(e.truth_within_envelope, Some(1.0));
+        for (i, [lo, hi]) in e.mu_d_envelope.iter().enumerate() {
+            assert!((lo - 0.8 * e.mu_d[i]).abs() < 1e-15 && *hi == e.mu_d[i] + 0.002);
+        }
+        let short = Alternative {
+            band: [vec![0.0; 3], vec![1.0; 3]],
+            ..alt
+        };
+        assert_eq!(c.clone().with_alternatives(&[short]), c);
     }
 
     /// The band widened to evaluated points against closed forms: a law 3 % above the fitted one
@@ -502,7 +595,7 @@ mod tests {
         }
         assert_eq!(w.truth_within_band, Some(0.5));
         // The envelope starts from the widened band.
-        let e = w.clone().with_alternatives(&[scaled(1.01)]);
+        let e = (w.clone()).with_alternatives(&[w.alternative(scaled(1.01), None, &[], &[])]);
         assert_eq!(e.envelope_edges().unwrap(), [lo, hi]);
         assert_eq!(c.clone().with_near_best(&points, &[0.1; CURVE_POINTS]), c);
         assert_eq!(c.clone().with_near_best(&points, &[0.5; 3]), c);

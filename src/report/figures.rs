@@ -1357,7 +1357,10 @@ mod tests {
         assert!(!svg.contains("does not distinguish"));
         // A law the recording does not distinguish: the envelope is drawn and named.
         let curve = r.friction_curve.clone();
-        r.friction_curve = curve.clone().map(|c| c.with_alternatives(&[truth]));
+        r.friction_curve = (curve.clone()).map(|c| {
+            let other = c.alternative(truth, None, &[], &[]);
+            c.with_alternatives(&[other])
+        });
         friction_law_figure(dir.path(), &r, &LAW, Some(0.167)).unwrap();
         let svg = std::fs::read_to_string(dir.path().join("friction_law.svg")).unwrap();
         assert!(svg.contains("with the 1 model(s) the recording does not distinguish"));

@@ -600,7 +600,9 @@ mod tests {
         );
         // The truth as the one other candidate: the envelope runs from it (0.8 e^(−0.1) + 0.2 =
         // 0.924 at 10 mm/s, 0.525 at 90 mm/s) to the fitted μ_d + 1σ (0.943, 0.537).
-        let words = curve_words(&r.friction_curve.unwrap().with_alternatives(&[truth]));
+        let c = r.friction_curve.unwrap();
+        let other = c.alternative(truth, None, &[], &[]);
+        let words = curve_words(&c.with_alternatives(&[other]));
         assert!(
             words.contains(
                 "With the 1 model(s) the recording does not distinguish from this one, μ_d lies \
