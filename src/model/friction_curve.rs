@@ -331,7 +331,9 @@ fn near_best_ranges(
 }
 
 /// A band's lower and upper edges: `mu` ∓ `sigma`, widened to `near` where that reaches further
-/// (either may be empty); `None` when both are.
+/// (either may be empty), the lower edge no lower than zero, since a friction coefficient is not
+/// negative (a coefficient the recording leaves undetermined has a σ beyond μ_d itself); `None`
+/// when both are empty.
 fn band_edges(mu: &[f64], sigma: &[f64], near: &[[f64; 2]]) -> Option<[Vec<f64>; 2]> {
     if sigma.is_empty() && near.is_empty() {
         return None;
@@ -342,8 +344,9 @@ fn band_edges(mu: &[f64], sigma: &[f64], near: &[[f64; 2]]) -> Option<[Vec<f64>;
                 let m = mu[i];
                 let s = sigma.get(i).map_or(m, |s| m + sign * s);
                 match near.get(i) {
-                    Some([lo, _]) if sign < 0.0 => s.min(*lo),
+                    Some([lo, _]) if sign < 0.0 => s.min(*lo).max(0.0),
                     Some([_, hi]) => s.max(*hi),
+                    None if sign < 0.0 => s.max(0.0),
                     None => s,
                 }
             })
@@ -519,7 +522,7 @@ mod tests {
     /// within a 0.3-nat limit, gives a band from 0.8·μ_d up to 0.9·μ_d + 0.004. The envelope with
     /// the fitted ±0.002 band then runs from 0.8·μ_d to μ_d + 0.002 (μ_d ≥ 0.49 here), and holds
     /// a truth 15 % below the fit that a point-only alternative at 0.9·μ_d would leave out. A band
-    /// off the grid leaves the curve as it was.
+    /// off the grid leaves the curve as it was, and no band's lower edge falls below zero.
     #[test]
     fn an_alternatives_envelope_holds_its_own_band() {
         let speeds: Vec<f64> = (0..=100).map(|i| i as f64 * 0.001).collect();
@@ -541,6 +544,14 @@ mod tests {
             assert!((alt.band[0][i] - 0.8 * m).abs() < 1e-15, "{i}");
             assert!((alt.band[1][i] - (0.9 * m + 0.004)).abs() < 1e-15, "{i}");
         }
+        // A σ of 2 (an undetermined coefficient) reaches below zero: the lower edge stops there.
+        let loose = Spread {
+            sigma: &[2.0],
+            ..spread
+        };
+        let undetermined = c.alternative(scaled(0.9), Some(loose), &[], &[]);
+        assert!(undetermined.band[0].iter().all(|&lo| lo == 0.0));
+        assert!((undetermined.band[1][0] - (0.9 * c.mu_d[0] + 2.0)).abs() < 1e-15);
         let point_only = c.alternative(scaled(0.9), None, &[], &[]);
         assert_eq!(point_only.band[0], point_only.band[1]);
         assert_eq!(
