@@ -1180,6 +1180,7 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
         "law_rms_rel_diff",
         "law_share_in_band",
         "law_share_in_envelope",
+        "law_open_rel",
         "gof_p",
         "true_model_delta_tic",
         "true_model_k",
@@ -1219,6 +1220,10 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
                 .unwrap_or_default(),
             r.law
                 .and_then(|l| l.within_envelope)
+                .map(csv_num)
+                .unwrap_or_default(),
+            r.law
+                .and_then(|l| l.open_rel)
                 .map(csv_num)
                 .unwrap_or_default(),
             r.gof_p.map(csv_num).unwrap_or_default(),
@@ -1697,31 +1702,33 @@ mod tests {
     }
 
     /// The law section groups by departure: a viscous recording found within 3 % with a failed
-    /// test and an invented shoulder, one not found; a recording of the model itself.
+    /// test and an invented shoulder, one not found though its envelope leaves 2 % open (both
+    /// determined); a recording of the model itself, found, whose envelope leaves 5 % open.
     #[test]
     fn the_law_section_scores_curves_by_departure() {
         use super::super::law::LawScore;
         let c = |s: &str| s.parse::<Candidate>().ok();
-        let law = |rms, band, envelope| {
+        let law = |rms, band, envelope, open| {
             Some(LawScore {
                 rms_rel_diff: rms,
                 within_band: Some(band),
                 within_envelope: Some(envelope),
+                open_rel: Some(open),
             })
         };
         let mut a = recording(&[]);
         a.true_model = c("blade2dof");
         a.chosen = c("blade2dof+shoulder");
         a.departure = Some("viscous".into());
-        a.law = law(0.02, 0.5, 1.0);
+        a.law = law(0.02, 0.5, 1.0, 0.01);
         a.gof_p = Some(0.001);
         let mut b = a.clone();
         b.chosen = c("blade2dof");
-        b.law = law(0.08, 0.0, 0.0);
+        b.law = law(0.08, 0.0, 0.0, 0.02);
         b.gof_p = Some(0.4);
         let mut own = recording(&[]);
         own.true_model = c("blade2dof");
-        own.law = law(0.004, 1.0, 1.0);
+        own.law = law(0.004, 1.0, 1.0, 0.05);
         let recordings = vec![a, b, own];
         let cal = Calibration {
             name: "t".into(),
@@ -1732,11 +1739,13 @@ mod tests {
         };
         let md = to_markdown(&cal, None, "x");
         assert!(
-            md.contains("| viscous | 2 | 2 | 1 | 5.0 % | 8.0 % | 25.0 % | 50.0 % | 1 | 1 |"),
+            md.contains(
+                "| viscous | 2 | 2 | 1 | 2 | 1 | 5.0 % | 8.0 % | 25.0 % | 50.0 % | 1 | 1 |"
+            ),
             "{md}"
         );
         assert!(
-            md.contains("| none | 1 | 1 | 1 | 0.4 % | 0.4 % | 100.0 % | 100.0 % | 0 | 0 |"),
+            md.contains("| none | 1 | 1 | 1 | 0 | 0 | 0.4 % | 0.4 % | 100.0 % | 100.0 % | 0 | 0 |"),
             "{md}"
         );
     }

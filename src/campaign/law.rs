@@ -24,6 +24,9 @@ pub struct LawScore {
     /// Share where it lies within the envelope of the models the recording does not distinguish
     /// (the band where there are none).
     pub within_envelope: Option<f64>,
+    /// How much of μ_d the envelope (or band) leaves open: its median half-width relative to the
+    /// fitted μ_d ([`crate::model::friction_curve::FrictionCurve::open_rel_half_width`]).
+    pub open_rel: Option<f64>,
 }
 
 impl LawScore {
@@ -34,14 +37,27 @@ impl LawScore {
             rms_rel_diff: c.rms_rel_diff_to_truth?,
             within_band: c.truth_within_band,
             within_envelope: c.truth_within_envelope.or(c.truth_within_band),
+            open_rel: c.open_rel_half_width(),
         })
+    }
+
+    /// Whether the recording determines the law to [`LAW_TOLERANCE`]: the envelope (or band)
+    /// leaves at most that much of μ_d open.
+    pub fn determined(&self) -> bool {
+        self.open_rel.is_some_and(|o| o <= LAW_TOLERANCE)
+    }
+
+    /// Whether the fitted law lies within [`LAW_TOLERANCE`] of the true one.
+    pub fn found(&self) -> bool {
+        self.rms_rel_diff < LAW_TOLERANCE
     }
 }
 
 /// The law section of the calibration table: per departure, the fitted recordings, how many find
-/// the law within [`LAW_TOLERANCE`], the median and largest rms difference, the median share of
-/// speeds inside the band, shoulders chosen for shoulder-free truths, and failed goodness-of-fit
-/// tests. Nothing when no recording has a law score.
+/// the law within [`LAW_TOLERANCE`], how many the recording determines to that tolerance and how
+/// many of those find it, the median and largest rms difference, the median share of speeds
+/// inside the band and the envelope, shoulders chosen for shoulder-free truths, and failed
+/// goodness-of-fit tests. Nothing when no recording has a law score.
 pub fn law_section(md: &mut String, c: &Calibration) {
     // The fitted recordings of each departure: one row each.
     let mut groups: BTreeMap<&str, Vec<&RecordingScore>> = BTreeMap::new();
@@ -60,21 +76,28 @@ pub fn law_section(md: &mut String, c: &Calibration) {
          (none: the fitted model itself). Found: rms relative difference below {}. Band: the share \
          of the range's speeds where the true μ_d lies inside the fitted 68 % band (±1σ, widened \
          to the points the search evaluated within μ_d's profile rise limit). \
-         Envelope: inside that band or the laws of the models the recording does not distinguish \
-         from the chosen one (the band where there are none). \
+         Envelope: inside that band or the bands of the models the recording does not distinguish \
+         from the chosen one (the band where there are none). Determined: the envelope leaves at \
+         most {} of μ_d open (its median half-width relative to the fitted μ_d); a recording that \
+         determines the law should find it. \
          Invented shoulder: a shoulder chosen for a blade without one. Misfit: the goodness-of-fit \
          test failed (p ≤ 0.01).\n",
+        pct(LAW_TOLERANCE),
         pct(LAW_TOLERANCE)
     );
     let _ = writeln!(
         md,
-        "| departure | fitted | law scored | found | median rms difference | largest | median share in band | median share in envelope | invented shoulder | misfit |"
+        "| departure | fitted | law scored | found | determined | found where determined | median rms difference | largest | median share in band | median share in envelope | invented shoulder | misfit |"
     );
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (name, fitted) in &groups {
         let scored: Vec<LawScore> = fitted.iter().filter_map(|r| r.law).collect();
         let rms: Vec<f64> = scored.iter().map(|s| s.rms_rel_diff).collect();
-        let found = rms.iter().filter(|d| **d < LAW_TOLERANCE).count();
+        let found = scored.iter().filter(|s| s.found()).count();
+        let determined = scored.iter().filter(|s| s.determined()).count();
+        let found_determined = (scored.iter())
+            .filter(|s| s.determined() && s.found())
+            .count();
         let largest = rms.iter().copied().fold(f64::NAN, f64::max);
         let band: Vec<f64> = scored.iter().filter_map(|s| s.within_band).collect();
         let envelope: Vec<f64> = scored.iter().filter_map(|s| s.within_envelope).collect();
@@ -93,7 +116,7 @@ pub fn law_section(md: &mut String, c: &Calibration) {
             .count();
         let _ = writeln!(
             md,
-            "| {name} | {} | {} | {found} | {} | {} | {} | {} | {invented} | {misfit} |",
+            "| {name} | {} | {} | {found} | {determined} | {found_determined} | {} | {} | {} | {} | {invented} | {misfit} |",
             fitted.len(),
             scored.len(),
             pct(quantile(&rms, 0.5)),

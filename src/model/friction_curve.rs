@@ -289,6 +289,18 @@ impl FrictionCurve {
         Some([edge(0), edge(1)])
     }
 
+    /// How much of μ_d the recording leaves open: the median over the grid of the envelope's
+    /// half-width (the band's where there is no envelope) relative to the fitted μ_d; `None`
+    /// without either.
+    pub fn open_rel_half_width(&self) -> Option<f64> {
+        let [lo, hi] = self.envelope_edges().or_else(|| self.band_edges())?;
+        let mut rel: Vec<f64> = (0..self.mu_d.len())
+            .map(|i| 0.5 * (hi[i] - lo[i]) / self.mu_d[i].abs())
+            .collect();
+        rel.sort_by(f64::total_cmp);
+        Some(percentile(&rel, 50.0))
+    }
+
     /// Whether `speed_m_per_s` lies inside the measured range.
     pub fn measures(&self, speed_m_per_s: f64) -> bool {
         let [lo, hi] = self.measured_range_m_per_s;
@@ -560,6 +572,20 @@ mod tests {
         );
         let e = c.clone().with_alternatives(std::slice::from_ref(&alt));
         assert_eq!(e.truth_within_envelope, Some(1.0));
+        // Open: half of (μ_d + 0.002 − 0.8·μ_d) over μ_d, 0.1 + 0.001/μ_d point by point, at the
+        // median over the grid; the band alone leaves 0.002/μ_d open.
+        let median_of = |f: &dyn Fn(f64) -> f64| {
+            let mut m: Vec<f64> = c.mu_d.iter().map(|&m| f(m)).collect();
+            m.sort_by(f64::total_cmp);
+            percentile(&m, 50.0)
+        };
+        let open = e.open_rel_half_width().unwrap();
+        assert!(
+            (open - median_of(&|m| 0.1 + 0.001 / m)).abs() < 1e-12,
+            "{open}"
+        );
+        let open = c.open_rel_half_width().unwrap();
+        assert!((open - median_of(&|m| 0.002 / m)).abs() < 1e-12, "{open}");
         for (i, [lo, hi]) in e.mu_d_envelope.iter().enumerate() {
             assert!((lo - 0.8 * e.mu_d[i]).abs() < 1e-15 && *hi == e.mu_d[i] + 0.002);
         }
