@@ -359,6 +359,18 @@ fn main_job_end_to_end() {
         },
         "{curve}"
     );
+    // It holds the chosen band, no coefficient below zero, and each such candidate's curve,
+    // around which its own band is drawn (docs/results.md).
+    let fc: wiperlab::model::friction_curve::FrictionCurve =
+        serde_json::from_value(curve.clone()).expect("the friction curve");
+    let [band_lo, band_hi] = fc.band_edges().expect("the chosen law's band");
+    for (i, [lo, hi]) in fc.mu_d_envelope.iter().enumerate() {
+        assert!(*lo >= 0.0 && *lo <= band_lo[i] && band_hi[i] <= *hi, "{i}");
+        for law in &fc.alternative_laws {
+            let m = law.mu_slip(fc.speed_m_per_s[i]);
+            assert!(*lo <= m && m <= *hi, "{i}: {m} outside [{lo}, {hi}]");
+        }
+    }
     // Correlations from the sandwich are finite (positive semi-definite by construction).
     assert_eq!(r["spread_source"], "sandwich");
     for row in r["correlation"].as_array().expect("correlation") {
