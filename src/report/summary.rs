@@ -283,6 +283,12 @@ fn curve_words(c: &crate::model::friction_curve::FrictionCurve) -> String {
             num(last[0], 3),
             num(last[1], 3)
         );
+        if let Some(open) = c.open_rel_half_width() {
+            s += &format!(
+                " Over the range they leave ±{} of μ_d open (the envelope's median half-width).",
+                pct_abs(open)
+            );
+        }
     }
     if let Some(rms) = c.rms_rel_diff_to_truth {
         s += &format!(" It lies {} rms from the true law there", pct_abs(rms));
@@ -602,12 +608,24 @@ mod tests {
         // 0.924 at 10 mm/s, 0.525 at 90 mm/s) to the fitted μ_d + 1σ (0.943, 0.537).
         let c = r.friction_curve.unwrap();
         let other = c.alternative(truth, None, &[], &[]);
-        let words = curve_words(&c.with_alternatives(&[other]));
+        let c = c.with_alternatives(&[other]);
+        let words = curve_words(&c);
         assert!(
             words.contains(
                 "With the 1 model(s) the recording does not distinguish from this one, μ_d lies \
                  within 0.924–0.943 at the slowest and 0.525–0.537 at the fastest of these speeds."
             ) && words.ends_with("of the speeds, inside that envelope at 100 %."),
+            "{words}"
+        );
+        // What the envelope leaves open, as FrictionCurve::open_rel_half_width reads it (its
+        // closed forms are friction_curve's tests): a share of μ_d between 0 and 5 % here.
+        let open = c.open_rel_half_width().unwrap();
+        assert!(open > 0.0 && open < 0.05, "{open}");
+        assert!(
+            words.contains(&format!(
+                " Over the range they leave ±{} of μ_d open",
+                pct_abs(open)
+            )),
             "{words}"
         );
     }
