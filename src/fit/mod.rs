@@ -213,7 +213,7 @@ fn friction_curve(
         .filter_map(|p| p.interval.as_ref())
         .any(|iv| iv.method.widens_to_near_best());
     let law = best.params.friction;
-    let chosen = CandidateSpread::of_result(r, cf);
+    let chosen = CandidateSpread::of(job, cf);
     let curve = crate::model::friction_curve::FrictionCurve::new(
         law,
         &best.sim.slip_speeds(),
@@ -229,7 +229,7 @@ fn friction_curve(
             let Some(o) = others.iter().find(|f| f.candidate == t.model) else {
                 return Some(curve.alternative(law, None, &[], &[]));
             };
-            let s = CandidateSpread::of_fit(job, o);
+            let s = CandidateSpread::of(job, o);
             let (limits, near) = s.near_best(&curve.speed_m_per_s, &law, widens, o);
             Some(curve.alternative(law, Some(s.spread()), &near, &limits))
         })
@@ -247,21 +247,9 @@ struct CandidateSpread {
 }
 
 impl CandidateSpread {
-    /// The chosen fit's, as the result reports them.
-    fn of_result(r: &FitResult, cf: &CandidateFit) -> Self {
-        let fisher_sigma = (r.parameters.iter())
-            .map(|p| p.fisher_std_error.unwrap_or(f64::NAN))
-            .collect();
-        CandidateSpread {
-            ids: r.parameters.iter().map(|p| p.name).collect(),
-            sigma: r.parameters.iter().map(|p| p.std_error).collect(),
-            corr: r.correlation.clone(),
-            fisher: cf.fisher_corr.clone().map(|c| (fisher_sigma, c)),
-        }
-    }
-
-    /// Another candidate's, from its fit.
-    fn of_fit(job: &LoadedJob, cf: &CandidateFit) -> Self {
+    /// The candidate's, from its fit (the chosen one's are the result's parameters' 1σ and its
+    /// correlations).
+    fn of(job: &LoadedJob, cf: &CandidateFit) -> Self {
         let params = fitted_parameters(job, cf);
         let fisher_sigma = (params.iter())
             .map(|p| p.fisher_std_error.unwrap_or(f64::NAN))

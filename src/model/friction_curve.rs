@@ -144,10 +144,7 @@ impl FrictionCurve {
         let speed: Vec<f64> = (0..CURVE_POINTS)
             .map(|i| range[0] + i as f64 * step)
             .collect();
-        let mu_d: Vec<f64> = speed.iter().map(|&v| law.mu_slip(v)).collect();
-        let mu_d_sigma: Vec<f64> = spread
-            .and_then(|s| speed.iter().map(|&v| s.mu_sigma(&law, v)).collect())
-            .unwrap_or_default();
+        let (mu_d, mu_d_sigma) = law_on_grid(&law, &speed, spread);
         let mu_d_true: Vec<f64> = truth
             .map(|t| speed.iter().map(|&v| t.mu_slip(v)).collect())
             .unwrap_or_default();
@@ -223,10 +220,7 @@ impl FrictionCurve {
         rise_limit_nats: &[f64],
     ) -> Alternative {
         let speeds = &self.speed_m_per_s;
-        let mu: Vec<f64> = speeds.iter().map(|&v| law.mu_slip(v)).collect();
-        let sigma: Vec<f64> = spread
-            .and_then(|s| speeds.iter().map(|&v| s.mu_sigma(&law, v)).collect())
-            .unwrap_or_default();
+        let (mu, sigma) = law_on_grid(&law, speeds, spread);
         let near = near_best_ranges(speeds, points, rise_limit_nats).unwrap_or_default();
         let band = band_edges(&mu, &sigma, &near).unwrap_or_else(|| [mu.clone(), mu]);
         Alternative { law, band }
@@ -316,6 +310,20 @@ pub struct Alternative {
     pub law: FrictionLaw,
     /// Its band's lower and upper edges on the grid.
     pub band: [Vec<f64>; 2],
+}
+
+/// `law`'s μ_d on `speeds` and its 1σ there by the delta method from `spread` (empty without one,
+/// or where [`Spread::mu_sigma`] has none).
+fn law_on_grid(
+    law: &FrictionLaw,
+    speeds: &[f64],
+    spread: Option<Spread<'_>>,
+) -> (Vec<f64>, Vec<f64>) {
+    let mu = speeds.iter().map(|&v| law.mu_slip(v)).collect();
+    let sigma = spread
+        .and_then(|s| speeds.iter().map(|&v| s.mu_sigma(law, v)).collect())
+        .unwrap_or_default();
+    (mu, sigma)
 }
 
 /// On each of `speeds`, the lowest and highest μ_d of the `points` (cost above the fit's, nats;
