@@ -29,7 +29,8 @@ use crate::likelihood;
 use crate::likelihood::measure::measure;
 use crate::model::BladeParams;
 use crate::search::strategy::{
-    self as search, CandidateFit, confirm_deferred, descend_chosen, fit_candidates, progress_bar,
+    self as search, CandidateFit, confirm_deferred, confirm_the_smaller, descend_chosen,
+    fit_candidates, progress_bar,
 };
 use crate::search::{SpectralProblem, interrupt, scan};
 use crate::simulate::blade::BladeSimulation;
@@ -83,6 +84,9 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         })
     };
     let mut selection = choose(&mut fits)?;
+    if confirm_the_smaller(job, &mut fits, selection.chosen, &pb)? {
+        selection = choose(&mut fits)?;
+    }
     let (mut best, mut gof) = chosen_goodness(&fits[selection.chosen])?;
     let chosen_name = fits[selection.chosen].candidate.to_string();
     if let Some(why) = scan::scan_reason(fit.contact_angle_scan, &chosen_name, gof_ref(&gof))

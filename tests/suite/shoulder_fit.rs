@@ -116,6 +116,19 @@ keys = {{ k1 = "/k1", k1c = "/k1c", theta_c = "/theta_c" }}
             law: None,
         }
     );
+    // The shoulder is chosen only after one more batch of the model without it ran
+    // (`confirm_the_smaller`), whose reason says so.
+    let smaller = out
+        .result
+        .model_trials
+        .iter()
+        .find(|t| !t.model.shoulder)
+        .expect("blade2dof's trial");
+    assert!(
+        smaller.reason.contains("was chosen over it, so restarts"),
+        "{}",
+        smaller.reason
+    );
     let k1c_fit = out
         .result
         .parameters
