@@ -1158,8 +1158,9 @@ pub(crate) fn confirm_deferred(
 /// optimum, with structure the blade need not have: on a departure scene `X`'s first restarts all
 /// ended in a basin 8 nats above its optimum (a confirmed end, so no second batch ran) and a
 /// shoulder was chosen that the blade lacks (docs/validation.md, "Confirming the smaller model").
-/// A batch that ends below `X`'s search end replaces it: `X` is settled anew, and a candidate
-/// nested on it keeps at least its likelihood ([`keep_nested_above`]). The note says what ran.
+/// A batch that ends below `X`'s search end replaces it: `X` is settled anew, a candidate nested on
+/// it polishes again from its new optimum ([`rewarm_nested`]) and keeps at least its likelihood
+/// ([`keep_nested_above`]). The notes say what ran.
 /// Returns whether a candidate moved (the choice is then made again).
 pub(crate) fn confirm_the_smaller(
     job: &LoadedJob,
@@ -1214,6 +1215,7 @@ pub(crate) fn confirm_the_smaller(
                 };
                 settle_anew(f, found, &reporting, pb)?;
                 f.wall_time_s = wall_time_s + started.elapsed().as_secs_f64();
+                rewarm_nested(fits, i, fit, pb)?;
                 keep_nested_above(fits, i, pb)?;
                 moved = true;
             }
@@ -1226,6 +1228,70 @@ pub(crate) fn confirm_the_smaller(
         }
     }
     Ok(moved)
+}
+
+/// Each candidate nested on `fits[smaller]`, whose search started from the smaller model's earlier
+/// optimum, polished again from the warm points of its new one ([`nested_warm_points`],
+/// [`warm_polishes`]): a shoulder that adds to the smaller model's true basin is found from there,
+/// not from the basin it has left. An end more than [`VALLEY_GAIN_NATS`] below the candidate's own
+/// search end replaces it, and the candidate is settled anew; its note says what the polishes did.
+fn rewarm_nested(
+    fits: &mut [CandidateFit],
+    smaller: usize,
+    fit: &job::FitSection,
+    pb: &Option<indicatif::ProgressBar>,
+) -> Result<()> {
+    for j in 0..fits.len() {
+        if !fits[j].candidate.extends(&fits[smaller].candidate) || interrupt::stop_requested() {
+            continue;
+        }
+        let started = std::time::Instant::now();
+        let warm = nested_warm_points(&fits[smaller], fits[j].candidate, &fits[j].free);
+        let from = fits[smaller].candidate;
+        let f = &fits[j];
+        let reporting = Reporting::continuing(f, pb);
+        if let Some(pb) = pb {
+            pb.inc_length(warm.len() as u64 * polish_budget(fit, f.free.len()));
+        }
+        reporting.stage(format_args!("local search from {from}'s new optimum"));
+        let (ends, iters) = warm_polishes(&f.problem, fit, &warm, &reporting)?;
+        let best = ends.into_iter().min_by(|a, b| a.1.total_cmp(&b.1));
+        let f = &mut fits[j];
+        let (wall_time_s, search_cost) = (f.wall_time_s, f.search_cost);
+        let best_cost = best.as_ref().map_or(f64::INFINITY, |b| b.1);
+        let gained = best_cost < search_cost - VALLEY_GAIN_NATS && !interrupt::stop_requested();
+        add_note(
+            &mut f.search_note,
+            format!(
+                "{} polishes from {from}'s new optimum: best end {best_cost:.3} nats against its \
+                 search end {search_cost:.3}{}",
+                warm.len(),
+                if gained {
+                    ", so it continues from there"
+                } else {
+                    ", which stands"
+                }
+            ),
+        );
+        match best {
+            Some((u, cost)) if gained => {
+                let found = Optimised {
+                    u,
+                    swarm_iters: f.swarm_iters,
+                    polish_iters: f.polish_iters + iters,
+                    cost,
+                    unconfirmed_ends: None,
+                };
+                settle_anew(f, found, &reporting, pb)?;
+            }
+            _ => {
+                f.polish_iters += iters;
+                f.history = reporting.sorted_history();
+            }
+        }
+        f.wall_time_s = wall_time_s + started.elapsed().as_secs_f64();
+    }
+    Ok(())
 }
 
 /// The first restart index no search of `f` has used: one past the highest swarm restart in its
@@ -1326,41 +1392,15 @@ fn nested_search(
     reporting: &Reporting,
     confirming: Confirming,
 ) -> Result<(Optimised, Option<String>)> {
-    use rayon::prelude::*;
     reporting.stage(format_args!("local search"));
     let at_warm = warm.first().map_or(f64::INFINITY, |w| problem.cost_at(w));
     let (smaller_search_cost, smaller) =
         smaller.unwrap_or((f64::INFINITY, "the smaller model".into()));
     let base = at_warm.min(smaller_search_cost);
-    let observer = |r: usize| SearchObserver {
-        stage: SearchStage::Polish,
-        restart: r,
-        reporting: reporting.clone(),
-        evals: problem.evaluations.clone(),
-        run_evals: Arc::new(AtomicUsize::new(0)),
-    };
-    let runs: Vec<Result<(Vec<f64>, u64, f64)>> = warm
-        .par_iter()
-        .enumerate()
-        .map(|(r, w)| {
-            polish(
-                problem,
-                w,
-                POLISH_STEP_U,
-                fit.polish_iterations,
-                Some(observer(r)),
-            )
-        })
-        .collect();
     let mut local: Option<(Vec<f64>, f64)> = warm.first().map(|w| (w.clone(), at_warm));
     let mut ends = vec![at_warm, smaller_search_cost];
-    let mut polish_iters = 0;
-    for run in runs {
-        let (u, iters, cost) = match run {
-            Err(_) if interrupt::stop_requested() => continue,
-            other => other?,
-        };
-        polish_iters += iters;
+    let (polished, polish_iters) = warm_polishes(problem, fit, warm, reporting)?;
+    for (u, cost) in polished {
         ends.push(cost);
         if local.as_ref().is_none_or(|b| cost < b.1) {
             local = Some((u, cost));
@@ -1425,6 +1465,48 @@ fn nested_search(
         (global.u, global.cost) = (u, cost);
     }
     Ok((global, Some(note)))
+}
+
+/// Nelder–Mead polishes from each of `warm` (in parallel, each its own restart in the history):
+/// their ends with their costs, in order, and the iterations they took (an interrupted polish has
+/// no end).
+fn warm_polishes(
+    problem: &Arc<SpectralProblem>,
+    fit: &job::FitSection,
+    warm: &[Vec<f64>],
+    reporting: &Reporting,
+) -> Result<(Vec<Scored>, u64)> {
+    use rayon::prelude::*;
+    let observer = |r: usize| SearchObserver {
+        stage: SearchStage::Polish,
+        restart: r,
+        reporting: reporting.clone(),
+        evals: problem.evaluations.clone(),
+        run_evals: Arc::new(AtomicUsize::new(0)),
+    };
+    let runs: Vec<Result<(Vec<f64>, u64, f64)>> = warm
+        .par_iter()
+        .enumerate()
+        .map(|(r, w)| {
+            polish(
+                problem,
+                w,
+                POLISH_STEP_U,
+                fit.polish_iterations,
+                Some(observer(r)),
+            )
+        })
+        .collect();
+    let (mut ends, mut iterations) = (Vec::new(), 0);
+    for run in runs {
+        let (u, iters, cost) = match run {
+            Err(_) if interrupt::stop_requested() => continue,
+            other => other?,
+        };
+        iterations += iters;
+        ends.push((u, cost));
+    }
+    Ok((ends, iterations))
 }
 
 /// Where a nested candidate (`X+shoulder`) starts: `X`'s optimum with k1_contact = k1, so that
