@@ -1119,34 +1119,9 @@ pub(crate) fn confirm_deferred(
         let reporting = unconfirmed
             .reporting
             .resumed(f.problem.evaluations.load(Ordering::Relaxed));
-        let mut best: Option<Run> = None;
-        let (mut swarm_iters, mut polish_iters) = (0, 0);
-        for run in more_restarts(&f.problem, fit, fit.seed, Some(&reporting)) {
-            let Some(run) = run? else { continue };
-            swarm_iters += run.swarm_iters;
-            polish_iters += run.polish_iters;
-            if best.as_ref().is_none_or(|b| run.cost < b.cost) {
-                best = Some(run);
-            }
-        }
+        let runs = more_restarts(&f.problem, fit, fit.seed, Some(&reporting));
         let wall_time_s = f.wall_time_s;
-        match best {
-            Some(run) if run.cost < f.search_cost && !interrupt::stop_requested() => {
-                let found = Optimised {
-                    u: run.u,
-                    swarm_iters: f.swarm_iters + swarm_iters,
-                    polish_iters: f.polish_iters + polish_iters,
-                    cost: run.cost,
-                    unconfirmed_ends: None,
-                };
-                settle_anew(f, found, &reporting, pb)?;
-            }
-            _ => {
-                f.swarm_iters += swarm_iters;
-                f.polish_iters += polish_iters;
-                f.history = reporting.sorted_history();
-            }
-        }
+        take_batch(f, runs, &reporting, pb)?;
         f.wall_time_s = wall_time_s + started.elapsed().as_secs_f64();
     }
     Ok(())
@@ -1187,47 +1162,63 @@ pub(crate) fn confirm_the_smaller(
         let reporting = Reporting::continuing(f, pb);
         let why = format!("{larger} chosen over it");
         let runs = restart_batch_from(&f.problem, fit, fit.seed, first, Some(&reporting), &why);
-        let mut best: Option<Run> = None;
-        let (mut swarm_iters, mut polish_iters) = (0, 0);
-        for run in runs {
-            let Some(run) = run? else { continue };
-            swarm_iters += run.swarm_iters;
-            polish_iters += run.polish_iters;
-            if best.as_ref().is_none_or(|b| run.cost < b.cost) {
-                best = Some(run);
-            }
-        }
         let f = &mut fits[i];
         let (wall_time_s, search_cost) = (f.wall_time_s, f.search_cost);
-        let best_end = best.as_ref().map_or(f64::INFINITY, |r| r.cost);
+        let (best_end, took) = take_batch(f, runs, &reporting, pb)?;
         add_note(
             &mut f.search_note,
             smaller_note(&larger, first, fit.restarts.max(1), best_end, search_cost),
         );
-        match best {
-            Some(run) if run.cost < search_cost && !interrupt::stop_requested() => {
-                let found = Optimised {
-                    u: run.u,
-                    swarm_iters: f.swarm_iters + swarm_iters,
-                    polish_iters: f.polish_iters + polish_iters,
-                    cost: run.cost,
-                    unconfirmed_ends: None,
-                };
-                settle_anew(f, found, &reporting, pb)?;
-                f.wall_time_s = wall_time_s + started.elapsed().as_secs_f64();
-                rewarm_nested(fits, i, fit, pb)?;
-                keep_nested_above(fits, i, pb)?;
-                moved = true;
-            }
-            _ => {
-                f.swarm_iters += swarm_iters;
-                f.polish_iters += polish_iters;
-                f.history = reporting.sorted_history();
-                f.wall_time_s = wall_time_s + started.elapsed().as_secs_f64();
-            }
+        f.wall_time_s = wall_time_s + started.elapsed().as_secs_f64();
+        if took {
+            rewarm_nested(fits, i, fit, pb)?;
+            keep_nested_above(fits, i, pb)?;
+            moved = true;
         }
     }
     Ok(moved)
+}
+
+/// A further batch of restarts `runs` of the candidate `f`: its best end replaces the candidate's
+/// search end when lower, and the candidate is settled anew from it ([`settle_anew`]); otherwise
+/// the batch's iterations and history are added to the candidate's. Returns the batch's best end
+/// (nats; ∞ with none) and whether it was taken. The caller keeps the wall time.
+fn take_batch(
+    f: &mut CandidateFit,
+    runs: Vec<Result<Option<Run>>>,
+    reporting: &Reporting,
+    pb: &Option<indicatif::ProgressBar>,
+) -> Result<(f64, bool)> {
+    let mut best: Option<Run> = None;
+    let (mut swarm_iters, mut polish_iters) = (0, 0);
+    for run in runs {
+        let Some(run) = run? else { continue };
+        swarm_iters += run.swarm_iters;
+        polish_iters += run.polish_iters;
+        if best.as_ref().is_none_or(|b| run.cost < b.cost) {
+            best = Some(run);
+        }
+    }
+    let best_end = best.as_ref().map_or(f64::INFINITY, |r| r.cost);
+    match best {
+        Some(run) if run.cost < f.search_cost && !interrupt::stop_requested() => {
+            let found = Optimised {
+                u: run.u,
+                swarm_iters: f.swarm_iters + swarm_iters,
+                polish_iters: f.polish_iters + polish_iters,
+                cost: run.cost,
+                unconfirmed_ends: None,
+            };
+            settle_anew(f, found, reporting, pb)?;
+            Ok((best_end, true))
+        }
+        _ => {
+            f.swarm_iters += swarm_iters;
+            f.polish_iters += polish_iters;
+            f.history = reporting.sorted_history();
+            Ok((best_end, false))
+        }
+    }
 }
 
 /// Each candidate nested on `fits[smaller]`, whose search started from the smaller model's earlier
