@@ -1132,8 +1132,8 @@ pub(crate) fn confirm_deferred(
 /// contains `X`'s optimum, so it wins on any recording where `X`'s search stopped short of that
 /// optimum, with structure the blade need not have: on a departure scene two of `X`'s first three
 /// restarts ended in one basin 7 nats above its optimum (a confirmed end, so no second batch ran)
-/// and a shoulder was chosen that the blade lacks (docs/validation.md, "Confirming the smaller
-/// model").
+/// and a shoulder was chosen that the blade lacks
+/// (docs/validation.md, "Confirming the smaller model").
 /// A batch that ends below `X`'s search end replaces it: `X` is settled anew, a candidate nested on
 /// it polishes again from its new optimum ([`rewarm_nested`]) and keeps at least its likelihood
 /// ([`keep_nested_above`]). The notes say what ran.
