@@ -1201,23 +1201,38 @@ fn take_batch(
         }
     }
     let best_end = best.as_ref().map_or(f64::INFINITY, |r| r.cost);
-    match best {
-        Some(run) if run.cost < f.search_cost && !interrupt::stop_requested() => {
+    let lower = best_end < f.search_cost && !interrupt::stop_requested();
+    let end = best.map(|r| (r.u, r.cost)).filter(|_| lower);
+    continue_from(f, end, (swarm_iters, polish_iters), reporting, pb)?;
+    Ok((best_end, lower))
+}
+
+/// The candidate `f` after further search work of `iterations` (swarm, polish): settled anew from
+/// `end` ([`settle_anew`]) when there is one to take, else with the iterations and the history
+/// added to its own.
+fn continue_from(
+    f: &mut CandidateFit,
+    end: Option<Scored>,
+    (swarm_iters, polish_iters): (u64, u64),
+    reporting: &Reporting,
+    pb: &Option<indicatif::ProgressBar>,
+) -> Result<()> {
+    match end {
+        Some((u, cost)) => {
             let found = Optimised {
-                u: run.u,
+                u,
                 swarm_iters: f.swarm_iters + swarm_iters,
                 polish_iters: f.polish_iters + polish_iters,
-                cost: run.cost,
+                cost,
                 unconfirmed_ends: None,
             };
-            settle_anew(f, found, reporting, pb)?;
-            Ok((best_end, true))
+            settle_anew(f, found, reporting, pb)
         }
-        _ => {
+        None => {
             f.swarm_iters += swarm_iters;
             f.polish_iters += polish_iters;
             f.history = reporting.sorted_history();
-            Ok((best_end, false))
+            Ok(())
         }
     }
 }
@@ -1265,22 +1280,7 @@ fn rewarm_nested(
                 }
             ),
         );
-        match best {
-            Some((u, cost)) if gained => {
-                let found = Optimised {
-                    u,
-                    swarm_iters: f.swarm_iters,
-                    polish_iters: f.polish_iters + iters,
-                    cost,
-                    unconfirmed_ends: None,
-                };
-                settle_anew(f, found, &reporting, pb)?;
-            }
-            _ => {
-                f.polish_iters += iters;
-                f.history = reporting.sorted_history();
-            }
-        }
+        continue_from(f, best.filter(|_| gained), (0, iters), &reporting, pb)?;
         f.wall_time_s = wall_time_s + started.elapsed().as_secs_f64();
     }
     Ok(())
