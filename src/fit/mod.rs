@@ -84,7 +84,8 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         })
     };
     let mut selection = choose(&mut fits)?;
-    if confirm_the_smaller(job, &mut fits, selection.chosen, &pb)? {
+    let mut confirmed = vec![false; fits.len()];
+    if confirm_the_smaller(job, &mut fits, selection.chosen, &mut confirmed, &pb)? {
         selection = choose(&mut fits)?;
     }
     let (mut best, mut gof) = chosen_goodness(&fits[selection.chosen])?;
@@ -97,6 +98,9 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         // polishes run again only from a moved optimum.
         if scan::scan_contact_angle(job, &meas, &mut fits, &pb, &why)? {
             selection = choose(&mut fits)?;
+            if confirm_the_smaller(job, &mut fits, selection.chosen, &mut confirmed, &pb)? {
+                selection = choose(&mut fits)?;
+            }
             (best, gof) = chosen_goodness(&fits[selection.chosen])?;
         } else {
             selection = select::choose(&fits, &job.job.spectrum.bands, explicit, &[]);

@@ -1137,11 +1137,15 @@ pub(crate) fn confirm_deferred(
 /// A batch that ends below `X`'s search end replaces it: `X` is settled anew, a candidate nested on
 /// it polishes again from its new optimum ([`rewarm_nested`]) and keeps at least its likelihood
 /// ([`keep_nested_above`]). The notes say what ran.
+/// Each smaller candidate runs this batch once per fit (`confirmed[i]`, indexed like `fits`), so
+/// a larger candidate chosen later (after the contact-angle scan) confirms the smaller ones it was
+/// not yet weighed against.
 /// Returns whether a candidate moved (the choice is then made again).
 pub(crate) fn confirm_the_smaller(
     job: &LoadedJob,
     fits: &mut Vec<CandidateFit>,
     chosen: usize,
+    confirmed: &mut [bool],
     pb: &Option<indicatif::ProgressBar>,
 ) -> Result<bool> {
     let fit = &job.job.fit;
@@ -1150,13 +1154,16 @@ pub(crate) fn confirm_the_smaller(
     }
     let larger = fits[chosen].candidate;
     let smaller: Vec<usize> = (0..fits.len())
-        .filter(|&i| larger.extends(&fits[i].candidate) && fits[i].problem.cost_is_nll())
+        .filter(|&i| {
+            !confirmed[i] && larger.extends(&fits[i].candidate) && fits[i].problem.cost_is_nll()
+        })
         .collect();
     let mut moved = false;
     for i in smaller {
         if interrupt::stop_requested() {
             break;
         }
+        confirmed[i] = true;
         let started = std::time::Instant::now();
         let f = &fits[i];
         let first = next_restart(f, fit);
