@@ -129,6 +129,18 @@ pub fn method_standardised_error(p: &FittedParam, truth: f64) -> Option<f64> {
     Some(error_in_interval(p, own, iv.level, truth))
 }
 
+/// [`standardised_error`] against the 95 % interval: the method's own where the result gives one
+/// (`range_95`: a profile walked on to the 95 % rise, a posterior's 2.5–97.5 % quantiles), else the
+/// reported interval's half-widths times 1.96 (exactly ±1.96σ for a Laplace interval), where this
+/// is [`standardised_error`]. Covered when `|z| ≤ Φ⁻¹(0.975)`.
+pub fn wide_standardised_error(p: &FittedParam, truth: f64) -> Option<f64> {
+    let iv = p.interval.as_ref()?;
+    Some(match iv.range_95 {
+        Some(range) => error_in_interval(p, range, WIDE_LEVEL, truth),
+        None => error_in_interval(p, [iv.lo, iv.hi], iv.level, truth),
+    })
+}
+
 /// [`standardised_error`] for the interval `[lo, hi]` at `level` around `p`'s value.
 fn error_in_interval(p: &FittedParam, [lo, hi]: [f64; 2], level: f64, truth: f64) -> f64 {
     let g = search_coordinate(p);
@@ -191,6 +203,9 @@ pub struct Scored {
     pub z_method: Option<f64>,
     /// Standardised error in sandwich σ ([`sandwich_standardised_error`]).
     pub z_sandwich: Option<f64>,
+    /// Standardised error against the 95 % interval ([`wide_standardised_error`]): covered when
+    /// `|z_95| ≤ 1.96`.
+    pub z_95: Option<f64>,
 }
 
 /// One recording of the calibration.
@@ -305,15 +320,18 @@ pub fn param_stats<'a>(
     let wide_sigmas = sigmas_at(WIDE_LEVEL);
     by.into_iter()
         .map(|(param, scored)| {
-            let zs: Vec<(f64, f64)> = scored
+            let zs: Vec<(f64, f64, f64)> = scored
                 .iter()
-                .filter_map(|s| s.z.map(|z| (z, s.level)))
+                .filter_map(|s| s.z.map(|z| (z, s.level, s.z_95.unwrap_or(z))))
                 .collect();
             let n = zs.len();
             let level = zs.first().map_or(f64::NAN, |z| z.1);
-            let covered = zs.iter().filter(|(z, l)| z.abs() <= sigmas_at(*l)).count();
-            let covered_wide = zs.iter().filter(|(z, _)| z.abs() <= wide_sigmas).count();
-            let sum_z2: f64 = zs.iter().map(|(z, _)| z * z).sum();
+            let covered = zs
+                .iter()
+                .filter(|(z, l, _)| z.abs() <= sigmas_at(*l))
+                .count();
+            let covered_wide = zs.iter().filter(|(.., w)| w.abs() <= wide_sigmas).count();
+            let sum_z2: f64 = zs.iter().map(|(z, ..)| z * z).sum();
             let rel: Vec<f64> = scored
                 .iter()
                 .map(|s| ((s.value - s.truth) / s.truth).abs())
@@ -648,6 +666,7 @@ fn score(r: &mut RecordingScore, result: &FitResult) {
             level: p.interval.as_ref().map_or(f64::NAN, |i| i.level),
             z_method: method_standardised_error(p, truth),
             z_sandwich: sandwich_standardised_error(p, truth),
+            z_95: wide_standardised_error(p, truth),
         });
     }
 }
@@ -779,15 +798,16 @@ pub struct VariantCoverage {
 
 /// Coverage of the reported interval, the method's own before widening and the sandwich Laplace
 /// interval, per parameter, over `recordings` where all three exist; 68.27 % is `|z| ≤ 1`, 95 %
-/// `|z| ≤ 1.96`.
+/// `|z| ≤ 1.96` (the reported one's 95 % interval: [`wide_standardised_error`]; the method's own
+/// before widening and the sandwich's: 1.96 times their 68.27 % half-widths).
 pub fn variant_coverage<'a>(
     recordings: impl IntoIterator<Item = &'a RecordingScore>,
 ) -> Vec<VariantCoverage> {
     let wide = sigmas_at(WIDE_LEVEL);
     let mut by: BTreeMap<ParamId, VariantCoverage> = BTreeMap::new();
-    let count = |c: &mut (usize, usize), z: f64| {
+    let count = |c: &mut (usize, usize), z: f64, z_95: f64| {
         c.0 += usize::from(z.abs() <= 1.0);
-        c.1 += usize::from(z.abs() <= wide);
+        c.1 += usize::from(z_95.abs() <= wide);
     };
     for s in recordings.into_iter().flat_map(|r| &r.params) {
         let (Some(z), Some(zm), Some(zs)) = (s.z, s.z_method, s.z_sandwich) else {
@@ -801,9 +821,9 @@ pub fn variant_coverage<'a>(
             sandwich: (0, 0),
         });
         v.n += 1;
-        count(&mut v.reported, z);
-        count(&mut v.method, zm);
-        count(&mut v.sandwich, zs);
+        count(&mut v.reported, z, s.z_95.unwrap_or(z));
+        count(&mut v.method, zm, zm);
+        count(&mut v.sandwich, zs, zs);
     }
     by.into_values().collect()
 }
@@ -1000,8 +1020,10 @@ pub fn to_markdown(c: &Calibration, notes: Option<&str>, command: &str) -> Strin
         "## Coverage and error by parameter\n\n\
          Over the {scored} fitted recordings whose chosen model contains the true one (a parameter is \
          scored when the true model has it). The 68 % interval is the one the result reports (level \
-         0.6827); the 95 % interval is the same interval's half-widths times 1.96 in the search's \
-         coordinate (for Laplace intervals, ±1.96σ). A count is **outside** when it leaves the central \
+         0.6827); the 95 % interval is the method's own where the result gives one (`range_95`: the \
+         profile walked on to the 95 % rise, a posterior's 2.5–97.5 % quantiles), else the reported \
+         interval's half-widths times 1.96 in the search's coordinate (for Laplace intervals, \
+         ±1.96σ). A count is **outside** when it leaves the central \
          95 % band of Binomial(n, level). z = the truth's distance from the estimate in σ read from the \
          interval on the truth's side; Σz² is compared with χ²(n), small p on either side: too large, \
          intervals too narrow; too small, too wide.\n"
@@ -1195,6 +1217,7 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
             format!("{p}_z"),
             format!("{p}_z_method"),
             format!("{p}_z_sandwich"),
+            format!("{p}_z_95"),
         ]);
     }
     w.write_record(&header).map_err(err)?;
@@ -1243,8 +1266,9 @@ pub fn recordings_csv(c: &Calibration) -> Result<String> {
                     s.z.map(csv_num).unwrap_or_default(),
                     s.z_method.map(csv_num).unwrap_or_default(),
                     s.z_sandwich.map(csv_num).unwrap_or_default(),
+                    s.z_95.map(csv_num).unwrap_or_default(),
                 ]),
-                None => rec.extend(std::iter::repeat_n(String::new(), 5)),
+                None => rec.extend(std::iter::repeat_n(String::new(), 6)),
             }
         }
         w.write_record(&rec).map_err(err)?;
@@ -1367,6 +1391,7 @@ mod tests {
                 level: 0.6827,
                 method: IntervalMethod::Curvature,
                 widened_from: None,
+                range_95: None,
             }),
         }
     }
@@ -1388,6 +1413,26 @@ mod tests {
         assert!((standardised_error(&b, 25.0).unwrap() + 2.0 * sigma).abs() < 1e-12);
         let flat = param(ParamId::A, 0.5, [0.2, 1.5], [0.5, 0.6]);
         assert_eq!(standardised_error(&flat, 0.4), Some(f64::NEG_INFINITY));
+    }
+
+    /// The 95 % interval: without a `range_95` it is the reported one's half-widths times 1.96,
+    /// so the wide z is the 68.27 % z; with one, z reads its half-width on the truth's side as
+    /// Φ⁻¹(0.975) σ. A = 0.5 on [0.45, 0.6] with the 95 % range [0.3, 0.65]: a truth at 0.4 is 2σ
+    /// out by the 68.27 % interval (outside ±1.96) and 0.5·1.96 σ inside the 95 % range; a truth
+    /// at 0.7 is beyond the range's upper end 0.65 (z = 2/1.5 · 1.96).
+    #[test]
+    fn the_95_range_is_scored_where_the_result_has_one() {
+        let mut a = param(ParamId::A, 0.5, [0.2, 1.5], [0.45, 0.6]);
+        let sigma = Normal::standard().inverse_cdf(0.5 * 1.6827);
+        let z95 = Normal::standard().inverse_cdf(0.975);
+        assert_eq!(
+            wide_standardised_error(&a, 0.4),
+            standardised_error(&a, 0.4)
+        );
+        assert!((standardised_error(&a, 0.4).unwrap() + 2.0 * sigma).abs() < 1e-12);
+        a.interval.as_mut().unwrap().range_95 = Some([0.3, 0.65]);
+        assert!((wide_standardised_error(&a, 0.4).unwrap() + 0.5 * z95).abs() < 1e-12);
+        assert!((wide_standardised_error(&a, 0.7).unwrap() - 2.0 / 1.5 * z95).abs() < 1e-12);
     }
 
     /// A profile interval [0.48, 0.52] around A = 0.5 widened to [0.40, 0.52], sandwich 1σ 0.01:
@@ -1450,6 +1495,7 @@ mod tests {
                     level: 0.6827,
                     z_method: Some(z),
                     z_sandwich: Some(z),
+                    z_95: Some(z),
                 })
                 .collect(),
             departure: None,

@@ -20,6 +20,12 @@ pub struct Interval {
     /// it was not widened.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub widened_from: Option<[f64; 2]>,
+    /// `[lo, hi]` of the same method's 95 % interval, where it gives one: a profile walked on to
+    /// the 95 % rise ([`crate::uncertainty::PROFILE_95_NATS`]·μ, widened alike to the search's
+    /// points within it), a posterior sample's 2.5 % and 97.5 % quantiles. It contains `[lo, hi]`.
+    /// Absent for Laplace and bootstrap intervals, whose 95 % interval is ±1.96σ of theirs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub range_95: Option<[f64; 2]>,
 }
 
 /// How a confidence interval was obtained.

@@ -213,8 +213,9 @@ struct IntervalView {
     hi: String,
     /// The method's own ends when the interval was widened to points the fit evaluated.
     widened_from: Option<String>,
-    /// With a posterior sample: its 95 % interval, and "not determined by this recording" when
-    /// it spans most of the search range.
+    /// The 95 % interval where the method gives one (a profile walked on to the 95 % rise, a
+    /// posterior sample), and with a posterior sample "not determined by this recording" when it
+    /// spans most of the search range.
     posterior_note: Option<String>,
     level_pct: String,
     footnote: usize,
@@ -273,7 +274,10 @@ fn parameter_rows(r: &FitResult) -> (Vec<ParamView>, Vec<String>) {
                     widened_from: i
                         .widened_from
                         .map(|[lo, hi]| format!("[{}, {}]", num(lo, 4), num(hi, 4))),
-                    posterior_note: posterior_note(r, p.name),
+                    posterior_note: posterior_note(r, p.name).or_else(|| {
+                        i.range_95
+                            .map(|[lo, hi]| format!("95 %: [{}, {}]", num(lo, 4), num(hi, 4)))
+                    }),
                     level_pct: format!("{:.0}", 100.0 * i.level),
                     footnote: methods.iter().position(|m| *m == method).unwrap_or(0) + 1,
                 }
@@ -1215,6 +1219,7 @@ pub(super) mod tests {
                             rise_limit_nats: 0.125,
                         },
                         widened_from: None,
+                        range_95: None,
                     }),
                 ),
                 p("B", false, None),

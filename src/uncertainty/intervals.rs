@@ -356,6 +356,7 @@ pub(super) fn mcmc_intervals(
                 level: 0.6827,
                 method: method.clone(),
                 widened_from: None,
+                range_95: Some([p.quantiles[0], p.quantiles[4]]),
             }
         })
         .collect();
@@ -401,6 +402,7 @@ pub fn laplace_intervals(
                     span_sigma: crate::search::evidence::SANDWICH_SPAN_SIGMA,
                 },
                 widened_from: None,
+                range_95: None,
             }
         })
         .collect()
@@ -441,30 +443,42 @@ const PROFILE_POLISH_ITERATIONS_TYPICAL: u64 = 10;
 /// One end of a parameter's profile-likelihood interval ([`profile_end`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ProfileEnd {
-    /// The end, normalised coordinate of the profiled parameter.
+    /// The 68.27 % end, normalised coordinate of the profiled parameter.
     pub u: f64,
-    /// The profile crossed the rise limit (else the end is the search box's bound or the last
-    /// point of the walk).
+    /// The profile crossed the 68.27 % rise limit (else the end is the search box's bound or the
+    /// last point of the walk).
     pub closed: bool,
     /// The end is the search box's bound, reached with the profile still below the limit.
     pub at_bound: bool,
+    /// The 95 % end: where the walk, carried on past the 68.27 % end, crossed the 95 % rise limit
+    /// (else the bound or the walk's last point, as for `u`).
+    pub u_95: f64,
     /// The lowest rise met along the walk, nats (negative: a point more likely than the fit).
     pub lowest_rise_nats: f64,
     /// Where that lowest rise was met, normalised coordinate.
     pub lowest_u: f64,
 }
 
+/// Where the profile crosses `limit` between a point at distance `d_in` (rise `r_in`) and one at
+/// `d` (rise `r`) from the fit, linearly in √rise (exact for a quadratic profile).
+fn crossing(limit: f64, (d_in, r_in): (f64, f64), (d, r): (f64, f64)) -> f64 {
+    let (a, b) = (r_in.max(0.0).sqrt(), r.sqrt());
+    let t = ((limit.sqrt() - a) / (b - a)).clamp(0.0, 1.0);
+    d_in + t * (d - d_in)
+}
+
 /// Walks a parameter's profile from the fit at `u0` in direction `side` (±1): steps of
 /// `first_step`, 2·`first_step`, 4·`first_step`, … (at most [`PROFILE_MAX_STEPS`]), each point's
 /// `rise(u)` (the minimum of the NLL over the other parameters with this one held at `u`, minus
-/// the fit's), until the rise exceeds `limit`; the end is interpolated between the last two points
-/// linearly in √rise (exact for a quadratic profile). Stops at the unit box's bound if the
-/// profile stays below the limit up to it.
+/// the fit's), until the rise exceeds `limit_95` (`[limit_68, limit_95]`: the rises at the 68.27 %
+/// and the 95 % ends); each end is interpolated between the two points around its limit linearly
+/// in √rise (exact for a quadratic profile). Stops at the unit box's bound if the profile stays
+/// below a limit up to it.
 pub fn profile_end(
     u0: f64,
     first_step: f64,
     side: f64,
-    limit: f64,
+    [limit, limit_95]: [f64; 2],
     mut rise: impl FnMut(f64) -> f64,
 ) -> ProfileEnd {
     let (mut d_in, mut r_in) = (0.0_f64, 0.0_f64);
@@ -472,6 +486,7 @@ pub fn profile_end(
         u: u0,
         closed: false,
         at_bound: false,
+        u_95: u0,
         lowest_rise_nats: 0.0,
         lowest_u: u0,
     };
@@ -479,24 +494,28 @@ pub fn profile_end(
         let x = (u0 + side * first_step * f64::from(1u32 << j)).clamp(0.0, 1.0);
         let d = (x - u0).abs();
         if d <= d_in {
-            end.at_bound = true;
+            end.at_bound = !end.closed;
             return end;
         }
         let r = rise(x);
         if r < end.lowest_rise_nats {
             (end.lowest_rise_nats, end.lowest_u) = (r, x);
         }
-        if r > limit {
-            let (a, b) = (r_in.max(0.0).sqrt(), r.sqrt());
-            let t = ((limit.sqrt() - a) / (b - a)).clamp(0.0, 1.0);
-            end.u = u0 + side * (d_in + t * (d - d_in));
+        if !end.closed && r > limit {
+            end.u = u0 + side * crossing(limit, (d_in, r_in), (d, r));
             end.closed = true;
+        }
+        if r > limit_95.max(limit) {
+            end.u_95 = u0 + side * crossing(limit_95.max(limit), (d_in, r_in), (d, r));
             return end;
         }
         (d_in, r_in) = (d, r);
-        end.u = x;
+        if !end.closed {
+            end.u = x;
+        }
+        end.u_95 = x;
         if x == 0.0 || x == 1.0 {
-            end.at_bound = true;
+            end.at_bound = !end.closed;
             return end;
         }
     }
@@ -670,7 +689,8 @@ fn profile_with(
         let mut start = at.u.to_vec();
         let mut x_prev = at.u[i];
         let mut failure = None;
-        let end = profile_end(at.u[i], first, side, limit(i), |x| {
+        let limits = [limit(i), limit(i) * PROFILE_95_OVER_68];
+        let end = profile_end(at.u[i], first, side, limits, |x| {
             let observer = progress.clone();
             let from = step_start(problem, &at, &start, (i, x_prev, x));
             x_prev = x;
@@ -719,6 +739,7 @@ fn profile_with(
                 rise_limit_nats: limit(i),
             },
             widened_from: None,
+            range_95: Some([fp.value(lo.u_95), fp.value(hi.u_95)]),
         });
         warnings.extend(profile_warnings(fp, limit(i), lo, hi));
     }
@@ -829,6 +850,12 @@ pub fn widen_to_near_best(
             p_hi = p_hi.max(v);
         }
         widen(&mut intervals[i], p_lo, p_hi);
+        widen_range_95(
+            &mut intervals[i],
+            near,
+            at.cost_nats + limit * PROFILE_95_OVER_68,
+            |u| fp.value(u[i]),
+        );
         let (lo, hi) = (intervals[i].lo, intervals[i].hi);
         if (lo0 - lo) + (hi - hi0) > NEAR_BEST_WARN_WIDTH * (hi0 - lo0) {
             warnings.push(FitWarning::WidenedInterval {
@@ -904,7 +931,7 @@ pub(crate) fn near_best_laws(
 }
 
 /// Widens `interval` to contain `[lo, hi]`, keeping its ends before the first widening in
-/// [`Interval::widened_from`].
+/// [`Interval::widened_from`]; its 95 % range, where it has one, keeps containing it.
 fn widen(interval: &mut Interval, lo: f64, hi: f64) {
     if lo >= interval.lo && hi <= interval.hi {
         return;
@@ -914,6 +941,31 @@ fn widen(interval: &mut Interval, lo: f64, hi: f64) {
         .get_or_insert([interval.lo, interval.hi]);
     interval.lo = interval.lo.min(lo);
     interval.hi = interval.hi.max(hi);
+    if let Some(r) = interval.range_95.as_mut() {
+        *r = [r[0].min(interval.lo), r[1].max(interval.hi)];
+    }
+}
+
+/// The 95 % rise over the 68.27 % one ([`PROFILE_95_NATS`] / [`PROFILE_68_NATS`]): a parameter's
+/// 95 % limit is its calibrated 68.27 % limit times this.
+pub const PROFILE_95_OVER_68: f64 = PROFILE_95_NATS / PROFILE_68_NATS;
+
+/// Widens `interval`'s 95 % range (where it has one) to the values `value(u)` of the points in
+/// `near` whose cost is at most `ceiling` nats: as [`widen_to_near_best`] does the 68.27 %
+/// interval, at the 95 % rise.
+fn widen_range_95(
+    interval: &mut Interval,
+    near: &crate::search::problem::EvaluatedNearBest,
+    ceiling: f64,
+    value: impl Fn(&[f64]) -> f64,
+) {
+    let Some(r) = interval.range_95.as_mut() else {
+        return;
+    };
+    for (_, u) in near.at_most(ceiling) {
+        let v = value(u);
+        *r = [r[0].min(v), r[1].max(v)];
+    }
 }
 
 /// The growth of an interval (a fraction of its width) above which [`widen_to_near_best`] warns.
@@ -930,6 +982,10 @@ pub const RIDGE_K1_FACTORS: [f64; 4] = [
 /// The rise of the NLL at a 68.27 % one-parameter profile-likelihood bound: half the 68.27 % point of
 /// χ²₁ (Pawitan 2001, *In All Likelihood*, §2.6).
 pub const PROFILE_68_NATS: f64 = 0.5;
+
+/// The rise of the NLL at a 95 % one-parameter profile-likelihood bound: half the 95 % point of
+/// χ²₁, 3.841459/2 (Pawitan 2001, §2.6); scaled by μ like [`PROFILE_68_NATS`].
+pub const PROFILE_95_NATS: f64 = 1.920_729_410_347_062;
 
 /// Widens the intervals of `k1` and `theta_c` along the shoulder's contact-moment ridge, where a
 /// fit frees both with `k1c`. While the neck rests on the shoulder its moment is
@@ -1095,6 +1151,7 @@ pub fn bootstrap_intervals(
                     full_refit: settings.full_refit,
                 },
                 widened_from: None,
+                range_95: None,
             }
         })
         .collect())
@@ -1266,6 +1323,7 @@ mod tests {
                 span_sigma: 0.5,
             },
             widened_from: None,
+            range_95: None,
         };
         assert!((width_ratio((&iv(1.0, 2.0), &iv(0.8, 2.2))) - 1.4).abs() < 1e-12);
         assert_eq!(width_ratio((&iv(1.0, 1.0), &iv(0.9, 1.0))), f64::INFINITY);
@@ -1295,22 +1353,30 @@ mod tests {
 
     #[test]
     fn a_quadratic_profile_ends_at_one_sigma() {
-        // Closed form: a quadratic log-likelihood's 68.27 % profile interval is the estimate ± 1σ,
-        // and with the rise scaled by μ = σ²_sandwich/σ²_Fisher the calibrated limit μ/2 gives
-        // the same ends (the walk interpolates in √rise, exact for a quadratic).
+        // Closed form: a quadratic log-likelihood's 68.27 % profile interval is the estimate ± 1σ
+        // and its 95 % one ± 1.959964σ (√(2·PROFILE_95_NATS), the 97.5 % point of N(0, 1)); with
+        // the rise scaled by μ = σ²_sandwich/σ²_Fisher the calibrated limits give the same ends
+        // (the walk interpolates in √rise, exact for a quadratic).
+        assert!(((2.0 * PROFILE_95_NATS).sqrt() - 1.959_963_984_540_054).abs() < 1e-12);
         for (u0, sigma, first, mu) in [
             (0.4, 0.02, 0.02, 1.0),
             (0.4, 0.02, 0.005, 0.3),
             (0.7, 0.013, 0.1, 0.5),
         ] {
             for side in [-1.0, 1.0] {
-                let limit = PROFILE_68_NATS * mu;
-                let end = profile_end(u0, first, side, limit, quadratic_rise(u0, sigma, mu));
+                let limits = [PROFILE_68_NATS * mu, PROFILE_95_NATS * mu];
+                let end = profile_end(u0, first, side, limits, quadratic_rise(u0, sigma, mu));
                 assert!(end.closed && !end.at_bound, "{end:?}");
                 assert!(
                     (end.u - (u0 + side * sigma)).abs() < 1e-12,
                     "u0 {u0} σ {sigma} side {side}: end {}",
                     end.u
+                );
+                let want_95 = u0 + side * 1.959_963_984_540_054 * sigma;
+                assert!(
+                    (end.u_95 - want_95).abs() < 1e-12,
+                    "u0 {u0} σ {sigma} side {side}: 95 % end {}",
+                    end.u_95
                 );
             }
         }
@@ -1353,14 +1419,16 @@ mod tests {
     #[test]
     fn a_flat_profile_reaches_the_bound_and_a_dip_is_reported() {
         // Flat: the walk doubles its step (0.01, 0.02, …) to the box's bound (0.45 + 0.64 > 1).
-        let end = profile_end(0.45, 0.01, 1.0, 0.5, |_| 0.1);
+        let end = profile_end(0.45, 0.01, 1.0, [0.5, 1.9], |_| 0.1);
         assert!(end.at_bound && !end.closed, "{end:?}");
-        assert_eq!(end.u, 1.0);
+        assert_eq!((end.u, end.u_95), (1.0, 1.0));
         // An estimate on the bound: nothing to walk.
-        let end = profile_end(0.0, 0.01, -1.0, 0.5, |_| panic!("no step beyond the bound"));
+        let end = profile_end(0.0, 0.01, -1.0, [0.5, 1.9], |_| {
+            panic!("no step beyond the bound")
+        });
         assert!(end.at_bound && end.u == 0.0);
         // A point more likely than the fit on the way out is kept.
-        let end = profile_end(0.5, 0.01, 1.0, 0.5, |x| {
+        let end = profile_end(0.5, 0.01, 1.0, [0.5, 1.9], |x| {
             if (x - 0.52).abs() < 1e-12 {
                 -2.0
             } else {
@@ -1370,20 +1438,29 @@ mod tests {
         assert_eq!((end.lowest_rise_nats, end.lowest_u), (-2.0, 0.52));
         assert!(end.closed);
         // Eight doublings and still below the limit: open, at the walk's last point.
-        let end = profile_end(0.5, 1e-4, 1.0, 0.5, |_| 0.0);
+        let end = profile_end(0.5, 1e-4, 1.0, [0.5, 1.9], |_| 0.0);
         assert!(!end.closed && !end.at_bound);
         assert!((end.u - (0.5 + 1e-4 * 128.0)).abs() < 1e-15);
+        assert_eq!(end.u_95, end.u);
+        // A profile that flattens past its 68.27 % end (rise 0.6 from 0.52 on, below the 95 %
+        // limit up to the bound): the 95 % end is the bound, where the 68.27 % end stays closed.
+        let end = profile_end(0.5, 0.01, 1.0, [0.5, 1.9], |x| {
+            if x > 0.515 { 0.6 } else { 0.1 }
+        });
+        assert!(end.closed && !end.at_bound, "{end:?}");
+        assert!(end.u < 0.52 && end.u_95 == 1.0, "{end:?}");
     }
 
     #[test]
     fn a_failed_step_closes_the_interval_at_the_last_good_point() {
         // Steps 0.01, 0.02, 0.04 from 0.5. A simulation that fails beyond 0.53 is an infinite
         // rise: the end is the last point the model could simulate (0.52), not beyond it.
-        let end = profile_end(0.5, 0.01, 1.0, 0.5, |x| {
+        let end = profile_end(0.5, 0.01, 1.0, [0.5, 1.9], |x| {
             if x > 0.53 { f64::INFINITY } else { 0.1 }
         });
         assert!(end.closed);
         assert!((end.u - 0.52).abs() < 1e-12, "{}", end.u);
+        assert_eq!(end.u_95, end.u);
     }
 
     #[test]
@@ -1393,6 +1470,7 @@ mod tests {
             u,
             closed: !at_bound,
             at_bound,
+            u_95: u,
             lowest_rise_nats,
             lowest_u: 0.6,
         };
@@ -1583,6 +1661,46 @@ mod tests {
         let edge = valley_start(&[0.5, 0.999, 0.6], (0, 0.5, 0.6), &sigma, &corr).unwrap();
         assert_eq!(edge[1], 1.0);
         assert!(valley_start(&u0, (0, 0.5, 0.6), &[0.0, 0.01, 0.05], &corr).is_none());
+    }
+
+    /// The 95 % range widens like the 68.27 % interval, at the 95 % rise: on a valley 10× wider in
+    /// A than the curvature's 1σ (0.01), the grid's points within 1.92 nats reach its edge
+    /// (Δu = ±0.05, rise 0.125 nats) in A; in C, where the bowl is the curvature's, the farthest
+    /// grid point within 1.92 nats lies at ±0.015 (±0.02 rises 2.0), inside the range's own
+    /// ±1.96σ, which stays.
+    #[test]
+    fn the_95_range_widens_to_evaluated_points_within_the_95_rise() {
+        let free = vec![
+            FreeParam::new(ParamId::A, 0.2, 2.0),
+            FreeParam::new(ParamId::C, 0.3, 0.8),
+        ];
+        let u0 = [0.4, 0.6];
+        let sigma = [0.01, 0.01];
+        let at = ProfileStart {
+            u: &u0,
+            cost_nats: 0.0,
+            sigma_u: &sigma,
+            fisher_sigma_u: &sigma,
+            fisher_corr: None,
+        };
+        let z95 = (2.0 * PROFILE_95_NATS).sqrt();
+        let mut iv = laplace_intervals(&free, &u0, &sigma, None);
+        for (i, v) in iv.iter_mut().enumerate() {
+            v.range_95 = Some([
+                free[i].value(u0[i] - z95 * sigma[i]),
+                free[i].value(u0[i] + z95 * sigma[i]),
+            ]);
+        }
+        let before = iv[1].range_95;
+        let valley = |u: &[f64]| {
+            ((u[0] - u0[0]) / 0.1).powi(2) / 2.0 + ((u[1] - u0[1]) / sigma[1]).powi(2) / 2.0
+        };
+        let near = evaluated_grid(&u0, 0.05, valley);
+        widen_to_near_best(&free, at, &near, &mut iv);
+        let r = iv[0].range_95.expect("A's 95 % range");
+        assert!((r[0] - free[0].value(0.35)).abs() < 1e-12, "{r:?}");
+        assert!((r[1] - free[0].value(0.45)).abs() < 1e-12, "{r:?}");
+        assert_eq!(iv[1].range_95, before);
     }
 
     #[test]

@@ -25,6 +25,7 @@ fn sample_parameter() -> FittedParam {
                 rise_limit_nats: 0.125,
             },
             widened_from: None,
+            range_95: None,
         }),
     }
 }
