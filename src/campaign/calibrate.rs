@@ -129,26 +129,38 @@ pub fn method_standardised_error(p: &FittedParam, truth: f64) -> Option<f64> {
     Some(error_in_interval(p, own, iv.level, truth))
 }
 
-/// [`standardised_error`] against the 95 % interval: the method's own where the result gives one
-/// (`range_95`: a profile walked on to the 95 % rise, a posterior's 2.5–97.5 % quantiles), else the
-/// reported interval's half-widths times 1.96 (exactly ±1.96σ for a Laplace interval), where this
-/// is [`standardised_error`]. Covered when `|z| ≤ Φ⁻¹(0.975)`.
+/// [`standardised_error`] against the 95 % interval: the reported interval's half-widths times
+/// 1.96 (exactly ±1.96σ for a Laplace interval), where this is [`standardised_error`], or the
+/// method's own 95 % interval where the result gives one and it reaches further (`range_95`: a
+/// profile walked on to the 95 % rise, a posterior's 2.5–97.5 % quantiles; a fit's profile range
+/// is already at least the former, [`crate::uncertainty::wide_over_68_half_widths`]). Covered when
+/// `|z| ≤ Φ⁻¹(0.975)`.
 pub fn wide_standardised_error(p: &FittedParam, truth: f64) -> Option<f64> {
     let iv = p.interval.as_ref()?;
-    Some(match iv.range_95 {
-        Some(range) => error_in_interval(p, range, WIDE_LEVEL, truth),
-        None => error_in_interval(p, [iv.lo, iv.hi], iv.level, truth),
-    })
+    let Some(range) = iv.range_95 else {
+        return Some(error_in_interval(p, [iv.lo, iv.hi], iv.level, truth));
+    };
+    let g = search_coordinate(p);
+    let (v, t) = (g(p.value), g(truth));
+    let k = sigmas_at(WIDE_LEVEL) / sigmas_at(iv.level);
+    let lo = (v - k * (v - g(iv.lo))).min(g(range[0]));
+    let hi = (v + k * (g(iv.hi) - v)).max(g(range[1]));
+    Some(error_in_search_coordinate((v, t), [lo, hi], WIDE_LEVEL))
 }
 
 /// [`standardised_error`] for the interval `[lo, hi]` at `level` around `p`'s value.
 fn error_in_interval(p: &FittedParam, [lo, hi]: [f64; 2], level: f64, truth: f64) -> f64 {
     let g = search_coordinate(p);
-    let (v, t) = (g(p.value), g(truth));
+    error_in_search_coordinate((g(p.value), g(truth)), [g(lo), g(hi)], level)
+}
+
+/// [`error_in_interval`] with the estimate `v`, the truth `t` and the interval's ends already in
+/// the search's coordinate.
+fn error_in_search_coordinate((v, t): (f64, f64), [lo, hi]: [f64; 2], level: f64) -> f64 {
     if t == v {
         return 0.0;
     }
-    let half = if t >= v { g(hi) - v } else { v - g(lo) };
+    let half = if t >= v { hi - v } else { v - lo };
     if half.is_nan() || half <= 0.0 {
         return f64::INFINITY.copysign(t - v);
     }
@@ -1020,10 +1032,10 @@ pub fn to_markdown(c: &Calibration, notes: Option<&str>, command: &str) -> Strin
         "## Coverage and error by parameter\n\n\
          Over the {scored} fitted recordings whose chosen model contains the true one (a parameter is \
          scored when the true model has it). The 68 % interval is the one the result reports (level \
-         0.6827); the 95 % interval is the method's own where the result gives one (`range_95`: the \
-         profile walked on to the 95 % rise, a posterior's 2.5–97.5 % quantiles), else the reported \
-         interval's half-widths times 1.96 in the search's coordinate (for Laplace intervals, \
-         ±1.96σ). A count is **outside** when it leaves the central \
+         0.6827); the 95 % interval is the reported interval's half-widths times 1.96 in the search's \
+         coordinate (for Laplace intervals, ±1.96σ), or the method's own where the result gives one \
+         and it reaches further (`range_95`: the profile walked on to the 95 % rise, a posterior's \
+         2.5–97.5 % quantiles). A count is **outside** when it leaves the central \
          95 % band of Binomial(n, level). z = the truth's distance from the estimate in σ read from the \
          interval on the truth's side; Σz² is compared with χ²(n), small p on either side: too large, \
          intervals too narrow; too small, too wide.\n"
@@ -1416,10 +1428,11 @@ mod tests {
     }
 
     /// The 95 % interval: without a `range_95` it is the reported one's half-widths times 1.96,
-    /// so the wide z is the 68.27 % z; with one, z reads its half-width on the truth's side as
-    /// Φ⁻¹(0.975) σ. A = 0.5 on [0.45, 0.6] with the 95 % range [0.3, 0.65]: a truth at 0.4 is 2σ
-    /// out by the 68.27 % interval (outside ±1.96) and 0.5·1.96 σ inside the 95 % range; a truth
-    /// at 0.7 is beyond the range's upper end 0.65 (z = 2/1.5 · 1.96).
+    /// so the wide z is the 68.27 % z; with one, z reads the wider of its half-width and that on
+    /// the truth's side as Φ⁻¹(0.975) σ. A = 0.5 on [0.45, 0.6] with the 95 % range [0.3, 0.65]:
+    /// a truth at 0.4 is 2σ out by the 68.27 % interval (outside ±1.96) and 0.5·1.96 σ inside the
+    /// range (half-width 0.2 against 1.96·0.05); above, the range's 0.15 is narrower than
+    /// 1.96·0.1, so a truth at 0.7 scores as without the range.
     #[test]
     fn the_95_range_is_scored_where_the_result_has_one() {
         let mut a = param(ParamId::A, 0.5, [0.2, 1.5], [0.45, 0.6]);
@@ -1432,7 +1445,8 @@ mod tests {
         assert!((standardised_error(&a, 0.4).unwrap() + 2.0 * sigma).abs() < 1e-12);
         a.interval.as_mut().unwrap().range_95 = Some([0.3, 0.65]);
         assert!((wide_standardised_error(&a, 0.4).unwrap() + 0.5 * z95).abs() < 1e-12);
-        assert!((wide_standardised_error(&a, 0.7).unwrap() - 2.0 / 1.5 * z95).abs() < 1e-12);
+        let without = standardised_error(&a, 0.7).unwrap();
+        assert!((wide_standardised_error(&a, 0.7).unwrap() - without).abs() < 1e-12);
     }
 
     /// A profile interval [0.48, 0.52] around A = 0.5 widened to [0.40, 0.52], sandwich 1σ 0.01:

@@ -208,6 +208,7 @@ fn other_intervals(
             Ok(_) => {
                 let (mut intervals, mut warnings) = profile_intervals(cf, fit, pb)?;
                 warnings.extend(near_best_of(cf, &mut intervals));
+                floor_range_95(&cf.free, &cf.best_u, &mut intervals);
                 Ok((Some(intervals), warnings))
             }
             Err(why) => Ok((None, vec![no_intervals(UncertaintyMethod::Profile, why)])),
@@ -946,6 +947,35 @@ fn widen(interval: &mut Interval, lo: f64, hi: f64) {
     }
 }
 
+/// How many of its 68.27 % half-widths a 95 % interval reaches on a quadratic likelihood:
+/// Φ⁻¹(0.975)/Φ⁻¹(0.84135) = 1.959964/1.000022 (the 68.27 % level is 0.6827).
+pub fn wide_over_68_half_widths() -> f64 {
+    use statrs::distribution::{ContinuousCDF, Normal};
+    let n = Normal::standard();
+    n.inverse_cdf(0.975) / n.inverse_cdf(0.5 * (1.0 + 0.6827))
+}
+
+/// Widens each interval's 95 % range to at least [`wide_over_68_half_widths`] times its reported
+/// 68.27 % half-width on each side, in the search's coordinate (clamped to the search box), around
+/// the estimate at `best_u`. Where the reported interval was widened to the search's points within
+/// the 68.27 % rise ([`widen_to_near_best`]), the walk's polishes found the profile higher than
+/// those points show it to be, and beyond them it is likely too high as well: a 95 % end short of
+/// the reported interval's quadratic extrapolation would claim less than the reported interval
+/// does. On the calibration recordings the walk's own 95 % end fell short of it on one side in
+/// most widened fits (docs/validation.md, "Calibration by simulation").
+fn floor_range_95(free: &[FreeParam], best_u: &[f64], intervals: &mut [Interval]) {
+    let k = wide_over_68_half_widths();
+    for ((fp, &u0), iv) in free.iter().zip(best_u).zip(intervals.iter_mut()) {
+        let Some(r) = iv.range_95.as_mut() else {
+            continue;
+        };
+        let (u_lo, u_hi) = (fp.u_of(iv.lo), fp.u_of(iv.hi));
+        let lo = fp.value(u0 - k * (u0 - u_lo));
+        let hi = fp.value(u0 + k * (u_hi - u0));
+        *r = [r[0].min(lo), r[1].max(hi)];
+    }
+}
+
 /// The 95 % rise over the 68.27 % one ([`PROFILE_95_NATS`] / [`PROFILE_68_NATS`]): a parameter's
 /// 95 % limit is its calibrated 68.27 % limit times this.
 pub const PROFILE_95_OVER_68: f64 = PROFILE_95_NATS / PROFILE_68_NATS;
@@ -1661,6 +1691,30 @@ mod tests {
         let edge = valley_start(&[0.5, 0.999, 0.6], (0, 0.5, 0.6), &sigma, &corr).unwrap();
         assert_eq!(edge[1], 1.0);
         assert!(valley_start(&u0, (0, 0.5, 0.6), &[0.0, 0.01, 0.05], &corr).is_none());
+    }
+
+    /// The 95 % range reaches at least 1.959964/1.000022 = 1.96 reported half-widths on each side
+    /// (in the search's coordinate): A searched linearly on [0.2, 1.5] at u = 0.4 with the
+    /// interval u ∈ [0.35, 0.5] and the range u ∈ [0.33, 0.7] gets its lower end at
+    /// u = 0.4 − 1.96·0.05 and keeps its upper one (0.7 beyond 0.4 + 1.96·0.1).
+    #[test]
+    fn the_95_range_reaches_at_least_the_quadratic_extrapolation_of_the_reported_interval() {
+        let k = wide_over_68_half_widths();
+        assert!(
+            (k - 1.959_963_984_540_054 / 1.000_021_713_322_999).abs() < 1e-6,
+            "{k}"
+        );
+        let free = [FreeParam::new(ParamId::A, 0.2, 1.5)];
+        let mut iv = laplace_intervals(&free, &[0.4], &[0.05], None);
+        iv[0].hi = free[0].value(0.5);
+        iv[0].range_95 = Some([free[0].value(0.33), free[0].value(0.7)]);
+        floor_range_95(&free, &[0.4], &mut iv);
+        let r = iv[0].range_95.expect("range");
+        assert!(
+            (r[0] - free[0].value(0.4 - k * 0.05)).abs() < 1e-12,
+            "{r:?}"
+        );
+        assert!((r[1] - free[0].value(0.7)).abs() < 1e-12, "{r:?}");
     }
 
     #[test]
