@@ -131,36 +131,29 @@ pub fn method_standardised_error(p: &FittedParam, truth: f64) -> Option<f64> {
 
 /// [`standardised_error`] against the 95 % interval: the reported interval's half-widths times
 /// 1.96 (exactly ±1.96σ for a Laplace interval), where this is [`standardised_error`], or the
-/// method's own 95 % interval where the result gives one and it reaches further (`range_95`: a
-/// profile walked on to the 95 % rise, a posterior's 2.5–97.5 % quantiles; a fit's profile range
-/// is already at least the former, [`crate::uncertainty::wide_over_68_half_widths`]). Covered when
-/// `|z| ≤ Φ⁻¹(0.975)`.
+/// method's own 95 % interval where the result gives one (`range_95`: a profile walked on to the
+/// 95 % rise, a posterior's 2.5–97.5 % quantiles), at least those 1.96 half-widths as the fit
+/// reports it ([`crate::uncertainty::floored_range_95`], applied again to results written
+/// without it). Covered when `|z| ≤ Φ⁻¹(0.975)`.
 pub fn wide_standardised_error(p: &FittedParam, truth: f64) -> Option<f64> {
     let iv = p.interval.as_ref()?;
-    let Some(range) = iv.range_95 else {
-        return Some(error_in_interval(p, [iv.lo, iv.hi], iv.level, truth));
-    };
-    let g = search_coordinate(p);
-    let (v, t) = (g(p.value), g(truth));
-    let k = sigmas_at(WIDE_LEVEL) / sigmas_at(iv.level);
-    let lo = (v - k * (v - g(iv.lo))).min(g(range[0]));
-    let hi = (v + k * (g(iv.hi) - v)).max(g(range[1]));
-    Some(error_in_search_coordinate((v, t), [lo, hi], WIDE_LEVEL))
+    let fp = FreeParam::new(p.name, p.lower, p.upper);
+    Some(
+        match crate::uncertainty::floored_range_95(&fp, fp.u_of(p.value), iv) {
+            Some(range) => error_in_interval(p, range, WIDE_LEVEL, truth),
+            None => error_in_interval(p, [iv.lo, iv.hi], iv.level, truth),
+        },
+    )
 }
 
 /// [`standardised_error`] for the interval `[lo, hi]` at `level` around `p`'s value.
 fn error_in_interval(p: &FittedParam, [lo, hi]: [f64; 2], level: f64, truth: f64) -> f64 {
     let g = search_coordinate(p);
-    error_in_search_coordinate((g(p.value), g(truth)), [g(lo), g(hi)], level)
-}
-
-/// [`error_in_interval`] with the estimate `v`, the truth `t` and the interval's ends already in
-/// the search's coordinate.
-fn error_in_search_coordinate((v, t): (f64, f64), [lo, hi]: [f64; 2], level: f64) -> f64 {
+    let (v, t) = (g(p.value), g(truth));
     if t == v {
         return 0.0;
     }
-    let half = if t >= v { hi - v } else { v - lo };
+    let half = if t >= v { g(hi) - v } else { v - g(lo) };
     if half.is_nan() || half <= 0.0 {
         return f64::INFINITY.copysign(t - v);
     }

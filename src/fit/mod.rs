@@ -51,6 +51,41 @@ pub struct FitOutcome {
     pub signal: SignalKind,
 }
 
+/// The choice among the candidates `fits` ([`select::choose`]), made again when the chosen one
+/// descended to a more likely point ([`descend_chosen`]).
+fn choose_descended(
+    job: &LoadedJob,
+    fits: &mut Vec<CandidateFit>,
+    explicit: bool,
+    pb: &Option<indicatif::ProgressBar>,
+) -> Result<select::Selection> {
+    let bands = &job.job.spectrum.bands;
+    let selection = select::choose(fits, bands, explicit, &[]);
+    Ok(if descend_chosen(job, fits, selection.chosen, pb)? {
+        select::choose(fits, bands, explicit, &[])
+    } else {
+        selection
+    })
+}
+
+/// [`choose_descended`], made again when the chosen candidate extends a smaller one whose extra
+/// batch of restarts moved it ([`confirm_the_smaller`]; `confirmed` marks the smaller candidates
+/// that ran theirs).
+fn choose_confirmed(
+    job: &LoadedJob,
+    fits: &mut Vec<CandidateFit>,
+    explicit: bool,
+    confirmed: &mut [bool],
+    pb: &Option<indicatif::ProgressBar>,
+) -> Result<select::Selection> {
+    let selection = choose_descended(job, fits, explicit, pb)?;
+    if confirm_the_smaller(job, fits, selection.chosen, confirmed, pb)? {
+        choose_descended(job, fits, explicit, pb)
+    } else {
+        Ok(selection)
+    }
+}
+
 /// Runs the job in stages: measure the recording (or read the targets), search each candidate
 /// model (particle swarm, Nelder–Mead, curvature: [`search`]), choose among them by TIC (target
 /// jobs: [`aic`]; [`select`]), attach intervals and warnings to the chosen fit ([`uncertainty`]), and assemble
@@ -75,19 +110,9 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     confirm_deferred(job, &mut fits, &gaps, &pb)?;
     search::take_nested_optima(&mut fits, &pb)?;
     let explicit = !fit.models.is_empty();
-    let choose = |fits: &mut Vec<CandidateFit>| -> Result<select::Selection> {
-        let selection = select::choose(fits, &job.job.spectrum.bands, explicit, &[]);
-        Ok(if descend_chosen(job, fits, selection.chosen, &pb)? {
-            select::choose(fits, &job.job.spectrum.bands, explicit, &[])
-        } else {
-            selection
-        })
-    };
-    let mut selection = choose(&mut fits)?;
+    let choose = |fits: &mut Vec<CandidateFit>| choose_descended(job, fits, explicit, &pb);
     let mut confirmed = vec![false; fits.len()];
-    if confirm_the_smaller(job, &mut fits, selection.chosen, &mut confirmed, &pb)? {
-        selection = choose(&mut fits)?;
-    }
+    let mut selection = choose_confirmed(job, &mut fits, explicit, &mut confirmed, &pb)?;
     let (mut best, mut gof) = chosen_goodness(&fits[selection.chosen])?;
     let chosen_name = fits[selection.chosen].candidate.to_string();
     if let Some(why) = scan::scan_reason(fit.contact_angle_scan, &chosen_name, gof_ref(&gof))
@@ -97,10 +122,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
         // The scan's notes reach the trials' reasons through a new choice either way; the valley
         // polishes run again only from a moved optimum.
         if scan::scan_contact_angle(job, &meas, &mut fits, &pb, &why)? {
-            selection = choose(&mut fits)?;
-            if confirm_the_smaller(job, &mut fits, selection.chosen, &mut confirmed, &pb)? {
-                selection = choose(&mut fits)?;
-            }
+            selection = choose_confirmed(job, &mut fits, explicit, &mut confirmed, &pb)?;
             (best, gof) = chosen_goodness(&fits[selection.chosen])?;
         } else {
             selection = select::choose(&fits, &job.job.spectrum.bands, explicit, &[]);

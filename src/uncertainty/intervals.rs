@@ -964,16 +964,20 @@ pub fn wide_over_68_half_widths() -> f64 {
 /// does. On the calibration recordings the walk's own 95 % end fell short of it on one side in
 /// most widened fits (docs/validation.md, "Calibration by simulation").
 fn floor_range_95(free: &[FreeParam], best_u: &[f64], intervals: &mut [Interval]) {
-    let k = wide_over_68_half_widths();
     for ((fp, &u0), iv) in free.iter().zip(best_u).zip(intervals.iter_mut()) {
-        let Some(r) = iv.range_95.as_mut() else {
-            continue;
-        };
-        let (u_lo, u_hi) = (fp.u_of(iv.lo), fp.u_of(iv.hi));
-        let lo = fp.value(u0 - k * (u0 - u_lo));
-        let hi = fp.value(u0 + k * (u_hi - u0));
-        *r = [r[0].min(lo), r[1].max(hi)];
+        iv.range_95 = floored_range_95(fp, u0, iv);
     }
+}
+
+/// `iv`'s 95 % range as [`floor_range_95`] leaves it, for the parameter `fp` estimated at the
+/// normalised coordinate `u0`; `None` where `iv` has no 95 % range.
+pub fn floored_range_95(fp: &FreeParam, u0: f64, iv: &Interval) -> Option<[f64; 2]> {
+    let r = iv.range_95?;
+    let k = wide_over_68_half_widths();
+    let (u_lo, u_hi) = (fp.u_of(iv.lo), fp.u_of(iv.hi));
+    let lo = fp.value(u0 - k * (u0 - u_lo));
+    let hi = fp.value(u0 + k * (u_hi - u0));
+    Some([r[0].min(lo), r[1].max(hi)])
 }
 
 /// The 95 % rise over the 68.27 % one ([`PROFILE_95_NATS`] / [`PROFILE_68_NATS`]): a parameter's

@@ -11,10 +11,9 @@ pub mod climb;
 pub mod intervals;
 
 pub use intervals::{
-    MIN_ESS, PROFILE_68_NATS, PROFILE_95_NATS, PROFILE_95_OVER_68, ProfileStart, RHAT_LIMIT,
-    bootstrap_intervals, identifiability_warnings, laplace_intervals, mu_d_rise_limits,
-    posterior_tempering, profile_intervals_at, valley_start, wide_over_68_half_widths,
-    widen_to_near_best,
+    MIN_ESS, PROFILE_95_NATS, ProfileStart, RHAT_LIMIT, bootstrap_intervals, floored_range_95,
+    identifiability_warnings, laplace_intervals, mu_d_rise_limits, posterior_tempering,
+    profile_intervals_at, valley_start, wide_over_68_half_widths, widen_to_near_best,
 };
 /// The chosen fit's intervals by the job's method ([`intervals::intervals`]), and the friction laws
 /// of the points the search evaluated near its best ([`intervals::near_best_laws`]).
