@@ -1079,8 +1079,8 @@ pub fn to_markdown(c: &Calibration, notes: Option<&str>, command: &str) -> Strin
     let _ = writeln!(
         md,
         "\n## Fit time\n\nWall time per fitted recording: median {} s, 90th percentile {} s, over {} fits; \
-         their sum {} h (the campaign's length with one fit at a time; fits that ran side by side on \
-         shared cores each took longer).",
+         their sum {} h (the campaign's length when the fits run one at a time; where they ran side by \
+         side on shared cores, each took longer and the sum overstates it).",
         num(quantile(&times, 0.5), 1),
         num(quantile(&times, 0.9), 1),
         times.len(),
