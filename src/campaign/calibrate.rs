@@ -111,6 +111,25 @@ fn sigmas_at(level: f64) -> f64 {
     Normal::standard().inverse_cdf(0.5 * (1.0 + level))
 }
 
+/// How far out in likelihood a fit's truth lies ([`Calibration::wide_misses_against_ratio`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RatioAtTruth {
+    /// D/(tr(F⁻¹V)/2): the truth's cost above the fit's over its mean under the calibrated
+    /// likelihood.
+    pub over_mean: f64,
+    /// D exceeds the 95 % point of `(tr/k)·χ²(k)/2`.
+    pub beyond_95: bool,
+}
+
+/// Whether the truth's cost `d` nats above the fit's exceeds the 95 % point of
+/// `(tr/k)·χ²(k)/2`, the likelihood ratio's law under the calibrated likelihood with `k` freed
+/// parameters and Takeuchi's `tr(F⁻¹V)` (Varin, Reid & Firth 2011, §2.3).
+fn beyond_ratio_95(d: f64, k: usize, tr: f64) -> bool {
+    ChiSquared::new(k as f64)
+        .map(|c| d > tr / k as f64 * c.inverse_cdf(0.95) / 2.0)
+        .unwrap_or(false)
+}
+
 /// `p`'s standardised error against `truth`: `(g(truth) − g(value)) / h · Φ⁻¹((1 + level)/2)`,
 /// with `g` the search's coordinate (`ln` on a log scale) and `h` the interval's half-width in
 /// it on the truth's side; `±∞` when that side has no width and the truth lies beyond it; `None`
@@ -492,11 +511,7 @@ impl Calibration {
             |f: &dyn Fn(&(f64, usize, f64)) -> f64| rows.iter().map(f).sum::<f64>() / n as f64;
         let beyond = rows
             .iter()
-            .filter(|(d, k, tr)| {
-                ChiSquared::new(*k as f64)
-                    .map(|c| *d > tr / *k as f64 * c.inverse_cdf(0.95) / 2.0)
-                    .unwrap_or(false)
-            })
+            .filter(|(d, k, tr)| beyond_ratio_95(*d, *k, *tr))
             .count();
         (
             n,
@@ -505,6 +520,38 @@ impl Calibration {
             mean(&|r| r.1 as f64 / 2.0),
             beyond,
         )
+    }
+
+    /// The fits that reached the truth ([`Calibration::reached`]) with their true model's `(k,
+    /// tr(F⁻¹V))`, split by whether a parameter's 95 % interval misses the truth (`|z_95|` above
+    /// 1.96): for each, D/(tr/2) (D = the truth's cost above the fit's, tr/2 its mean under the
+    /// calibrated likelihood) and whether D exceeds the 95 % point of `(tr/k)·χ²(k)/2`;
+    /// (fits with a miss, the others).
+    pub fn wide_misses_against_ratio(&self) -> (Vec<RatioAtTruth>, Vec<RatioAtTruth>) {
+        let wide = sigmas_at(WIDE_LEVEL);
+        let (mut missed, mut covered) = (Vec::new(), Vec::new());
+        for r in self.reached() {
+            let (Some(short), Some((k, tr))) = (r.shortfall_nats, r.true_model_k_tr) else {
+                continue;
+            };
+            if k == 0 || tr <= 0.0 {
+                continue;
+            }
+            let d = -short;
+            let row = RatioAtTruth {
+                over_mean: d / (tr / 2.0),
+                beyond_95: beyond_ratio_95(d, k, tr),
+            };
+            if r.params
+                .iter()
+                .any(|p| p.z_95.is_some_and(|z| z.abs() > wide))
+            {
+                missed.push(row);
+            } else {
+                covered.push(row);
+            }
+        }
+        (missed, covered)
     }
 
     /// Of the done recordings whose chosen model is not the true one: (how many, of them how many
@@ -750,7 +797,42 @@ fn reached_section(md: &mut String, c: &Calibration) {
         );
         stats_table(md, &param_stats(c.reached()));
         variants_section(md, c);
+        wide_misses_paragraph(md, c);
     }
+}
+
+/// Where the 95 % intervals of the fits that reached the truth miss it, how far out in
+/// likelihood the truth lies against the fits whose intervals all cover it
+/// ([`Calibration::wide_misses_against_ratio`]). Nothing when no fit has a miss.
+fn wide_misses_paragraph(md: &mut String, c: &Calibration) {
+    let (missed, covered) = c.wide_misses_against_ratio();
+    if missed.is_empty() {
+        return;
+    }
+    let ratios = |rows: &[RatioAtTruth]| rows.iter().map(|r| r.over_mean).collect::<Vec<f64>>();
+    let (m, n) = (missed.len(), missed.len() + covered.len());
+    let beyond = missed.iter().filter(|r| r.beyond_95).count();
+    let others = if covered.is_empty() {
+        String::new()
+    } else {
+        let cr = ratios(&covered);
+        format!(
+            ", at the other {} a median {} (at most {})",
+            covered.len(),
+            num(quantile(&cr, 0.5), 1),
+            num(cr.iter().copied().fold(f64::NAN, f64::max), 1)
+        )
+    };
+    let _ = writeln!(
+        md,
+        "\nOf the {n} of these fits priced with their true model's `tr(F⁻¹V)`, {m} miss the truth \
+         with a parameter's 95 % interval. There the truth's cost lies a median {} times \
+         tr(F⁻¹V)/2 above the fit's{others}; {beyond} of the {m} lie beyond the 95 % point of \
+         (tr/k)·χ²(k)/2. A miss whose truth lies that far out in likelihood is beyond the scale \
+         the noise replicates give the intervals; a miss at the others' ratios is the interval \
+         method's own.",
+        num(quantile(&ratios(&missed), 0.5), 1)
+    );
 }
 
 /// Coverage split by the truth's cost jitter ([`RecordingScore::truth_jitter_nats`]): the fits
@@ -1642,6 +1724,45 @@ mod tests {
         assert!(md.contains("4 fits whose result prices the truth"), "{md}");
         assert!(
             md.contains("Over the 1 of the fits above that did not fall short"),
+            "{md}"
+        );
+    }
+
+    /// Three fits that reached the truth with k = 4 and tr(F⁻¹V) = 1: the truth 0.25 nats out with
+    /// every 95 % interval covering, 0.5 and 3.0 nats out with a miss (|z_95| = 2.5). The 95 %
+    /// point of (1/4)·χ²(4)/2 is 9.4877/8 = 1.186 nats (χ²(4)'s 95 % point from the table of
+    /// Abramowitz & Stegun 26.8), so only the 3-nat one lies beyond it.
+    #[test]
+    fn wide_misses_are_set_against_the_likelihood_ratio() {
+        let fit = |d: f64, z: f64| {
+            let mut r = recording(&[z]);
+            r.shortfall_nats = Some(-d);
+            r.true_model_k_tr = Some((4, 1.0));
+            r
+        };
+        let c = Calibration {
+            name: "t".into(),
+            campaign: PathBuf::from("t.toml"),
+            recordings: vec![fit(0.25, 1.0), fit(0.5, 2.5), fit(3.0, -2.5)],
+            overall: Vec::new(),
+            by_model: Vec::new(),
+        };
+        let (missed, covered) = c.wide_misses_against_ratio();
+        let rows = |v: &[RatioAtTruth]| {
+            v.iter()
+                .map(|r| (r.over_mean, r.beyond_95))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(rows(&missed), vec![(1.0, false), (6.0, true)]);
+        assert_eq!(rows(&covered), vec![(0.5, false)]);
+        let md = to_markdown(&c, None, "wiperlab campaign collect t.toml");
+        assert!(
+            md.contains("Of the 3 of these fits priced with their true model's `tr(F⁻¹V)`, 2 miss"),
+            "{md}"
+        );
+        assert!(md.contains("a median 3.5 times"), "{md}");
+        assert!(
+            md.contains("at the other 1 a median 0.5 (at most 0.5); 1 of the 2 lie beyond"),
             "{md}"
         );
     }
