@@ -284,6 +284,14 @@ impl RecordingScore {
         self.truth_spread_nats.is_none_or(|w| w <= SPREAD_WARN_NATS)
     }
 
+    /// (D, k, tr(F⁻¹V)): the truth's cost above the fit's, nats, with the true model's freed
+    /// parameters and Takeuchi's trace, where the result prices all three and `k`, `tr` are
+    /// positive.
+    fn priced_ratio(&self) -> Option<(f64, usize, f64)> {
+        let (k, tr) = self.true_model_k_tr.filter(|(k, tr)| *k > 0 && *tr > 0.0)?;
+        Some((-self.shortfall_nats?, k, tr))
+    }
+
     /// Whether a truth that names a model saw another chosen ([`same_model`]).
     pub fn chose_another_model(&self) -> bool {
         match (self.chosen, self.true_model) {
@@ -502,9 +510,8 @@ impl Calibration {
         let rows: Vec<(f64, usize, f64)> = self
             .done()
             .filter(|r| r.truth_resolved())
-            .filter_map(|r| Some((-r.shortfall_nats?, r.true_model_k_tr?)))
-            .filter(|(d, (k, tr))| *d >= -SHORTFALL_TOLERANCE_NATS && *k > 0 && *tr > 0.0)
-            .map(|(d, (k, tr))| (d, k, tr))
+            .filter_map(RecordingScore::priced_ratio)
+            .filter(|(d, ..)| *d >= -SHORTFALL_TOLERANCE_NATS)
             .collect();
         let n = rows.len();
         let mean =
@@ -531,13 +538,9 @@ impl Calibration {
         let wide = sigmas_at(WIDE_LEVEL);
         let (mut missed, mut covered) = (Vec::new(), Vec::new());
         for r in self.reached() {
-            let (Some(short), Some((k, tr))) = (r.shortfall_nats, r.true_model_k_tr) else {
+            let Some((d, k, tr)) = r.priced_ratio() else {
                 continue;
             };
-            if k == 0 || tr <= 0.0 {
-                continue;
-            }
-            let d = -short;
             let row = RatioAtTruth {
                 over_mean: d / (tr / 2.0),
                 beyond_95: beyond_ratio_95(d, k, tr),
@@ -1561,6 +1564,18 @@ mod tests {
         );
     }
 
+    /// A calibration of `recordings` with no coverage tables, for the sections read from the
+    /// recordings alone.
+    fn unscored(recordings: Vec<RecordingScore>) -> Calibration {
+        Calibration {
+            name: "t".into(),
+            campaign: PathBuf::from("t.toml"),
+            recordings,
+            overall: Vec::new(),
+            by_model: Vec::new(),
+        }
+    }
+
     fn recording(z: &[f64]) -> RecordingScore {
         RecordingScore {
             id: "r".into(),
@@ -1639,18 +1654,12 @@ mod tests {
             r.truth_jitter_nats = jitter;
             r
         };
-        let c = Calibration {
-            name: "t".into(),
-            campaign: PathBuf::from("t.toml"),
-            recordings: vec![
-                fit(2.0, Some(1.5)),
-                fit(2.0, Some(0.5)),
-                fit(0.05, Some(1.0)),
-                fit(3.0, None),
-            ],
-            overall: Vec::new(),
-            by_model: Vec::new(),
-        };
+        let c = unscored(vec![
+            fit(2.0, Some(1.5)),
+            fit(2.0, Some(0.5)),
+            fit(0.05, Some(1.0)),
+            fit(3.0, None),
+        ]);
         assert_eq!(c.shortfall_jittered(), (2, 1));
     }
 
@@ -1667,19 +1676,13 @@ mod tests {
             r.shortfall_nats = Some(short);
             r
         };
-        let c = Calibration {
-            name: "t".into(),
-            campaign: PathBuf::from("t.toml"),
-            recordings: vec![
-                fit(3.7, Some(15.0), -0.8),
-                fit(9.8, Some(6.0), 4.0),
-                fit(0.3, Some(-1.0), -1.3),
-                fit(2.0, None, 0.5),
-                fit(0.01, Some(5.0), 5.0),
-            ],
-            overall: Vec::new(),
-            by_model: Vec::new(),
-        };
+        let c = unscored(vec![
+            fit(3.7, Some(15.0), -0.8),
+            fit(9.8, Some(6.0), 4.0),
+            fit(0.3, Some(-1.0), -1.3),
+            fit(2.0, None, 0.5),
+            fit(0.01, Some(5.0), 5.0),
+        ]);
         assert_eq!(c.averaged_shortfalls(), (3, 2, 1));
     }
 
@@ -1697,18 +1700,12 @@ mod tests {
             r.true_model_k_tr = Some((4, 1.0));
             r
         };
-        let c = Calibration {
-            name: "t".into(),
-            campaign: PathBuf::from("t.toml"),
-            recordings: vec![
-                fit(2.0, 5.0),
-                fit(0.3, 0.2),
-                fit(-40.0, 90.0),
-                fit(-1.0, 0.1),
-            ],
-            overall: Vec::new(),
-            by_model: Vec::new(),
-        };
+        let c = unscored(vec![
+            fit(2.0, 5.0),
+            fit(0.3, 0.2),
+            fit(-40.0, 90.0),
+            fit(-1.0, 0.1),
+        ]);
         assert_eq!(c.shortfall_unresolved(), (2, 1));
         let reached: Vec<f64> = c.reached().filter_map(|r| r.shortfall_nats).collect();
         assert_eq!(reached, vec![-1.0], "neither short nor unresolved");
@@ -1740,13 +1737,7 @@ mod tests {
             r.true_model_k_tr = Some((4, 1.0));
             r
         };
-        let c = Calibration {
-            name: "t".into(),
-            campaign: PathBuf::from("t.toml"),
-            recordings: vec![fit(0.25, 1.0), fit(0.5, 2.5), fit(3.0, -2.5)],
-            overall: Vec::new(),
-            by_model: Vec::new(),
-        };
+        let c = unscored(vec![fit(0.25, 1.0), fit(0.5, 2.5), fit(3.0, -2.5)]);
         let (missed, covered) = c.wide_misses_against_ratio();
         let rows = |v: &[RatioAtTruth]| {
             v.iter()
@@ -1905,13 +1896,7 @@ mod tests {
         own.true_model = c("blade2dof");
         own.law = law(0.004, 1.0, 1.0, 0.05);
         let recordings = vec![a, b, own];
-        let cal = Calibration {
-            name: "t".into(),
-            campaign: PathBuf::from("t.toml"),
-            overall: Vec::new(),
-            by_model: Vec::new(),
-            recordings,
-        };
+        let cal = unscored(recordings);
         let md = to_markdown(&cal, None, "x");
         assert!(
             md.contains(
