@@ -35,6 +35,7 @@ use super::friction::FrictionLaw;
 use super::stick_slip::{
     ConstraintAngle, Contact, LinearSystem, LinkModel, Mode, ModelFault, Phase, StickSlipModel,
 };
+use super::trig;
 use nalgebra::{Matrix3, Matrix4, Vector3, Vector4};
 use serde::{Deserialize, Serialize};
 
@@ -252,7 +253,7 @@ pub enum StickForm {
 /// ([`BladeParams::drive_speed_harmonic`]).
 #[inline]
 fn drive(a: f64, w: f64, h: f64, t: f64) -> (f64, f64, f64) {
-    let (s, c) = (w * t).sin_cos();
+    let (s, c) = trig::sin_cos(w * t);
     let (v, vd, vdd) = (a * (1.0 - c), a * w * s, a * w * w * c);
     if h == 0.0 {
         return (v, vd, vdd);
@@ -372,7 +373,7 @@ impl Blade {
 
     /// Head drop u = l1(1 − cos θ) + l2(1 − cos φ), m.
     pub fn head_drop(&self, y: &[f64; 4]) -> f64 {
-        self.head_drop_from([y[0].cos(), y[1].cos()])
+        self.head_drop_from([trig::cos(y[0]), trig::cos(y[1])])
     }
 
     /// [`Blade::head_drop`] from `cos = [cos θ, cos φ]`.
@@ -383,13 +384,13 @@ impl Blade {
 
     /// Tip horizontal position v3 = v + l1 sin θ + l2 sin φ, m.
     pub fn tip_position(&self, t: f64, y: &[f64; 4]) -> f64 {
-        self.drive(t).0 + self.params.l1_m * y[0].sin() + self.params.l2_m * y[1].sin()
+        self.drive(t).0 + self.params.l1_m * trig::sin(y[0]) + self.params.l2_m * trig::sin(y[1])
     }
 
     /// Tip horizontal velocity v̇3, m/s.
     #[inline]
     pub fn tip_velocity(&self, t: f64, y: &[f64; 4]) -> f64 {
-        self.tip_velocity_from(self.drive(t).1, [y[0].cos(), y[1].cos()], y)
+        self.tip_velocity_from(self.drive(t).1, [trig::cos(y[0]), trig::cos(y[1])], y)
     }
 
     /// [`Blade::tip_velocity`] from the head's speed `v̇` and `cos = [cos θ, cos φ]` at the state `y`.
@@ -403,8 +404,8 @@ impl Blade {
     /// [`Blade::tip_position`] give (`sin_cos` and `sin`, `cos` agree).
     pub fn kinematics(&self, t: f64, y: &[f64; 4]) -> Kinematics {
         let (v, vd, _) = self.drive(t);
-        let (sth, cth) = y[0].sin_cos();
-        let (sph, cph) = y[1].sin_cos();
+        let (sth, cth) = trig::sin_cos(y[0]);
+        let (sph, cph) = trig::sin_cos(y[1]);
         let cos = [cth, cph];
         Kinematics {
             head_position_m: v,
@@ -434,8 +435,8 @@ impl Blade {
     #[inline]
     pub(crate) fn rows_with_kinematics(&self, t: f64, y: &[f64; 4], touching: bool) -> Rows {
         let angles = Angles {
-            theta: y[0].sin_cos(),
-            phi: y[1].sin_cos(),
+            theta: trig::sin_cos(y[0]),
+            phi: trig::sin_cos(y[1]),
         };
         self.rows_from(self.drive(t), angles, y, touching)
     }
@@ -676,7 +677,7 @@ impl Blade {
         anchor: f64,
     ) -> Result<(f64, f64), ModelFault> {
         let (phi, phi_d, _) =
-            self.constrained_lip_from(self.drive(t), theta.sin_cos(), theta_d, anchor)?;
+            self.constrained_lip_from(self.drive(t), trig::sin_cos(theta), theta_d, anchor)?;
         Ok((phi, phi_d))
     }
 
@@ -699,7 +700,7 @@ impl Blade {
             });
         }
         let phi = arg.asin();
-        let (sph, cph) = phi.sin_cos();
+        let (sph, cph) = trig::sin_cos(phi);
         let phi_d = -(vd + l1 * cth * theta_d) / (l2 * cph);
         let angles = Angles {
             theta: (sth, cth),
@@ -776,7 +777,7 @@ impl StickSlipModel<4> for Blade {
                 // The drive and sin θ, cos θ serve both the constraint and the rows.
                 let drive = self.drive(t);
                 let (phi, phi_d, angles) =
-                    self.constrained_lip_from(drive, y[0].sin_cos(), y[2], mode.anchor)?;
+                    self.constrained_lip_from(drive, trig::sin_cos(y[0]), y[2], mode.anchor)?;
                 let yc = [y[0], phi, y[2], phi_d];
                 let rows = self.rows_from(drive, angles, &yc, touching);
                 let d = self.stick_dynamics_of(&rows, mode.anchor, 0.0)?;
@@ -826,7 +827,7 @@ impl StickSlipModel<4> for Blade {
         // Re-impose Φ̇ = 0 exactly (physics.md §0.3) by correcting φ̇; Φ = 0 holds by the anchor choice.
         let (_, vd, _) = self.drive(t);
         let (l1, l2) = (self.params.l1_m, self.params.l2_m);
-        y[3] = -(vd + l1 * y[0].cos() * y[2]) / (l2 * y[1].cos());
+        y[3] = -(vd + l1 * trig::cos(y[0]) * y[2]) / (l2 * trig::cos(y[1]));
     }
 
     fn complete(&self, mode: &Mode, t: f64, y: &mut [f64; 4]) -> Result<(), ModelFault> {
@@ -958,7 +959,7 @@ impl LockedBlade {
     }
 
     fn slip_velocity_of(&self, t: f64, th: f64, thd: f64) -> f64 {
-        self.tip_velocity_from(self.blade.drive(t).1, th.cos(), thd)
+        self.tip_velocity_from(self.blade.drive(t).1, trig::cos(th), thd)
     }
 
     /// The link tip's velocity `v̇ + (l1 + l2) cos θ θ̇` from the head's speed `v̇` and `cos θ`.
@@ -979,7 +980,7 @@ impl LockedBlade {
             });
         }
         let th = arg.asin();
-        Ok((th, -vd / (l * th.cos())))
+        Ok((th, -vd / (l * trig::cos(th))))
     }
 
     /// Quasi-static slip equilibrium at `t` (θ̇ = 0, θ̈ = 0), by Newton's method on θ̈.
@@ -1049,12 +1050,12 @@ impl StickSlipModel<4> for LockedBlade {
     }
 
     fn contact_position(&self, t: f64, y: &[f64; 4]) -> f64 {
-        self.blade.drive(t).0 + self.reach() * y[0].sin()
+        self.blade.drive(t).0 + self.reach() * trig::sin(y[0])
     }
 
     fn enter_stick(&self, t: f64, y: &mut [f64; 4], _anchor: f64) {
         let (_, vd, _) = self.blade.drive(t);
-        let thd = -vd / (self.reach() * y[0].cos());
+        let thd = -vd / (self.reach() * trig::cos(y[0]));
         y[1] = y[0];
         y[2] = thd;
         y[3] = thd;

@@ -11,6 +11,7 @@ pub mod modes;
 pub mod necklip;
 pub mod params;
 pub mod stick_slip;
+pub mod trig;
 
 pub use blade::{Blade, BladeParams, Shoulder, StickForm};
 pub use error::{FrictionTableError, ParamError, TrackError};

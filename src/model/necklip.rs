@@ -27,6 +27,7 @@
 use super::TrackError;
 use super::blade::{Blade, BladeParams, Dynamics, StickForm};
 use super::stick_slip::{Contact, LinearSystem, LinkModel, Mode, ModelFault, StickSlipModel};
+use super::trig;
 use nalgebra::{Matrix3, Vector3};
 
 /// Baumgarte gain of the head-height constraint, s⁻¹ (physics.md §0.3).
@@ -412,8 +413,8 @@ impl NeckLip {
         }
         let solve = |mut th: f64, mut ph: f64| {
             for _ in 0..30 {
-                let (st, ct) = th.sin_cos();
-                let (sp, cp) = ph.sin_cos();
+                let (st, ct) = trig::sin_cos(th);
+                let (sp, cp) = trig::sin_cos(ph);
                 let f = [l1 * st + l2 * sp - d, l1 * (1.0 - ct) + l2 * (1.0 - cp) - u];
                 let det = l1 * l2 * (ct * sp - st * cp);
                 if det.abs() < 1e-300 || f[0].abs().max(f[1].abs()) < 1e-16 * reach {
@@ -437,8 +438,8 @@ impl NeckLip {
         } else {
             (mid, mid)
         };
-        let (st, ct) = th.sin_cos();
-        let (sp, cp) = ph.sin_cos();
+        let (st, ct) = trig::sin_cos(th);
+        let (sp, cp) = trig::sin_cos(ph);
         let det = l1 * l2 * (ct * sp - st * cp);
         if det.abs() < 1e-6 * l1 * l2 {
             return Err(ModelFault::AlignedLinks {
@@ -458,8 +459,8 @@ impl NeckLip {
     fn height_row(&self, t: f64, y: &[f64; 4]) -> (Vector3<f64>, f64) {
         let p = &self.blade.params;
         let (l1, l2) = (p.l1_m, p.l2_m);
-        let (sth, cth) = y[0].sin_cos();
-        let (sph, cph) = y[1].sin_cos();
+        let (sth, cth) = trig::sin_cos(y[0]);
+        let (sph, cph) = trig::sin_cos(y[1]);
         let u = l1 * (1.0 - cth) + l2 * (1.0 - cph);
         let ud = l1 * sth * y[2] + l2 * sph * y[3];
         let (up, udp, uddp) = self.head.at(t);

@@ -325,8 +325,8 @@ pub(crate) fn piped_interval() -> std::time::Duration {
 }
 
 /// The job's progress bar, its length the model runs the search is expected to take: per
-/// candidate and restart the swarm's particles × (iterations + 1), the polish's simplex and two
-/// runs per iteration, and the curvature's stencil. A nested candidate searched adaptively counts
+/// candidate and restart the swarm's particles × (iterations + 1), the local CMA-ES run's cap, the
+/// polish's simplex and two runs per iteration, and the curvature's stencil. A nested candidate searched adaptively counts
 /// its local polishes only; its global search, when it runs, lengthens the bar
 /// ([`nested_search`]).
 pub(crate) fn progress_bar(job: &LoadedJob, candidates: &[Candidate]) -> indicatif::ProgressBar {
@@ -383,10 +383,15 @@ pub(crate) fn polish_budget(fit: &job::FitSection, n: usize) -> u64 {
     n as u64 + 1 + 2 * fit.polish_iterations
 }
 
-/// Model runs of [`optimise`]'s restarts over `n` parameters: each a swarm and a polish.
+/// Model runs of [`optimise`]'s restarts over `n` parameters: each a swarm, its local CMA-ES run
+/// when `[fit.search] local = "cmaes"` (counted at its cap, `local_evaluations`) and a polish.
 fn restarts_budget(fit: &job::FitSection, n: usize) -> u64 {
+    let local = match fit.search.local {
+        job::LocalSearch::Cmaes => fit.search.local_evaluations as u64,
+        job::LocalSearch::NelderMead => 0,
+    };
     fit.restarts.max(1) as u64
-        * (fit.particles as u64 * (fit.swarm_iterations + 1) + polish_budget(fit, n))
+        * (fit.particles as u64 * (fit.swarm_iterations + 1) + local + polish_budget(fit, n))
 }
 
 /// Fits every candidate in turn; a `+shoulder` candidate starts from the fit of the same model
@@ -2340,6 +2345,21 @@ mod tests {
         let candidate: Candidate = "blade2dof".parse().expect("candidate");
         let problem = Arc::new(problem_for(&job, candidate).expect("problem"));
         (job, candidate, problem)
+    }
+
+    /// The progress bar counts each restart's local CMA-ES run at its cap: with the main job's
+    /// settings (3 restarts of 24 particles × 26 swarm iterations, a local run of at most 1,000
+    /// evaluations, a polish of 4 + 1 + 2 × 60 over 4 parameters) 3 × (624 + 1,000 + 125) = 5,247
+    /// runs, against 3 × 749 without the local stage.
+    #[test]
+    fn restarts_budget_counts_the_local_stage() {
+        let (job, _, _) = main_job_problem();
+        let fit = &job.job.fit;
+        assert_eq!(fit.search.local, job::LocalSearch::Cmaes);
+        assert_eq!(restarts_budget(fit, 4), 5_247);
+        let mut nelder_mead = fit.clone();
+        nelder_mead.search.local = job::LocalSearch::NelderMead;
+        assert_eq!(restarts_budget(&nelder_mead, 4), 2_247);
     }
 
     /// The smaller candidate's note names the restarts 1-based and says whether the batch moved
