@@ -238,6 +238,9 @@ pub enum FitWarning {
     /// The cost at the optimum jitters under rounding-level steps by more than the likelihood's
     /// rise at an interval's edge ([`crate::search::jitter`]).
     CostJitter(Jitter),
+    /// The tracked head departs from the drive the fit used (its second harmonic or its
+    /// amplitude: [`crate::model::drive::DriveCheck`]).
+    DriveDeparts(crate::model::drive::DriveCheck),
     /// A parameter fitted beyond [`crate::likelihood::prior::PRIOR_CONFLICT_Z`] standard
     /// deviations of its `[fit.priors]` prior.
     PriorConflict(ParamConflict),
@@ -346,6 +349,7 @@ impl FitWarning {
             | RigCurveConflict(_)
             | JointSignalsDropped(_)
             | CostJitter(_)
+            | DriveDeparts(_)
             | Text { .. } => Severity::Attention,
         }
     }
@@ -384,6 +388,7 @@ impl FitWarning {
             NoBladeModes { .. } => "no_blade_modes",
             JointSignalsDropped(_) => "joint_signals_dropped",
             CostJitter(_) => "cost_jitter",
+            DriveDeparts(_) => "drive_departs",
             PriorConflict(_) => "prior_conflict",
             RigCurveConflict(_) => "rig_curve_conflict",
             Text { .. } => "text",

@@ -8,6 +8,7 @@
 
 /// The spectral features the fit compares (they belong to the spectrum stage).
 pub use crate::spectrum::features;
+mod drive;
 pub mod result;
 pub mod select;
 pub mod tolerance;
@@ -102,6 +103,8 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     // Provenance: the hash of the recording as it was read.
     let input_sha256 = crate::io::sha256_file(&job.recording_path)?;
     let meas = measure(job)?;
+    let (job, drive, drive_warning) = drive::fitted_drive(job, &meas.trace)?;
+    let job = job.as_ref();
     let fit = &job.job.fit;
     let candidates = job.candidates();
     let pb = progress.then(|| progress_bar(job, &candidates));
@@ -164,6 +167,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let truth = optimum_checks(job, (&cf, &fits), &best, tol, interrupted, &mut warnings);
     warnings.extend(failure_warning(&cf.problem));
     warnings.extend(joint_dropped_warning(&cf.problem));
+    warnings.extend(drive_warning);
     // The chosen model's counts include its bootstrap replicates and the tolerance check's
     // simulations (they share its counters).
     let chosen = &mut selection.trials[selection.chosen];
@@ -193,6 +197,7 @@ pub fn run_fit(job: &LoadedJob, progress: bool) -> Result<FitOutcome> {
     let result = FitResult {
         friction_curve: friction_curve(job, &result, &best, (&cf, &fits)),
         posterior,
+        drive,
         ..result
     };
     Ok(FitOutcome {
@@ -824,6 +829,7 @@ fn assemble_result(job: &LoadedJob, cf: &CandidateFit, a: Assembled) -> FitResul
         truth_segment: a.truth.and_then(|t| t.segment),
         friction_curve: None,
         posterior: None,
+        drive: None,
         priors,
         history: cf.history.clone(),
     }

@@ -242,6 +242,10 @@ pub struct FitResult {
     /// noise`); `None` without a likelihood.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tracking_noise: Option<NoiseEstimate>,
+    /// The drive the fit used beside the one read from the tracked head x
+    /// ([`crate::model::drive`]); `None` without a tracked head or when it cannot be read.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drive: Option<crate::model::drive::DriveCheck>,
     /// The chosen model's cost at the job's `[truth]` (every freed parameter at its true value, the
     /// rest as the blade file), nats, at the fit's solver: a fit whose cost lies above it stopped
     /// short of the likelihood's maximum. `None` without a truth for every freed parameter.

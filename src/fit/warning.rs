@@ -170,11 +170,45 @@ impl fmt::Display for FitWarning {
             NoBladeModes { reason } => no_blade_modes(f, reason),
             JointSignalsDropped(d) => d.fmt(f),
             CostJitter(j) => j.fmt(f),
+            DriveDeparts(c) => drive_departs(f, c),
             PriorConflict(c) => c.fmt(f),
             RigCurveConflict(c) => c.fmt(f),
             Text { text } => f.write_str(text),
         }
     }
+}
+
+/// [`FitWarning::DriveDeparts`]'s sentence: what departs, by how much, and what to do.
+fn drive_departs(f: &mut fmt::Formatter<'_>, c: &crate::model::drive::DriveCheck) -> fmt::Result {
+    let r = &c.reading;
+    f.write_str("the tracked head departs from the drive the fit used:")?;
+    let mut sep = " ";
+    if c.harmonic_departs() {
+        write!(
+            f,
+            "{sep}its speed's second harmonic is h = {:+.4} ± {} of aω against the fit's {:+.4}",
+            r.speed_harmonic,
+            crate::names::significant(r.speed_harmonic_se, 2),
+            c.fitted_speed_harmonic
+        )?;
+        sep = "; ";
+    }
+    if c.amplitude_departs() {
+        write!(
+            f,
+            "{sep}its amplitude is a = {:.4} ± {} mm against the blade file's {:.4} mm ({:+.1} %)",
+            1e3 * r.amplitude_m,
+            crate::names::significant(1e3 * r.amplitude_se_m, 2),
+            1e3 * c.blade_amplitude_m,
+            100.0 * (r.amplitude_m / c.blade_amplitude_m - 1.0)
+        )?;
+    }
+    f.write_str(
+        ": the model moves the head otherwise than the camera saw, and the friction law and the \
+         neck absorb the difference; `[fit] drive = \"recording\"` takes the harmonic from the \
+         recording, the blade file's `drive_a_m` and `drive_omega_rad_per_s` set the rest \
+         (docs/fit.md, \"The drive\")",
+    )
 }
 
 /// [`FitWarning::TruthMoreLikely`]'s sentence.

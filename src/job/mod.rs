@@ -258,6 +258,11 @@ pub struct FitSection {
     /// model fails its goodness-of-fit test (default `on-misfit`; [`crate::search::scan`]).
     #[serde(default)]
     pub contact_angle_scan: ContactAngleScan,
+    /// Where the drive's second harmonic comes from (default `blade`: the blade file's
+    /// `drive_speed_harmonic`; `recording`: read from the tracked head x,
+    /// [`crate::model::drive::read_drive`]).
+    #[serde(default)]
+    pub drive: DriveSource,
     /// Fresh Nelder–Mead polishes from the chosen model's settled optimum, each kept while it
     /// lowers the likelihood's cost by more than 0.1 nats (see `search::descend_chosen` and
     /// docs/fit.md, "Down the valley"). Default (`None`): [`SHOULDER_VALLEY_POLISHES`] when the
@@ -465,6 +470,19 @@ impl SearchSection {
 /// Evolution Strategy: A Tutorial", table 1).
 pub fn default_population(n: usize) -> usize {
     4 + (3.0 * (n.max(1) as f64).ln()).floor() as usize
+}
+
+crate::names::named_enum! {
+    /// Where the fit's drive `v = a(1 − cos ωt) + (h·a/2)·sin 2ωt` comes from (docs/fit.md,
+    /// "The drive").
+    #[derive(Default)]
+    pub enum DriveSource: "drive source" {
+        /// The blade file's a, ω and h as written; the tracked head only checks them.
+        #[default]
+        Blade => "blade",
+        /// The blade file's a and ω, with the second harmonic h read from the tracked head x.
+        Recording => "recording",
+    }
 }
 
 crate::names::named_enum! {

@@ -4,6 +4,7 @@
 pub mod belt;
 pub mod benchmarks;
 pub mod blade;
+pub mod drive;
 mod error;
 pub mod friction;
 pub mod friction_curve;

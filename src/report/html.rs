@@ -1262,6 +1262,7 @@ pub(super) mod tests {
             goodness_of_fit: None,
             tolerance_check: None,
             tracking_noise: None,
+            drive: None,
             truth_cost: None,
             truth_segment: None,
             truth_tolerance: None,

@@ -300,6 +300,11 @@ fn fit_headline(w: &FitWarning) -> String {
         }
         JointSignalsDropped(d) => joint_dropped_headline(d.half_dof),
         CostJitter(j) => cost_jitter_headline(j.sd_nats),
+        DriveDeparts(c) => format!(
+            "The tracked head does not move as the blade file's drive says (second harmonic \
+             {:+.3} of the peak speed, the fit's {:+.3}): the fitted law absorbs the difference.",
+            c.reading.speed_harmonic, c.fitted_speed_harmonic
+        ),
         PriorConflict(c) => prior_conflict_headline(c.parameter, c.z),
         RigCurveConflict(c) => rig_curve_conflict_headline(c.rms_z, c.points),
         Text { text } => text.clone(),

@@ -156,6 +156,7 @@ fn sample() -> FitResult {
             vec!["rtol 1e-10: too many steps".into()],
         )),
         tracking_noise: None,
+        drive: None,
         truth_cost: Some(35.9),
         truth_segment: Some(wiperlab::fit::truth::TruthSegment {
             rise_nats: vec![5.0, 31.1, -2.0],
