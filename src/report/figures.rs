@@ -1192,18 +1192,19 @@ pub fn fit_summary(r: &FitResult) -> String {
     }
     if let Some(d) = &r.drive {
         let h = d.reading;
+        let sig = |v: f64| crate::names::significant(v, 3);
         let _ = writeln!(
             s,
-            "  drive read from the head: a {:.3} mm, second harmonic h {:+.5} ± {}, clock offset \
-             {:+.2} ± {} µs (blade file: a {:.3} mm, h {:+.4}; the fit used h {:+.5})",
-            1e3 * h.amplitude_m,
-            h.speed_harmonic,
+            "  drive read from the head: a {} mm, second harmonic h {} ± {}, clock offset {} ± {} µs \
+             (blade file: a {} mm, h {}; the fit used h {})",
+            sig(1e3 * h.amplitude_m),
+            sig(h.speed_harmonic),
             crate::names::significant(h.speed_harmonic_se, 2),
-            1e6 * h.clock_offset_s,
+            sig(1e6 * h.clock_offset_s),
             crate::names::significant(1e6 * h.clock_offset_se_s, 2),
-            1e3 * d.blade_amplitude_m,
-            d.blade_speed_harmonic,
-            d.fitted_speed_harmonic
+            sig(1e3 * d.blade_amplitude_m),
+            sig(d.blade_speed_harmonic),
+            sig(d.fitted_speed_harmonic)
         );
     }
     if let Some(n) = &r.tracking_noise {
