@@ -714,6 +714,26 @@ fn tolerance_lists(t: &crate::fit::tolerance::ToleranceCheck) -> (String, String
 /// then within the spread's own sampling error over the noise replicates.
 const WIDENING_WORTH_SAYING: f64 = 1.05;
 
+/// The drive in one line: the blade file's, the second harmonic the fit used, and what the tracked
+/// head shows (docs/fit.md, "The drive").
+pub(super) fn drive_line(d: &crate::model::drive::DriveCheck) -> String {
+    let r = &d.reading;
+    let sig = |v: f64| crate::names::significant(v, 3);
+    format!(
+        "v = a(1 − cos ωt) + (h·a/2)·sin 2ωt, blade file a = {} mm, h = {}; the fit used h = {}; \
+         the tracked head shows a = {} ± {} mm, h = {} ± {}, clock offset {} ± {} µs",
+        sig(1e3 * d.blade_amplitude_m),
+        sig(d.blade_speed_harmonic),
+        sig(d.fitted_speed_harmonic),
+        sig(1e3 * r.amplitude_m),
+        crate::names::significant(1e3 * r.amplitude_se_m, 2),
+        sig(r.speed_harmonic),
+        crate::names::significant(r.speed_harmonic_se, 2),
+        sig(1e6 * r.clock_offset_s),
+        crate::names::significant(1e6 * r.clock_offset_se_s, 2),
+    )
+}
+
 /// The summary's line on how much the rounding's draws widen each parameter's 1σ
 /// (`rounding_widening`), when any does by [`WIDENING_WORTH_SAYING`] or more.
 pub(super) fn rounding_widening_words(params: &[crate::estimate::FittedParam]) -> Option<String> {
@@ -1191,21 +1211,7 @@ pub fn fit_summary(r: &FitResult) -> String {
         let _ = writeln!(s, "  {w}");
     }
     if let Some(d) = &r.drive {
-        let h = d.reading;
-        let sig = |v: f64| crate::names::significant(v, 3);
-        let _ = writeln!(
-            s,
-            "  drive read from the head: a {} mm, second harmonic h {} ± {}, clock offset {} ± {} µs \
-             (blade file: a {} mm, h {}; the fit used h {})",
-            sig(1e3 * h.amplitude_m),
-            sig(h.speed_harmonic),
-            crate::names::significant(h.speed_harmonic_se, 2),
-            sig(1e6 * h.clock_offset_s),
-            crate::names::significant(1e6 * h.clock_offset_se_s, 2),
-            sig(1e3 * d.blade_amplitude_m),
-            sig(d.blade_speed_harmonic),
-            sig(d.fitted_speed_harmonic)
-        );
+        let _ = writeln!(s, "  drive: {}", drive_line(d));
     }
     if let Some(n) = &r.tracking_noise {
         let _ = writeln!(
@@ -1242,9 +1248,40 @@ pub fn fit_summary(r: &FitResult) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::friction_law_figure;
+    use super::{drive_line, friction_law_figure};
     use crate::model::friction_curve::{FrictionCurve, Spread};
     use crate::model::{FrictionLaw, ParamId};
+
+    /// The drive line reads the result's numbers: dep_009's drive departure as its fit read it
+    /// (h −0.043624 ± 6.9e-7 against the blade file's 0; docs/validation.md, "The drive read from
+    /// the head").
+    #[test]
+    fn the_drive_line_gives_the_blade_files_drive_and_the_heads() {
+        let reading = crate::model::drive::DriveReading {
+            amplitude_m: 0.100_000_006,
+            amplitude_se_m: 4.2e-8,
+            speed_harmonic: -0.043_624,
+            speed_harmonic_se: 6.9e-7,
+            clock_offset_s: 2.6e-8,
+            clock_offset_se_s: 2.1e-7,
+            residual_rms_m: 2.4e-6,
+            residual_lag_one: 0.0,
+            samples: 33_953,
+        };
+        let check = crate::model::drive::DriveCheck {
+            reading,
+            blade_amplitude_m: 0.1,
+            blade_speed_harmonic: 0.0,
+            fitted_speed_harmonic: 0.0,
+        };
+        let line = drive_line(&check);
+        assert!(
+            line.contains("blade file a = 100 mm, h = 0; the fit used h = 0"),
+            "{line}"
+        );
+        assert!(line.contains("h = -0.0436 ± 6.9e-7"), "{line}");
+        assert!(line.contains("clock offset 0.026 ± 0.21 µs"), "{line}");
+    }
 
     const LAW: FrictionLaw = FrictionLaw::Exponential {
         a: 0.8,

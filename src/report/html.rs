@@ -741,7 +741,8 @@ struct PageView<'a> {
     bands: Vec<BandView>,
     signal: Option<SignalView>,
     fit_settings: Option<String>,
-    /// The drive the fit used and the one read from the tracked head ([`drive_line`]).
+    /// The drive the fit used and the one read from the tracked head
+    /// ([`super::figures::drive_line`]).
     drive: Option<String>,
     settings: &'a str,
     /// `[fit.priors]` beside the fit, when the job gave any.
@@ -822,26 +823,6 @@ fn priors_view(r: &FitResult) -> Option<PriorsView> {
                 .collect()
         }),
     })
-}
-
-/// The drive in one line: the blade file's, the second harmonic the fit used, and what the tracked
-/// head shows (docs/fit.md, "The drive").
-fn drive_line(d: &crate::model::drive::DriveCheck) -> String {
-    let r = &d.reading;
-    let sig = |v: f64| crate::names::significant(v, 3);
-    format!(
-        "v = a(1 − cos ωt) + (h·a/2)·sin 2ωt, blade file a = {} mm, h = {}; the fit used h = {}; \
-         the tracked head shows a = {} ± {} mm, h = {} ± {}, clock offset {} ± {} µs",
-        sig(1e3 * d.blade_amplitude_m),
-        sig(d.blade_speed_harmonic),
-        sig(d.fitted_speed_harmonic),
-        sig(1e3 * r.amplitude_m),
-        crate::names::significant(1e3 * r.amplitude_se_m, 2),
-        sig(r.speed_harmonic),
-        crate::names::significant(r.speed_harmonic_se, 2),
-        sig(1e6 * r.clock_offset_s),
-        crate::names::significant(1e6 * r.clock_offset_se_s, 2),
-    )
 }
 
 /// The settings part of the view: bands, signal and fit settings as the result records them.
@@ -950,7 +931,7 @@ fn page_view<'a>(
         bands,
         signal,
         fit_settings,
-        drive: r.drive.as_ref().map(drive_line),
+        drive: r.drive.as_ref().map(super::figures::drive_line),
         settings: &r.settings,
         priors: priors_view(r),
     }
@@ -1152,37 +1133,6 @@ fn result_warnings(r: &FitResult) -> Vec<PageWarning> {
 pub(super) mod tests {
     use super::*;
     use crate::io::sha256_hex;
-
-    /// The drive line reads the result's numbers: dep_009's drive departure as its fit read it
-    /// (h −0.043624 ± 6.9e-7 against the blade file's 0; docs/validation.md, "The drive read from
-    /// the head").
-    #[test]
-    fn the_drive_line_gives_the_blade_files_drive_and_the_heads() {
-        let reading = crate::model::drive::DriveReading {
-            amplitude_m: 0.100_000_006,
-            amplitude_se_m: 4.2e-8,
-            speed_harmonic: -0.043_624,
-            speed_harmonic_se: 6.9e-7,
-            clock_offset_s: 2.6e-8,
-            clock_offset_se_s: 2.1e-7,
-            residual_rms_m: 2.4e-6,
-            residual_lag_one: 0.0,
-            samples: 33_953,
-        };
-        let check = crate::model::drive::DriveCheck {
-            reading,
-            blade_amplitude_m: 0.1,
-            blade_speed_harmonic: 0.0,
-            fitted_speed_harmonic: 0.0,
-        };
-        let line = drive_line(&check);
-        assert!(
-            line.contains("blade file a = 100 mm, h = 0; the fit used h = 0"),
-            "{line}"
-        );
-        assert!(line.contains("h = -0.0436 ± 6.9e-7"), "{line}");
-        assert!(line.contains("clock offset 0.026 ± 0.21 µs"), "{line}");
-    }
 
     /// The main job's search (`fits/reversal.toml`: 3 restarts of a 24 × 25 swarm at rtol 1e-6, a
     /// local CMA-ES run of at most 1,000 evaluations at rtol 1e-7, a 60-iteration polish) in the
