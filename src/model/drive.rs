@@ -9,10 +9,10 @@
 //! harmonic from it (`[fit] drive = "recording"`).
 //!
 //! Standard errors are the regression's (`σ²(XᵀX)⁻¹`, σ² from the residuals), each variance
-//! multiplied by `(1 + ρ)/(1 − ρ)` for the residuals' lag-one correlation ρ (tracking noise that
-//! is correlated from frame to frame carries less information per frame: the AR(1) variance
-//! inflation, Bartlett 1946; Box, Jenkins & Reinsel, *Time Series Analysis*, §2.1.5), and `h`'s and
-//! `δ`'s by the delta method.
+//! multiplied by `(1 + ρ)/(1 − ρ)`, never less than 1, for the residuals' lag-one correlation ρ
+//! over consecutive tracked frames (tracking noise that is correlated from frame to frame carries
+//! less information per frame: the AR(1) variance inflation, Bartlett 1946; Box, Jenkins &
+//! Reinsel, *Time Series Analysis*, §2.1.5), and `h`'s and `δ`'s by the delta method.
 
 use nalgebra::{DMatrix, DVector, Matrix4};
 use serde::{Deserialize, Serialize};
