@@ -727,6 +727,53 @@ mod tests {
         }
     }
 
+    /// A drive the head contradicts needs attention and says what departs and what to do: a
+    /// second harmonic of −0.0436 of aω read to 6.9e-7 (dep_009's, docs/validation.md, "The drive
+    /// read from the head") against the fit's 0; an amplitude 2 % off beside it. A harmonic
+    /// 0.5 % off is within `HARMONIC_TOLERANCE` and says nothing.
+    #[test]
+    fn a_drive_the_head_contradicts_says_what_departs() {
+        use crate::model::drive::{DriveCheck, DriveReading};
+        let reading = DriveReading {
+            amplitude_m: 0.102,
+            amplitude_se_m: 4.2e-8,
+            speed_harmonic: -0.043_624,
+            speed_harmonic_se: 6.9e-7,
+            clock_offset_s: 0.0,
+            clock_offset_se_s: 2.1e-7,
+            residual_rms_m: 2.4e-6,
+            residual_lag_one: 0.0,
+            samples: 33_953,
+        };
+        let check = DriveCheck {
+            reading,
+            blade_amplitude_m: 0.1,
+            blade_speed_harmonic: 0.0,
+            fitted_speed_harmonic: 0.0,
+        };
+        assert!(check.harmonic_departs() && check.amplitude_departs());
+        let w = FitWarning::DriveDeparts(check);
+        assert_eq!(w.severity(), Severity::Attention);
+        assert_eq!(w.kind(), "drive_departs");
+        let text = w.to_string();
+        for part in [
+            "second harmonic is h = -0.0436 ± 6.9e-7 of aω against the fit's +0.0000",
+            "amplitude is a = 102.0000 ± 4.2e-5 mm against the blade file's 100.0000 mm (+2.0 %)",
+            "`[fit] drive = \"recording\"`",
+        ] {
+            assert!(text.contains(part), "{part} not in: {text}");
+        }
+        let small = DriveCheck {
+            reading: DriveReading {
+                speed_harmonic: -0.005,
+                amplitude_m: 0.1,
+                ..reading
+            },
+            ..check
+        };
+        assert!(!small.harmonic_departs() && !small.amplitude_departs());
+    }
+
     #[test]
     fn a_harmonic_both_spectra_share_is_information_and_renders_the_concern() {
         let w = harmonic_line(LineSource::Recording, true);
