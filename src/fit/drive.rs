@@ -23,26 +23,24 @@ pub(crate) fn fitted_drive<'a>(
     trace: &Trace,
 ) -> Result<(Cow<'a, LoadedJob>, Option<DriveCheck>, Option<FitWarning>)> {
     let wanted = job.job.fit.drive == DriveSource::Recording;
+    let unchecked = || Ok((Cow::Borrowed(job), None, None));
+    if job.job.targets.is_some() {
+        return unchecked();
+    }
     let reading = match trace.role(Role::Head) {
-        _ if job.job.targets.is_some() => None,
-        Some(head) => Some(
-            read_drive(&trace.t_s, &head.x_m, job.blade.drive_omega_rad_per_s)
-                .map_err(|e| e.to_string()),
-        ),
-        None => Some(Err("the recording has no tracked head".to_string())),
+        Some(head) => read_drive(&trace.t_s, &head.x_m, job.blade.drive_omega_rad_per_s)
+            .map_err(|e| e.to_string()),
+        None => Err("the recording has no tracked head".to_string()),
     };
-    let reading = match (reading, wanted) {
-        (Some(Ok(r)), _) => Some(r),
-        (Some(Err(why)), true) => {
+    let reading = match reading {
+        Ok(r) => r,
+        Err(why) if wanted => {
             return Err(Error::input(
                 &job.recording_path,
                 format!("[fit] drive = \"recording\": {why}"),
             ));
         }
-        _ => None,
-    };
-    let Some(reading) = reading else {
-        return Ok((Cow::Borrowed(job), None, None));
+        Err(_) => return unchecked(),
     };
     let blade_speed_harmonic = job.blade.drive_speed_harmonic;
     let mut job = Cow::Borrowed(job);

@@ -14,7 +14,7 @@
 //! less information per frame: the AR(1) variance inflation, Bartlett 1946; Box, Jenkins &
 //! Reinsel, *Time Series Analysis*, §2.1.5), and `h`'s and `δ`'s by the delta method.
 
-use nalgebra::{DMatrix, DVector, Matrix4};
+use nalgebra::{DMatrix, DVector, Matrix4, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// Fewer tracked head samples than this cannot separate the four terms from the noise.
@@ -129,37 +129,34 @@ pub fn read_drive(
     }
     let design = DMatrix::from_fn(n, 4, |i, j| rows[i][j]);
     let y = DVector::from_vec(x);
-    let beta = design
-        .clone()
-        .svd(true, true)
-        .solve(&y, 1e-12)
+    let svd = design.clone().svd(true, true);
+    let sv = &svd.singular_values;
+    if sv.min() <= 1e-12 * sv.max() {
+        return Err(DriveReadingError::Singular);
+    }
+    let beta = svd
+        .solve(&y, 0.0)
         .map_err(|_| DriveReadingError::Singular)?;
     let residual = &y - &design * &beta;
     let rss = residual.norm_squared();
     let lag_one = lag_one_correlation(residual.as_slice());
     let inflation = ((1.0 + lag_one) / (1.0 - lag_one)).max(1.0);
-    let normal: Matrix4<f64> = (design.transpose() * &design)
-        .fixed_view::<4, 4>(0, 0)
-        .into();
-    let cov = normal
-        .try_inverse()
-        .ok_or(DriveReadingError::Singular)?
-        .scale(rss / (n - 4) as f64 * inflation);
+    // (XᵀX)⁻¹ = V Σ⁻² Vᵀ from the decomposition the solution came from.
+    let v_t = svd.v_t.as_ref().ok_or(DriveReadingError::Singular)?;
+    let cov: Matrix4<f64> =
+        (v_t.transpose() * DMatrix::from_diagonal(&sv.map(|s| s.powi(-2))) * v_t)
+            .fixed_view::<4, 4>(0, 0)
+            .scale(rss / (n - 4) as f64 * inflation);
     let (b1, b2, b3) = (beta[1], beta[2], beta[3]);
     if b1 == 0.0 {
         return Err(DriveReadingError::Singular);
     }
     // h = −2β₃/β₁ and δ = −β₂/(β₁ω): gradients for the delta method over (β₁, β₂, β₃).
-    let var = |g: [f64; 3]| {
-        (0..3)
-            .flat_map(|i| (0..3).map(move |j| (i, j)))
-            .map(|(i, j)| g[i] * g[j] * cov[(i + 1, j + 1)])
-            .sum::<f64>()
-            .max(0.0)
-    };
-    let h_grad = [2.0 * b3 / (b1 * b1), 0.0, -2.0 / b1];
+    let block = cov.fixed_view::<3, 3>(1, 1);
+    let var = |g: Vector3<f64>| g.dot(&(block * g)).max(0.0);
+    let h_grad = Vector3::new(2.0 * b3 / (b1 * b1), 0.0, -2.0 / b1);
     let w = omega_rad_per_s;
-    let d_grad = [b2 / (b1 * b1 * w), -1.0 / (b1 * w), 0.0];
+    let d_grad = Vector3::new(b2 / (b1 * b1 * w), -1.0 / (b1 * w), 0.0);
     Ok(DriveReading {
         amplitude_m: -b1,
         amplitude_se_m: cov[(1, 1)].max(0.0).sqrt(),

@@ -284,11 +284,7 @@ fn fit_headline(w: &FitWarning) -> String {
             tic_gap,
             spread_nats,
         } => choice_unresolved_headline([chosen, runner_up], *tic_gap, *spread_nats),
-        ChosenOnMisfit { chosen, nested, .. } => format!(
-            "{chosen} is chosen on a fit that fails the goodness-of-fit test: what it adds to \
-             {nested} is not confirmed by this recording. Read the misfit's description before \
-             believing it."
-        ),
+        ChosenOnMisfit { chosen, nested, .. } => chosen_on_misfit_headline(chosen, nested),
         FailedEvaluations {
             failed,
             evaluations,
@@ -300,15 +296,32 @@ fn fit_headline(w: &FitWarning) -> String {
         }
         JointSignalsDropped(d) => joint_dropped_headline(d.half_dof),
         CostJitter(j) => cost_jitter_headline(j.sd_nats),
-        DriveDeparts(c) => format!(
-            "The tracked head does not move as the blade file's drive says (second harmonic \
-             {:+.3} of the peak speed, the fit's {:+.3}): the fitted law absorbs the difference.",
-            c.reading.speed_harmonic, c.fitted_speed_harmonic
-        ),
+        DriveDeparts(c) => drive_departs_headline(c),
         PriorConflict(c) => prior_conflict_headline(c.parameter, c.z),
         RigCurveConflict(c) => rig_curve_conflict_headline(c.rms_z, c.points),
         Text { text } => text.clone(),
     }
+}
+
+/// [`FitWarning::ChosenOnMisfit`]'s headline: `chosen` kept over `nested` on a failed fit.
+fn chosen_on_misfit_headline(
+    chosen: &impl std::fmt::Display,
+    nested: &impl std::fmt::Display,
+) -> String {
+    format!(
+        "{chosen} is chosen on a fit that fails the goodness-of-fit test: what it adds to \
+         {nested} is not confirmed by this recording. Read the misfit's description before \
+         believing it."
+    )
+}
+
+/// [`FitWarning::DriveDeparts`]'s headline: the head's second harmonic against the fit's.
+fn drive_departs_headline(c: &crate::model::drive::DriveCheck) -> String {
+    format!(
+        "The tracked head does not move as the blade file's drive says (second harmonic \
+         {:+.3} of the peak speed, the fit's {:+.3}): the fitted law absorbs the difference.",
+        c.reading.speed_harmonic, c.fitted_speed_harmonic
+    )
 }
 
 /// [`FitWarning::PriorConflict`]'s headline: `parameter` fitted `z` prior sds from its prior.
