@@ -315,12 +315,28 @@ fn chosen_on_misfit_headline(
     )
 }
 
-/// [`FitWarning::DriveDeparts`]'s headline: the head's second harmonic against the fit's.
+/// [`FitWarning::DriveDeparts`]'s headline: what departs, the head's second harmonic against the
+/// fit's and its amplitude against the blade file's.
 fn drive_departs_headline(c: &crate::model::drive::DriveCheck) -> String {
+    let r = &c.reading;
+    let mut what = Vec::new();
+    if c.harmonic_departs() {
+        what.push(format!(
+            "second harmonic {:+.3} of the peak speed, the fit's {:+.3}",
+            r.speed_harmonic, c.fitted_speed_harmonic
+        ));
+    }
+    if c.amplitude_departs() {
+        what.push(format!(
+            "amplitude {:.1} mm, the blade file's {:.1} mm",
+            1e3 * r.amplitude_m,
+            1e3 * c.blade_amplitude_m
+        ));
+    }
     format!(
-        "The tracked head does not move as the blade file's drive says (second harmonic \
-         {:+.3} of the peak speed, the fit's {:+.3}): the fitted law absorbs the difference.",
-        c.reading.speed_harmonic, c.fitted_speed_harmonic
+        "The tracked head does not move as the blade file's drive says ({}): the fitted law \
+         absorbs the difference.",
+        what.join("; ")
     )
 }
 
@@ -613,4 +629,51 @@ fn joint_dropped_headline(half_dof: f64) -> String {
          between lost frames for their cross-spectra (ν/2 = {half_dof:.2}), so the fit reads its \
          own signal alone."
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::drive::{DriveCheck, DriveReading};
+
+    /// The headline names what departs: a head 2 % beyond the blade file's amplitude with the
+    /// drive's harmonic as the fit's gives the amplitude alone; dep_009's harmonic (−0.0436,
+    /// docs/validation.md, "The drive read from the head") gives the harmonic alone.
+    #[test]
+    fn the_drive_headline_names_what_departs() {
+        let reading = DriveReading {
+            amplitude_m: 0.102,
+            amplitude_se_m: 4.2e-8,
+            speed_harmonic: 0.0,
+            speed_harmonic_se: 6.9e-7,
+            clock_offset_s: 0.0,
+            clock_offset_se_s: 2.1e-7,
+            residual_rms_m: 2.4e-6,
+            residual_lag_one: 0.0,
+            samples: 33_953,
+        };
+        let check = DriveCheck {
+            reading,
+            blade_amplitude_m: 0.1,
+            blade_speed_harmonic: 0.0,
+            fitted_speed_harmonic: 0.0,
+        };
+        let amplitude = drive_departs_headline(&check);
+        assert!(
+            amplitude.contains("(amplitude 102.0 mm, the blade file's 100.0 mm)"),
+            "{amplitude}"
+        );
+        let harmonic = drive_departs_headline(&DriveCheck {
+            reading: DriveReading {
+                amplitude_m: 0.1,
+                speed_harmonic: -0.043_624,
+                ..reading
+            },
+            ..check
+        });
+        assert!(
+            harmonic.contains("(second harmonic -0.044 of the peak speed, the fit's +0.000)"),
+            "{harmonic}"
+        );
+    }
 }
